@@ -1,0 +1,247 @@
+//! Command implementations behind `main`: parse nothing, print results. Errors that are the
+//! user's input come back as [`InputError`] (exit code 2); everything else is a job failure.
+
+use crate::fit::{self, Data, FitOptions, Objective, RationalModel};
+use crate::pipeline::{self, Built, Mode};
+use crate::quantity;
+use crate::spec::{self, data::read_csv, ModelSpec, Spec};
+use anyhow::{Context, Result};
+use indicatif::{ProgressBar, ProgressStyle};
+use serde_json::json;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// Bad input: exit code 2.
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct InputError(pub String);
+
+fn input_err(e: impl std::fmt::Display) -> anyhow::Error {
+    InputError(e.to_string()).into()
+}
+
+/// Project paths: specs in `fits/`, outputs in `generated/`.
+pub struct Paths {
+    pub fits: PathBuf,
+    pub generated: PathBuf,
+}
+
+pub fn eval(name: &str, params: &[String], as_json: bool) -> Result<()> {
+    let q = quantity::lookup(name).map_err(input_err)?;
+    let mut named = BTreeMap::new();
+    for p in params {
+        let (k, v) = p
+            .split_once('=')
+            .ok_or_else(|| input_err(format!("parameter '{p}' must be name=value")))?;
+        let v: f64 = v
+            .trim()
+            .parse()
+            .map_err(|_| input_err(format!("parameter '{}': '{}' is not a number", k.trim(), v.trim())))?;
+        if named.insert(k.trim().to_string(), v).is_some() {
+            return Err(input_err(format!("parameter '{}' is given twice", k.trim())));
+        }
+    }
+    let canonical = q.resolve(&named).map_err(input_err)?;
+    let est = (q.eval)(&canonical, 1e-12);
+    if as_json {
+        let out = json!({
+            "quantity": q.name,
+            "params": named,
+            "value": est.value,
+            "error_estimate": est.error,
+        });
+        println!("{out}");
+    } else {
+        println!("{} = {:.17e}  (error estimate {:.1e})", q.name, est.value, est.error);
+    }
+    Ok(())
+}
+
+fn load_specs(paths: &Paths, only: &[String]) -> Result<Vec<Spec>> {
+    let specs = spec::load_dir(&paths.fits).map_err(input_err)?;
+    for name in only {
+        if !specs.iter().any(|s| &s.file.name == name) {
+            return Err(input_err(format!(
+                "--only: no spec named '{name}' in {} (known: {})",
+                paths.fits.display(),
+                specs.iter().map(|s| s.file.name.as_str()).collect::<Vec<_>>().join(", ")
+            )));
+        }
+    }
+    Ok(specs)
+}
+
+fn progress(len: usize, what: &str) -> ProgressBar {
+    // indicatif draws only on a terminal: pipes and CI stay quiet.
+    let pb = ProgressBar::new(len as u64);
+    pb.set_style(ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len} {elapsed}").expect("valid template"));
+    pb.set_message(what.to_string());
+    pb
+}
+
+pub fn build(paths: &Paths, only: &[String], check: bool) -> Result<()> {
+    let specs = load_specs(paths, only)?;
+    let selected: Vec<&Spec> =
+        specs.iter().filter(|s| only.is_empty() || only.contains(&s.file.name)).collect();
+    let mode = if check { Mode::Committed } else { Mode::Fit };
+    let pb = progress(selected.len(), if check { "check" } else { "build" });
+    let mut built: Vec<Built> = Vec::new();
+    for s in &selected {
+        pb.set_message(s.file.name.clone());
+        let b = pipeline::build_spec(s, mode, &paths.generated).with_context(|| format!("building {}", s.file.name))?;
+        pb.inc(1);
+        built.push(b);
+    }
+    pb.finish_and_clear();
+    let mut artifacts: Vec<_> = built.iter().flat_map(|b| b.artifacts.clone()).collect();
+    artifacts.push(pipeline::runtime_index(&specs));
+    if check {
+        let mut bad = pipeline::stale(&paths.generated, &artifacts);
+        if only.is_empty() {
+            bad.extend(pipeline::orphans(&paths.generated, &artifacts).into_iter().map(|p| format!("{p} (no spec produces it)")));
+        }
+        if bad.is_empty() {
+            println!("generated/ is up to date ({} files from {} specs)", artifacts.len(), selected.len());
+            return Ok(());
+        }
+        for p in &bad {
+            println!("stale: {p}");
+        }
+        anyhow::bail!("{} generated file(s) differ from what the specs and committed coefficients produce; run `shadefit build`", bad.len());
+    }
+    let written = pipeline::write_all(&paths.generated, &artifacts)?;
+    for b in &built {
+        let v = &b.verification;
+        println!(
+            "{:<22} max abs {:.3e}  rms {:.3e}  (f32 code: max abs {:.3e})  over {} points",
+            b.name, v.max_abs_error, v.rms_error, v.max_abs_error_f32, v.points
+        );
+    }
+    println!("{written} file(s) written, {} unchanged", artifacts.len() - written);
+    Ok(())
+}
+
+pub fn list(paths: &Paths) -> Result<()> {
+    let specs = spec::load_dir(&paths.fits).map_err(input_err)?;
+    println!("{:<22} {:<6} {:<18} {:<28} status", "name", "kind", "quantity", "function");
+    for s in &specs {
+        let status = match pipeline::build_spec(s, Mode::Committed, &paths.generated) {
+            Ok(b) if pipeline::stale(&paths.generated, &b.artifacts).is_empty() => "up to date".to_string(),
+            Ok(_) => "stale".to_string(),
+            Err(e) => format!("stale ({})", short(&e.to_string())),
+        };
+        println!(
+            "{:<22} {:<6} {:<18} {:<28} {status}",
+            s.file.name,
+            format!("{:?}", s.file.kind).to_lowercase(),
+            s.file.quantity,
+            s.file.emit.function
+        );
+    }
+    Ok(())
+}
+
+fn short(s: &str) -> String {
+    s.split(';').next().unwrap_or(s).chars().take(60).collect()
+}
+
+pub fn fit_data(
+    data_path: &Path,
+    x_cols: &[String],
+    y_col: &str,
+    model_arg: &str,
+    objective: Objective,
+    as_json: bool,
+) -> Result<()> {
+    let model = load_model(model_arg, x_cols)?;
+    let data: Data = read_csv(data_path, x_cols, y_col).map_err(input_err)?;
+    let opts = FitOptions { objective, ..FitOptions::default() };
+    let f = fit::fit(&model, &data, &opts, &data_path.display().to_string())?;
+    let nn = model.numerator.len();
+    let c = &f.coefficients;
+    let mut den = vec![1.0];
+    den.extend((nn..model.n_full()).map(|j| c[j]));
+    let r = &f.report;
+    if as_json {
+        let out = json!({
+            "model": model_arg,
+            "features": model.features,
+            "numerator_terms": model.numerator.iter().map(|t| t.label.clone()).collect::<Vec<_>>(),
+            "denominator_terms": std::iter::once("1".to_string()).chain(model.denominator.iter().map(|t| t.label.clone())).collect::<Vec<_>>(),
+            "numerator": (0..nn).map(|j| c[j]).collect::<Vec<_>>(),
+            "denominator": den,
+            "objective": objective,
+            "rss": r.rss,
+            "max_abs_error": r.max_abs_error,
+            "rms_error": r.rms_error,
+            "worst_point": r.worst_point,
+            "condition_number": r.condition_number,
+            "iterations": r.iterations,
+            "samples": r.samples,
+        });
+        println!("{}", serde_json::to_string_pretty(&out)?);
+    } else {
+        println!("model {model_arg} on {} samples ({:?})", r.samples, objective);
+        for (t, j) in model.numerator.iter().zip(0..) {
+            println!("  num[{t}] = {:.17e}", c[j]);
+        }
+        for (t, j) in model.denominator.iter().zip(nn..) {
+            println!("  den[{t}] = {:.17e}", c[j]);
+        }
+        println!(
+            "rss {:.10e}  max abs {:.3e}  rms {:.3e}  cond {:.2e}",
+            r.rss, r.max_abs_error, r.rms_error, r.condition_number
+        );
+    }
+    Ok(())
+}
+
+/// `rational(m,n)` (one feature, named by the x column) or a model TOML file.
+fn load_model(arg: &str, x_cols: &[String]) -> Result<RationalModel> {
+    if arg.trim_start().starts_with("rational(") {
+        if x_cols.len() != 1 {
+            return Err(input_err(format!("{arg} is one-dimensional but --x names {} columns", x_cols.len())));
+        }
+        return RationalModel::parse_form(arg, &x_cols[0]).map_err(input_err);
+    }
+    let path = Path::new(arg);
+    if !path.is_file() {
+        return Err(input_err(format!("--model '{arg}' is neither rational(m,n) nor a model spec file")));
+    }
+    let text = std::fs::read_to_string(path).map_err(|e| input_err(format!("{}: {e}", path.display())))?;
+    let ms: ModelSpec = spec::parse_toml(path, &text).map_err(input_err)?;
+    let features = ms.features.clone().unwrap_or_else(|| x_cols.to_vec());
+    if features.len() != x_cols.len() {
+        return Err(input_err(format!(
+            "{}: the model has {} features ({}) but --x names {} columns",
+            path.display(),
+            features.len(),
+            features.join(", "),
+            x_cols.len()
+        )));
+    }
+    ms.build(path, &text, features, &|_| None).map_err(input_err)
+}
+
+pub fn validate(paths: &Paths, as_json: bool) -> Result<()> {
+    let items = crate::validate::all(&paths.generated);
+    if as_json {
+        println!("{}", serde_json::to_string_pretty(&json!({ "items": items }))?);
+        return Ok(());
+    }
+    for it in &items {
+        println!("{}\n  source: {}\n  domain: {}", it.name, it.source, it.domain);
+        println!(
+            "  {} points: max abs {:.3e}, rms {:.3e}, worst at {:?}",
+            it.points, it.max_abs_error, it.rms_error, it.worst_point
+        );
+        for (k, v) in &it.extra {
+            println!("  {k}: {v:.3e}");
+        }
+        for f in &it.findings {
+            println!("  finding: {f}");
+        }
+        println!();
+    }
+    Ok(())
+}

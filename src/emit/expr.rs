@@ -1,0 +1,209 @@
+//! A small expression tree for emitted functions: built once from a fitted model, rendered
+//! to WGSL and Rust, and evaluated in f32 here with the same operation order, so the error
+//! shadefit measures is the error of the code it emits (up to FMA contraction on a GPU).
+
+use crate::fit::model::{RationalModel, Term};
+use nalgebra::DVector;
+
+#[derive(Debug, Clone, PartialEq)]
+pub enum Expr {
+    Lit(f32),
+    /// Index into the argument list (already clamped to the domain).
+    Var(usize),
+    /// (array, index): 0 = numerator array, 1 = denominator array.
+    Coef(u8, usize),
+    Add(Box<Expr>, Box<Expr>),
+    Mul(Box<Expr>, Box<Expr>),
+    Div(Box<Expr>, Box<Expr>),
+}
+
+use Expr::*;
+
+fn add(a: Expr, b: Expr) -> Expr {
+    Add(Box::new(a), Box::new(b))
+}
+fn mul(a: Expr, b: Expr) -> Expr {
+    Mul(Box::new(a), Box::new(b))
+}
+
+/// Monomial as a product of variables (x^3 → x*x*x); constant → None.
+fn monomial(exps: &[u32]) -> Option<Expr> {
+    let mut out: Option<Expr> = None;
+    for (i, &e) in exps.iter().enumerate() {
+        for _ in 0..e {
+            out = Some(match out {
+                None => Var(i),
+                Some(p) => mul(p, Var(i)),
+            });
+        }
+    }
+    out
+}
+
+fn term_expr(t: &Term) -> Option<Expr> {
+    let mut out: Option<Expr> = None;
+    let mut constant = 0.0f32;
+    for m in &t.monomials {
+        match monomial(&m.exps) {
+            Some(e) => out = Some(match out {
+                None => e,
+                Some(p) => add(p, e),
+            }),
+            None => constant += 1.0,
+        }
+    }
+    match (out, constant) {
+        (None, c) => Some(Lit(c)),
+        (Some(e), c) if c == 0.0 => Some(e),
+        (Some(e), c) => Some(add(Lit(c), e)),
+    }
+}
+
+/// If the terms are the powers start, start+1, … of one feature, return (feature, start).
+fn consecutive_powers(terms: &[Term]) -> Option<(usize, u32)> {
+    let first = terms.first()?;
+    if first.monomials.len() != 1 {
+        return None;
+    }
+    let nz: Vec<usize> = (0..first.monomials[0].exps.len()).collect();
+    let var = if first.is_constant() {
+        terms.get(1).and_then(|t| t.monomials[0].exps.iter().position(|&e| e > 0)).unwrap_or(0)
+    } else {
+        first.monomials[0].exps.iter().position(|&e| e > 0)?
+    };
+    let start = first.monomials[0].exps[var];
+    for (k, t) in terms.iter().enumerate() {
+        if t.monomials.len() != 1 {
+            return None;
+        }
+        for &i in &nz {
+            let want = if i == var { start + k as u32 } else { 0 };
+            if t.monomials[0].exps[i] != want {
+                return None;
+            }
+        }
+    }
+    Some((var, start))
+}
+
+/// Σ_j coef(array, j)·term_j, in Horner form for consecutive powers of one feature.
+fn linear_combination(terms: &[Term], array: u8) -> Expr {
+    if let Some((var, start)) = consecutive_powers(terms) {
+        let n = terms.len();
+        let mut e = Coef(array, n - 1);
+        for j in (0..n - 1).rev() {
+            e = add(Coef(array, j), mul(Var(var), e));
+        }
+        for _ in 0..start {
+            e = mul(Var(var), e);
+        }
+        return e;
+    }
+    let mut out: Option<Expr> = None;
+    for (j, t) in terms.iter().enumerate() {
+        let e = match term_expr(t) {
+            Some(Lit(c)) if c == 1.0 => Coef(array, j),
+            Some(te) => mul(Coef(array, j), te),
+            None => continue,
+        };
+        out = Some(match out {
+            None => e,
+            Some(p) => add(p, e),
+        });
+    }
+    out.unwrap_or(Lit(0.0))
+}
+
+/// The emitted form of a rational model: offset + factor·P/Q (clamp applied by the caller).
+pub fn model_expr(model: &RationalModel) -> Expr {
+    let p = linear_combination(&model.numerator, 0);
+    let q = if model.denominator.is_empty() {
+        Lit(1.0)
+    } else {
+        add(Lit(1.0), linear_combination(&model.denominator, 1))
+    };
+    let mut e = Div(Box::new(p), Box::new(q));
+    if let Some(f) = &model.factor
+        && let Some(fe) = term_expr(f)
+    {
+        e = mul(fe, e);
+    }
+    if model.offset != 0.0 {
+        e = add(Lit(model.offset as f32), e);
+    }
+    e
+}
+
+/// Coefficient arrays in f32: (numerator, denominator without the implicit 1).
+pub fn f32_arrays(model: &RationalModel, c: &DVector<f64>) -> (Vec<f32>, Vec<f32>) {
+    let nn = model.numerator.len();
+    (
+        (0..nn).map(|j| c[j] as f32).collect(),
+        (0..model.denominator.len()).map(|j| c[nn + j] as f32).collect(),
+    )
+}
+
+/// Evaluate in f32 with the emitted operation order.
+pub fn eval_f32(e: &Expr, vars: &[f32], num: &[f32], den: &[f32]) -> f32 {
+    match e {
+        Lit(v) => *v,
+        Var(i) => vars[*i],
+        Coef(0, j) => num[*j],
+        Coef(_, j) => den[*j],
+        Add(a, b) => eval_f32(a, vars, num, den) + eval_f32(b, vars, num, den),
+        Mul(a, b) => eval_f32(a, vars, num, den) * eval_f32(b, vars, num, den),
+        Div(a, b) => eval_f32(a, vars, num, den) / eval_f32(b, vars, num, den),
+    }
+}
+
+/// Render with language-specific names for variables, coefficients and literals.
+pub fn render(
+    e: &Expr,
+    var: &dyn Fn(usize) -> String,
+    coef: &dyn Fn(u8, usize) -> String,
+    lit: &dyn Fn(f32) -> String,
+) -> String {
+    match e {
+        Lit(v) => lit(*v),
+        Var(i) => var(*i),
+        Coef(a, j) => coef(*a, *j),
+        Add(a, b) => format!("{} + {}", render(a, var, coef, lit), render(b, var, coef, lit)),
+        Mul(a, b) => format!("{} * {}", paren(a, var, coef, lit), paren(b, var, coef, lit)),
+        Div(a, b) => format!("({}) / ({})", render(a, var, coef, lit), render(b, var, coef, lit)),
+    }
+}
+
+fn paren(
+    e: &Expr,
+    var: &dyn Fn(usize) -> String,
+    coef: &dyn Fn(u8, usize) -> String,
+    lit: &dyn Fn(f32) -> String,
+) -> String {
+    match e {
+        Add(..) => format!("({})", render(e, var, coef, lit)),
+        _ => render(e, var, coef, lit),
+    }
+}
+
+/// Clamp to [lo, hi] with NaN mapped to lo, in f32 (what emitted code does with inputs).
+pub fn sanitize(x: f32, lo: f32, hi: f32) -> f32 {
+    if x.is_nan() { lo } else { x.clamp(lo, hi) }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn horner_form_matches_direct_sum() {
+        let m = RationalModel::rational_1d("x", 3, 2);
+        let e = model_expr(&m);
+        let num = [0.5f32, -1.0, 2.0, 0.25];
+        let den = [0.3f32, 0.1];
+        let x = 0.7f32;
+        let p = 0.5 - x + 2.0 * x * x + 0.25 * x * x * x;
+        let q = 1.0 + 0.3 * x + 0.1 * x * x;
+        // Horner vs power sum in f32 differ by a few ulps of values ~1.
+        assert!((eval_f32(&e, &[x], &num, &den) - p / q).abs() < 1e-6);
+    }
+}

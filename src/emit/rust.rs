@@ -1,0 +1,135 @@
+//! Rust modules for the runtime crate: `pub const` coefficient arrays and `pub fn` CPU
+//! versions of every emitted WGSL function, with the same operation order in f32.
+
+use super::expr::render;
+use super::f32_literal;
+use super::wgsl::{Body, Function};
+
+fn lit(v: f32) -> String {
+    format!("{}_f32", f32_literal(v))
+}
+
+fn array(name: &str, doc: &str, values: &[f32]) -> String {
+    let mut s = format!("/// {doc}\npub const {name}: [f32; {}] = [", values.len());
+    for (i, v) in values.iter().enumerate() {
+        if i % 6 == 0 {
+            s.push_str("\n    ");
+        } else {
+            s.push(' ');
+        }
+        s.push_str(&lit(*v));
+        s.push(',');
+    }
+    s.push_str("\n];\n");
+    s
+}
+
+pub fn render_module(header: &[String], f: &Function<'_>, doc: &str) -> String {
+    let upper = f.module.to_uppercase();
+    let mut s = String::new();
+    for h in header {
+        s.push_str(&format!("//! {h}\n"));
+    }
+    s.push_str(&format!("//!\n//! {doc}\n\n"));
+    s.push_str(&format!(
+        "/// Domain of each argument; inputs are clamped to it (NaN maps to the lower end).\n\
+         pub const {upper}_DOMAIN: [[f32; 2]; {}] = [{}];\n\n",
+        f.domain.len(),
+        f.domain.iter().map(|(a, b)| format!("[{}, {}]", lit(*a), lit(*b))).collect::<Vec<_>>().join(", ")
+    ));
+    s.push_str(
+        "#[inline]\nfn input(v: f32, lo: f32, hi: f32) -> f32 {\n    if v.is_nan() { lo } else { v.clamp(lo, hi) }\n}\n\n",
+    );
+    let params: Vec<String> = f.args.iter().map(|a| format!("{a}: f32")).collect();
+    let inputs: String = f
+        .args
+        .iter()
+        .zip(f.domain)
+        .enumerate()
+        .map(|(i, (a, (lo, hi)))| format!("    let x{i} = input({a}, {}, {});\n", lit(*lo), lit(*hi)))
+        .collect();
+    match &f.body {
+        Body::Fit { expr, num, den, clamp } => {
+            s.push_str(&array(&format!("{upper}_NUM"), "Numerator coefficients, one per numerator term.", num));
+            if !den.is_empty() {
+                s.push_str(&array(
+                    &format!("{upper}_DEN"),
+                    "Denominator coefficients (the constant term 1 is implicit).",
+                    den,
+                ));
+            }
+            let body = render(
+                expr,
+                &|i| format!("x{i}"),
+                &|a, j| format!("{upper}_{}[{j}]", if a == 0 { "NUM" } else { "DEN" }),
+                &lit,
+            );
+            let ret = match clamp {
+                Some((lo, hi)) => format!("({body}).clamp({}, {})", lit(*lo), lit(*hi)),
+                None => body,
+            };
+            s.push_str(&format!(
+                "\n/// CPU version of the WGSL function of the same name.\npub fn {}({}) -> f32 {{\n{inputs}    {ret}\n}}\n",
+                f.name,
+                params.join(", ")
+            ));
+        }
+        Body::Table { values, counts } => {
+            s.push_str(&array(&format!("{upper}_TABLE"), "Table values on a uniform grid (first axis fastest).", values));
+            s.push_str(&format!(
+                "\n/// CPU version of the WGSL function of the same name (linear interpolation).\npub fn {}({}) -> f32 {{\n{inputs}",
+                f.name,
+                params.join(", ")
+            ));
+            for (i, ((lo, hi), n)) in f.domain.iter().zip(counts.iter()).enumerate() {
+                s.push_str(&format!(
+                    "    let t{i} = (x{i} - {lo}) * {scale};\n    let i{i} = (t{i} as u32).min({last});\n    let f{i} = t{i} - i{i} as f32;\n",
+                    lo = lit(*lo),
+                    scale = lit((*n as f32 - 1.0) / (hi - lo)),
+                    last = n - 2
+                ));
+            }
+            let t = format!("{upper}_TABLE");
+            if counts.len() == 1 {
+                s.push_str(&format!(
+                    "    let i0 = i0 as usize;\n    {t}[i0] * (1.0 - f0) + {t}[i0 + 1] * f0\n}}\n"
+                ));
+            } else {
+                let nx = counts[0];
+                s.push_str(&format!(
+                    "    let k = (i1 * {nx} + i0) as usize;\n    \
+                     let a = {t}[k] * (1.0 - f0) + {t}[k + 1] * f0;\n    \
+                     let b = {t}[k + {nx}] * (1.0 - f0) + {t}[k + {nx1}] * f0;\n    \
+                     a * (1.0 - f1) + b * f1\n}}\n",
+                    nx1 = nx + 1
+                ));
+            }
+        }
+    }
+    s
+}
+
+/// f32 evaluation of a table lookup with the emitted operation order.
+pub fn table_eval_f32(values: &[f32], counts: &[usize], domain: &[(f32, f32)], x: &[f32]) -> f32 {
+    let mut idx = [0usize; 2];
+    let mut frac = [0f32; 2];
+    for d in 0..counts.len() {
+        let (lo, hi) = domain[d];
+        let xd = super::expr::sanitize(x[d], lo, hi);
+        let t = (xd - lo) * ((counts[d] as f32 - 1.0) / (hi - lo));
+        let i = (t as u32).min(counts[d] as u32 - 2);
+        idx[d] = i as usize;
+        frac[d] = t - i as f32;
+    }
+    if counts.len() == 1 {
+        let i = idx[0];
+        values[i] * (1.0 - frac[0]) + values[i + 1] * frac[0]
+    } else {
+        let nx = counts[0];
+        let k = idx[1] * nx + idx[0];
+        let (f0, f1) = (frac[0], frac[1]);
+        let a = values[k] * (1.0 - f0) + values[k + 1] * f0;
+        let b = values[k + nx] * (1.0 - f0) + values[k + nx + 1] * f0;
+        a * (1.0 - f1) + b * f1
+    }
+}

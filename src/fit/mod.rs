@@ -1,0 +1,13 @@
+//! Fitting: model forms (`model`), the problem on data (`problem`), solvers (`solve`),
+//! reports (`report`) and the denominator positivity proof (`positivity`).
+
+pub mod model;
+pub mod positivity;
+pub mod problem;
+pub mod report;
+pub mod solve;
+
+pub use model::{Pin, RationalModel, Term};
+pub use problem::Data;
+pub use report::FitReport;
+pub use solve::{fit, Fit, FitError, FitOptions, LsqSolver, Objective};

@@ -1,0 +1,384 @@
+//! Model forms: rational functions of named features,
+//!
+//!   f(x) = offset + factor(x) · P(x) / Q(x),   P = Σ a_j φ_j(x),   Q = 1 + Σ b_j ψ_j(x),
+//!
+//! where every basis function φ_j, ψ_j is a *term*: a sum of monomials sharing one coefficient
+//! (`"x^2 + y^2"` ties the coefficients of x² and y²; `"x*y"` is one monomial; `"1"` is the
+//! constant). Constraints map the free parameters θ affinely onto the full coefficient vector
+//! c = [a; b]:
+//! - a fixed coefficient is a constant (`MGH09`'s numerator has no constant term);
+//! - a pinned point f(x_k) = v_k is linear in c (P(x_k) = v'_k Q(x_k), v' = (v − offset)/factor),
+//!   so it eliminates one numerator coefficient per pin by a K×K solve.
+//!
+//! So c = M θ + m₀, computed once; the Jacobian in θ is the Jacobian in c times M.
+
+use nalgebra::{DMatrix, DVector};
+use std::fmt;
+
+/// A product of powers of features; `exps[i]` is the power of feature i.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Monomial {
+    pub exps: Vec<u32>,
+}
+
+/// A sum of monomials with one shared coefficient.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Term {
+    pub label: String,
+    pub monomials: Vec<Monomial>,
+}
+
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum ModelError {
+    #[error("term '{term}': {why}")]
+    BadTerm { term: String, why: String },
+    #[error("'{0}' is not a model form: expected rational(m,n) or a model spec file")]
+    BadForm(String),
+    #[error("coefficient '{0}' named in a constraint is not a term of the model")]
+    UnknownCoefficient(String),
+    #[error("pin at {at:?}: {why}")]
+    BadPin { at: Vec<f64>, why: String },
+    #[error("the model has no free coefficient left after its constraints")]
+    NoFreeParameter,
+}
+
+impl Term {
+    /// Parse `"1"`, `"x"`, `"x^2*y"`, `"x^2 + y^2"` over the given feature names.
+    pub fn parse(text: &str, features: &[String]) -> Result<Term, ModelError> {
+        let bad = |why: String| ModelError::BadTerm { term: text.to_string(), why };
+        let mut monomials = Vec::new();
+        for mono in text.split('+') {
+            let mono = mono.trim();
+            if mono.is_empty() {
+                return Err(bad("empty monomial".into()));
+            }
+            let mut exps = vec![0u32; features.len()];
+            if mono != "1" {
+                for factor in mono.split('*') {
+                    let factor = factor.trim();
+                    let (name, power) = match factor.split_once('^') {
+                        Some((n, p)) => {
+                            let p: u32 = p.trim().parse().map_err(|_| {
+                                bad(format!("power '{}' is not a non-negative integer", p.trim()))
+                            })?;
+                            (n.trim(), p)
+                        }
+                        None => (factor, 1),
+                    };
+                    let i = features.iter().position(|f| f == name).ok_or_else(|| {
+                        bad(format!("unknown feature '{name}' (features: {})", features.join(", ")))
+                    })?;
+                    exps[i] += power;
+                }
+            }
+            monomials.push(Monomial { exps });
+        }
+        Ok(Term { label: text.trim().to_string(), monomials })
+    }
+
+    pub fn eval(&self, x: &[f64]) -> f64 {
+        self.monomials
+            .iter()
+            .map(|m| m.exps.iter().zip(x).map(|(&e, &xi)| xi.powi(e as i32)).product::<f64>())
+            .sum()
+    }
+
+    pub fn is_constant(&self) -> bool {
+        self.monomials.len() == 1 && self.monomials[0].exps.iter().all(|&e| e == 0)
+    }
+
+    pub fn degree(&self) -> u32 {
+        self.monomials.iter().map(|m| m.exps.iter().sum::<u32>()).max().unwrap_or(0)
+    }
+}
+
+impl fmt::Display for Term {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.label)
+    }
+}
+
+/// f(x_k) = value, eliminating numerator coefficient `eliminate`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Pin {
+    pub at: Vec<f64>,
+    pub value: f64,
+    pub eliminate: usize,
+}
+
+/// A rational model with its constraints resolved into an affine parameter map.
+#[derive(Debug, Clone)]
+pub struct RationalModel {
+    pub features: Vec<String>,
+    pub numerator: Vec<Term>,
+    /// Non-constant denominator terms; the constant 1 is implicit.
+    pub denominator: Vec<Term>,
+    pub offset: f64,
+    pub factor: Option<Term>,
+    pub fixed: Vec<(usize, f64)>,
+    pub pins: Vec<Pin>,
+    /// Clamp applied to the model output (clamp-aware objective).
+    pub clamp: Option<(f64, f64)>,
+    /// c = m · θ + m0.
+    map: DMatrix<f64>,
+    map0: DVector<f64>,
+    free: Vec<usize>,
+}
+
+impl RationalModel {
+    /// Plain 1-D rational(m, n) in feature `x`: numerator 1..x^m, denominator 1 + x..x^n.
+    pub fn rational_1d(feature: &str, m: u32, n: u32) -> RationalModel {
+        let features = vec![feature.to_string()];
+        let power = |p: u32| match p {
+            0 => "1".to_string(),
+            1 => feature.to_string(),
+            _ => format!("{feature}^{p}"),
+        };
+        let num = (0..=m).map(|p| Term::parse(&power(p), &features).expect("valid term")).collect();
+        let den = (1..=n).map(|p| Term::parse(&power(p), &features).expect("valid term")).collect();
+        RationalModel::new(features, num, den, 0.0, None, vec![], vec![], None)
+            .expect("an unconstrained rational model is always valid")
+    }
+
+    /// Parse `rational(m,n)` (feature name given).
+    pub fn parse_form(form: &str, feature: &str) -> Result<RationalModel, ModelError> {
+        let f = form.trim();
+        let inner = f
+            .strip_prefix("rational(")
+            .and_then(|s| s.strip_suffix(')'))
+            .ok_or_else(|| ModelError::BadForm(form.to_string()))?;
+        let (m, n) = inner.split_once(',').ok_or_else(|| ModelError::BadForm(form.to_string()))?;
+        let m: u32 = m.trim().parse().map_err(|_| ModelError::BadForm(form.to_string()))?;
+        let n: u32 = n.trim().parse().map_err(|_| ModelError::BadForm(form.to_string()))?;
+        if m > 12 || n > 12 {
+            return Err(ModelError::BadForm(format!("{form} (degrees above 12 are not supported)")));
+        }
+        Ok(RationalModel::rational_1d(feature, m, n))
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        features: Vec<String>,
+        numerator: Vec<Term>,
+        denominator: Vec<Term>,
+        offset: f64,
+        factor: Option<Term>,
+        fixed: Vec<(usize, f64)>,
+        pins: Vec<Pin>,
+        clamp: Option<(f64, f64)>,
+    ) -> Result<RationalModel, ModelError> {
+        if let Some(t) = denominator.iter().find(|t| t.is_constant()) {
+            return Err(ModelError::BadTerm {
+                term: t.label.clone(),
+                why: "the denominator's constant term is fixed to 1; list only its other terms"
+                    .into(),
+            });
+        }
+        let nn = numerator.len();
+        let nfull = nn + denominator.len();
+        let eliminated: Vec<usize> = pins.iter().map(|p| p.eliminate).collect();
+        let free: Vec<usize> = (0..nfull)
+            .filter(|i| !fixed.iter().any(|f| f.0 == *i) && !eliminated.contains(i))
+            .collect();
+        if free.is_empty() {
+            return Err(ModelError::NoFreeParameter);
+        }
+        let mut model = RationalModel {
+            features,
+            numerator,
+            denominator,
+            offset,
+            factor,
+            fixed,
+            pins,
+            clamp,
+            map: DMatrix::zeros(nfull, free.len()),
+            map0: DVector::zeros(nfull),
+            free,
+        };
+        for p in &model.pins {
+            if model.fixed.iter().any(|f| f.0 == p.eliminate) || p.eliminate >= nn {
+                return Err(ModelError::BadPin {
+                    at: p.at.clone(),
+                    why: "must eliminate a numerator coefficient that is not fixed".into(),
+                });
+            }
+            let fac = model.factor.as_ref().map_or(1.0, |t| t.eval(&p.at));
+            if fac == 0.0 || !fac.is_finite() {
+                return Err(ModelError::BadPin { at: p.at.clone(), why: "the factor is zero there".into() });
+            }
+        }
+        let theta0 = DVector::zeros(model.free.len());
+        let base = model.full_from_free_uncached(&theta0)?;
+        for j in 0..model.free.len() {
+            let mut e = theta0.clone();
+            e[j] = 1.0;
+            let col = model.full_from_free_uncached(&e)? - &base;
+            model.map.set_column(j, &col);
+        }
+        model.map0 = base;
+        Ok(model)
+    }
+
+    fn full_from_free_uncached(&self, theta: &DVector<f64>) -> Result<DVector<f64>, ModelError> {
+        let nn = self.numerator.len();
+        let mut c = DVector::zeros(nn + self.denominator.len());
+        for (j, &i) in self.free.iter().enumerate() {
+            c[i] = theta[j];
+        }
+        for &(i, v) in &self.fixed {
+            c[i] = v;
+        }
+        let k = self.pins.len();
+        if k == 0 {
+            return Ok(c);
+        }
+        let mut a = DMatrix::zeros(k, k);
+        let mut rhs = DVector::zeros(k);
+        for (r, pin) in self.pins.iter().enumerate() {
+            let fac = self.factor.as_ref().map_or(1.0, |t| t.eval(&pin.at));
+            let v = (pin.value - self.offset) / fac;
+            let q = 1.0
+                + self.denominator.iter().enumerate().map(|(j, t)| c[nn + j] * t.eval(&pin.at)).sum::<f64>();
+            let mut s = v * q;
+            for (j, t) in self.numerator.iter().enumerate() {
+                if let Some(col) = self.pins.iter().position(|p| p.eliminate == j) {
+                    a[(r, col)] = t.eval(&pin.at);
+                } else {
+                    s -= c[j] * t.eval(&pin.at);
+                }
+            }
+            rhs[r] = s;
+        }
+        let sol = a.lu().solve(&rhs).ok_or_else(|| ModelError::BadPin {
+            at: self.pins[0].at.clone(),
+            why: "the pins do not determine the eliminated coefficients (singular system)".into(),
+        })?;
+        for (col, pin) in self.pins.iter().enumerate() {
+            c[pin.eliminate] = sol[col];
+        }
+        Ok(c)
+    }
+
+    pub fn n_free(&self) -> usize {
+        self.free.len()
+    }
+
+    pub fn n_full(&self) -> usize {
+        self.numerator.len() + self.denominator.len()
+    }
+
+    /// Full coefficients [a; b] from free parameters θ.
+    pub fn full(&self, theta: &DVector<f64>) -> DVector<f64> {
+        &self.map * theta + &self.map0
+    }
+
+    /// Least-squares projection of full coefficients onto the free parameters (exact when
+    /// `c` satisfies the constraints).
+    pub fn free_from_full(&self, c: &DVector<f64>) -> DVector<f64> {
+        DVector::from_iterator(self.free.len(), self.free.iter().map(|&i| c[i]))
+    }
+
+    pub fn map(&self) -> &DMatrix<f64> {
+        &self.map
+    }
+
+    pub fn map0(&self) -> &DVector<f64> {
+        &self.map0
+    }
+
+    /// Labels of the full coefficients, e.g. `num[x^2]`, `den[x]`.
+    pub fn coefficient_labels(&self) -> Vec<String> {
+        self.numerator
+            .iter()
+            .map(|t| format!("num[{t}]"))
+            .chain(self.denominator.iter().map(|t| format!("den[{t}]")))
+            .collect()
+    }
+
+    /// Basis values of one point: (φ, ψ, factor).
+    pub fn basis(&self, x: &[f64]) -> Basis {
+        Basis {
+            phi: self.numerator.iter().map(|t| t.eval(x)).collect(),
+            psi: self.denominator.iter().map(|t| t.eval(x)).collect(),
+            factor: self.factor.as_ref().map_or(1.0, |t| t.eval(x)),
+        }
+    }
+
+    /// Unclamped value at a point, from full coefficients.
+    pub fn eval_full(&self, c: &DVector<f64>, x: &[f64]) -> f64 {
+        self.basis(x).value(c, self.offset)
+    }
+
+    /// Value with the model's clamp applied.
+    pub fn eval_clamped(&self, c: &DVector<f64>, x: &[f64]) -> f64 {
+        let v = self.eval_full(c, x);
+        match self.clamp {
+            Some((lo, hi)) => v.clamp(lo, hi),
+            None => v,
+        }
+    }
+
+    /// Denominator Q at a point.
+    pub fn denominator_at(&self, c: &DVector<f64>, x: &[f64]) -> f64 {
+        let nn = self.numerator.len();
+        1.0 + self.denominator.iter().enumerate().map(|(j, t)| c[nn + j] * t.eval(x)).sum::<f64>()
+    }
+}
+
+/// Precomputed basis values at one sample.
+#[derive(Debug, Clone)]
+pub struct Basis {
+    pub phi: Vec<f64>,
+    pub psi: Vec<f64>,
+    pub factor: f64,
+}
+
+impl Basis {
+    pub fn pq(&self, c: &DVector<f64>) -> (f64, f64) {
+        let nn = self.phi.len();
+        let p: f64 = self.phi.iter().enumerate().map(|(j, v)| c[j] * v).sum();
+        let q: f64 = 1.0 + self.psi.iter().enumerate().map(|(j, v)| c[nn + j] * v).sum::<f64>();
+        (p, q)
+    }
+
+    pub fn value(&self, c: &DVector<f64>, offset: f64) -> f64 {
+        let (p, q) = self.pq(c);
+        offset + self.factor * p / q
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn term_parsing_ties_monomials() {
+        let feats = vec!["x".to_string(), "y".to_string()];
+        let t = Term::parse("x^2 + y^2", &feats).unwrap();
+        assert_eq!(t.eval(&[2.0, 3.0]), 13.0);
+        let t = Term::parse("x*y^2", &feats).unwrap();
+        assert_eq!(t.eval(&[2.0, 3.0]), 18.0);
+        assert!(Term::parse("z", &feats).is_err());
+        assert!(Term::parse("x^-1", &feats).is_err());
+    }
+
+    #[test]
+    fn pins_hold_for_any_free_parameters() {
+        let feats = vec!["x".to_string()];
+        let num: Vec<Term> =
+            ["1", "x", "x^2", "x^3"].iter().map(|s| Term::parse(s, &feats).unwrap()).collect();
+        let den: Vec<Term> = ["x", "x^2"].iter().map(|s| Term::parse(s, &feats).unwrap()).collect();
+        let pins = vec![
+            Pin { at: vec![0.0], value: 0.5, eliminate: 0 },
+            Pin { at: vec![1.0], value: 0.9, eliminate: 3 },
+        ];
+        let m = RationalModel::new(feats, num, den, 0.0, None, vec![], pins, None).unwrap();
+        assert_eq!(m.n_free(), 4);
+        let theta = DVector::from_vec(vec![0.3, -1.2, 0.7, 2.5]);
+        let c = m.full(&theta);
+        // The map is exact up to rounding of a 2×2 solve on O(1) numbers.
+        assert!((m.eval_full(&c, &[0.0]) - 0.5).abs() < 1e-14);
+        assert!((m.eval_full(&c, &[1.0]) - 0.9).abs() < 1e-14);
+    }
+}

@@ -1,0 +1,179 @@
+//! The least-squares problem of a rational model on data, seen through argmin's problem
+//! traits (`Operator` = residuals, `Jacobian`, `CostFunction`, `Gradient`) and through the
+//! `levenberg-marquardt` crate's `LeastSquaresProblem`. Solvers live in `solve.rs`.
+//!
+//! Residuals: r_i(θ) = w_i · (clamp(f(x_i; c(θ))) − y_i), c = Mθ + m₀ (see `model.rs`).
+//! Where the clamp is active the residual is constant in θ and its Jacobian row is zero.
+
+use super::model::{Basis, RationalModel};
+use argmin::core::{CostFunction, Error as ArgminError, Gradient, Jacobian, Operator};
+use levenberg_marquardt::LeastSquaresProblem;
+use nalgebra::{DMatrix, DVector, Dyn, Owned};
+
+/// Samples of a target function: feature vectors and values.
+#[derive(Debug, Clone, Default)]
+pub struct Data {
+    pub x: Vec<Vec<f64>>,
+    pub y: Vec<f64>,
+}
+
+impl Data {
+    pub fn len(&self) -> usize {
+        self.y.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.y.is_empty()
+    }
+
+    /// Bounding box of the features: (min, max) per feature.
+    pub fn bounds(&self) -> Vec<(f64, f64)> {
+        let nf = self.x.first().map_or(0, Vec::len);
+        (0..nf)
+            .map(|j| {
+                self.x.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+                    (lo.min(p[j]), hi.max(p[j]))
+                })
+            })
+            .collect()
+    }
+}
+
+/// A rational model bound to data with per-sample weights.
+#[derive(Debug, Clone)]
+pub struct Residuals<'a> {
+    pub model: &'a RationalModel,
+    pub basis: Vec<Basis>,
+    pub y: &'a [f64],
+    /// Square roots of the sample weights.
+    pub sqrt_w: Vec<f64>,
+    pub theta: DVector<f64>,
+}
+
+impl<'a> Residuals<'a> {
+    pub fn new(model: &'a RationalModel, data: &'a Data, theta: DVector<f64>) -> Self {
+        Residuals {
+            model,
+            basis: data.x.iter().map(|x| model.basis(x)).collect(),
+            y: &data.y,
+            sqrt_w: vec![1.0; data.len()],
+            theta,
+        }
+    }
+
+    pub fn set_weights(&mut self, w: &[f64]) {
+        self.sqrt_w = w.iter().map(|w| w.sqrt()).collect();
+    }
+
+    /// Unweighted residuals f(x_i) − y_i at θ.
+    pub fn raw(&self, theta: &DVector<f64>) -> DVector<f64> {
+        let c = self.model.full(theta);
+        DVector::from_iterator(
+            self.y.len(),
+            self.basis.iter().zip(self.y).map(|(b, y)| self.clamped(b.value(&c, self.model.offset)) - y),
+        )
+    }
+
+    fn clamped(&self, v: f64) -> f64 {
+        match self.model.clamp {
+            Some((lo, hi)) => v.clamp(lo, hi),
+            None => v,
+        }
+    }
+
+    pub fn weighted(&self, theta: &DVector<f64>) -> DVector<f64> {
+        self.raw(theta).component_mul(&DVector::from_column_slice(&self.sqrt_w))
+    }
+
+    /// Jacobian of the weighted residuals with respect to θ.
+    pub fn jacobian_at(&self, theta: &DVector<f64>) -> DMatrix<f64> {
+        let c = self.model.full(theta);
+        let nn = self.model.numerator.len();
+        let nfull = self.model.n_full();
+        let mut jc = DMatrix::zeros(self.y.len(), nfull);
+        for (i, b) in self.basis.iter().enumerate() {
+            let (p, q) = b.pq(&c);
+            let v = self.model.offset + b.factor * p / q;
+            if let Some((lo, hi)) = self.model.clamp
+                && (v < lo || v > hi)
+            {
+                continue;
+            }
+            let s = self.sqrt_w[i] * b.factor / q;
+            for (j, phi) in b.phi.iter().enumerate() {
+                jc[(i, j)] = s * phi;
+            }
+            for (j, psi) in b.psi.iter().enumerate() {
+                jc[(i, nn + j)] = -s * p / q * psi;
+            }
+        }
+        jc * self.model.map()
+    }
+}
+
+impl Operator for Residuals<'_> {
+    type Param = DVector<f64>;
+    type Output = DVector<f64>;
+    fn apply(&self, theta: &Self::Param) -> Result<Self::Output, ArgminError> {
+        Ok(self.weighted(theta))
+    }
+}
+
+impl Jacobian for Residuals<'_> {
+    type Param = DVector<f64>;
+    type Jacobian = DMatrix<f64>;
+    fn jacobian(&self, theta: &Self::Param) -> Result<Self::Jacobian, ArgminError> {
+        Ok(self.jacobian_at(theta))
+    }
+}
+
+impl CostFunction for Residuals<'_> {
+    type Param = DVector<f64>;
+    type Output = f64;
+    /// Weighted residual sum of squares.
+    fn cost(&self, theta: &Self::Param) -> Result<f64, ArgminError> {
+        Ok(self.weighted(theta).norm_squared())
+    }
+}
+
+impl Gradient for Residuals<'_> {
+    type Param = DVector<f64>;
+    type Gradient = DVector<f64>;
+    fn gradient(&self, theta: &Self::Param) -> Result<Self::Gradient, ArgminError> {
+        Ok(2.0 * self.jacobian_at(theta).transpose() * self.weighted(theta))
+    }
+}
+
+impl LeastSquaresProblem<f64, Dyn, Dyn> for Residuals<'_> {
+    type ResidualStorage = Owned<f64, Dyn>;
+    type JacobianStorage = Owned<f64, Dyn, Dyn>;
+    type ParameterStorage = Owned<f64, Dyn>;
+
+    fn set_params(&mut self, x: &DVector<f64>) {
+        self.theta.copy_from(x);
+    }
+    fn params(&self) -> DVector<f64> {
+        self.theta.clone()
+    }
+    fn residuals(&self) -> Option<DVector<f64>> {
+        let r = self.weighted(&self.theta);
+        r.iter().all(|v| v.is_finite()).then_some(r)
+    }
+    fn jacobian(&self) -> Option<DMatrix<f64>> {
+        let j = self.jacobian_at(&self.theta);
+        j.iter().all(|v| v.is_finite()).then_some(j)
+    }
+}
+
+/// Max-abs residual as an argmin cost (for derivative-free polishing of minimax fits).
+pub struct MaxAbs<'a>(pub &'a Residuals<'a>);
+
+impl CostFunction for MaxAbs<'_> {
+    type Param = DVector<f64>;
+    type Output = f64;
+    fn cost(&self, theta: &Self::Param) -> Result<f64, ArgminError> {
+        let r = self.0.raw(theta);
+        let m = r.iter().fold(0.0_f64, |m, v| if v.is_nan() { f64::INFINITY } else { m.max(v.abs()) });
+        Ok(m)
+    }
+}

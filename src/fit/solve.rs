@@ -1,0 +1,332 @@
+//! Solvers for rational fits, chosen by the caller:
+//!
+//! 1. **Linearised start** (no user start values): Loeb's linearisation
+//!    (y − offset)·Q = factor·P is linear in the coefficients; a few Sanathanan–Koerner
+//!    re-weightings by 1/Q of the previous iterate remove its bias. Solved by SVD.
+//! 2. **Least squares**: Levenberg–Marquardt (MINPACK's, from the `levenberg-marquardt`
+//!    crate) on the analytic Jacobian; or argmin's Gauss–Newton with a Moré–Thuente line search.
+//! 3. **Minimax**: Lawson's iteratively re-weighted least squares (weights w_i ← w_i·|r_i|,
+//!    each weighted problem solved by LM from the previous iterate, best iterate kept), then
+//!    a derivative-free polish of max|r| with argmin's Nelder–Mead, kept only if it improves.
+
+use super::model::RationalModel;
+use super::problem::{Data, MaxAbs, Residuals};
+use super::positivity::{prove_denominator_positive, Positivity};
+use super::report::FitReport;
+use argmin::core::{Executor, State};
+use argmin::solver::neldermead::NelderMead;
+use levenberg_marquardt::LevenbergMarquardt;
+use nalgebra::{DMatrix, DVector};
+use serde::{Deserialize, Serialize};
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Objective {
+    Lsq,
+    Minimax,
+}
+
+impl std::str::FromStr for Objective {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "lsq" => Ok(Objective::Lsq),
+            "minimax" => Ok(Objective::Minimax),
+            other => Err(format!("unknown objective '{other}' (expected lsq or minimax)")),
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum LsqSolver {
+    /// MINPACK Levenberg–Marquardt (levenberg-marquardt crate).
+    Lm,
+    /// argmin Gauss–Newton with Moré–Thuente line search.
+    GaussNewton,
+}
+
+#[derive(Debug, Clone, Copy)]
+pub struct FitOptions {
+    pub objective: Objective,
+    pub solver: LsqSolver,
+    /// Outer iterations of Lawson's algorithm (minimax).
+    pub minimax_iters: usize,
+    /// Nelder–Mead iterations of the minimax polish (0 disables it).
+    pub polish_iters: u64,
+}
+
+impl Default for FitOptions {
+    fn default() -> Self {
+        FitOptions { objective: Objective::Lsq, solver: LsqSolver::Lm, minimax_iters: 300, polish_iters: 3000 }
+    }
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum FitError {
+    #[error("{what}: no data to fit")]
+    NoData { what: String },
+    #[error("{what}: {n} samples cannot determine {p} free coefficients")]
+    Underdetermined { what: String, n: usize, p: usize },
+    #[error("{what}: the linearised start is singular (the basis is degenerate on these samples)")]
+    SingularStart { what: String },
+    #[error("{what}: the fit diverged after {iters} iterations (residual {residual:e})")]
+    Diverged { what: String, iters: usize, residual: f64 },
+    #[error("{what}: denominator not provably positive on the domain: Q ≥ {lower:e} on the box {region:?}")]
+    PoleInDomain { what: String, lower: f64, region: Vec<(f64, f64)> },
+    #[error("{what}: solver failed: {msg}")]
+    Solver { what: String, msg: String },
+}
+
+/// A fitted model: free parameters, full coefficients and the report on the fitting data.
+#[derive(Debug, Clone)]
+pub struct Fit {
+    pub theta: DVector<f64>,
+    pub coefficients: DVector<f64>,
+    pub report: FitReport,
+}
+
+/// Fit `model` to `data` from no start values.
+pub fn fit(model: &RationalModel, data: &Data, opts: &FitOptions, what: &str) -> Result<Fit, FitError> {
+    if data.is_empty() {
+        return Err(FitError::NoData { what: what.into() });
+    }
+    if data.len() < model.n_free() {
+        return Err(FitError::Underdetermined { what: what.into(), n: data.len(), p: model.n_free() });
+    }
+    // Multi-start: LM from every linearised candidate; keep the best least-squares optimum
+    // whose denominator is provably positive on the data's bounding box (a rational with a pole
+    // between samples can fit the samples and still be useless), else the best one.
+    let starts = linearised_starts(model, data, what)?;
+    let domain = data.bounds();
+    let lsq = FitOptions { objective: Objective::Lsq, ..*opts };
+    let mut best: Option<(bool, f64, DVector<f64>)> = None;
+    for theta0 in starts {
+        let Ok(f) = fit_from(model, data, theta0, &lsq, what) else { continue };
+        let valid = matches!(
+            prove_denominator_positive(model, &f.coefficients, &domain),
+            Positivity::Proven { .. }
+        );
+        let better = match &best {
+            None => true,
+            Some((bv, brss, _)) => (valid && !bv) || (valid == *bv && f.report.rss < *brss),
+        };
+        if better {
+            best = Some((valid, f.report.rss, f.theta));
+        }
+    }
+    let (_, _, theta0) = best.ok_or_else(|| FitError::SingularStart { what: what.into() })?;
+    fit_from(model, data, theta0, opts, what)
+}
+
+/// Fit from given free parameters.
+pub fn fit_from(
+    model: &RationalModel,
+    data: &Data,
+    theta0: DVector<f64>,
+    opts: &FitOptions,
+    what: &str,
+) -> Result<Fit, FitError> {
+    let mut problem = Residuals::new(model, data, theta0);
+    let (theta, iters, evals) = match opts.objective {
+        Objective::Lsq => {
+            let (t, it, ev) = least_squares(&mut problem, opts.solver, what)?;
+            (t, it, ev)
+        }
+        Objective::Minimax => minimax(&mut problem, opts, what)?,
+    };
+    problem.sqrt_w.iter_mut().for_each(|w| *w = 1.0);
+    let report = FitReport::measure(&problem, data, &theta, opts, iters, evals);
+    if !report.rss.is_finite() {
+        return Err(FitError::Diverged { what: what.into(), iters, residual: report.rss });
+    }
+    Ok(Fit { coefficients: model.full(&theta), theta, report })
+}
+
+/// Start candidates: the polynomial fit (Q ≡ 1 where the constraints allow), then Loeb's
+/// linearisation and each of its Sanathanan–Koerner re-weightings, solved by SVD.
+pub fn linearised_starts(model: &RationalModel, data: &Data, what: &str) -> Result<Vec<DVector<f64>>, FitError> {
+    let nn = model.numerator.len();
+    let nfull = model.n_full();
+    let rows: Vec<usize> = (0..data.len())
+        .filter(|&i| match model.clamp {
+            // Samples at the clamp carry no information about P/Q beyond an inequality.
+            Some((lo, hi)) => data.y[i] > lo && data.y[i] < hi,
+            None => true,
+        })
+        .collect();
+    if rows.len() < model.n_free() {
+        return Err(FitError::Underdetermined { what: what.into(), n: rows.len(), p: model.n_free() });
+    }
+    let basis: Vec<_> = rows.iter().map(|&i| model.basis(&data.x[i])).collect();
+    let mut inv_q = vec![1.0; rows.len()];
+    let mut starts = Vec::new();
+    for sk in 0..7 {
+        let mut a = DMatrix::zeros(rows.len(), nfull);
+        let mut rhs = DVector::zeros(rows.len());
+        for (r, (&i, b)) in rows.iter().zip(&basis).enumerate() {
+            let yv = data.y[i] - model.offset;
+            for (j, phi) in b.phi.iter().enumerate() {
+                a[(r, j)] = inv_q[r] * b.factor * phi;
+            }
+            for (j, psi) in b.psi.iter().enumerate() {
+                a[(r, nn + j)] = -inv_q[r] * yv * psi;
+            }
+            rhs[r] = inv_q[r] * yv;
+        }
+        let rhs = rhs - &a * model.map0();
+        let mut a = a * model.map();
+        if sk == 0 {
+            // Polynomial start: free parameters that move the denominator are held at 0.
+            let den_rows = model.map().rows(nn, nfull - nn).into_owned();
+            for j in 0..a.ncols() {
+                if den_rows.column(j).iter().any(|v| *v != 0.0) {
+                    a.column_mut(j).fill(0.0);
+                }
+            }
+        }
+        // Column scaling makes the SVD's rank decision independent of feature units.
+        let scale: Vec<f64> = (0..a.ncols()).map(|j| a.column(j).norm()).map(|n| if n > 0.0 { n } else { 1.0 }).collect();
+        let mut a_s = a.clone();
+        for (j, s) in scale.iter().enumerate() {
+            a_s.column_mut(j).scale_mut(1.0 / s);
+        }
+        let svd = a_s.svd(true, true);
+        let Ok(t) = svd.solve(&rhs, 1e-13) else { continue };
+        let t = DVector::from_iterator(t.len(), t.iter().zip(&scale).map(|(v, s)| v / s));
+        if !t.iter().all(|v| v.is_finite()) {
+            continue;
+        }
+        let c = model.full(&t);
+        starts.push(t);
+        if sk == 0 {
+            continue;
+        }
+        for (r, &i) in rows.iter().enumerate() {
+            let q = model.denominator_at(&c, &data.x[i]);
+            // Stop re-weighting through a sign change of Q: keep the previous weights there.
+            if q.abs() > 1e-8 {
+                inv_q[r] = 1.0 / q.abs();
+            }
+        }
+    }
+    if starts.is_empty() {
+        return Err(FitError::SingularStart { what: what.into() });
+    }
+    Ok(starts)
+}
+
+fn least_squares(
+    problem: &mut Residuals<'_>,
+    solver: LsqSolver,
+    what: &str,
+) -> Result<(DVector<f64>, usize, usize), FitError> {
+    match solver {
+        LsqSolver::Lm => {
+            let lm = LevenbergMarquardt::new()
+                .with_ftol(1e-15)
+                .with_xtol(1e-15)
+                .with_gtol(0.0)
+                .with_patience(400);
+            let (p, report) = lm.minimize(problem.clone());
+            let theta = p.theta.clone();
+            if !theta.iter().all(|v| v.is_finite()) {
+                return Err(FitError::Diverged {
+                    what: what.into(),
+                    iters: report.number_of_evaluations,
+                    residual: report.objective_function,
+                });
+            }
+            problem.theta.copy_from(&theta);
+            Ok((theta, report.number_of_evaluations, report.number_of_evaluations))
+        }
+        LsqSolver::GaussNewton => {
+            use argmin::solver::gaussnewton::GaussNewtonLS;
+            use argmin::solver::linesearch::MoreThuenteLineSearch;
+            let ls = MoreThuenteLineSearch::new();
+            let gn = GaussNewtonLS::new(ls);
+            let res = Executor::new(problem.clone(), gn)
+                .configure(|s| s.param(problem.theta.clone()).max_iters(200))
+                .run()
+                .map_err(|e| FitError::Solver { what: what.into(), msg: e.to_string() })?;
+            let st = res.state();
+            let theta = st.get_best_param().cloned().unwrap_or_else(|| problem.theta.clone());
+            problem.theta.copy_from(&theta);
+            let iters = st.get_iter() as usize;
+            Ok((theta, iters, iters))
+        }
+    }
+}
+
+fn minimax(
+    problem: &mut Residuals<'_>,
+    opts: &FitOptions,
+    what: &str,
+) -> Result<(DVector<f64>, usize, usize), FitError> {
+    // Start from the least-squares optimum.
+    let (mut theta, mut iters, mut evals) = least_squares(problem, opts.solver, what)?;
+    let max_abs = |p: &Residuals<'_>, t: &DVector<f64>| {
+        p.raw(t).iter().fold(0.0_f64, |m, v| if v.is_nan() { f64::INFINITY } else { m.max(v.abs()) })
+    };
+    let n = problem.y.len();
+    let mut w = vec![1.0 / n as f64; n];
+    let mut best = (max_abs(problem, &theta), theta.clone());
+    let mut since_best = 0;
+    for _ in 0..opts.minimax_iters {
+        let r = problem.raw(&theta);
+        let mut sum = 0.0;
+        for (wi, ri) in w.iter_mut().zip(r.iter()) {
+            *wi *= ri.abs();
+            sum += *wi;
+        }
+        if !(sum > 0.0) || !sum.is_finite() {
+            break;
+        }
+        w.iter_mut().for_each(|wi| *wi /= sum);
+        // Keep every sample in play: a floor far below any weight that matters.
+        w.iter_mut().for_each(|wi| *wi = wi.max(1e-14 / n as f64));
+        problem.set_weights(&w);
+        problem.theta.copy_from(&theta);
+        let (t, it, ev) = match least_squares(problem, opts.solver, what) {
+            Ok(v) => v,
+            Err(_) => break,
+        };
+        iters += it;
+        evals += ev;
+        theta = t;
+        let m = max_abs(problem, &theta);
+        if m < best.0 * (1.0 - 1e-9) {
+            best = (m, theta.clone());
+            since_best = 0;
+        } else {
+            since_best += 1;
+            if since_best >= 25 {
+                break;
+            }
+        }
+    }
+    let mut theta = best.1.clone();
+    problem.sqrt_w.iter_mut().for_each(|w| *w = 1.0);
+    if opts.polish_iters > 0 {
+        let mut simplex = vec![theta.clone()];
+        for j in 0..theta.len() {
+            let mut t = theta.clone();
+            t[j] += 1e-4 * t[j].abs().max(1e-3);
+            simplex.push(t);
+        }
+        if let Ok(nm) = NelderMead::new(simplex).with_sd_tolerance(1e-16) {
+            let cost = MaxAbs(problem);
+            if let Ok(res) = Executor::new(cost, nm).configure(|s| s.max_iters(opts.polish_iters)).run() {
+                let st = res.state();
+                if let Some(p) = st.get_best_param()
+                    && st.get_best_cost() < best.0
+                {
+                    theta = p.clone();
+                }
+                evals += st.get_iter() as usize;
+            }
+        }
+    }
+    problem.theta.copy_from(&theta);
+    Ok((theta, iters, evals))
+}

@@ -1,0 +1,12 @@
+//! shadefit: integrals behind real-time shading models, fitted, verified and emitted.
+//!
+//! Pipeline: spec → integrate → sample → fit → verify → emit. See ARCHITECTURE.md.
+
+pub mod fit;
+pub mod integrate;
+pub mod quantity;
+pub mod cli;
+pub mod emit;
+pub mod pipeline;
+pub mod spec;
+pub mod validate;

@@ -1,0 +1,89 @@
+//! The `shadefit` command line: parse, call the library, print. Exit codes: 0 ok, 1 the job
+//! failed, 2 bad input.
+
+use clap::{Parser, Subcommand};
+use shadefit::cli::{self, InputError, Paths};
+use shadefit::fit::Objective;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(name = "shadefit", version, about = "Integrate, fit, verify and emit shading-model approximations")]
+struct Cli {
+    /// Folder of fit specs.
+    #[arg(long, global = true, default_value = "fits")]
+    fits: PathBuf,
+    /// Folder the emitted files go to.
+    #[arg(long, global = true, default_value = "generated")]
+    generated: PathBuf,
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Tables and fits known from the specs, with whether generated/ is up to date.
+    List,
+    /// Evaluate an integral (not a fit) at one point: QUANTITY name=value ...
+    #[command(after_help = "Quantities:\n  gloss-length       gloss=G | alpha=A   GGX average normal length\n  gloss-from-length  length=L            gloss with that average normal length\n  gloss-combine      x=G1 y=G2           combined gloss (RNM)")]
+    Eval {
+        quantity: String,
+        /// Parameters as name=value.
+        params: Vec<String>,
+        #[arg(long)]
+        json: bool,
+    },
+    /// Integrate, fit, verify and emit every spec (or the named ones) into generated/.
+    Build {
+        /// Comma-separated spec names.
+        #[arg(long, value_delimiter = ',')]
+        only: Vec<String>,
+        /// Write nothing; fail if any generated file differs from what the specs and the
+        /// committed coefficients produce.
+        #[arg(long)]
+        check: bool,
+    },
+    /// Fit a model to your own CSV data, from no start values.
+    Fit {
+        /// CSV file with a header row.
+        #[arg(long)]
+        data: PathBuf,
+        /// Feature column(s), comma-separated.
+        #[arg(long, value_delimiter = ',', required = true)]
+        x: Vec<String>,
+        /// Target column.
+        #[arg(long)]
+        y: String,
+        /// `rational(m,n)` or a model spec TOML file.
+        #[arg(long)]
+        model: String,
+        #[arg(long, default_value = "lsq")]
+        objective: Objective,
+        #[arg(long)]
+        json: bool,
+    },
+    /// Measure published tables and approximations against the integrals.
+    Validate {
+        #[arg(long)]
+        json: bool,
+    },
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let paths = Paths { fits: cli.fits, generated: cli.generated };
+    let result = match cli.command {
+        Command::List => cli::list(&paths),
+        Command::Eval { quantity, params, json } => cli::eval(&quantity, &params, json),
+        Command::Build { only, check } => cli::build(&paths, &only, check),
+        Command::Fit { data, x, y, model, objective, json } => cli::fit_data(&data, &x, &y, &model, objective, json),
+        Command::Validate { json } => cli::validate(&paths, json),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            if e.chain().any(|c| c.is::<InputError>()) { ExitCode::from(2) } else { ExitCode::from(1) }
+        }
+    }
+}

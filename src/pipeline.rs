@@ -1,0 +1,471 @@
+//! The build: for every spec, sample the integral, fit (or tabulate), verify, emit.
+//!
+//! - `Mode::Fit` integrates and fits from scratch (what `shadefit build` does);
+//! - `Mode::Committed` takes the coefficients or table values from the committed JSON in
+//!   generated/json and re-verifies and re-emits them (what `shadefit build --check` compares
+//!   byte for byte; it fails if a spec changed since its JSON was written).
+//!
+//! Samples are computed in parallel with rayon and collected in grid order, so outputs are
+//! byte-identical at any thread count.
+
+use crate::emit::expr;
+use crate::emit::{self, header_lines, rust, wgsl, Artifact, GENERATOR};
+use crate::fit::positivity::{prove_denominator_positive, Positivity};
+use crate::fit::{self, Data, FitOptions, FitReport};
+use crate::spec::{Kind, Spec};
+use nalgebra::DVector;
+use rayon::prelude::*;
+use serde::Serialize;
+use serde_json::{json, Value};
+use sha2::{Digest, Sha256};
+use std::path::Path;
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Mode {
+    Fit,
+    Committed,
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum BuildError {
+    #[error(transparent)]
+    Fit(#[from] fit::FitError),
+    #[error("{spec}: generated/json/{spec}.json is missing or unreadable ({why}); run `shadefit build`")]
+    NoCommitted { spec: String, why: String },
+    #[error("{spec}: the spec changed since generated/json/{spec}.json was written (hash {committed} ≠ {current}); run `shadefit build`")]
+    SpecChanged { spec: String, committed: String, current: String },
+    #[error("{spec}: the f32 code returns a non-finite value at {at:?}")]
+    NonFinite { spec: String, at: Vec<f64> },
+}
+
+/// Errors of an emitted function against the integral on the verification grid.
+#[derive(Debug, Clone, Serialize)]
+pub struct Verification {
+    pub points: usize,
+    pub max_abs_error: f64,
+    pub rms_error: f64,
+    pub worst_point: Vec<f64>,
+    /// The same for the emitted f32 code (f32 coefficients, f32 arithmetic, emitted order).
+    pub max_abs_error_f32: f64,
+    pub rms_error_f32: f64,
+    /// For 1-D quantities with an inverse: max error after mapping back to parameter units.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_abs_error_in_parameter: Option<f64>,
+}
+
+/// Result of building one spec.
+#[derive(Debug, Clone)]
+pub struct Built {
+    pub name: String,
+    pub artifacts: Vec<Artifact>,
+    pub verification: Verification,
+    pub fit: Option<FitReport>,
+}
+
+pub fn input_hash(spec: &Spec) -> String {
+    let mut h = Sha256::new();
+    h.update(GENERATOR.as_bytes());
+    h.update(b"\n");
+    h.update(spec.text.as_bytes());
+    let d = h.finalize();
+    format!("sha256:{}", d.iter().map(|b| format!("{b:02x}")).collect::<String>())
+}
+
+/// Tensor grid over axes with the given counts, first axis fastest.
+pub fn grid(spec: &Spec, counts: &[usize]) -> Vec<Vec<f64>> {
+    let axes: Vec<Vec<f64>> = spec.file.axis.iter().zip(counts).map(|(a, &n)| a.points(n)).collect();
+    let total: usize = counts.iter().product();
+    (0..total)
+        .map(|mut k| {
+            axes.iter()
+                .map(|pts| {
+                    let i = k % pts.len();
+                    k /= pts.len();
+                    pts[i]
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// The integral at each point, in parallel, in order.
+pub fn sample(spec: &Spec, points: &[Vec<f64>]) -> Vec<f64> {
+    let q = spec.quantity;
+    let tol = spec.file.tolerance;
+    points.par_iter().map(|p| (q.eval)(p, tol).value).collect()
+}
+
+fn spec_rel_path(spec: &Spec) -> String {
+    format!("fits/{}", spec.path.file_name().and_then(|s| s.to_str()).unwrap_or("?"))
+}
+
+fn committed_json(root: &Path, spec: &Spec) -> Result<Value, BuildError> {
+    let name = &spec.file.name;
+    let path = root.join("json").join(format!("{name}.json"));
+    let text = std::fs::read_to_string(&path)
+        .map_err(|e| BuildError::NoCommitted { spec: name.clone(), why: e.to_string() })?;
+    let v: Value = serde_json::from_str(&text)
+        .map_err(|e| BuildError::NoCommitted { spec: name.clone(), why: e.to_string() })?;
+    let committed = v["input_hash"].as_str().unwrap_or("").to_string();
+    let current = input_hash(spec);
+    if committed != current {
+        return Err(BuildError::SpecChanged { spec: name.clone(), committed, current });
+    }
+    Ok(v)
+}
+
+fn f64_array(v: &Value, spec: &str, key: &str) -> Result<Vec<f64>, BuildError> {
+    v[key]
+        .as_array()
+        .and_then(|a| a.iter().map(Value::as_f64).collect::<Option<Vec<f64>>>())
+        .ok_or_else(|| BuildError::NoCommitted { spec: spec.into(), why: format!("no numeric array '{key}'") })
+}
+
+fn fmt_err(v: f64) -> String {
+    format!("{v:.3e}")
+}
+
+/// Build one spec in the given mode; `root` is the generated/ folder.
+pub fn build_spec(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> {
+    match spec.file.kind {
+        Kind::Fit => build_fit(spec, mode, root),
+        Kind::Table => build_table(spec, mode, root),
+    }
+}
+
+fn domain(spec: &Spec) -> Vec<(f64, f64)> {
+    spec.file.axis.iter().map(|a| (a.range[0], a.range[1])).collect()
+}
+
+fn domain_f32(spec: &Spec) -> Vec<(f32, f32)> {
+    domain(spec).iter().map(|&(a, b)| (a as f32, b as f32)).collect()
+}
+
+fn args(spec: &Spec) -> Vec<String> {
+    spec.file.axis.iter().map(|a| a.name.clone()).collect()
+}
+
+fn build_fit(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> {
+    let name = spec.file.name.clone();
+    let model = spec.model.as_ref().expect("fit specs carry a model");
+    let objective = spec.file.fit.as_ref().expect("fit specs carry [fit]").objective;
+    let counts: Vec<usize> = spec.file.axis.iter().map(|a| a.count).collect();
+    let (coefficients, report) = match mode {
+        Mode::Fit => {
+            let x = grid(spec, &counts);
+            let y = sample(spec, &x);
+            let data = Data { x, y };
+            let opts = FitOptions { objective, ..FitOptions::default() };
+            let f = fit::fit(model, &data, &opts, &name)?;
+            (f.coefficients, Some(f.report))
+        }
+        Mode::Committed => {
+            let v = committed_json(root, spec)?;
+            let c = f64_array(&v["model"], &name, "coefficients")?;
+            if c.len() != model.n_full() {
+                return Err(BuildError::NoCommitted { spec: name, why: "coefficient count differs from the spec".into() });
+            }
+            (DVector::from_vec(c), None)
+        }
+    };
+    let dom = domain(spec);
+    let lower = match prove_denominator_positive(model, &coefficients, &dom) {
+        Positivity::Proven { lower, .. } => lower,
+        Positivity::NotProven { lower, region, .. } => {
+            return Err(fit::FitError::PoleInDomain { what: name, lower, region }.into());
+        }
+    };
+    let e = expr::model_expr(model);
+    let (num, den) = expr::f32_arrays(model, &coefficients);
+    let clamp32 = model.clamp.map(|(a, b)| (a as f32, b as f32));
+    let vcounts: Vec<usize> = spec.file.axis.iter().map(|a| a.verify_count()).collect();
+    let vx = grid(spec, &vcounts);
+    let truth = sample(spec, &vx);
+    let d32 = domain_f32(spec);
+    let approx64: Vec<f64> = vx.iter().map(|x| model.eval_clamped(&coefficients, x)).collect();
+    let approx32: Vec<f32> = vx
+        .iter()
+        .map(|x| {
+            let xs: Vec<f32> =
+                x.iter().zip(&d32).map(|(&v, &(lo, hi))| expr::sanitize(v as f32, lo, hi)).collect();
+            let v = expr::eval_f32(&e, &xs, &num, &den);
+            match clamp32 {
+                Some((lo, hi)) => v.clamp(lo, hi),
+                None => v,
+            }
+        })
+        .collect();
+    if let Some(i) = approx32.iter().position(|v| !v.is_finite()) {
+        return Err(BuildError::NonFinite { spec: name, at: vx[i].clone() });
+    }
+    let verification = verify(spec, &vx, &truth, &approx64, &approx32);
+    let hash = input_hash(spec);
+    let err_line = format!(
+        "max abs {}, rms {} over {} points (f32 code: max abs {}, rms {})",
+        fmt_err(verification.max_abs_error),
+        fmt_err(verification.rms_error),
+        verification.points,
+        fmt_err(verification.max_abs_error_f32),
+        fmt_err(verification.rms_error_f32)
+    );
+    let header = header_lines(&spec_rel_path(spec), &hash, &err_line);
+    let a = args(spec);
+    let func = wgsl::Function {
+        module: &name,
+        name: &spec.file.emit.function,
+        args: &a,
+        domain: &d32,
+        body: wgsl::Body::Fit { expr: &e, num: &num, den: &den, clamp: clamp32 },
+    };
+    let doc = describe_fit(spec, model);
+    let labels = model.coefficient_labels();
+    let json = json!({
+        "generator": GENERATOR,
+        "spec": spec_rel_path(spec),
+        "input_hash": hash,
+        "name": name,
+        "kind": "fit",
+        "quantity": spec.file.quantity,
+        "description": spec.file.description,
+        "function": spec.file.emit.function,
+        "axes": axes_json(spec),
+        "model": {
+            "form": "offset + factor * P / Q, Q = 1 + sum(den)",
+            "features": a,
+            "numerator": model.numerator.iter().map(|t| t.label.clone()).collect::<Vec<_>>(),
+            "denominator": model.denominator.iter().map(|t| t.label.clone()).collect::<Vec<_>>(),
+            "offset": model.offset,
+            "factor": model.factor.as_ref().map(|t| t.label.clone()),
+            "clamp": model.clamp.map(|(a, b)| [a, b]),
+            "labels": labels,
+            "coefficients": coefficients.iter().cloned().collect::<Vec<f64>>(),
+            "numerator_f32": num,
+            "denominator_f32": den,
+            "denominator_lower_bound": lower,
+            "objective": objective,
+        },
+        "verification": verification,
+    });
+    let artifacts = vec![
+        Artifact { path: format!("wgsl/{name}.wgsl").into(), contents: wgsl::render_module(&header, &func) },
+        Artifact { path: format!("src/{name}.rs").into(), contents: rust::render_module(&header, &func, &doc) },
+        Artifact { path: format!("json/{name}.json").into(), contents: json_text(&json) },
+    ];
+    Ok(Built { name, artifacts, verification, fit: report })
+}
+
+fn describe_fit(spec: &Spec, model: &fit::RationalModel) -> String {
+    let num: Vec<String> = model.numerator.iter().map(|t| format!("({t})")).collect();
+    let den: Vec<String> = model.denominator.iter().map(|t| format!("({t})")).collect();
+    format!(
+        "{}: `{}` ≈ {} of quantity `{}`, P = NUM · [{}], Q = 1 + DEN · [{}].",
+        spec.file.description,
+        spec.file.emit.function,
+        if model.clamp.is_some() { "clamp(P/Q)" } else { "P/Q" },
+        spec.file.quantity,
+        num.join(", "),
+        den.join(", ")
+    )
+}
+
+fn axes_json(spec: &Spec) -> Value {
+    Value::Array(
+        spec.file
+            .axis
+            .iter()
+            .map(|a| json!({"name": a.name, "range": a.range, "count": a.count, "verify": a.verify_count()}))
+            .collect(),
+    )
+}
+
+fn json_text(v: &Value) -> String {
+    let mut s = serde_json::to_string_pretty(v).expect("JSON values serialise");
+    s.push('\n');
+    s
+}
+
+fn verify(spec: &Spec, vx: &[Vec<f64>], truth: &[f64], a64: &[f64], a32: &[f32]) -> Verification {
+    let n = truth.len();
+    let mut worst = (0usize, 0.0f64);
+    let (mut ss, mut ss32, mut max32) = (0.0, 0.0, 0.0f64);
+    for i in 0..n {
+        let e = (a64[i] - truth[i]).abs();
+        if e > worst.1 {
+            worst = (i, e);
+        }
+        ss += e * e;
+        let e32 = (a32[i] as f64 - truth[i]).abs();
+        ss32 += e32 * e32;
+        max32 = max32.max(e32);
+    }
+    let inverse = spec.quantity.inverse.filter(|_| vx.first().is_some_and(|x| x.len() == 1)).map(|inv| {
+        vx.iter().zip(a64).map(|(x, &v)| (inv(v) - x[0]).abs()).fold(0.0, f64::max)
+    });
+    Verification {
+        points: n,
+        max_abs_error: worst.1,
+        rms_error: (ss / n as f64).sqrt(),
+        worst_point: vx.get(worst.0).cloned().unwrap_or_default(),
+        max_abs_error_f32: max32,
+        rms_error_f32: (ss32 / n as f64).sqrt(),
+        max_abs_error_in_parameter: inverse,
+    }
+}
+
+fn build_table(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> {
+    let name = spec.file.name.clone();
+    let counts: Vec<usize> = spec.file.axis.iter().map(|a| a.count).collect();
+    let points = grid(spec, &counts);
+    let values: Vec<f64> = match mode {
+        Mode::Fit => sample(spec, &points),
+        Mode::Committed => {
+            let v = committed_json(root, spec)?;
+            let vals = f64_array(&v, &name, "values")?;
+            if vals.len() != points.len() {
+                return Err(BuildError::NoCommitted { spec: name, why: "table size differs from the spec".into() });
+            }
+            vals
+        }
+    };
+    let v32: Vec<f32> = values.iter().map(|&v| v as f32).collect();
+    let d32 = domain_f32(spec);
+    let vcounts: Vec<usize> = spec.file.axis.iter().map(|a| a.verify_count()).collect();
+    let vx = grid(spec, &vcounts);
+    let truth = sample(spec, &vx);
+    let approx32: Vec<f32> = vx
+        .iter()
+        .map(|x| {
+            let xs: Vec<f32> = x.iter().map(|&v| v as f32).collect();
+            rust::table_eval_f32(&v32, &counts, &d32, &xs)
+        })
+        .collect();
+    let approx64: Vec<f64> = approx32.iter().map(|&v| v as f64).collect();
+    let verification = verify(spec, &vx, &truth, &approx64, &approx32);
+    let hash = input_hash(spec);
+    let err_line = format!(
+        "linear interpolation of the f32 table: max abs {}, rms {} over {} points",
+        fmt_err(verification.max_abs_error_f32),
+        fmt_err(verification.rms_error_f32),
+        verification.points
+    );
+    let header = header_lines(&spec_rel_path(spec), &hash, &err_line);
+    let a = args(spec);
+    let func = wgsl::Function {
+        module: &name,
+        name: &spec.file.emit.function,
+        args: &a,
+        domain: &d32,
+        body: wgsl::Body::Table { values: &v32, counts: &counts },
+    };
+    let doc = format!(
+        "{}: `{}` interpolates a {} table of quantity `{}`.",
+        spec.file.description,
+        spec.file.emit.function,
+        counts.iter().map(|c| c.to_string()).collect::<Vec<_>>().join("×"),
+        spec.file.quantity
+    );
+    let json = json!({
+        "generator": GENERATOR,
+        "spec": spec_rel_path(spec),
+        "input_hash": hash,
+        "name": name,
+        "kind": "table",
+        "quantity": spec.file.quantity,
+        "description": spec.file.description,
+        "function": spec.file.emit.function,
+        "axes": axes_json(spec),
+        "layout": "first axis fastest",
+        "values": values,
+        "verification": verification,
+    });
+    let mut csv = String::new();
+    for h in &header {
+        csv.push_str(&format!("# {h}\n"));
+    }
+    csv.push_str(&format!("{},value\n", a.join(",")));
+    for (p, v) in points.iter().zip(&values) {
+        let cols: Vec<String> = p.iter().map(|x| format!("{x:?}")).collect();
+        csv.push_str(&format!("{},{v:?}\n", cols.join(",")));
+    }
+    let artifacts = vec![
+        Artifact { path: format!("wgsl/{name}.wgsl").into(), contents: wgsl::render_module(&header, &func) },
+        Artifact { path: format!("src/{name}.rs").into(), contents: rust::render_module(&header, &func, &doc) },
+        Artifact { path: format!("json/{name}.json").into(), contents: json_text(&json) },
+        Artifact { path: format!("data/{name}.csv").into(), contents: csv },
+    ];
+    Ok(Built { name, artifacts, verification, fit: None })
+}
+
+/// The runtime crate's module index (generated/src/lib.rs) for a set of specs.
+pub fn runtime_index(specs: &[Spec]) -> Artifact {
+    let mut s = String::new();
+    s.push_str(&format!(
+        "//! @generated by {GENERATOR}: do not edit; regenerate with `shadefit build`.\n//!\n\
+         //! shadefit-runtime: shading approximations and lookup tables emitted by shadefit.\n\
+         //! Each module holds the f32 coefficients (or table) and a CPU version of its WGSL\n\
+         //! function; [`wgsl::module`] returns the WGSL library of the same name.\n\n"
+    ));
+    s.push_str("#![allow(clippy::excessive_precision, clippy::approx_constant)]\n\n");
+    for spec in specs {
+        let fam = family(spec);
+        s.push_str(&format!("#[cfg(feature = \"{fam}\")]\npub mod {};\n", spec.file.name));
+    }
+    s.push_str("\n/// WGSL libraries by module name (each starts with `#define_import_path shadefit::NAME`).\npub mod wgsl {\n");
+    for spec in specs {
+        let fam = family(spec);
+        s.push_str(&format!(
+            "    #[cfg(feature = \"{fam}\")]\n    pub const {}: &str = include_str!(\"../wgsl/{}.wgsl\");\n",
+            spec.file.name.to_uppercase(),
+            spec.file.name
+        ));
+    }
+    s.push_str("\n    /// The WGSL library of a module, if its feature is enabled.\n    pub fn module(name: &str) -> Option<&'static str> {\n        match name {\n");
+    for spec in specs {
+        let fam = family(spec);
+        s.push_str(&format!(
+            "            #[cfg(feature = \"{fam}\")]\n            \"{}\" => Some({}),\n",
+            spec.file.name,
+            spec.file.name.to_uppercase()
+        ));
+    }
+    s.push_str("            _ => None,\n        }\n    }\n\n    /// Names of the modules compiled in.\n    pub const NAMES: &[&str] = &[\n");
+    for spec in specs {
+        s.push_str(&format!("        #[cfg(feature = \"{}\")]\n        \"{}\",\n", family(spec), spec.file.name));
+    }
+    s.push_str("    ];\n}\n");
+    Artifact { path: "src/lib.rs".into(), contents: s }
+}
+
+/// Feature family of a spec: the quantity name up to its first '-'.
+pub fn family(spec: &Spec) -> &str {
+    spec.file.quantity.split('-').next().unwrap_or("core")
+}
+
+/// Compare artifacts with the files under `root`: the paths that differ or are missing.
+pub fn stale(root: &Path, artifacts: &[Artifact]) -> Vec<String> {
+    artifacts
+        .iter()
+        .filter(|a| std::fs::read(root.join(&a.path)).map_or(true, |old| old != a.contents.as_bytes()))
+        .map(|a| a.path.display().to_string())
+        .collect()
+}
+
+/// Files under generated/{wgsl,src,json,data} that no spec produces.
+pub fn orphans(root: &Path, artifacts: &[Artifact]) -> Vec<String> {
+    let mut out = Vec::new();
+    for dir in ["wgsl", "src", "json", "data"] {
+        let Ok(rd) = std::fs::read_dir(root.join(dir)) else { continue };
+        let mut names: Vec<_> = rd.filter_map(|e| e.ok()).map(|e| e.path()).collect();
+        names.sort();
+        for p in names {
+            let rel = p.strip_prefix(root).unwrap_or(&p).to_path_buf();
+            let hand_written = rel.starts_with("src") && rel.file_name().is_some_and(|n| n.to_string_lossy().starts_with('_'));
+            if p.is_file() && !hand_written && !artifacts.iter().any(|a| a.path == rel) {
+                out.push(rel.display().to_string());
+            }
+        }
+    }
+    out
+}
+
+pub use emit::write_all;

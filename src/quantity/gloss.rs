@@ -1,0 +1,173 @@
+//! Gloss ↔ GGX average-normal-length relation and the gloss-combine table
+//! (Call of Duty: WWII, "Mipmapping normal and gloss", "Combining gloss").
+//!
+//! # Conventions
+//! - Gloss g ∈ [0, 1] maps to GGX roughness α = sqrt(2 / (1 + 2^(18·g))) (the WWII
+//!   parameterisation, after the slides' own erratum: the exponent is 18·g, not a product
+//!   18·g inside the sum). g = 0 gives α = 1; g = 1 gives α = sqrt(2/262145) ≈ 0.002762.
+//! - The average ("shortened") normal length of an NDF is ‖n_s‖ = ‖E[h]‖ for microfacet normals
+//!   h drawn with density D(h)(n·h) over solid angle. By symmetry E[h] = (0, 0, E[n·h]), so
+//!   ‖n_s‖ = E[n·h] = ∫ D(h) (n·h)² dω_h.
+//!
+//! # Closed form
+//! With t = n·h and GGX D(h) = α² / (π (1 + (α² − 1) t²)²):
+//!
+//!   L(α) = 2α² ∫₀¹ t² / (1 − k t²)² dt,   k = 1 − α²,
+//!
+//! which integrates to L = (1 − α² atanh(√k)/√k) / k. Two cancellation-free evaluations:
+//! - k < ½ (α near 1): the power series L = Σ_{n≥0} 2kⁿ / ((2n+1)(2n+3)); k = 0 gives 2/3.
+//! - otherwise: 1 − L = α² (atanh(√k)/√k − 1) / k with atanh(√k) = ln((1 + √k)/α), exact
+//!   because (1 + √k)(1 − √k) = α². Both terms are positive, so small α loses nothing.
+//!
+//! The module also keeps an independent adaptive quadrature of the defining integral, used by
+//! tests and by `validate` as a check on the closed form.
+//!
+//! # Inverse and combine
+//! L increases strictly with g, so g(L) is found by bisection in g on the cancellation-free
+//! 1 − L, after clamping L to [L(0), L(1)] (the table ends). Combining two glosses with
+//! Reoriented Normal Mapping multiplies their lengths (the slides' derivation), so
+//! combine(x, y) = g(L(x)·L(y)), clamped at g = 0 where the product falls below 2/3.
+//!
+//! Fit specs: `fits/gloss_table.toml`, `fits/gloss_inverse_table.toml`,
+//! `fits/gloss_length.toml`, `fits/gloss_combine.toml`, `fits/gloss_combine_lut.toml`.
+
+use crate::integrate::{adaptive, Estimate, Tolerance};
+
+/// Exponent scale of the WWII gloss parameterisation.
+const GLOSS_EXPONENT: f64 = 18.0;
+
+/// GGX α for gloss g (WWII parameterisation).
+pub fn alpha_from_gloss(g: f64) -> f64 {
+    (2.0 / (1.0 + (GLOSS_EXPONENT * g).exp2())).sqrt()
+}
+
+/// Gloss for GGX α ∈ (0, 1] (inverse of [`alpha_from_gloss`]).
+pub fn gloss_from_alpha(alpha: f64) -> f64 {
+    (2.0 / (alpha * alpha) - 1.0).log2() / GLOSS_EXPONENT
+}
+
+/// 1 − L(α), accurate to a few ulps of itself for every α ∈ (0, 1].
+pub fn one_minus_length(alpha: f64) -> f64 {
+    let k = (1.0 - alpha) * (1.0 + alpha);
+    if k < 0.5 {
+        1.0 - length_series(k)
+    } else {
+        let s = k.sqrt();
+        let atanh = ((1.0 + s) / alpha).ln();
+        alpha * alpha * (atanh / s - 1.0) / k
+    }
+}
+
+/// Average normal length L(α) = E[n·h] of GGX with roughness α ∈ (0, 1].
+pub fn normal_length(alpha: f64) -> f64 {
+    let k = (1.0 - alpha) * (1.0 + alpha);
+    if k < 0.5 { length_series(k) } else { 1.0 - one_minus_length(alpha) }
+}
+
+/// Σ 2kⁿ/((2n+1)(2n+3)) for 0 ≤ k < ½: terms fall at least 2× per step, so 60 terms
+/// reach below 1e-18.
+fn length_series(k: f64) -> f64 {
+    let mut sum = 0.0;
+    let mut kn = 1.0;
+    for n in 0..64 {
+        let nf = n as f64;
+        let term = 2.0 * kn / ((2.0 * nf + 1.0) * (2.0 * nf + 3.0));
+        sum += term;
+        if term < 1e-18 * sum {
+            break;
+        }
+        kn *= k;
+    }
+    sum
+}
+
+/// Average normal length of gloss g.
+pub fn length_from_gloss(g: f64) -> f64 {
+    normal_length(alpha_from_gloss(g))
+}
+
+/// L(α) by adaptive Gauss–Kronrod quadrature of 2α² t²/(1 − k t²)² over t ∈ [0, 1];
+/// independent of the closed form. For small α the integrand is a peak of width ~α² at t = 1.
+pub fn normal_length_quadrature(alpha: f64, abs_tol: f64) -> Estimate {
+    let a2 = alpha * alpha;
+    let k = (1.0 - alpha) * (1.0 + alpha);
+    let tol = Tolerance { abs: abs_tol, rel: 0.0, max_panels: 10_000 };
+    adaptive(0.0, 1.0, tol, |t| {
+        let den = 1.0 - k * t * t;
+        2.0 * a2 * t * t / (den * den)
+    })
+}
+
+/// Bounds of the length table: L(g = 0) = 2/3 and L(g = 1).
+pub fn length_range() -> (f64, f64) {
+    (length_from_gloss(0.0), length_from_gloss(1.0))
+}
+
+/// Gloss whose average normal length is `length`, clamped to g ∈ [0, 1] outside the table.
+pub fn gloss_from_length(length: f64) -> f64 {
+    let (lo, hi) = length_range();
+    if length <= lo {
+        return 0.0;
+    }
+    if length >= hi {
+        return 1.0;
+    }
+    // Bisection on 1 − L, which decreases strictly with g: 64 halvings of [0, 1] reach the
+    // f64 spacing of g, so the result is the nearest representable root up to one ulp.
+    let target = 1.0 - length;
+    let (mut a, mut b) = (0.0_f64, 1.0_f64);
+    for _ in 0..64 {
+        let m = 0.5 * (a + b);
+        if m <= a || m >= b {
+            break;
+        }
+        if one_minus_length(alpha_from_gloss(m)) > target {
+            a = m;
+        } else {
+            b = m;
+        }
+    }
+    0.5 * (a + b)
+}
+
+/// Combined gloss of two glosses under Reoriented Normal Mapping.
+pub fn combine(x: f64, y: f64) -> f64 {
+    gloss_from_length(length_from_gloss(x) * length_from_gloss(y))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn limits_from_theory() {
+        // α = 1 is the uniform-cosine case: E[t] with density 2t... gives exactly 2/3.
+        assert_eq!(normal_length(1.0), 2.0 / 3.0);
+        // α → 0: 1 − L ≈ α² (ln(2/α) − 1); at α = 1e-6 that is 1.35e-11.
+        let a = 1e-6_f64;
+        let approx = a * a * ((2.0 / a).ln() - 1.0);
+        // Next term of the expansion is O(α⁴ ln α): relative 1e-11 here.
+        assert!((one_minus_length(a) - approx).abs() < 1e-9 * approx);
+    }
+
+    #[test]
+    fn series_and_log_branches_meet() {
+        // At the branch point k = ½ both formulas must agree to rounding (1e-15 absolute:
+        // a few ulps of values near 0.7).
+        let alpha = 0.5_f64.sqrt();
+        let k = (1.0 - alpha) * (1.0 + alpha);
+        let s = k.sqrt();
+        let log_form = 1.0 - alpha * alpha * (((1.0 + s) / alpha).ln() / s - 1.0) / k;
+        assert!((length_series(k) - log_form).abs() < 1e-15);
+    }
+
+    #[test]
+    fn inverse_round_trips() {
+        for i in 0..=64 {
+            let g = i as f64 / 64.0;
+            let back = gloss_from_length(length_from_gloss(g));
+            // dL/dg ≥ ~1e-5 near g = 1, so one ulp of L (1e-16) maps to ≤1e-11 in g.
+            assert!((back - g).abs() < 1e-10, "g={g} back={back}");
+        }
+    }
+}

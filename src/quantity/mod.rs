@@ -1,0 +1,160 @@
+//! Quantity families: each module holds an integrand, its conventions and its reference
+//! evaluator. This file is the registry the CLI and the spec layer look quantities up in.
+
+pub mod gloss;
+
+use crate::integrate::Estimate;
+use std::collections::BTreeMap;
+
+/// One named parameter of a quantity, with its closed domain.
+#[derive(Debug, Clone, Copy)]
+pub struct ParamSpec {
+    pub name: &'static str,
+    pub min: f64,
+    pub max: f64,
+    pub doc: &'static str,
+}
+
+/// A quantity `shadefit eval` serves and specs sample.
+#[derive(Debug)]
+pub struct QuantityDef {
+    pub name: &'static str,
+    pub doc: &'static str,
+    /// Canonical parameters, in the order `eval` receives them.
+    pub params: &'static [ParamSpec],
+    /// Alternative parameters: (spec, conversion to the canonical parameter of the same index).
+    pub aliases: &'static [(ParamSpec, usize, fn(f64) -> f64)],
+    /// Evaluate at canonical parameters (already inside the domain) to an absolute tolerance.
+    pub eval: fn(&[f64], f64) -> Estimate,
+    /// For 1-D quantities: the inverse map value → parameter, used to report a fit's error in
+    /// parameter units (e.g. gloss recovered from a fitted length).
+    pub inverse: Option<fn(f64) -> f64>,
+}
+
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum QuantityError {
+    #[error("unknown quantity '{0}' (known: {1})")]
+    Unknown(String, String),
+    #[error("{quantity}: unknown parameter '{param}' (expected {expected})")]
+    UnknownParam { quantity: String, param: String, expected: String },
+    #[error("{quantity}: missing parameter '{param}'")]
+    MissingParam { quantity: String, param: String },
+    #[error("{quantity}: parameter '{param}' = {value} is outside its domain [{min}, {max}]")]
+    OutOfDomain { quantity: String, param: String, value: f64, min: f64, max: f64 },
+    #[error("{quantity}: parameter '{param}' is given twice (directly or through an alias)")]
+    Duplicate { quantity: String, param: String },
+}
+
+fn gloss_length(p: &[f64], _tol: f64) -> Estimate {
+    // Closed form (see gloss.rs); its error is rounding only: ≤ 4 ulps of a value ≤ 1.
+    Estimate { value: gloss::length_from_gloss(p[0]), error: 4.0 * f64::EPSILON, evals: 1 }
+}
+
+fn gloss_from_length(p: &[f64], _tol: f64) -> Estimate {
+    // Bisection to one ulp of g; the inverse amplifies L's rounding by 1/(dL/dg) ≤ 1e5.
+    Estimate { value: gloss::gloss_from_length(p[0]), error: 1e5 * 4.0 * f64::EPSILON, evals: 64 }
+}
+
+fn gloss_combine(p: &[f64], _tol: f64) -> Estimate {
+    Estimate { value: gloss::combine(p[0], p[1]), error: 1e5 * 8.0 * f64::EPSILON, evals: 130 }
+}
+
+const GLOSS: ParamSpec = ParamSpec { name: "gloss", min: 0.0, max: 1.0, doc: "gloss g" };
+
+static REGISTRY: &[QuantityDef] = &[
+    QuantityDef {
+        name: "gloss-length",
+        doc: "GGX average (shortened) normal length for a gloss, or for a GGX alpha",
+        params: &[GLOSS],
+        aliases: &[(
+            ParamSpec { name: "alpha", min: 0.002762135, max: 1.0, doc: "GGX alpha" },
+            0,
+            gloss::gloss_from_alpha,
+        )],
+        eval: gloss_length,
+        inverse: Some(gloss::gloss_from_length),
+    },
+    QuantityDef {
+        name: "gloss-from-length",
+        doc: "gloss whose GGX average normal length is `length` (clamped to the table ends)",
+        params: &[ParamSpec { name: "length", min: 0.0, max: 1.0, doc: "normal length" }],
+        aliases: &[],
+        eval: gloss_from_length,
+        inverse: None,
+    },
+    QuantityDef {
+        name: "gloss-combine",
+        doc: "gloss of two combined glosses (Reoriented Normal Mapping of their NDFs)",
+        params: &[
+            ParamSpec { name: "x", min: 0.0, max: 1.0, doc: "first gloss" },
+            ParamSpec { name: "y", min: 0.0, max: 1.0, doc: "second gloss" },
+        ],
+        aliases: &[],
+        eval: gloss_combine,
+        inverse: None,
+    },
+];
+
+pub fn registry() -> &'static [QuantityDef] {
+    REGISTRY
+}
+
+pub fn lookup(name: &str) -> Result<&'static QuantityDef, QuantityError> {
+    REGISTRY.iter().find(|q| q.name == name).ok_or_else(|| {
+        QuantityError::Unknown(
+            name.to_string(),
+            REGISTRY.iter().map(|q| q.name).collect::<Vec<_>>().join(", "),
+        )
+    })
+}
+
+impl QuantityDef {
+    /// Canonical parameter vector from named values: checks names, domains (NaN is outside
+    /// every domain) and applies aliases.
+    pub fn resolve(&self, named: &BTreeMap<String, f64>) -> Result<Vec<f64>, QuantityError> {
+        let mut out: Vec<Option<f64>> = vec![None; self.params.len()];
+        for (key, &value) in named {
+            let (spec, idx, conv): (&ParamSpec, usize, Option<fn(f64) -> f64>) =
+                if let Some(i) = self.params.iter().position(|p| p.name == key) {
+                    (&self.params[i], i, None)
+                } else if let Some((s, i, f)) = self.aliases.iter().find(|a| a.0.name == key) {
+                    (s, *i, Some(*f))
+                } else {
+                    let mut names: Vec<&str> = self.params.iter().map(|p| p.name).collect();
+                    names.extend(self.aliases.iter().map(|a| a.0.name));
+                    return Err(QuantityError::UnknownParam {
+                        quantity: self.name.into(),
+                        param: key.clone(),
+                        expected: names.join(", "),
+                    });
+                };
+            if !(value >= spec.min && value <= spec.max) {
+                return Err(QuantityError::OutOfDomain {
+                    quantity: self.name.into(),
+                    param: key.clone(),
+                    value,
+                    min: spec.min,
+                    max: spec.max,
+                });
+            }
+            if out[idx].is_some() {
+                return Err(QuantityError::Duplicate { quantity: self.name.into(), param: key.clone() });
+            }
+            let canonical = conv.map_or(value, |f| f(value));
+            out[idx] = Some(canonical.clamp(self.params[idx].min, self.params[idx].max));
+        }
+        out.into_iter()
+            .zip(self.params)
+            .map(|(v, p)| {
+                v.ok_or_else(|| QuantityError::MissingParam {
+                    quantity: self.name.into(),
+                    param: p.name.into(),
+                })
+            })
+            .collect()
+    }
+
+    pub fn param_index(&self, name: &str) -> Option<usize> {
+        self.params.iter().position(|p| p.name == name)
+    }
+}

@@ -1,0 +1,351 @@
+//! Specs: the TOML files users edit (`fits/*.toml`), model specs for `shadefit fit`, and the
+//! CSV data reader. Every error names the file, the line and the field.
+//!
+//! Schema (see README "Spec files"):
+//!
+//! ```toml
+//! name = "gloss_length"            # output stem; must match the file stem
+//! kind = "fit"                     # "fit" (a model fitted to samples) or "table" (a LUT)
+//! quantity = "gloss-length"        # see `shadefit eval --help`
+//! description = "..."
+//!
+//! [[axis]]                         # one per quantity parameter, in the quantity's order
+//! name = "gloss"
+//! range = [0.0, 1.0]
+//! count = 256                      # samples (uniform, ends included)
+//! verify = 1024                    # verification grid for the measured error (fits/tables)
+//!
+//! [model]                          # kind = "fit" only
+//! numerator = ["1", "gloss", "gloss^2", "gloss^3"]
+//! denominator = ["gloss", "gloss^2"]  # the constant 1 is implicit
+//! clamp = [0.0, 1.0]               # optional: clamp-aware objective
+//! fixed = { "1" = 0.0 }            # optional: numerator terms fixed (prefix "den:" for denominator)
+//! [[model.pin]]                    # optional: f(at) = value (value defaults to the integral)
+//! at = [1.0]
+//! eliminate = "gloss^3"
+//!
+//! [fit]
+//! objective = "minimax"            # or "lsq"
+//!
+//! [emit]
+//! function = "gloss_to_normal_length"
+//! ```
+
+pub mod data;
+
+use crate::fit::model::{ModelError, Pin, RationalModel, Term};
+use crate::fit::Objective;
+use crate::quantity::{self, QuantityDef};
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// Bad input: names where, and why.
+#[derive(Debug, thiserror::Error)]
+#[error("{file}:{line}: field '{field}': {msg}")]
+pub struct SpecError {
+    pub file: String,
+    pub line: usize,
+    pub field: String,
+    pub msg: String,
+}
+
+impl SpecError {
+    pub fn new(file: &Path, line: usize, field: &str, msg: impl Into<String>) -> Self {
+        SpecError { file: file.display().to_string(), line, field: field.into(), msg: msg.into() }
+    }
+}
+
+/// 1-based line of the first `key =` or `[key]`/`[[key]]` in a TOML text (1 when absent).
+pub fn line_of(text: &str, key: &str) -> usize {
+    let last = key.rsplit('.').next().unwrap_or(key);
+    for (i, line) in text.lines().enumerate() {
+        let t = line.trim_start();
+        let hit = t.starts_with(&format!("{last} "))
+            || t.starts_with(&format!("{last}="))
+            || t.starts_with(&format!("\"{last}\""))
+            || t == format!("[{key}]")
+            || t == format!("[[{key}]]");
+        if hit {
+            return i + 1;
+        }
+    }
+    1
+}
+
+fn line_of_offset(text: &str, offset: usize) -> usize {
+    text[..offset.min(text.len())].bytes().filter(|&b| b == b'\n').count() + 1
+}
+
+/// Parse TOML into `T`, turning syntax and schema errors into a [`SpecError`].
+pub fn parse_toml<T: for<'de> Deserialize<'de>>(path: &Path, text: &str) -> Result<T, SpecError> {
+    toml::from_str(text).map_err(|e| {
+        let line = e.span().map_or(1, |s| line_of_offset(text, s.start));
+        let msg = e.message().to_string();
+        let field = msg
+            .split('`')
+            .nth(1)
+            .map(str::to_string)
+            .unwrap_or_else(|| "(syntax)".to_string());
+        SpecError::new(path, line, &field, msg)
+    })
+}
+
+#[derive(Debug, Clone, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct PinSpec {
+    pub at: Vec<f64>,
+    pub value: Option<f64>,
+    pub eliminate: String,
+}
+
+/// A model in TOML, shared by fit specs and `shadefit fit --model FILE`.
+#[derive(Debug, Clone, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ModelSpec {
+    /// Feature names (fit specs take them from the axes; model files must give them).
+    pub features: Option<Vec<String>>,
+    pub numerator: Vec<String>,
+    #[serde(default)]
+    pub denominator: Vec<String>,
+    #[serde(default)]
+    pub offset: f64,
+    pub factor: Option<String>,
+    pub clamp: Option<[f64; 2]>,
+    #[serde(default)]
+    pub fixed: BTreeMap<String, f64>,
+    #[serde(default)]
+    pub pin: Vec<PinSpec>,
+}
+
+impl ModelSpec {
+    /// Build the model; `pin_value` supplies a pin's value when the spec leaves it out.
+    pub fn build(
+        &self,
+        path: &Path,
+        text: &str,
+        features: Vec<String>,
+        pin_value: &dyn Fn(&[f64]) -> Option<f64>,
+    ) -> Result<RationalModel, SpecError> {
+        let err = |field: &str, e: ModelError| SpecError::new(path, line_of(text, field), field, e.to_string());
+        let parse_all = |field: &str, list: &[String]| -> Result<Vec<Term>, SpecError> {
+            list.iter().map(|s| Term::parse(s, &features).map_err(|e| err(field, e))).collect()
+        };
+        let num = parse_all("numerator", &self.numerator)?;
+        let den = parse_all("denominator", &self.denominator)?;
+        let factor = match &self.factor {
+            Some(f) => Some(Term::parse(f, &features).map_err(|e| err("factor", e))?),
+            None => None,
+        };
+        let mut fixed = Vec::new();
+        for (key, &v) in &self.fixed {
+            if !v.is_finite() {
+                return Err(SpecError::new(path, line_of(text, "fixed"), "fixed", format!("'{key}' is not finite")));
+            }
+            let idx = if let Some(d) = key.strip_prefix("den:") {
+                den.iter().position(|t| t.label == d.trim()).map(|i| num.len() + i)
+            } else {
+                num.iter().position(|t| t.label == key.trim())
+            };
+            let idx = idx.ok_or_else(|| err("fixed", ModelError::UnknownCoefficient(key.clone())))?;
+            fixed.push((idx, v));
+        }
+        let mut pins = Vec::new();
+        for p in &self.pin {
+            if p.at.len() != features.len() || p.at.iter().any(|v| !v.is_finite()) {
+                return Err(SpecError::new(
+                    path,
+                    line_of(text, "at"),
+                    "pin.at",
+                    format!("needs {} finite coordinates ({})", features.len(), features.join(", ")),
+                ));
+            }
+            let eliminate = num
+                .iter()
+                .position(|t| t.label == p.eliminate.trim())
+                .ok_or_else(|| err("eliminate", ModelError::UnknownCoefficient(p.eliminate.clone())))?;
+            let value = match p.value {
+                Some(v) if v.is_finite() => v,
+                Some(_) => return Err(SpecError::new(path, line_of(text, "value"), "pin.value", "not finite")),
+                None => pin_value(&p.at).ok_or_else(|| {
+                    SpecError::new(path, line_of(text, "pin"), "pin.value", "missing (no quantity to take it from)")
+                })?,
+            };
+            pins.push(Pin { at: p.at.clone(), value, eliminate });
+        }
+        let clamp = match self.clamp {
+            Some([lo, hi]) if lo < hi => Some((lo, hi)),
+            Some(_) => return Err(SpecError::new(path, line_of(text, "clamp"), "clamp", "needs min < max")),
+            None => None,
+        };
+        if !self.offset.is_finite() {
+            return Err(SpecError::new(path, line_of(text, "offset"), "offset", "not finite"));
+        }
+        RationalModel::new(features, num, den, self.offset, factor, fixed, pins, clamp)
+            .map_err(|e| err("model", e))
+    }
+}
+
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum Kind {
+    Fit,
+    Table,
+}
+
+#[derive(Debug, Clone, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct AxisSpec {
+    pub name: String,
+    pub range: [f64; 2],
+    pub count: usize,
+    /// Verification grid size along this axis (default: 4·count + 1).
+    pub verify: Option<usize>,
+}
+
+impl AxisSpec {
+    pub fn points(&self, n: usize) -> Vec<f64> {
+        let [a, b] = self.range;
+        if n == 1 {
+            return vec![a];
+        }
+        (0..n).map(|i| if i + 1 == n { b } else { a + (b - a) * i as f64 / (n - 1) as f64 }).collect()
+    }
+
+    pub fn verify_count(&self) -> usize {
+        self.verify.unwrap_or(4 * self.count + 1)
+    }
+}
+
+#[derive(Debug, Clone, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct FitSection {
+    pub objective: Objective,
+}
+
+#[derive(Debug, Clone, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct EmitSection {
+    /// Name of the emitted function (WGSL and Rust).
+    pub function: String,
+}
+
+#[derive(Debug, Clone, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct SpecFile {
+    pub name: String,
+    pub kind: Kind,
+    pub quantity: String,
+    #[serde(default)]
+    pub description: String,
+    /// Integrator absolute tolerance for every sample.
+    #[serde(default = "default_tolerance")]
+    pub tolerance: f64,
+    pub axis: Vec<AxisSpec>,
+    pub model: Option<ModelSpec>,
+    pub fit: Option<FitSection>,
+    pub emit: EmitSection,
+}
+
+fn default_tolerance() -> f64 {
+    1e-12
+}
+
+/// A validated spec with its text (hashed into generated headers).
+#[derive(Debug, Clone)]
+pub struct Spec {
+    pub path: PathBuf,
+    pub text: String,
+    pub file: SpecFile,
+    pub quantity: &'static QuantityDef,
+    pub model: Option<RationalModel>,
+}
+
+fn is_identifier(s: &str) -> bool {
+    let mut chars = s.chars();
+    matches!(chars.next(), Some(c) if c.is_ascii_lowercase() || c == '_')
+        && chars.all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_')
+}
+
+impl Spec {
+    pub fn load(path: &Path) -> Result<Spec, SpecError> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| SpecError::new(path, 0, "(file)", format!("cannot read: {e}")))?;
+        Spec::parse(path, text)
+    }
+
+    pub fn parse(path: &Path, text: String) -> Result<Spec, SpecError> {
+        let file: SpecFile = parse_toml(path, &text)?;
+        let at = |field: &str, msg: String| SpecError::new(path, line_of(&text, field), field, msg);
+        if !is_identifier(&file.name) {
+            return Err(at("name", format!("'{}' must be a lowercase identifier (a-z, 0-9, _)", file.name)));
+        }
+        if path.file_stem().and_then(|s| s.to_str()) != Some(file.name.as_str()) {
+            return Err(at("name", format!("'{}' must match the file name", file.name)));
+        }
+        if !is_identifier(&file.emit.function) {
+            return Err(at("function", format!("'{}' is not a valid function name", file.emit.function)));
+        }
+        if !(file.tolerance > 0.0 && file.tolerance < 1.0) {
+            return Err(at("tolerance", format!("{} must be in (0, 1)", file.tolerance)));
+        }
+        let quantity = quantity::lookup(&file.quantity).map_err(|e| at("quantity", e.to_string()))?;
+        let names: Vec<&str> = quantity.params.iter().map(|p| p.name).collect();
+        let axis_names: Vec<&str> = file.axis.iter().map(|a| a.name.as_str()).collect();
+        if axis_names != names {
+            return Err(at(
+                "axis",
+                format!("axes must be the quantity's parameters in order: [{}], found [{}]", names.join(", "), axis_names.join(", ")),
+            ));
+        }
+        for (a, p) in file.axis.iter().zip(quantity.params) {
+            let [lo, hi] = a.range;
+            if !(lo.is_finite() && hi.is_finite() && lo < hi && lo >= p.min && hi <= p.max) {
+                return Err(at(
+                    "range",
+                    format!("axis '{}' range [{lo}, {hi}] must be finite, increasing and inside [{}, {}]", a.name, p.min, p.max),
+                ));
+            }
+            if a.count < 2 || a.count > 100_000 {
+                return Err(at("count", format!("axis '{}' count {} must be in [2, 100000]", a.name, a.count)));
+            }
+            if a.verify_count() < 2 || a.verify_count() > 1_000_000 {
+                return Err(at("verify", format!("axis '{}' verify count must be in [2, 1000000]", a.name)));
+            }
+        }
+        let model = match (file.kind, &file.model) {
+            (Kind::Fit, Some(m)) => {
+                if file.fit.is_none() {
+                    return Err(at("fit", "kind = \"fit\" needs a [fit] section".into()));
+                }
+                let features: Vec<String> = file.axis.iter().map(|a| a.name.clone()).collect();
+                if let Some(f) = &m.features
+                    && f != &features
+                {
+                    return Err(at("features", "a fit spec takes its features from its axes; remove 'features'".into()));
+                }
+                let q = quantity;
+                let tol = file.tolerance;
+                Some(m.build(path, &text, features, &|x: &[f64]| Some((q.eval)(x, tol).value))?)
+            }
+            (Kind::Fit, None) => return Err(at("model", "kind = \"fit\" needs a [model] section".into())),
+            (Kind::Table, Some(_)) => return Err(at("model", "kind = \"table\" takes no [model]".into())),
+            (Kind::Table, None) => None,
+        };
+        if file.kind == Kind::Table && file.axis.len() > 2 {
+            return Err(at("axis", "tables have one or two axes".into()));
+        }
+        Ok(Spec { path: path.to_path_buf(), text, file, quantity, model })
+    }
+}
+
+/// All specs in a folder (`*.toml`, sorted by name; `scenes/` is not read).
+pub fn load_dir(dir: &Path) -> Result<Vec<Spec>, SpecError> {
+    let mut paths: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map_err(|e| SpecError::new(dir, 0, "(folder)", format!("cannot read: {e}")))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|e| e == "toml") && p.is_file())
+        .collect();
+    paths.sort();
+    paths.iter().map(|p| Spec::load(p)).collect()
+}
