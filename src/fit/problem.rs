@@ -48,6 +48,9 @@ pub struct Residuals<'a> {
     /// Square roots of the sample weights.
     pub sqrt_w: Vec<f64>,
     pub theta: DVector<f64>,
+    /// Solve for Σ r⁴ instead of Σ r²: residuals become s_i = r_i·|r_i| (so Σ s_i² = Σ r_i⁴),
+    /// with Jacobian 2|r_i|·∂r_i.
+    pub fourth_power: bool,
 }
 
 impl<'a> Residuals<'a> {
@@ -58,6 +61,7 @@ impl<'a> Residuals<'a> {
             y: &data.y,
             sqrt_w: vec![1.0; data.len()],
             theta,
+            fourth_power: false,
         }
     }
 
@@ -82,7 +86,8 @@ impl<'a> Residuals<'a> {
     }
 
     pub fn weighted(&self, theta: &DVector<f64>) -> DVector<f64> {
-        self.raw(theta).component_mul(&DVector::from_column_slice(&self.sqrt_w))
+        let r = self.raw(theta).component_mul(&DVector::from_column_slice(&self.sqrt_w));
+        if self.fourth_power { r.map(|v| v * v.abs()) } else { r }
     }
 
     /// Jacobian of the weighted residuals with respect to θ.
@@ -107,7 +112,14 @@ impl<'a> Residuals<'a> {
                 jc[(i, nn + j)] = -s * p / q * psi;
             }
         }
-        jc * self.model.map()
+        let mut j = jc * self.model.map();
+        if self.fourth_power {
+            let r = self.raw(theta).component_mul(&DVector::from_column_slice(&self.sqrt_w));
+            for (i, ri) in r.iter().enumerate() {
+                j.row_mut(i).scale_mut(2.0 * ri.abs());
+            }
+        }
+        j
     }
 }
 

@@ -25,7 +25,7 @@
 //! eliminate = "gloss^3"
 //!
 //! [fit]
-//! objective = "minimax"            # or "lsq"
+//! objective = "minimax"            # or "lsq", or "l4" (Σ r⁴: between the two)
 //!
 //! [emit]
 //! function = "gloss_to_normal_length"

@@ -55,10 +55,11 @@ fn uniform(n: usize) -> Vec<f64> {
 }
 
 /// Committed refit coefficients from generated/json/NAME.json, if present.
-fn committed(generated: &Path, name: &str) -> Option<Vec<f64>> {
+fn committed(generated: &Path, name: &str) -> Option<(Vec<f64>, String)> {
     let text = std::fs::read_to_string(generated.join("json").join(format!("{name}.json"))).ok()?;
     let v: Value = serde_json::from_str(&text).ok()?;
-    v["model"]["coefficients"].as_array()?.iter().map(Value::as_f64).collect()
+    let c = v["model"]["coefficients"].as_array()?.iter().map(Value::as_f64).collect::<Option<Vec<f64>>>()?;
+    Some((c, v["model"]["objective"].as_str().unwrap_or("?").to_string()))
 }
 
 pub fn items(generated: &Path) -> Vec<Item> {
@@ -116,7 +117,7 @@ pub fn items(generated: &Path) -> Vec<Item> {
         ),
     ];
     let mut extra = vec![("max_abs_error_in_gloss".to_string(), gloss_err)];
-    if let Some(rc) = committed(generated, "gloss_length").filter(|v| v.len() == 6) {
+    if let Some((rc, objective)) = committed(generated, "gloss_length").filter(|v| v.0.len() == 6) {
         let rc: [f64; 6] = [rc[0], rc[1], rc[2], rc[3], rc[4], rc[5]];
         let ra: Vec<f64> = g.iter().map(|&x| rational_1d(&rc, x)).collect();
         let (rmax, rrms, _) = measure(&pts, &truth, &ra);
@@ -125,8 +126,9 @@ pub fn items(generated: &Path) -> Vec<Item> {
         extra.push(("refit_rms_error".into(), rrms));
         extra.push(("refit_max_abs_error_in_gloss".into(), rg));
         findings.push(format!(
-            "shadefit's refit (fits/gloss_length.toml, same form and constraints): max {rmax:.2e} ({:.2}× the published), rms {rrms:.2e}.",
-            rmax / max
+            "shadefit's refit (fits/gloss_length.toml, same form and constraints, {objective}): max {rmax:.2e} ({:.2}× the published), rms {rrms:.2e} ({:.2}×), in gloss units {rg:.2e}.",
+            rmax / max,
+            rrms / rms
         ));
     }
     out.push(Item {
@@ -149,7 +151,7 @@ pub fn items(generated: &Path) -> Vec<Item> {
     let (max, rms, worst) = measure(&pts, &truth, &approx);
     let mut findings = vec![];
     let mut extra = vec![];
-    if let Some(rc) = committed(generated, "gloss_combine").filter(|v| v.len() == 7) {
+    if let Some((rc, objective)) = committed(generated, "gloss_combine").filter(|v| v.0.len() == 7) {
         let f = |x: f64, y: f64| {
             let (s, s2, xy) = (x + y, x * x + y * y, x * y);
             let p = rc[0] + rc[1] * s + rc[2] * s2 + rc[3] * xy;
@@ -161,7 +163,7 @@ pub fn items(generated: &Path) -> Vec<Item> {
         extra.push(("refit_max_abs_error".into(), rmax));
         extra.push(("refit_rms_error".into(), rrms));
         findings.push(format!(
-            "shadefit's refit (fits/gloss_combine.toml, same form, clamp-aware minimax): max {rmax:.2e} ({:.2}× the published), rms {rrms:.2e} ({:.2}×).",
+            "shadefit's refit (fits/gloss_combine.toml, same form, clamp-aware {objective}): max {rmax:.2e} ({:.2}× the published), rms {rrms:.2e} ({:.2}×).",
             rmax / max,
             rrms / rms
         ));
