@@ -728,6 +728,7 @@ impl Layer {
                     wa += comp[0];
                     ee += quadpack_error(((resk - resg) * hl).abs(), resasc * hl, resabs * hl);
                 }
+                if std::env::var("JDBG").is_ok() { eprintln!("a {a:.5} n_eta {n_eta} ea {ea:.2e} ee {ee:.2e} budget {budget:.2e} evals {evals}"); }
                 if ee <= budget || n_eta >= 16 {
                     w_arc = wa;
                     e_arc = ea;
@@ -755,13 +756,16 @@ impl Layer {
         }
         // (2/π) ∫ sin A dA over the range = (2/π)(1 + sin θf): inner budget so that the
         // propagated inner errors stay below tol/2.
-        let tol_j = 0.5 * tol / ((2.0 / PI) * (1.0 + self.st));
+        let mut tol_j = 0.5 * tol / ((2.0 / PI) * (1.0 + self.st));
+        let mut tol_o = tol;
+        if let Ok(s) = std::env::var("TOLJ") { tol_j = s.parse().unwrap(); }
+        if let Ok(s) = std::env::var("TOLO") { tol_o = s.parse().unwrap(); }
         let mut value = 0.0;
         let mut error = 0.0;
         let mut evals = 0;
         for &(lo, hi, ls, hs) in &pieces {
             let d = hi - lo;
-            let (v, e, _) = gk21_adaptive(0.0, 1.0, 0.5 * tol / pieces.len() as f64, |t| {
+            let (v, e, _) = gk21_adaptive(0.0, 1.0, 0.5 * tol_o / pieces.len() as f64, |t| {
                 let (g, gp) = end_map(t, ls, hs);
                 let jac = d * gp;
                 if jac == 0.0 {
@@ -773,6 +777,7 @@ impl Layer {
                 let wgt = 2.0 / PI * sa * jac;
                 [wgt * j, wgt * ej]
             });
+            if std::env::var("RDBG").is_ok() { eprintln!("piece {lo:.4} {hi:.4}: v {:.15} outer err {e:.2e} inner {:.2e}", v[0], v[1]); }
             value += v[0];
             error += e + v[1];
         }
@@ -993,5 +998,21 @@ pub fn expn(n: u32, x: f64) -> f64 {
             }
         }
         ans
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn scratch_r() {
+        for &(al, tf) in &[(0.5, 0.3)] {
+            let t0 = std::time::Instant::now();
+            let e = r(al, tf, 1e-9);
+            let dt = t0.elapsed();
+            let e2 = r(al, tf, 1e-12);
+            println!("R {al} {tf}: {:.15} err {:.2e} evals {} {:?}  tight {:.15} err {:.1e} diff {:.1e}", e.value, e.error, e.evals, dt, e2.value, e2.error, e.value - e2.value);
+        }
     }
 }

@@ -82,11 +82,18 @@ pub fn parse_toml<T: for<'de> Deserialize<'de>>(path: &Path, text: &str) -> Resu
     toml::from_str(text).map_err(|e| {
         let line = e.span().map_or(1, |s| line_of_offset(text, s.start));
         let msg = e.message().to_string();
-        let field = msg
-            .split('`')
-            .nth(1)
-            .map(str::to_string)
-            .unwrap_or_else(|| "(syntax)".to_string());
+        // Schema errors name the field in backticks; syntax errors are named by the key on
+        // the offending line.
+        let named = (msg.starts_with("unknown field") || msg.starts_with("missing field"))
+            .then(|| msg.split('`').nth(1).map(str::to_string))
+            .flatten();
+        let field = named.unwrap_or_else(|| {
+            let l = text.lines().nth(line.saturating_sub(1)).unwrap_or("");
+            match l.split_once('=') {
+                Some((k, _)) => k.trim().trim_matches('"').to_string(),
+                None => l.trim().trim_matches(|c| c == '[' || c == ']').to_string(),
+            }
+        });
         SpecError::new(path, line, &field, msg)
     })
 }

@@ -1,0 +1,266 @@
+//! The CLI contract, end to end through the binary: JSON keys, exit codes, bad input, NIST.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn shadefit(args: &[&str], dir: Option<&Path>) -> Output {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_shadefit"));
+    c.args(args);
+    if let Some(d) = dir {
+        c.current_dir(d);
+    }
+    c.output().expect("the binary runs")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+#[test]
+fn eval_json_contract() {
+    let o = shadefit(&["eval", "gloss-length", "alpha=1", "--json"], None);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["quantity"], "gloss-length");
+    assert_eq!(v["params"]["alpha"], 1.0);
+    // α = 1 is exactly 2/3 (uniform cosine lobe); error_estimate present and tiny.
+    assert!((v["value"].as_f64().unwrap() - 2.0 / 3.0).abs() < 1e-15);
+    assert!(v["error_estimate"].as_f64().unwrap() < 1e-12);
+
+    let o = shadefit(&["eval", "gloss-combine", "x=0", "y=0", "--json"], None);
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    // (2/3)² = 4/9 < 2/3: below the table, clamped to gloss 0.
+    assert_eq!(v["value"].as_f64().unwrap(), 0.0);
+
+    // Round trip: gloss-from-length of gloss-length(0.3) is 0.3 (bisection to ~1e-11).
+    let o = shadefit(&["eval", "gloss-length", "gloss=0.3", "--json"], None);
+    let l = serde_json::from_slice::<serde_json::Value>(&o.stdout).unwrap()["value"].as_f64().unwrap();
+    let o = shadefit(&["eval", "gloss-from-length", &format!("length={l:.17e}"), "--json"], None);
+    let g = serde_json::from_slice::<serde_json::Value>(&o.stdout).unwrap()["value"].as_f64().unwrap();
+    assert!((g - 0.3).abs() < 1e-9);
+}
+
+#[test]
+fn eval_bad_parameters_exit_2() {
+    for args in [
+        vec!["eval", "gloss-length", "gloss=nan"],
+        vec!["eval", "gloss-length", "gloss=1.5"],
+        vec!["eval", "gloss-length", "gloss=abc"],
+        vec!["eval", "gloss-length", "roughness=0.5"],
+        vec!["eval", "gloss-length"],
+        vec!["eval", "gloss-length", "gloss=0.5", "alpha=0.5"],
+        vec!["eval", "no-such-quantity", "x=1"],
+    ] {
+        let o = shadefit(&args, None);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+        assert!(stderr(&o).contains("error:"), "{args:?}");
+    }
+    let o = shadefit(&["eval", "gloss-length", "gloss=nan"], None);
+    assert!(stderr(&o).contains("'gloss'"), "names the field: {}", stderr(&o));
+}
+
+/// A scratch project: a copy of fits/ plus an empty generated/ folder.
+fn scratch() -> tempfile::TempDir {
+    let d = tempfile::tempdir().unwrap();
+    std::fs::create_dir(d.path().join("fits")).unwrap();
+    for e in std::fs::read_dir(root().join("fits")).unwrap() {
+        let p = e.unwrap().path();
+        if p.extension().is_some_and(|x| x == "toml") {
+            std::fs::copy(&p, d.path().join("fits").join(p.file_name().unwrap())).unwrap();
+        }
+    }
+    d
+}
+
+fn assert_nothing_written(d: &Path) {
+    let g = d.join("generated");
+    let n = std::fs::read_dir(&g).map(|r| r.count()).unwrap_or(0);
+    assert_eq!(n, 0, "a failed build must write nothing");
+}
+
+fn bad_spec_case(file: &str, edit: impl Fn(&str) -> String, line: usize, field: &str) {
+    let d = scratch();
+    let p = d.path().join("fits").join(file);
+    let text = std::fs::read_to_string(&p).unwrap();
+    std::fs::write(&p, edit(&text)).unwrap();
+    let o = shadefit(&["build"], Some(d.path()));
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains(&format!("{file}:{line}:")), "names file and line {line}: {err}");
+    assert!(err.contains(field), "names field {field}: {err}");
+    assert_nothing_written(d.path());
+}
+
+#[test]
+fn malformed_specs_exit_2_name_file_line_field_and_write_nothing() {
+    let line_of = |text: &str, needle: &str| text.lines().position(|l| l.starts_with(needle)).unwrap() + 1;
+    let spec = std::fs::read_to_string(root().join("fits/gloss_length.toml")).unwrap();
+    // Malformed TOML: an unterminated string.
+    let l = line_of(&spec, "quantity");
+    bad_spec_case("gloss_length.toml", |t| t.replace("quantity = \"gloss-length\"", "quantity = \"gloss-length"), l, "quantity");
+    // Unknown field.
+    let l = line_of(&spec, "[fit]") + 1;
+    bad_spec_case("gloss_length.toml", |t| t.replace("[fit]\n", "[fit]\nsolver_speed = 3\n"), l, "solver_speed");
+    // NaN range.
+    let l = line_of(&spec, "range");
+    bad_spec_case("gloss_length.toml", |t| t.replace("range = [0.0, 1.0]", "range = [nan, 1.0]"), l, "range");
+    // Out-of-domain range.
+    bad_spec_case("gloss_length.toml", |t| t.replace("range = [0.0, 1.0]", "range = [0.0, 1.5]"), l, "range");
+    // Unknown term in the model.
+    let l = line_of(&spec, "numerator");
+    bad_spec_case("gloss_length.toml", |t| t.replace("\"gloss^3\"]", "\"roughness^3\"]"), l, "numerator");
+}
+
+#[test]
+fn build_check_passes_on_committed_tree_and_catches_a_changed_spec() {
+    let o = shadefit(&["build", "--check"], Some(&root()));
+    assert!(o.status.success(), "committed generated/ must be fresh: {}{}", String::from_utf8_lossy(&o.stdout), stderr(&o));
+
+    // A copy whose spec was edited: --check fails (exit 1) and writes nothing.
+    let d = scratch();
+    copy_dir(&root().join("generated"), &d.path().join("generated"));
+    let p = d.path().join("fits/gloss_table.toml");
+    let t = std::fs::read_to_string(&p).unwrap().replace("count = 256", "count = 128");
+    std::fs::write(&p, t).unwrap();
+    let before = snapshot(&d.path().join("generated"));
+    let o = shadefit(&["build", "--check"], Some(d.path()));
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("gloss_table"), "{}", stderr(&o));
+    assert_eq!(before, snapshot(&d.path().join("generated")));
+}
+
+fn copy_dir(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for e in std::fs::read_dir(from).unwrap() {
+        let p = e.unwrap().path();
+        if p.is_dir() {
+            copy_dir(&p, &to.join(p.file_name().unwrap()));
+        } else {
+            std::fs::copy(&p, to.join(p.file_name().unwrap())).unwrap();
+        }
+    }
+}
+
+fn snapshot(dir: &Path) -> Vec<(PathBuf, Vec<u8>)> {
+    let mut out = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                stack.push(p);
+            } else {
+                out.push((p.strip_prefix(dir).unwrap().to_path_buf(), std::fs::read(&p).unwrap()));
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+#[test]
+fn build_is_byte_identical_at_any_thread_count() {
+    let run = |threads: &str| {
+        let d = scratch();
+        let o = Command::new(env!("CARGO_BIN_EXE_shadefit"))
+            .args(["build", "--only", "gloss_length,gloss_combine_lut"])
+            .current_dir(d.path())
+            .env("RAYON_NUM_THREADS", threads)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", stderr(&o));
+        snapshot(&d.path().join("generated"))
+    };
+    let one = run("1");
+    assert!(!one.is_empty());
+    assert_eq!(one, run("2"), "RAYON_NUM_THREADS=1 and =2 must give the same bytes");
+}
+
+fn nist_csv(name: &str, dir: &Path) -> PathBuf {
+    // NIST StRD .dat: data rows after the "Data:  y  x" line; columns y then x.
+    let text = std::fs::read_to_string(root().join("../shared/data/nist").join(format!("{name}.dat")))
+        .expect("NIST data in ../shared/data/nist");
+    let mut csv = String::from("x,y\n");
+    let mut on = false;
+    for line in text.lines() {
+        let cols: Vec<&str> = line.split_whitespace().collect();
+        if on && cols.len() == 2 {
+            csv.push_str(&format!("{},{}\n", cols[1], cols[0]));
+        }
+        if line.starts_with("Data:") && cols.get(1) == Some(&"y") {
+            on = true;
+        }
+    }
+    let p = dir.join(format!("{name}.csv"));
+    std::fs::write(&p, csv).unwrap();
+    p
+}
+
+fn fit_json(args: &[&str]) -> serde_json::Value {
+    let o = shadefit(args, None);
+    assert!(o.status.success(), "{}", stderr(&o));
+    serde_json::from_slice(&o.stdout).unwrap()
+}
+
+#[test]
+fn nist_kirby2_certified_from_no_start_values() {
+    let d = tempfile::tempdir().unwrap();
+    let csv = nist_csv("Kirby2", d.path());
+    let v = fit_json(&["fit", "--data", csv.to_str().unwrap(), "--x", "x", "--y", "y", "--model", "rational(2,2)", "--json"]);
+    // Certified values (NIST StRD Kirby2); acceptance: 1e-6 relative.
+    let rss = v["rss"].as_f64().unwrap();
+    assert!((rss - 3.9050739624).abs() < 1e-6 * 3.9050739624, "rss {rss}");
+    let b = [1.6745063063, -1.3927397867e-1, 2.5961181191e-3];
+    let num: Vec<f64> = v["numerator"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
+    let den: Vec<f64> = v["denominator"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
+    for (got, want) in num.iter().zip(b) {
+        assert!((got - want).abs() < 1e-6 * want.abs(), "{got} vs {want}");
+    }
+    assert_eq!(den[0], 1.0);
+    for (got, want) in den[1..].iter().zip([-1.7241811870e-3, 2.1664802578e-5]) {
+        assert!((got - want).abs() < 1e-6 * f64::abs(want), "{got} vs {want}");
+    }
+}
+
+#[test]
+fn nist_mgh09_certified_from_no_start_values() {
+    let d = tempfile::tempdir().unwrap();
+    let csv = nist_csv("MGH09", d.path());
+    let model = root().join("tests/data/mgh09_model.toml");
+    let v = fit_json(&["fit", "--data", csv.to_str().unwrap(), "--x", "x", "--y", "y", "--model", model.to_str().unwrap(), "--json"]);
+    let rss = v["rss"].as_f64().unwrap();
+    assert!((rss - 3.0750560385e-4).abs() < 1e-6 * 3.0750560385e-4, "rss {rss}");
+    // y = b1(x² + b2 x)/(x² + b3 x + b4) = (b1b2/b4 x + b1/b4 x²)/(1 + b3/b4 x + 1/b4 x²).
+    let (b1, b2, b3, b4) = (1.9280693458e-1, 1.9128232873e-1, 1.2305650693e-1, 1.3606233068e-1);
+    let num: Vec<f64> = v["numerator"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
+    let den: Vec<f64> = v["denominator"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
+    assert_eq!(num[0], 0.0, "fixed coefficient stays fixed");
+    // Certified parameters carry 11 digits; derived ratios keep ~1e-9 relative. The fit's
+    // own parameter uncertainty at RSS tolerance 1e-6 is far larger: 1e-4 relative bounds it.
+    for (got, want) in [(num[1], b1 * b2 / b4), (num[2], b1 / b4), (den[1], b3 / b4), (den[2], 1.0 / b4)] {
+        assert!((got - want).abs() < 1e-4 * want.abs(), "{got} vs {want}");
+    }
+}
+
+#[test]
+fn bad_csv_exit_2_names_file_line_column() {
+    let d = tempfile::tempdir().unwrap();
+    let p = d.path().join("data.csv");
+    std::fs::write(&p, "x,y\n1,2\n2,oops\n3,4\n4,5\n").unwrap();
+    let o = shadefit(&["fit", "--data", p.to_str().unwrap(), "--x", "x", "--y", "y", "--model", "rational(1,1)"], None);
+    assert_eq!(o.status.code(), Some(2));
+    let e = stderr(&o);
+    assert!(e.contains("data.csv:3") && e.contains("'y'") && e.contains("oops"), "{e}");
+
+    std::fs::write(&p, "x,y\n1,2\n2,3\n3,4\n4,5\n").unwrap();
+    let o = shadefit(&["fit", "--data", p.to_str().unwrap(), "--x", "u", "--y", "y", "--model", "rational(1,1)"], None);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("'u'") && stderr(&o).contains("no such column"), "{}", stderr(&o));
+
+    let o = shadefit(&["fit", "--data", p.to_str().unwrap(), "--x", "x", "--y", "y", "--model", "rational(1"], None);
+    assert_eq!(o.status.code(), Some(2));
+}
