@@ -264,3 +264,25 @@ fn bad_csv_exit_2_names_file_line_column() {
     let o = shadefit(&["fit", "--data", p.to_str().unwrap(), "--x", "x", "--y", "y", "--model", "rational(1"], None);
     assert_eq!(o.status.code(), Some(2));
 }
+
+#[test]
+fn refit_reproduces_committed_coefficients() {
+    // The slow job of the freshness story: refit from scratch and compare with what is
+    // committed. Same algorithm and inputs: agreement to 1e-9 relative (looser than the
+    // bitwise identity seen on one machine, to allow another libm's last-ulp differences).
+    let d = scratch();
+    let o = shadefit(&["build", "--only", "gloss_length,gloss_combine"], Some(d.path()));
+    assert!(o.status.success(), "{}", stderr(&o));
+    for name in ["gloss_length", "gloss_combine"] {
+        let read = |p: PathBuf| -> Vec<f64> {
+            let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap();
+            v["model"]["coefficients"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect()
+        };
+        let fresh = read(d.path().join(format!("generated/json/{name}.json")));
+        let committed = read(root().join(format!("generated/json/{name}.json")));
+        assert_eq!(fresh.len(), committed.len());
+        for (a, b) in fresh.iter().zip(&committed) {
+            assert!((a - b).abs() <= 1e-9 * b.abs().max(1e-3), "{name}: {a} vs {b}");
+        }
+    }
+}

@@ -2,6 +2,7 @@
 //! evaluator. This file is the registry the CLI and the spec layer look quantities up in.
 
 pub mod gloss;
+pub mod skin;
 
 use crate::integrate::Estimate;
 use std::collections::BTreeMap;
