@@ -62,7 +62,7 @@ fn load_specs(paths: &Paths, only: &[String]) -> Result<Vec<Spec>> {
     for name in only {
         if !specs.iter().any(|s| &s.file.name == name) {
             return Err(input_err(format!(
-                "--only: no spec named '{name}' in {} (known: {})",
+                "no spec named '{name}' in {} (known: {})",
                 paths.fits.display(),
                 specs.iter().map(|s| s.file.name.as_str()).collect::<Vec<_>>().join(", ")
             )));
@@ -118,6 +118,44 @@ pub fn build(paths: &Paths, only: &[String], check: bool) -> Result<()> {
         );
     }
     println!("{written} file(s) written, {} unchanged", artifacts.len() - written);
+    Ok(())
+}
+
+/// The fitting samples of one spec (its grid and the integral there), as JSON or CSV.
+pub fn samples(paths: &Paths, name: &str, as_json: bool) -> Result<()> {
+    let specs = load_specs(paths, &[name.to_string()])?;
+    let s = specs.iter().find(|s| s.file.name == name).expect("load_specs checked the name");
+    let counts: Vec<usize> = s.file.axis.iter().map(|a| a.count).collect();
+    let x = pipeline::grid(s, &counts);
+    let y = pipeline::sample(s, &x);
+    let features: Vec<&str> = s.file.axis.iter().map(|a| a.name.as_str()).collect();
+    if as_json {
+        let model = s.model.as_ref().map(|m| {
+            json!({
+                "numerator": m.numerator.iter().map(|t| t.label.clone()).collect::<Vec<_>>(),
+                "denominator": m.denominator.iter().map(|t| t.label.clone()).collect::<Vec<_>>(),
+                "clamp": m.clamp.map(|(a, b)| [a, b]),
+                "pins": m.pins.iter().map(|p| json!({"at": p.at, "value": p.value, "eliminate": m.numerator[p.eliminate].label})).collect::<Vec<_>>(),
+                "fixed": m.fixed.iter().map(|(i, v)| json!({"coefficient": m.coefficient_labels()[*i], "value": v})).collect::<Vec<_>>(),
+            })
+        });
+        let out = json!({
+            "name": s.file.name,
+            "quantity": s.file.quantity,
+            "features": features,
+            "objective": s.file.fit.as_ref().map(|f| f.objective),
+            "model": model,
+            "x": x,
+            "y": y,
+        });
+        println!("{out}");
+    } else {
+        println!("{},value", features.join(","));
+        for (p, v) in x.iter().zip(&y) {
+            let cols: Vec<String> = p.iter().map(|c| format!("{c:?}")).collect();
+            println!("{},{v:?}", cols.join(","));
+        }
+    }
     Ok(())
 }
 

@@ -62,6 +62,13 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Print the fitting samples of one spec (grid points and the integral there).
+    Samples {
+        name: String,
+        /// JSON with the model description (default: CSV).
+        #[arg(long)]
+        json: bool,
+    },
     /// Measure published tables and approximations against the integrals.
     Validate {
         #[arg(long)]
@@ -77,6 +84,7 @@ fn main() -> ExitCode {
         Command::Eval { quantity, params, json } => cli::eval(&quantity, &params, json),
         Command::Build { only, check } => cli::build(&paths, &only, check),
         Command::Fit { data, x, y, model, objective, json } => cli::fit_data(&data, &x, &y, &model, objective, json),
+        Command::Samples { name, json } => cli::samples(&paths, &name, json),
         Command::Validate { json } => cli::validate(&paths, json),
     };
     match result {

@@ -393,7 +393,8 @@ struct Light {
     a: f64,
     /// sqrt(1 − a²)
     sa: f64,
-    /// sin, cos of η_u/2
+    /// η_u, and sin, cos of η_u/2
+    eta: f64,
     sh: f64,
     ch: f64,
     sigma: f64,
@@ -485,41 +486,75 @@ impl Layer {
         let (sh, ch) = (0.5 * eta).sin_cos();
         // σ² = 1 − a²(1 − α²) = s_a² + α² a², without cancellation.
         let sigma = (sa * sa + self.a2 * a * a).sqrt();
-        Light { a, sa, sh, ch, sigma }
+        Light { a, sa, eta, sh, ch, sigma }
     }
 
     /// Width of the specular peak in w around −a.
-    fn peak_scale(&self, a: f64, sa: f64) -> f64 {
+    fn peak_scale(&self, _a: f64, sa: f64) -> f64 {
         if self.k2 <= 0.0 {
             return 4.0;
         }
         (2.0 * self.alpha * (self.k2 * sa * sa + self.a2).sqrt() / self.k2).clamp(1e-12, 4.0)
     }
 
-    /// The pieces of the w-range [−1, sin θf] for a light with u·t = a.
-    fn pieces(&self, a: f64, sa: f64) -> Vec<Piece> {
+    /// Breakpoints in w of the grazing feature of a light at azimuth η_u.
+    ///
+    /// Near the cone D_F has a dip of width ∝ |ε| in Δ around the forward direction v = −u
+    /// (Δ = π, i.e. η = η_u + π). The horizon arc |η| < η₀(w) has its boundary at that azimuth
+    /// at w* = −sin θf cos η_u / sqrt(cos²θf + sin²θf cos²η_u); near w* the arc integral varies
+    /// like atan(τ(w)/(η₀(w) − (π − |η_u|))). When u grazes the horizon w* → −a, and this feature
+    /// is narrower than the Kronrod node spacing near the peak unless split there. Returns w*
+    /// and −a ± 8ε_δ, ε_δ = δ α s_a²/sqrt((1−α²)s_a² + α²) the |ε| at which τ equals half the
+    /// Δ-distance δ of the dip from the arc boundary at w = −a; only those well inside the peak.
+    fn graze_cuts(&self, a: f64, sa: f64, eta_u: f64, out: &mut Vec<f64>) {
         let w0 = -a;
         let scale = self.peak_scale(a, sa);
-        let mut out = Vec::with_capacity(4);
-        let mut push = |lo: f64, hi: f64, region: Region, ls: bool, hs: bool| {
-            if hi <= lo {
-                return;
+        let ce = eta_u.cos();
+        let den = (self.ct * self.ct + self.st * self.st * ce * ce).sqrt();
+        if den > 0.0 {
+            let ws = -self.st * ce / den;
+            if (ws - w0).abs() < scale {
+                out.push(ws);
             }
-            let mut add = |lo: f64, hi: f64, ls: bool, hs: bool| {
-                let xa = ((lo - w0) / scale).atan();
-                let xb = ((hi - w0) / scale).atan();
-                out.push(Piece { region, lo_sing: ls, hi_sing: hs, xa, dx: xb - xa, scale });
-            };
-            if w0 > lo && w0 < hi {
-                add(lo, w0, ls, false);
-                add(w0, hi, false, hs);
-            } else {
-                add(lo, hi, ls, hs);
-            }
-        };
+        }
+        let (eta0, _, _) = self.arc_half_width(w0);
+        if eta0 <= 0.0 || eta0 >= PI {
+            return;
+        }
+        let dist = |x: f64| (x - PI).rem_euclid(2.0 * PI).min((PI - x).rem_euclid(2.0 * PI));
+        let delta = dist(-eta_u - eta0).min(dist(-eta_u + eta0));
+        let e8 = 8.0 * delta * self.alpha * sa * sa / (self.k2 * sa * sa + self.a2).sqrt();
+        if e8 < 0.5 * scale && e8 > 1e-14 * scale {
+            out.push(w0 - e8);
+            out.push(w0 + e8);
+        }
+    }
+
+    /// The pieces of the w-range [−1, sin θf] for a light with u·t = a: split at ±sin θf, at the
+    /// cone w = −a and at the extra cuts given.
+    fn pieces(&self, a: f64, sa: f64, extra: &[f64]) -> Vec<Piece> {
+        let w0 = -a;
+        let scale = self.peak_scale(a, sa);
         let st = self.st;
-        push(-1.0, -st, Region::Full, false, false);
-        push(-st, st, Region::Arc, true, true);
+        let mut cuts: Vec<f64> = vec![-1.0, -st, st, w0];
+        cuts.extend_from_slice(extra);
+        cuts.retain(|&c| c >= -1.0 && c <= st);
+        cuts.sort_by(|x, y| x.total_cmp(y));
+        cuts.dedup();
+        let mut out = Vec::with_capacity(cuts.len());
+        for win in cuts.windows(2) {
+            let (lo, hi) = (win[0], win[1]);
+            if hi <= lo {
+                continue;
+            }
+            let region = if hi <= -st { Region::Full } else { Region::Arc };
+            // Square-root behaviour at ±sin θf, seen from the arc side only.
+            let ls = region == Region::Arc && lo == -st && st > 0.0;
+            let hs = region == Region::Arc && hi == st && st > 0.0;
+            let xa = ((lo - w0) / scale).atan();
+            let xb = ((hi - w0) / scale).atan();
+            out.push(Piece { region, lo_sing: ls, hi_sing: hs, xa, dx: xb - xa, scale });
+        }
         out
     }
 
@@ -604,7 +639,9 @@ impl Layer {
 
     /// P_s for one light.
     fn ps(&self, l: &Light, tol: f64) -> Estimate {
-        let pieces = self.pieces(l.a, l.sa);
+        let mut graze = Vec::with_capacity(3);
+        self.graze_cuts(l.a, l.sa, l.eta, &mut graze);
+        let pieces = self.pieces(l.a, l.sa, &graze);
         let norm = 1.0 / (4.0 * l.sigma * PI * self.alpha);
         let share = tol / norm / pieces.len().max(1) as f64;
         let mut value = 0.0;
@@ -649,7 +686,7 @@ impl Layer {
         let m_eta = a * self.ct * (PI - eta_min) + b * eta_min.sin();
         let l0 = self.light_fiber(a, sa, 0.0);
         let norm = 1.0 / (4.0 * l0.sigma * PI * self.alpha);
-        let pieces = self.pieces(a, sa);
+        let pieces = self.pieces(a, sa, &[]);
         let n_full = pieces.iter().filter(|p| p.region == Region::Full).count();
         let n_arc = pieces.len() - n_full;
         let budget = tol / norm / 3.0;
@@ -738,6 +775,7 @@ impl Layer {
                 n_eta *= 2;
             }
         }
+        if std::env::var("JDBG2").is_ok() { eprintln!("a {a:.6} full {:.15} e {:.1e} arc {:.15} e {:.1e} eta {:.1e}", norm*m_eta*w_full, norm*m_eta*e_full, norm*w_arc, norm*e_arc, norm*e_eta); }
         let value = norm * (m_eta * w_full + w_arc);
         let error = norm * (m_eta * e_full + e_arc + e_eta);
         (value, error, evals)
@@ -1004,6 +1042,40 @@ pub fn expn(n: u32, x: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn scratch_graze() {
+        for &(al, tf) in &[(0.5, 0.3), (0.15, 0.3), (0.15, 1.2), (0.05, 0.8)] {
+            let mut worst: f64 = 0.0;
+            for k in 1..=12 {
+                let mu = 2f64.powi(-k);
+                for j in 0..16 {
+                    let pu = PI * (j as f64 + 0.5) / 16.0;
+                    let d = ps(al, tf, mu.acos(), pu, 1e-9);
+                    let t = ps(al, tf, mu.acos(), pu, 1e-14);
+                    let ratio = (d.value - t.value).abs() / d.error;
+                    worst = worst.max(ratio);
+                    if ratio > 1.0 { println!("BAD {al} {tf} mu {mu:e} phi {pu:.3}: diff {:.2e} err {:.2e} evals {}", d.value - t.value, d.error, d.evals); }
+                }
+            }
+            println!("{al} {tf}: worst ratio {worst:.3}");
+        }
+    }
+
+    #[test]
+    fn scratch_j() {
+        let layer = Layer::new(0.5, 0.3);
+        let split = FRAC_PI_2 - 0.3;
+        for i in 2..=2 {
+            let t = i as f64 / 40.0;
+            let (g, _) = end_map(t, true, true);
+            let aa = split + 0.6 * g;
+            let (sa, a) = aa.sin_cos();
+            let d = layer.j_of_a(a, sa, 2.5e-10);
+            let tt = layer.j_of_a(a, sa, 1e-15);
+            println!("A {aa:.5} J {:.15} err {:.2e} actual {:.2e} {}", d.0, d.1, d.0 - tt.0, if (d.0 - tt.0).abs() > d.1 { "BAD" } else { "" });
+        }
+    }
 
     #[test]
     fn scratch_r() {
