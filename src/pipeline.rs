@@ -434,6 +434,29 @@ pub fn runtime_index(specs: &[Spec]) -> Artifact {
         s.push_str(&format!("        #[cfg(feature = \"{}\")]\n        \"{}\",\n", family(spec), spec.file.name));
     }
     s.push_str("    ];\n}\n");
+    s.push_str("\n/// Every emitted function with its domain and CPU version (for GPU verification).\npub const FUNCTIONS: &[EmittedFunction] = &[\n");
+    for spec in specs {
+        let arity = spec.file.axis.len();
+        let domain: Vec<String> = spec
+            .file
+            .axis
+            .iter()
+            .map(|a| format!("[{}, {}]", emit::f32_literal(a.range[0] as f32), emit::f32_literal(a.range[1] as f32)))
+            .collect();
+        let cpu = match arity {
+            1 => "Cpu::One",
+            2 => "Cpu::Two",
+            _ => "Cpu::Three",
+        };
+        s.push_str(&format!(
+            "    #[cfg(feature = \"{fam}\")]\n    EmittedFunction {{ module: \"{m}\", name: \"{f}\", domain: &[{d}], cpu: {cpu}({m}::{f}) }},\n",
+            fam = family(spec),
+            m = spec.file.name,
+            f = spec.file.emit.function,
+            d = domain.join(", ")
+        ));
+    }
+    s.push_str("];\n");
     Artifact { path: "src/emitted.rs".into(), contents: s }
 }
 

@@ -61,3 +61,17 @@ pub mod wgsl {
         "gloss_table",
     ];
 }
+
+/// Every emitted function with its domain and CPU version (for GPU verification).
+pub const FUNCTIONS: &[EmittedFunction] = &[
+    #[cfg(feature = "gloss")]
+    EmittedFunction { module: "gloss_combine", name: "combine_gloss", domain: &[[0e0, 1e0], [0e0, 1e0]], cpu: Cpu::Two(gloss_combine::combine_gloss) },
+    #[cfg(feature = "gloss")]
+    EmittedFunction { module: "gloss_combine_lut", name: "combine_gloss_lut", domain: &[[0e0, 1e0], [0e0, 1e0]], cpu: Cpu::Two(gloss_combine_lut::combine_gloss_lut) },
+    #[cfg(feature = "gloss")]
+    EmittedFunction { module: "gloss_inverse_table", name: "normal_length_to_gloss_lut", domain: &[[6.666667e-1, 1e0]], cpu: Cpu::One(gloss_inverse_table::normal_length_to_gloss_lut) },
+    #[cfg(feature = "gloss")]
+    EmittedFunction { module: "gloss_length", name: "gloss_to_normal_length", domain: &[[0e0, 1e0]], cpu: Cpu::One(gloss_length::gloss_to_normal_length) },
+    #[cfg(feature = "gloss")]
+    EmittedFunction { module: "gloss_table", name: "gloss_to_normal_length_lut", domain: &[[0e0, 1e0]], cpu: Cpu::One(gloss_table::gloss_to_normal_length_lut) },
+];

@@ -1,9 +1,28 @@
 //! shadefit-runtime: shading approximations and lookup tables emitted by shadefit.
 //!
 //! Each emitted module holds the f32 coefficients (or table) of one fit and a CPU version of
-//! its WGSL function; [`wgsl::module`] returns the WGSL library of the same name. Everything
-//! but this file, `Cargo.toml` and `tests/` is written by `shadefit build`.
+//! its WGSL function; [`wgsl::module`] returns the WGSL library of the same name and
+//! [`FUNCTIONS`] lists every emitted function. Everything but this file, `Cargo.toml`,
+//! `tests/` and the folders under `src/` is written by `shadefit build`.
 
 #![allow(clippy::excessive_precision, clippy::approx_constant)]
+
+/// CPU version of an emitted function, by arity.
+#[derive(Clone, Copy)]
+pub enum Cpu {
+    One(fn(f32) -> f32),
+    Two(fn(f32, f32) -> f32),
+    Three(fn(f32, f32, f32) -> f32),
+}
+
+/// One emitted function: its module (WGSL import path `shadefit::MODULE`), its name in WGSL
+/// and Rust, the domain its arguments are clamped to, and its CPU version.
+#[derive(Clone, Copy)]
+pub struct EmittedFunction {
+    pub module: &'static str,
+    pub name: &'static str,
+    pub domain: &'static [[f32; 2]],
+    pub cpu: Cpu,
+}
 
 include!("emitted.rs");

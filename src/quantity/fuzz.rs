@@ -497,29 +497,23 @@ impl Layer {
         (2.0 * self.alpha * (self.k2 * sa * sa + self.a2).sqrt() / self.k2).clamp(1e-12, 4.0)
     }
 
-    /// Breakpoints in w for the grazing feature of a light at azimuth η_u.
+    /// Smallest w-scale of the grazing feature of a light at azimuth η_u (∞ when none).
     ///
     /// Near the cone D_F has a dip of width ∝ |ε| in Δ around the forward direction v = −u
     /// (Δ = π, i.e. η = η_u + π). The horizon arc |η| < η₀(w) has its boundary at that azimuth
     /// at w* = −sin θf cos η_u / sqrt(cos²θf + sin²θf cos²η_u), and near the cone the arc
     /// integral varies like |ε| atan(τ(w)/(η₀(w) − (π − |η_u|))), τ ∝ |ε|. When u grazes the
-    /// horizon, w* → −a: the feature lives on scales from s = min(|w* + a|, 8ε_δ) up to the peak
-    /// width L (ε_δ = δ α s_a²/sqrt((1−α²)s_a² + α²), the |ε| at which τ reaches half the
+    /// horizon, w* → −a and the feature lives on scales from s = min(|w* + a|, 8ε_δ) up to the
+    /// peak width L (ε_δ = δ α s_a²/sqrt((1−α²)s_a² + α²): the |ε| at which τ reaches half the
     /// Δ-distance δ of the dip from the arc boundary at w = −a), far below the Kronrod node
-    /// spacing near the peak. Cuts: w*, and −a ± s·4^k below L/2 (graded, so every piece sees
-    /// the feature at a resolvable scale).
-    fn graze_cuts(&self, a: f64, sa: f64, eta_u: f64, out: &mut Vec<f64>) {
+    /// spacing near the peak.
+    fn graze_scale(&self, a: f64, sa: f64, eta_u: f64) -> f64 {
         let w0 = -a;
-        let scale = self.peak_scale(a, sa);
         let mut s = f64::INFINITY;
         let ce = eta_u.cos();
         let den = (self.ct * self.ct + self.st * self.st * ce * ce).sqrt();
         if den > 0.0 {
-            let ws = -self.st * ce / den;
-            if (ws - w0).abs() < scale {
-                out.push(ws);
-                s = (ws - w0).abs();
-            }
+            s = (-self.st * ce / den - w0).abs();
         }
         let (eta0, _, _) = self.arc_half_width(w0);
         if eta0 > 0.0 && eta0 < PI {
@@ -527,10 +521,17 @@ impl Layer {
             let delta = dist(-eta_u - eta0).min(dist(-eta_u + eta0));
             s = s.min(8.0 * delta * self.alpha * sa * sa / (self.k2 * sa * sa + self.a2).sqrt());
         }
-        s = s.max(1e-12 * scale);
+        s
+    }
+
+    /// Graded cuts −a ± s·4^k below L/2 (s ≥ 1e-12 L): every piece near the cone then sees a
+    /// grazing feature of scale ≥ s at a resolvable size.
+    fn graded_cuts(&self, a: f64, sa: f64, s: f64, out: &mut Vec<f64>) {
+        let scale = self.peak_scale(a, sa);
+        let mut s = s.max(1e-12 * scale);
         while s < 0.5 * scale {
-            out.push(w0 - s);
-            out.push(w0 + s);
+            out.push(-a - s);
+            out.push(-a + s);
             s *= 4.0;
         }
     }
@@ -644,9 +645,9 @@ impl Layer {
 
     /// P_s for one light.
     fn ps(&self, l: &Light, tol: f64) -> Estimate {
-        let mut graze = Vec::with_capacity(3);
-        self.graze_cuts(l.a, l.sa, l.eta, &mut graze);
-        let pieces = self.pieces(l.a, l.sa, &graze);
+        let mut cuts = Vec::new();
+        self.graded_cuts(l.a, l.sa, self.graze_scale(l.a, l.sa, l.eta), &mut cuts);
+        let pieces = self.pieces(l.a, l.sa, &cuts);
         let norm = 1.0 / (4.0 * l.sigma * PI * self.alpha);
         let share = tol / norm / pieces.len().max(1) as f64;
         let mut value = 0.0;
