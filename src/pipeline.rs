@@ -186,8 +186,7 @@ fn build_fit(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> 
     let approx32: Vec<f32> = vx
         .iter()
         .map(|x| {
-            let xs: Vec<f32> =
-                x.iter().zip(&d32).map(|(&v, &(lo, hi))| expr::sanitize(v as f32, lo, hi)).collect();
+            let xs = expr::features_f32(model, x, &d32);
             let v = expr::eval_f32(&e, &xs, &num, &den);
             match clamp32 {
                 Some((lo, hi)) => v.clamp(lo, hi),
@@ -214,6 +213,7 @@ fn build_fit(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> 
         module: &name,
         name: &spec.file.emit.function,
         args: &a,
+        derived: &model.derived,
         domain: &d32,
         body: wgsl::Body::Fit { expr: &e, num: &num, den: &den, clamp: clamp32 },
     };
@@ -230,10 +230,12 @@ fn build_fit(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> 
         "function": spec.file.emit.function,
         "axes": axes_json(spec),
         "model": {
-            "form": "offset + factor * P / Q, Q = 1 + sum(den)",
+            "form": "offset + factor * P / Q, Q = denominator_lead + sum(den)",
             "features": a,
             "numerator": model.numerator.iter().map(|t| t.label.clone()).collect::<Vec<_>>(),
             "denominator": model.denominator.iter().map(|t| t.label.clone()).collect::<Vec<_>>(),
+            "denominator_lead": model.lead.as_ref().map_or("1".to_string(), |t| t.label.clone()),
+            "derived": model.derived.iter().map(|d| json!({"name": d.name, "definition": d.describe(&a)})).collect::<Vec<_>>(),
             "offset": model.offset,
             "factor": model.factor.as_ref().map(|t| t.label.clone()),
             "clamp": model.clamp.map(|(a, b)| [a, b]),
@@ -354,6 +356,7 @@ fn build_table(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError
         module: &name,
         name: &spec.file.emit.function,
         args: &a,
+        derived: &[],
         domain: &d32,
         body: wgsl::Body::Table { values: &v32, counts: &counts },
     };

@@ -117,11 +117,8 @@ fn linear_combination(terms: &[Term], array: u8) -> Expr {
 /// The emitted form of a rational model: offset + factor·P/Q (clamp applied by the caller).
 pub fn model_expr(model: &RationalModel) -> Expr {
     let p = linear_combination(&model.numerator, 0);
-    let q = if model.denominator.is_empty() {
-        Lit(1.0)
-    } else {
-        add(Lit(1.0), linear_combination(&model.denominator, 1))
-    };
+    let lead = model.lead.as_ref().and_then(term_expr).unwrap_or(Lit(1.0));
+    let q = if model.denominator.is_empty() { lead } else { add(lead, linear_combination(&model.denominator, 1)) };
     let mut e = Div(Box::new(p), Box::new(q));
     if let Some(f) = &model.factor
         && let Some(fe) = term_expr(f)
@@ -183,6 +180,14 @@ fn paren(
         Add(..) => format!("({})", render(e, var, coef, lit)),
         _ => render(e, var, coef, lit),
     }
+}
+
+/// Sanitised f32 inputs extended with the model's derived features, as emitted code computes them.
+pub fn features_f32(model: &RationalModel, x: &[f64], domain: &[(f32, f32)]) -> Vec<f32> {
+    let mut v: Vec<f32> = x.iter().zip(domain).map(|(&v, &(lo, hi))| sanitize(v as f32, lo, hi)).collect();
+    let derived: Vec<f32> = model.derived.iter().map(|d| d.eval_f32(&v)).collect();
+    v.extend(derived);
+    v
 }
 
 /// Clamp to [lo, hi] with NaN mapped to lo, in f32 (what emitted code does with inputs).

@@ -47,6 +47,13 @@ pub fn render_module(header: &[String], f: &Function<'_>, doc: &str) -> String {
         .zip(f.domain)
         .enumerate()
         .map(|(i, (a, (lo, hi)))| format!("    let x{i} = input({a}, {}, {});\n", lit(*lo), lit(*hi)))
+        .chain(f.derived.iter().enumerate().map(|(k, d)| {
+            format!(
+                "    let x{} = {};\n",
+                f.args.len() + k,
+                super::wgsl::derived_expr(d, &lit, &|fun, v| format!("{v}.{fun}()"))
+            )
+        }))
         .collect();
     match &f.body {
         Body::Fit { expr, num, den, clamp } => {

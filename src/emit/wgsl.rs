@@ -18,6 +18,8 @@ pub struct Function<'a> {
     pub module: &'a str,
     pub name: &'a str,
     pub args: &'a [String],
+    /// Derived features, computed after the inputs are clamped (variables x{n_args + k}).
+    pub derived: &'a [crate::fit::model::Derived],
     pub domain: &'a [(f32, f32)],
     pub body: Body<'a>,
 }
@@ -62,6 +64,9 @@ pub fn render_module(header: &[String], f: &Function<'_>) -> String {
         .zip(f.domain)
         .enumerate()
         .map(|(i, (a, (lo, hi)))| format!("    let x{i} = {}_input({a}, {}, {});\n", f.module, lit(*lo), lit(*hi)))
+        .chain(f.derived.iter().enumerate().map(|(k, d)| {
+            format!("    let x{} = {};\n", f.args.len() + k, derived_expr(d, &lit, &|fun, v| format!("{fun}({v})")))
+        }))
         .collect();
     match &f.body {
         Body::Fit { expr, num, den, clamp } => {
@@ -112,6 +117,29 @@ pub fn render_module(header: &[String], f: &Function<'_>) -> String {
         }
     }
     s
+}
+
+/// A derived feature as an expression in the language (`call(fun, var)` renders cos/sin).
+pub fn derived_expr(
+    d: &crate::fit::model::Derived,
+    lit: &dyn Fn(f32) -> String,
+    call: &dyn Fn(&str, &str) -> String,
+) -> String {
+    use crate::fit::model::DerivedExpr;
+    match d.expr {
+        DerivedExpr::Affine { input, offset, scale } => {
+            let (o, s) = (offset as f32, scale as f32);
+            if s == 1.0 {
+                format!("{} + x{input}", lit(o))
+            } else if s == -1.0 {
+                format!("{} - x{input}", lit(o))
+            } else {
+                format!("{} + {} * x{input}", lit(o), lit(s))
+            }
+        }
+        DerivedExpr::Cos(i) => call("cos", &format!("x{i}")),
+        DerivedExpr::Sin(i) => call("sin", &format!("x{i}")),
+    }
 }
 
 /// The source with `#`-directive lines removed (what a composer hands to naga).

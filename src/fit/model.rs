@@ -1,6 +1,10 @@
 //! Model forms: rational functions of named features,
 //!
-//!   f(x) = offset + factor(x) · P(x) / Q(x),   P = Σ a_j φ_j(x),   Q = 1 + Σ b_j ψ_j(x),
+//!   f(x) = offset + factor(x) · P(x) / Q(x),   P = Σ a_j φ_j(x),   Q = lead(x) + Σ b_j ψ_j(x),
+//!
+//! (`lead` is the constant 1 unless the model names another term, as G̃'s d + c₂μ + c₃μ³ does)
+//! over *features*: the inputs, then derived features, each a cos, sin or affine map of one
+//! input (β = 1 − α, γ = cos θ_f, δ = sin θ_f in the fuzz fits).
 //!
 //! where every basis function φ_j, ψ_j is a *term*: a sum of monomials sharing one coefficient
 //! (`"x^2 + y^2"` ties the coefficients of x² and y²; `"x*y"` is one monomial; `"1"` is the
@@ -106,13 +110,162 @@ pub struct Pin {
     pub eliminate: usize,
 }
 
+/// A feature computed from one input.
+#[derive(Debug, Clone, PartialEq)]
+pub enum DerivedExpr {
+    /// offset + scale · input
+    Affine { input: usize, offset: f64, scale: f64 },
+    Cos(usize),
+    Sin(usize),
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Derived {
+    pub name: String,
+    pub expr: DerivedExpr,
+}
+
+impl Derived {
+    /// Parse `cos(x)`, `sin(x)`, `x`, `a - x`, `a + x`, `b*x`, `a + b*x`, `a - b*x` over `inputs`.
+    pub fn parse(name: &str, text: &str, inputs: &[String]) -> Result<Derived, ModelError> {
+        let bad = |why: &str| ModelError::BadTerm { term: format!("{name} = {text}"), why: why.into() };
+        let input = |s: &str| {
+            inputs
+                .iter()
+                .position(|i| i == s.trim())
+                .ok_or_else(|| bad(&format!("'{}' is not an input (inputs: {})", s.trim(), inputs.join(", "))))
+        };
+        let t = text.trim();
+        let expr = if let Some(arg) = t.strip_prefix("cos(").and_then(|r| r.strip_suffix(')')) {
+            DerivedExpr::Cos(input(arg)?)
+        } else if let Some(arg) = t.strip_prefix("sin(").and_then(|r| r.strip_suffix(')')) {
+            DerivedExpr::Sin(input(arg)?)
+        } else {
+            // offset ± [scale *] input, or [scale *] input.
+            let (offset, sign, rest) = match t.find(['+', '-']).filter(|&i| i > 0) {
+                Some(i) => {
+                    let off: f64 = t[..i].trim().parse().map_err(|_| bad("offset is not a number"))?;
+                    (off, if &t[i..i + 1] == "-" { -1.0 } else { 1.0 }, t[i + 1..].trim())
+                }
+                None => (0.0, 1.0, t),
+            };
+            let (scale, var) = match rest.split_once('*') {
+                Some((a, v)) => (a.trim().parse::<f64>().map_err(|_| bad("scale is not a number"))?, v),
+                None => (1.0, rest),
+            };
+            DerivedExpr::Affine { input: input(var)?, offset, scale: sign * scale }
+        };
+        Ok(Derived { name: name.to_string(), expr })
+    }
+
+    pub fn eval(&self, x: &[f64]) -> f64 {
+        match self.expr {
+            DerivedExpr::Affine { input, offset, scale } => affine(offset, scale, x[input]),
+            DerivedExpr::Cos(i) => x[i].cos(),
+            DerivedExpr::Sin(i) => x[i].sin(),
+        }
+    }
+
+    pub fn eval_f32(&self, x: &[f32]) -> f32 {
+        match self.expr {
+            DerivedExpr::Affine { input, offset, scale } => affine_f32(offset as f32, scale as f32, x[input]),
+            DerivedExpr::Cos(i) => x[i].cos(),
+            DerivedExpr::Sin(i) => x[i].sin(),
+        }
+    }
+
+    /// Range over an interval of its input (exact: extrema of cos/sin included).
+    pub fn range(&self, r: &[(f64, f64)]) -> (f64, f64) {
+        use std::f64::consts::PI;
+        let cos_range = |lo: f64, hi: f64| {
+            let (a, b) = (lo.cos(), hi.cos());
+            let mut out = (a.min(b), a.max(b));
+            if ((lo / (2.0 * PI)).ceil() * 2.0 * PI) <= hi {
+                out.1 = 1.0;
+            }
+            if (((lo - PI) / (2.0 * PI)).ceil() * 2.0 * PI + PI) <= hi {
+                out.0 = -1.0;
+            }
+            out
+        };
+        match self.expr {
+            DerivedExpr::Affine { input, offset, scale } => {
+                let (a, b) = (affine(offset, scale, r[input].0), affine(offset, scale, r[input].1));
+                (a.min(b), a.max(b))
+            }
+            DerivedExpr::Cos(i) => cos_range(r[i].0, r[i].1),
+            DerivedExpr::Sin(i) => cos_range(r[i].0 - PI / 2.0, r[i].1 - PI / 2.0),
+        }
+    }
+}
+
+impl Derived {
+    /// The definition over input names, e.g. `1 - alpha`, `cos(theta_f)`.
+    pub fn describe(&self, inputs: &[String]) -> String {
+        match self.expr {
+            DerivedExpr::Affine { input, offset, scale } => format!("{offset} + {scale}*{}", inputs[input]),
+            DerivedExpr::Cos(i) => format!("cos({})", inputs[i]),
+            DerivedExpr::Sin(i) => format!("sin({})", inputs[i]),
+        }
+    }
+}
+
+/// offset + scale·x, with the operation order the emitted code uses.
+pub fn affine(offset: f64, scale: f64, x: f64) -> f64 {
+    if scale == 1.0 {
+        offset + x
+    } else if scale == -1.0 {
+        offset - x
+    } else {
+        offset + scale * x
+    }
+}
+
+fn affine_f32(offset: f32, scale: f32, x: f32) -> f32 {
+    if scale == 1.0 {
+        offset + x
+    } else if scale == -1.0 {
+        offset - x
+    } else {
+        offset + scale * x
+    }
+}
+
+/// Everything that defines a model, before its constraints are resolved.
+#[derive(Debug, Clone, Default)]
+pub struct ModelParts {
+    /// Input names (the axes or data columns).
+    pub inputs: Vec<String>,
+    pub derived: Vec<Derived>,
+    pub numerator: Vec<Term>,
+    pub denominator: Vec<Term>,
+    /// Denominator lead term (None: the constant 1).
+    pub lead: Option<Term>,
+    pub offset: f64,
+    pub factor: Option<Term>,
+    pub fixed: Vec<(usize, f64)>,
+    pub pins: Vec<Pin>,
+    pub clamp: Option<(f64, f64)>,
+}
+
+impl ModelParts {
+    /// Feature names terms are parsed against: inputs, then derived features.
+    pub fn features(&self) -> Vec<String> {
+        self.inputs.iter().cloned().chain(self.derived.iter().map(|d| d.name.clone())).collect()
+    }
+}
+
 /// A rational model with its constraints resolved into an affine parameter map.
 #[derive(Debug, Clone)]
 pub struct RationalModel {
+    /// All features: inputs, then derived.
     pub features: Vec<String>,
+    pub n_inputs: usize,
+    pub derived: Vec<Derived>,
     pub numerator: Vec<Term>,
-    /// Non-constant denominator terms; the constant 1 is implicit.
+    /// Denominator terms with coefficients; the lead term (default 1) has none.
     pub denominator: Vec<Term>,
+    pub lead: Option<Term>,
     pub offset: f64,
     pub factor: Option<Term>,
     pub fixed: Vec<(usize, f64)>,
@@ -134,9 +287,9 @@ impl RationalModel {
             1 => feature.to_string(),
             _ => format!("{feature}^{p}"),
         };
-        let num = (0..=m).map(|p| Term::parse(&power(p), &features).expect("valid term")).collect();
-        let den = (1..=n).map(|p| Term::parse(&power(p), &features).expect("valid term")).collect();
-        RationalModel::new(features, num, den, 0.0, None, vec![], vec![], None)
+        let numerator = (0..=m).map(|p| Term::parse(&power(p), &features).expect("valid term")).collect();
+        let denominator = (1..=n).map(|p| Term::parse(&power(p), &features).expect("valid term")).collect();
+        RationalModel::new(ModelParts { inputs: features, numerator, denominator, ..ModelParts::default() })
             .expect("an unconstrained rational model is always valid")
     }
 
@@ -156,22 +309,14 @@ impl RationalModel {
         Ok(RationalModel::rational_1d(feature, m, n))
     }
 
-    #[allow(clippy::too_many_arguments)]
-    pub fn new(
-        features: Vec<String>,
-        numerator: Vec<Term>,
-        denominator: Vec<Term>,
-        offset: f64,
-        factor: Option<Term>,
-        fixed: Vec<(usize, f64)>,
-        pins: Vec<Pin>,
-        clamp: Option<(f64, f64)>,
-    ) -> Result<RationalModel, ModelError> {
-        if let Some(t) = denominator.iter().find(|t| t.is_constant()) {
+    pub fn new(parts: ModelParts) -> Result<RationalModel, ModelError> {
+        let features = parts.features();
+        let ModelParts { inputs, derived, numerator, denominator, lead, offset, factor, fixed, pins, clamp } = parts;
+        let lead_is_one = lead.as_ref().is_none_or(|t| t.is_constant() && t.monomials.len() == 1);
+        if lead_is_one && let Some(t) = denominator.iter().find(|t| t.is_constant()) {
             return Err(ModelError::BadTerm {
                 term: t.label.clone(),
-                why: "the denominator's constant term is fixed to 1; list only its other terms"
-                    .into(),
+                why: "the denominator's constant term is fixed to 1; list only its other terms".into(),
             });
         }
         let nn = numerator.len();
@@ -185,8 +330,11 @@ impl RationalModel {
         }
         let mut model = RationalModel {
             features,
+            n_inputs: inputs.len(),
+            derived,
             numerator,
             denominator,
+            lead: if lead_is_one { None } else { lead },
             offset,
             factor,
             fixed,
@@ -203,7 +351,7 @@ impl RationalModel {
                     why: "must eliminate a numerator coefficient that is not fixed".into(),
                 });
             }
-            let fac = model.factor.as_ref().map_or(1.0, |t| t.eval(&p.at));
+            let fac = model.factor.as_ref().map_or(1.0, |t| t.eval(&model.extend(&p.at)));
             if fac == 0.0 || !fac.is_finite() {
                 return Err(ModelError::BadPin { at: p.at.clone(), why: "the factor is zero there".into() });
             }
@@ -236,16 +384,17 @@ impl RationalModel {
         let mut a = DMatrix::zeros(k, k);
         let mut rhs = DVector::zeros(k);
         for (r, pin) in self.pins.iter().enumerate() {
-            let fac = self.factor.as_ref().map_or(1.0, |t| t.eval(&pin.at));
+            let at = self.extend(&pin.at);
+            let fac = self.factor.as_ref().map_or(1.0, |t| t.eval(&at));
             let v = (pin.value - self.offset) / fac;
-            let q = 1.0
-                + self.denominator.iter().enumerate().map(|(j, t)| c[nn + j] * t.eval(&pin.at)).sum::<f64>();
+            let q = self.lead_at(&at)
+                + self.denominator.iter().enumerate().map(|(j, t)| c[nn + j] * t.eval(&at)).sum::<f64>();
             let mut s = v * q;
             for (j, t) in self.numerator.iter().enumerate() {
                 if let Some(col) = self.pins.iter().position(|p| p.eliminate == j) {
-                    a[(r, col)] = t.eval(&pin.at);
+                    a[(r, col)] = t.eval(&at);
                 } else {
-                    s -= c[j] * t.eval(&pin.at);
+                    s -= c[j] * t.eval(&at);
                 }
             }
             rhs[r] = s;
@@ -296,12 +445,26 @@ impl RationalModel {
             .collect()
     }
 
-    /// Basis values of one point: (φ, ψ, factor).
+    /// Inputs followed by the derived features.
+    pub fn extend(&self, x: &[f64]) -> Vec<f64> {
+        let mut v = x[..self.n_inputs].to_vec();
+        v.extend(self.derived.iter().map(|d| d.eval(x)));
+        v
+    }
+
+    /// The denominator's lead term at extended features.
+    pub fn lead_at(&self, xe: &[f64]) -> f64 {
+        self.lead.as_ref().map_or(1.0, |t| t.eval(xe))
+    }
+
+    /// Basis values of one point (inputs only; derived features are computed here).
     pub fn basis(&self, x: &[f64]) -> Basis {
+        let xe = self.extend(x);
         Basis {
-            phi: self.numerator.iter().map(|t| t.eval(x)).collect(),
-            psi: self.denominator.iter().map(|t| t.eval(x)).collect(),
-            factor: self.factor.as_ref().map_or(1.0, |t| t.eval(x)),
+            phi: self.numerator.iter().map(|t| t.eval(&xe)).collect(),
+            psi: self.denominator.iter().map(|t| t.eval(&xe)).collect(),
+            lead: self.lead_at(&xe),
+            factor: self.factor.as_ref().map_or(1.0, |t| t.eval(&xe)),
         }
     }
 
@@ -321,8 +484,7 @@ impl RationalModel {
 
     /// Denominator Q at a point.
     pub fn denominator_at(&self, c: &DVector<f64>, x: &[f64]) -> f64 {
-        let nn = self.numerator.len();
-        1.0 + self.denominator.iter().enumerate().map(|(j, t)| c[nn + j] * t.eval(x)).sum::<f64>()
+        self.basis(x).pq(c).1
     }
 }
 
@@ -331,6 +493,7 @@ impl RationalModel {
 pub struct Basis {
     pub phi: Vec<f64>,
     pub psi: Vec<f64>,
+    pub lead: f64,
     pub factor: f64,
 }
 
@@ -338,7 +501,7 @@ impl Basis {
     pub fn pq(&self, c: &DVector<f64>) -> (f64, f64) {
         let nn = self.phi.len();
         let p: f64 = self.phi.iter().enumerate().map(|(j, v)| c[j] * v).sum();
-        let q: f64 = 1.0 + self.psi.iter().enumerate().map(|(j, v)| c[nn + j] * v).sum::<f64>();
+        let q: f64 = self.lead + self.psi.iter().enumerate().map(|(j, v)| c[nn + j] * v).sum::<f64>();
         (p, q)
     }
 
@@ -373,12 +536,36 @@ mod tests {
             Pin { at: vec![0.0], value: 0.5, eliminate: 0 },
             Pin { at: vec![1.0], value: 0.9, eliminate: 3 },
         ];
-        let m = RationalModel::new(feats, num, den, 0.0, None, vec![], pins, None).unwrap();
+        let m = RationalModel::new(ModelParts {
+            inputs: feats,
+            numerator: num,
+            denominator: den,
+            pins,
+            ..ModelParts::default()
+        })
+        .unwrap();
         assert_eq!(m.n_free(), 4);
         let theta = DVector::from_vec(vec![0.3, -1.2, 0.7, 2.5]);
         let c = m.full(&theta);
         // The map is exact up to rounding of a 2×2 solve on O(1) numbers.
         assert!((m.eval_full(&c, &[0.0]) - 0.5).abs() < 1e-14);
         assert!((m.eval_full(&c, &[1.0]) - 0.9).abs() < 1e-14);
+    }
+
+    #[test]
+    fn derived_features_parse_and_bound() {
+        let inputs = vec!["alpha".to_string(), "theta_f".to_string()];
+        let b = Derived::parse("beta", "1 - alpha", &inputs).unwrap();
+        assert_eq!(b.eval(&[0.25, 0.0]), 0.75);
+        let g = Derived::parse("gamma", "cos(theta_f)", &inputs).unwrap();
+        let r = g.range(&[(0.0, 1.0), (-0.5, 4.0)]);
+        // cos over [-0.5, 4] reaches 1 at 0 and -1 at π.
+        assert_eq!(r, (-1.0, 1.0));
+        let d = Derived::parse("delta", "sin(theta_f)", &inputs).unwrap();
+        let r = d.range(&[(0.0, 1.0), (0.1, 1.5)]);
+        assert!((r.0 - 0.1f64.sin()).abs() < 1e-15 && (r.1 - 1.5f64.sin()).abs() < 1e-15);
+        let e = Derived::parse("e", "2 + 3*alpha", &inputs).unwrap();
+        assert_eq!(e.eval(&[1.0, 0.0]), 5.0);
+        assert!(Derived::parse("z", "cos(phi)", &inputs).is_err());
     }
 }

@@ -42,18 +42,26 @@ pub enum Positivity {
     NotProven { lower: f64, region: Vec<(f64, f64)>, sample: f64 },
 }
 
+fn term_range(t: &crate::fit::model::Term, feats: &[(f64, f64)]) -> Iv {
+    let mut term = Iv(0.0, 0.0);
+    for m in &t.monomials {
+        let mut v = Iv(1.0, 1.0);
+        for (e, r) in m.exps.iter().zip(feats) {
+            v = v.mul(Iv(r.0, r.1).powi(*e));
+        }
+        term = Iv(term.0 + v.0, term.1 + v.1);
+    }
+    term
+}
+
 fn bound(model: &RationalModel, c: &DVector<f64>, region: &[(f64, f64)]) -> f64 {
     let nn = model.numerator.len();
-    let mut lo = 1.0;
+    // Feature ranges: the inputs' box, then each derived feature's exact range over it.
+    let mut feats = region.to_vec();
+    feats.extend(model.derived.iter().map(|d| d.range(region)));
+    let mut lo = model.lead.as_ref().map_or(1.0, |t| term_range(t, &feats).0);
     for (j, t) in model.denominator.iter().enumerate() {
-        let mut term = Iv(0.0, 0.0);
-        for m in &t.monomials {
-            let mut v = Iv(1.0, 1.0);
-            for (e, r) in m.exps.iter().zip(region) {
-                v = v.mul(Iv(r.0, r.1).powi(*e));
-            }
-            term = Iv(term.0 + v.0, term.1 + v.1);
-        }
+        let term = term_range(t, &feats);
         let b = c[nn + j];
         lo += if b >= 0.0 { b * term.0 } else { b * term.1 };
     }

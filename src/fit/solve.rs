@@ -179,7 +179,7 @@ pub fn linearised_starts(model: &RationalModel, data: &Data, what: &str) -> Resu
             for (j, psi) in b.psi.iter().enumerate() {
                 a[(r, nn + j)] = -inv_q[r] * yv * psi;
             }
-            rhs[r] = inv_q[r] * yv;
+            rhs[r] = inv_q[r] * yv * b.lead;
         }
         let rhs = rhs - &a * model.map0();
         let mut a = a * model.map();

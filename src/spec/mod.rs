@@ -33,7 +33,7 @@
 
 pub mod data;
 
-use crate::fit::model::{ModelError, Pin, RationalModel, Term};
+use crate::fit::model::{Derived, ModelError, ModelParts, Pin, RationalModel, Term};
 use crate::fit::Objective;
 use crate::quantity::{self, QuantityDef};
 use serde::Deserialize;
@@ -115,6 +115,11 @@ pub struct ModelSpec {
     pub numerator: Vec<String>,
     #[serde(default)]
     pub denominator: Vec<String>,
+    /// Denominator term without a coefficient (default "1").
+    pub denominator_lead: Option<String>,
+    /// Derived features, name = "cos(x)" | "sin(x)" | "a + b*x" (over the inputs).
+    #[serde(default)]
+    pub derived: BTreeMap<String, String>,
     #[serde(default)]
     pub offset: f64,
     pub factor: Option<String>,
@@ -131,10 +136,19 @@ impl ModelSpec {
         &self,
         path: &Path,
         text: &str,
-        features: Vec<String>,
+        inputs: Vec<String>,
         pin_value: &dyn Fn(&[f64]) -> Option<f64>,
     ) -> Result<RationalModel, SpecError> {
         let err = |field: &str, e: ModelError| SpecError::new(path, line_of(text, field), field, e.to_string());
+        let mut derived = Vec::new();
+        for (name, def) in &self.derived {
+            if inputs.contains(name) {
+                return Err(SpecError::new(path, line_of(text, name), name, "a derived feature cannot shadow an input"));
+            }
+            derived.push(Derived::parse(name, def, &inputs).map_err(|e| err(name, e))?);
+        }
+        let parts0 = ModelParts { inputs: inputs.clone(), derived: derived.clone(), ..ModelParts::default() };
+        let features = parts0.features();
         let parse_all = |field: &str, list: &[String]| -> Result<Vec<Term>, SpecError> {
             list.iter().map(|s| Term::parse(s, &features).map_err(|e| err(field, e))).collect()
         };
@@ -159,12 +173,12 @@ impl ModelSpec {
         }
         let mut pins = Vec::new();
         for p in &self.pin {
-            if p.at.len() != features.len() || p.at.iter().any(|v| !v.is_finite()) {
+            if p.at.len() != inputs.len() || p.at.iter().any(|v| !v.is_finite()) {
                 return Err(SpecError::new(
                     path,
                     line_of(text, "at"),
                     "pin.at",
-                    format!("needs {} finite coordinates ({})", features.len(), features.join(", ")),
+                    format!("needs {} finite coordinates ({})", inputs.len(), inputs.join(", ")),
                 ));
             }
             let eliminate = num
@@ -188,8 +202,22 @@ impl ModelSpec {
         if !self.offset.is_finite() {
             return Err(SpecError::new(path, line_of(text, "offset"), "offset", "not finite"));
         }
-        RationalModel::new(features, num, den, self.offset, factor, fixed, pins, clamp)
-            .map_err(|e| err("model", e))
+        let lead = match &self.denominator_lead {
+            Some(t) => Some(Term::parse(t, &features).map_err(|e| err("denominator_lead", e))?),
+            None => None,
+        };
+        RationalModel::new(ModelParts {
+            numerator: num,
+            denominator: den,
+            lead,
+            offset: self.offset,
+            factor,
+            fixed,
+            pins,
+            clamp,
+            ..parts0
+        })
+        .map_err(|e| err("model", e))
     }
 }
 
