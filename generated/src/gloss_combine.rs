@@ -26,5 +26,5 @@ pub const GLOSS_COMBINE_DEN: [f32; 3] = [
 pub fn combine_gloss(x: f32, y: f32) -> f32 {
     let x0 = input(x, 0e0_f32, 1e0_f32);
     let x1 = input(y, 0e0_f32, 1e0_f32);
-    ((GLOSS_COMBINE_NUM[0] + GLOSS_COMBINE_NUM[1] * (x0 + x1) + GLOSS_COMBINE_NUM[2] * (x0 * x0 + x1 * x1) + GLOSS_COMBINE_NUM[3] * x0 * x1) / (1e0_f32 + GLOSS_COMBINE_DEN[0] * (x0 + x1) + GLOSS_COMBINE_DEN[1] * (x0 * x0 + x1 * x1) + GLOSS_COMBINE_DEN[2] * x0 * x1)).clamp(0e0_f32, 1e0_f32)
+    ((GLOSS_COMBINE_NUM[0] + GLOSS_COMBINE_NUM[1] * (x0 + x1) + GLOSS_COMBINE_NUM[2] * (x0 * x0 + x1 * x1) + GLOSS_COMBINE_NUM[3] * (x0 * x1)) / (1e0_f32 + (GLOSS_COMBINE_DEN[0] * (x0 + x1) + GLOSS_COMBINE_DEN[1] * (x0 * x0 + x1 * x1) + GLOSS_COMBINE_DEN[2] * (x0 * x1)))).clamp(0e0_f32, 1e0_f32)
 }

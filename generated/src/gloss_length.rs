@@ -15,11 +15,11 @@ fn input(v: f32, lo: f32, hi: f32) -> f32 {
 
 /// Numerator coefficients, one per numerator term.
 pub const GLOSS_LENGTH_NUM: [f32; 4] = [
-    6.666667e-1_f32, 1.0266011e-1_f32, 7.5295296e0_f32, 5.550498e-1_f32,
+    6.666667e-1_f32, 1.0266422e-1_f32, 7.5295796e0_f32, 5.5504626e-1_f32,
 ];
 /// Denominator coefficients (the constant term 1 is implicit).
 pub const GLOSS_LENGTH_DEN: [f32; 2] = [
-    -1.072162e0_f32, 8.926446e0_f32,
+    -1.0721555e0_f32, 8.92649e0_f32,
 ];
 
 /// CPU version of the WGSL function of the same name.

@@ -21,5 +21,5 @@ const GLOSS_COMBINE_DEN: array<f32, 3> = array<f32, 3>(
 fn combine_gloss(x: f32, y: f32) -> f32 {
     let x0 = gloss_combine_input(x, 0e0f, 1e0f);
     let x1 = gloss_combine_input(y, 0e0f, 1e0f);
-    return clamp((GLOSS_COMBINE_NUM[0] + GLOSS_COMBINE_NUM[1] * (x0 + x1) + GLOSS_COMBINE_NUM[2] * (x0 * x0 + x1 * x1) + GLOSS_COMBINE_NUM[3] * x0 * x1) / (1e0f + GLOSS_COMBINE_DEN[0] * (x0 + x1) + GLOSS_COMBINE_DEN[1] * (x0 * x0 + x1 * x1) + GLOSS_COMBINE_DEN[2] * x0 * x1), 0e0f, 1e0f);
+    return clamp((GLOSS_COMBINE_NUM[0] + GLOSS_COMBINE_NUM[1] * (x0 + x1) + GLOSS_COMBINE_NUM[2] * (x0 * x0 + x1 * x1) + GLOSS_COMBINE_NUM[3] * (x0 * x1)) / (1e0f + (GLOSS_COMBINE_DEN[0] * (x0 + x1) + GLOSS_COMBINE_DEN[1] * (x0 * x0 + x1 * x1) + GLOSS_COMBINE_DEN[2] * (x0 * x1))), 0e0f, 1e0f);
 }

@@ -12,10 +12,10 @@ fn gloss_length_input(v: f32, lo: f32, hi: f32) -> f32 {
 }
 
 const GLOSS_LENGTH_NUM: array<f32, 4> = array<f32, 4>(
-    6.666667e-1f, 1.0266011e-1f, 7.5295296e0f, 5.550498e-1f,
+    6.666667e-1f, 1.0266422e-1f, 7.5295796e0f, 5.5504626e-1f,
 );
 const GLOSS_LENGTH_DEN: array<f32, 2> = array<f32, 2>(
-    -1.072162e0f, 8.926446e0f,
+    -1.0721555e0f, 8.92649e0f,
 );
 
 fn gloss_to_normal_length(gloss: f32) -> f32 {

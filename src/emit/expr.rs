@@ -153,32 +153,28 @@ pub fn eval_f32(e: &Expr, vars: &[f32], num: &[f32], den: &[f32]) -> f32 {
     }
 }
 
-/// Render with language-specific names for variables, coefficients and literals.
+/// Render with language-specific names for variables, coefficients and literals. Parentheses
+/// follow the tree exactly (a right operand of the same operator is bracketed), so the emitted
+/// code evaluates in the order [`eval_f32`] does.
 pub fn render(
     e: &Expr,
     var: &dyn Fn(usize) -> String,
     coef: &dyn Fn(u8, usize) -> String,
     lit: &dyn Fn(f32) -> String,
 ) -> String {
+    let r = |x: &Expr| render(x, var, coef, lit);
+    let wrap = |x: &Expr, when: bool| if when { format!("({})", r(x)) } else { r(x) };
     match e {
         Lit(v) => lit(*v),
         Var(i) => var(*i),
         Coef(a, j) => coef(*a, *j),
-        Add(a, b) => format!("{} + {}", render(a, var, coef, lit), render(b, var, coef, lit)),
-        Mul(a, b) => format!("{} * {}", paren(a, var, coef, lit), paren(b, var, coef, lit)),
-        Div(a, b) => format!("({}) / ({})", render(a, var, coef, lit), render(b, var, coef, lit)),
-    }
-}
-
-fn paren(
-    e: &Expr,
-    var: &dyn Fn(usize) -> String,
-    coef: &dyn Fn(u8, usize) -> String,
-    lit: &dyn Fn(f32) -> String,
-) -> String {
-    match e {
-        Add(..) => format!("({})", render(e, var, coef, lit)),
-        _ => render(e, var, coef, lit),
+        Add(a, b) => format!("{} + {}", r(a), wrap(b, matches!(**b, Add(..)))),
+        Mul(a, b) => format!(
+            "{} * {}",
+            wrap(a, matches!(**a, Add(..) | Div(..))),
+            wrap(b, matches!(**b, Add(..) | Mul(..) | Div(..)))
+        ),
+        Div(a, b) => format!("({}) / ({})", r(a), r(b)),
     }
 }
 
@@ -198,6 +194,17 @@ pub fn sanitize(x: f32, lo: f32, hi: f32) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn rendering_keeps_the_tree_order() {
+        // C * (x * y) and 1 + ((a + b) + c) must not be flattened into left-to-right chains.
+        let e = mul(Coef(0, 0), mul(Var(0), Var(1)));
+        let s = render(&e, &|i| format!("x{i}"), &|_, j| format!("c{j}"), &|v| format!("{v}"));
+        assert_eq!(s, "c0 * (x0 * x1)");
+        let e = add(Lit(1.0), add(add(Var(0), Var(1)), Var(2)));
+        let s = render(&e, &|i| format!("x{i}"), &|_, j| format!("c{j}"), &|v| format!("{v}"));
+        assert_eq!(s, "1 + (x0 + x1 + x2)");
+    }
 
     #[test]
     fn horner_form_matches_direct_sum() {

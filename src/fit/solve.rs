@@ -7,17 +7,18 @@
 //!    crate) on the analytic Jacobian; or argmin's Gauss–Newton with a Moré–Thuente line search.
 //! 3. **Minimax**: Lawson's iteratively re-weighted least squares (weights w_i ← w_i·|r_i|,
 //!    each weighted problem solved by LM from the previous iterate, best iterate kept), then
-//!    a derivative-free polish of max|r| with argmin's Nelder–Mead, kept only if it improves.
+//!    a sequential-LP trust-region polish ([`super::minimax::SlpMinimax`], an argmin Solver),
+//!    kept only if it improves.
 //! 4. **L4**: minimise Σ r⁴ by iteratively re-weighted least squares (w_i = r_i² of the previous
 //!    iterate): between least squares and minimax, it lowers the max error without giving up
 //!    the rms error (what a table fit is usually judged by: both).
 
 use super::model::RationalModel;
-use super::problem::{Data, MaxAbs, Residuals};
+use super::minimax::SlpMinimax;
+use super::problem::{Data, Residuals};
 use super::positivity::{prove_denominator_positive, Positivity};
 use super::report::FitReport;
 use argmin::core::{Executor, State};
-use argmin::solver::neldermead::NelderMead;
 use levenberg_marquardt::LevenbergMarquardt;
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
@@ -57,13 +58,13 @@ pub struct FitOptions {
     pub solver: LsqSolver,
     /// Outer iterations of Lawson's algorithm (minimax).
     pub minimax_iters: usize,
-    /// Nelder–Mead iterations of the minimax polish (0 disables it).
+    /// Iterations of the sequential-LP minimax polish (0 disables it).
     pub polish_iters: u64,
 }
 
 impl Default for FitOptions {
     fn default() -> Self {
-        FitOptions { objective: Objective::Lsq, solver: LsqSolver::Lm, minimax_iters: 300, polish_iters: 3000 }
+        FitOptions { objective: Objective::Lsq, solver: LsqSolver::Lm, minimax_iters: 300, polish_iters: 200 }
     }
 }
 
@@ -329,23 +330,19 @@ fn minimax(
     let mut theta = best.1.clone();
     problem.sqrt_w.iter_mut().for_each(|w| *w = 1.0);
     if opts.polish_iters > 0 {
-        let mut simplex = vec![theta.clone()];
-        for j in 0..theta.len() {
-            let mut t = theta.clone();
-            t[j] += 1e-4 * t[j].abs().max(1e-3);
-            simplex.push(t);
-        }
-        if let Ok(nm) = NelderMead::new(simplex).with_sd_tolerance(1e-16) {
-            let cost = MaxAbs(problem);
-            if let Ok(res) = Executor::new(cost, nm).configure(|s| s.max_iters(opts.polish_iters)).run() {
-                let st = res.state();
-                if let Some(p) = st.get_best_param()
-                    && st.get_best_cost() < best.0
-                {
-                    theta = p.clone();
-                }
-                evals += st.get_iter() as usize;
+        // Sequential-LP polish (an argmin Solver of ours): converges to the equioscillating
+        // optimum that Lawson's iteration only approaches linearly.
+        let res = Executor::new(problem.clone(), SlpMinimax::default())
+            .configure(|s| s.param(theta.clone()).max_iters(opts.polish_iters))
+            .run();
+        if let Ok(res) = res {
+            let st = res.state();
+            if let Some(p) = st.get_best_param()
+                && st.get_best_cost() < best.0
+            {
+                theta = p.clone();
             }
+            evals += st.get_iter() as usize;
         }
     }
     problem.theta.copy_from(&theta);

@@ -1,33 +1,39 @@
 //! Anisotropic asperity scattering ("fuzz") layer of Ghost of Tsushima (Patry, SIGGRAPH 2020
-//! course + supplemental material §1.1–1.4): reference values of P_s, G, Q and R.
+//! course "Samurai Shading" and its supplemental material §1.1–1.4): reference values of the
+//! integrals P_s, G, Q and R that the published shader approximations P̃_s, G̃, Q̃, R̃ fit.
 //!
 //! # Conventions (the contract)
-//! - Surface normal n = +z. Fiber direction t = (sin θf, 0, cos θf); θf is the fiber polar
-//!   angle from n. Light u = (sin θu cos φu, sin θu sin φu, cos θu); φu is measured from the
-//!   fiber azimuth. μ = direction·n. All angles in radians, everything f64.
+//! - Surface normal n = +z. Fiber direction t = (sin θf, 0, cos θf): θf is the fiber polar
+//!   angle from n. Light u = (sin θu cos φu, sin θu sin φu, cos θu): φu is measured from the
+//!   fiber azimuth. μ = direction·n. Angles in radians, everything f64.
 //! - SGGX "fiber" phase function (analytically normalised):
 //!     D_F(h) = α³ / (π ((h·t)²(1 − α²) + α²)²),   σ_F(u) = sqrt(1 − (u·t)²(1 − α²)),
 //!     p(u, v) = D_F(h) / (4 σ_F(u)),   h = (u + v)/|u + v|.
-//!   Over the whole sphere of v, p integrates to 1 (D_F is the SGGX NDF of
-//!   S = diag(α², 1, 1) in the fiber frame; dω_v = 4|u·h| dω_h and ∫ D_F(h)(u·h)₊ dω_h = σ_F(u)).
-//!   α ∈ (0, 1] is the projected area of the flakes along t (1 across it).
+//!   D_F is the SGGX NDF of S = diag(α², 1, 1) in the fiber frame (flake projected area α along
+//!   t, 1 across it); with dω_v = 4|u·h| dω_h and ∫ D_F(h)(u·h)₊ dω_h = σ_F(u), p integrates to 1
+//!   over the sphere of v. D_F is largest (1/(πα)) for h ⟂ t: the scattered light concentrates
+//!   on the specular cone v·t = −u·t, a band of width ~α.
 //! - P_s(u) = 1 − ∫_{v·n>0} p(u, v) dω_v = ∫_{v·n<0} p(u, v) dω_v: the fraction of light scattered
 //!   by the layer toward the base layer. Published fit domain α ∈ [0.15, 1], θf ∈ [0.1, π/2];
-//!   here any α ∈ (0, 1] (tested down to 0.05), any θf (θf = 0 included) and any u (also below
-//!   the horizon).
+//!   here any α ∈ (0, 1] (tested down to 0.05), any θf (θf = 0 included; θf outside [0, π/2] is
+//!   folded with t ≡ −t) and any u (also below the horizon).
 //! - G(d, μv) = (1/2π) ∫_Ω (1 − exp(−d (μu + μv)/(μu μv))) μu/(μu + μv) dω_u over the upper
 //!   hemisphere Ω (Koenderink–Pont single-scattering layer of optical thickness d; the seed
-//!   texts garble the exponent, this form is the decision). The azimuth integrates out:
+//!   texts garble this exponent, this form is the decision). The azimuth integrates out:
 //!     G(d, μv) = ∫₀¹ (1 − e^{−d/μv} e^{−d/μ}) μ/(μ + μv) dμ,
-//!   and in closed form (x = 1/μ, partial fractions 1/(x²(1+cx)) = 1/x² − c/x + c²/(1+cx)):
+//!   and with x = 1/μ and 1/(x²(1+cx)) = 1/x² − c/x + c²/(1+cx) it has the closed form
 //!     G = 1 − c ln((1+c)/c) − e^{−d/c} E₂(d) + c e^{−d/c} E₁(d) − c E₁(d(1+c)/c),   c = μv.
-//!   Limits: G → 1 as μv → 0 (d > 0); G = d/μv − (d²/2μv) ln(1/d) + O(d²) as d → 0.
-//! - Q(d) = (1/π) ∫_Ω exp(−d/μu) μu dω_u = 2 ∫₀¹ e^{−d/μ} μ dμ = 2 E₃(d) exactly (E_n: exponential
-//!   integral ∫₁^∞ e^{−xt} t^{−n} dt). Q(0) = 1.
-//! - R(θf, α) = (1/π) ∫_Ω P_s(u) μu dω_u. Density d ∈ [0, 0.5] is the published G/Q domain.
+//!   Limits: G → 1 as μv → 0 (d > 0), 1 − G ≈ μv ln(1/μv); G = d/μv − (d²/2μv) ln(1/d) + O(d²)
+//!   as d → 0 (the d² term is logarithmic because e^{−d/μ} is not expandable near μ = 0).
+//! - Q(d) = (1/π) ∫_Ω exp(−d/μu) μu dω_u = 2 ∫₀¹ e^{−d/μ} μ dμ = 2 E₃(d) exactly, E_n(x) =
+//!   ∫₁^∞ e^{−xt} t^{−n} dt. Q(0) = 1.
+//! - R(θf, α) = (1/π) ∫_Ω P_s(u) μu dω_u. Density d ∈ [0, 0.5] is the published G̃/Q̃ domain.
 //!
-//! Tolerances are absolute; [`DEFAULT_TOL`] = 1e-9. Each [`Estimate`] carries an error estimate
-//! meant as an upper estimate of |value − exact| (checked by convergence studies in the tests).
+//! Tolerances are absolute; [`DEFAULT_TOL`] = 1e-9 (a non-positive or NaN tolerance means the
+//! default). Each [`Estimate`] carries an error estimate meant as an upper estimate of
+//! |value − exact|; estimates are floored at 1e-12 (below that QUADPACK's extrapolating
+//! estimate was seen to under-estimate by up to 2×). `evals` counts scalar integrand
+//! evaluations (for R: arc integrals, below).
 //!
 //! # P_s: reduction to one dimension
 //! Coordinates of v about the fiber: w = v·t and the azimuth η about t in the frame
@@ -39,50 +45,68 @@
 //! so the Δ-integral over any arc is elementary:
 //!     ∫ dΔ/z = 2/sqrt(R² − S²) · atan(τ tan(Δ/2)),  τ = sqrt((R − S)/(R + S)),
 //!     ∫ dΔ/z² = (R ∫ dΔ/z − S sin Δ / z) / (R² − S²).
-//! Cancellation-free: m − ρ = ε²/(m + ρ), hence R − S = ε²(1 − α² + 2α²/(m + ρ)) and every
-//! factor 1/sqrt(R² − S²) ∝ 1/|ε| is paired with a K ∝ ε² before evaluation.
+//! Cancellation-free: m − ρ = ε²/(m + ρ), hence R − S = ε²(1 − α² + 2α²/(m + ρ)); every factor
+//! 1/sqrt(R² − S²) ∝ 1/|ε| is paired with a K ∝ ε² before evaluation, and z is evaluated as
+//! (R − S) + 2S cos²(Δ/2). With y = Δ/2, atan2(τ sin y, cos y) is a continuous antiderivative
+//! growing by π per period, so arcs need no wrapping.
 //! The horizon v_z = w cos θf − s_w sin θf cos η < 0 is, for fixed w: the whole circle for
 //! w < −sin θf, nothing for w > sin θf, and the arc |η| < η₀(w) in between. So
-//!     P_s(u) = 1/(4 σ_F(u)) ∫_{−1}^{sin θf} I(w) dw,
-//! where I(w) is the closed-form arc integral of D_F. The 1-D integrand has a cusp on the
-//! specular cone w = −a (peak width ≈ L = 2α sqrt((1−α²)(1−a²) + α²)/(1−α²), the scale on which
-//! K/z is of order one) and square-root endpoints at w = ±sin θf (the arc opens/closes). The
-//! range is split at these points; each piece is mapped by w = −a + L tan ξ (flattens the
-//! Cauchy-like peak and its tails) and by a quadratic/smoothstep end map (removes the square
-//! roots), then integrated with adaptive Gauss–Kronrod. Typically 40–200 integrand evaluations.
+//!     P_s(u) = 1/(4 σ_F(u)) · (1/πα) ∫_{−1}^{sin θf} I(w) dw,
+//! I(w) the closed-form arc integral of πα D_F. The 1-D integrand has
+//! - a cusp on the specular cone w = −a; the peak around it has width
+//!   L = 2α sqrt((1−α²)(1−a²) + α²)/(1−α²) (where K/z is of order one) and Cauchy-like tails;
+//! - square-root endpoints at w = ±sin θf (the arc opens and closes);
+//! - when u grazes the horizon, a multi-scale feature near the cone: D_F has a dip of width
+//!   ∝ |ε| around the forward direction v = −u, and the arc boundary passes close to it. Its
+//!   smallest scale s is min(|w* + a|, 8ε_δ) with w* the w where the arc boundary reaches the
+//!   dip's azimuth and ε_δ = δ α s_a²/sqrt((1−α²)s_a² + α²) (δ: the Δ-distance of the dip
+//!   from the arc boundary at w = −a).
+//! The range is split at ±sin θf and at the cone; pieces are mapped by w = −a + L tan ξ
+//! (flattens the peak and its tails) and by a quadratic/smoothstep end map at ±sin θf (removes
+//! the square roots). With a grazing scale s < L/16 the band s ≤ |w + a| ≤ L/2 is cut off and
+//! mapped logarithmically (w = −a ± e^ξ), so the feature spans O(1) in ξ at every scale.
+//! Each piece: adaptive Gauss–Kronrod. Typically 60–200 evaluations of I per P_s.
 //!
 //! # R: u in fiber coordinates
-//! With u = (a = cos A, η_u) about t, dω_u = sin A dA dη_u and μu = a cos θf − sin A sin θf cos η_u;
-//! u is above the horizon on the whole circle for A < π/2 − θf, on the arc η_u ∈ (η_min, π] (and
-//! its mirror) for A < π/2 + θf, nowhere beyond. By the φ-mirror symmetry,
-//!     R = (2/π) ∫ sin A ∫_{η_min}^{π} μu P_s dη_u dA.
-//! For fixed A the specular peak w = −a and all breakpoints of the w-integrand are the same for
-//! every η_u, and the part of I(w) with the whole circle (w < −sin θf) does not depend on η_u
-//! at all: it is integrated once, times ∫ μu dη_u (closed form). The arc part is integrated in w
-//! once for all 15 Kronrod nodes in η_u together. The η_u-integrand μu P_s is smooth (P_s is
-//! smooth across the horizon and μu vanishes linearly there), so G7/K15 in η_u suffices (split
-//! further when its estimate says so); A is adaptive G10/K21 split at π/2 − θf. P_s varies with
-//! A on the scale α near a = ±sin θf (the peak crossing the horizon breakpoints), which is
-//! exactly where the A pieces begin and end.
+//! With u = (a = cos A, η_u) about t, dω_u = sin A dA dη_u and μu = a cos θf − sin A sin θf cos η_u:
+//! u is above the horizon on the whole circle for A < π/2 − θf, on the arc η_u ∈ (η_min, π] and
+//! its mirror for A < π/2 + θf, nowhere beyond. By the φ-mirror symmetry
+//!     R = (2/π) ∫ sin A J(A) dA,   J(A) = ∫_{η_min}^{π} μu P_s dη_u.
+//! For fixed A the cone w = −a and all breakpoints in w are the same for every η_u, and the
+//! whole-circle part of I(w) does not depend on η_u: it is integrated once, times ∫ μu dη_u
+//! (closed form). The arc part is integrated in w once for all 15 nodes of a G7/K15 rule in
+//! η_u together (error control on every node, weighted as in the rule); nodes whose grazing
+//! band matters get their own banded integration. μu P_s is smooth in η_u (P_s is smooth
+//! across the horizon and μu vanishes linearly there), so G7/K15 panels suffice (bisected
+//! while the rule's estimate exceeds its share). The A-integral is split at π/2 − θf, where
+//! the u-circle touches the horizon and the cone crosses w = −sin θf (P_s is not analytic
+//! in A there); the second piece carries the smoothstep end map. Its integrand is analytic on
+//! each piece, so a 32-point Gauss–Legendre panel checked against a 24-point one usually
+//! suffices (G10/K21 would need several bisections because its estimate is the G10 error).
+//! Inner tolerances follow the outer weights (loose where sin A dA/dt is small).
 //!
 //! # Error estimates
-//! The private adaptive Gauss–Kronrod here uses QUADPACK's estimate
-//! resasc · min(1, (200 |K21 − G10| / resasc)^{3/2}), floored at 50 ε resabs (ε = f64 epsilon),
-//! which for the smooth mapped integrands is far closer to the true error than the raw
-//! |K − G|, yet still above it (the tests compare default-tolerance values with tight ones and
-//! with independent brute-force quadratures). Nested errors are propagated: R's error is the
-//! outer estimate plus the integral of the inner estimates.
+//! Panels use QUADPACK's estimate resasc · min(1, (200 |Q_hi − Q_lo| / resasc)^{3/2}),
+//! floored at 50 ε resabs (ε = f64 epsilon), with (Q_hi, Q_lo) = (K21, G10), (K15, G7) or
+//! (GL32, GL24). For the smooth mapped integrands this is far closer to the true error than
+//! the raw |Q_hi − Q_lo| and still above it: the tests compare default-tolerance values with
+//! tight ones and with independent brute-force quadratures. Nested errors are propagated: R's
+//! error is the outer estimate plus the integral of the inner estimates.
 //!
-//! # Symmetries (tested)
+//! # Symmetries and special values (tested)
 //! - P_s(θu, −φu) = P_s(θu, φu) (mirror y → −y keeps t and n).
 //! - P_s(−u) = 1 − P_s(u), since p(−u, −v) = p(u, v).
-//! - θf → π − θf with φu → π − φu (mirror x → −x, and t ≡ −t): P_s is unchanged; at θf = π/2
-//!   P_s is therefore even in u·t, so the published coefficients c₂, c₄ of the odd terms
-//!   should vanish there.
+//! - (θf, φu) → (π − θf, π − φu) leaves P_s unchanged (mirror x → −x, and t ≡ −t); at θf = π/2
+//!   P_s is therefore even in u·t, so the published coefficients c₂, c₄ of the odd terms u·t and
+//!   (u·n)(u·t) should vanish there.
 //! - α = 1: p = 1/(4π) is isotropic, so P_s ≡ ½ and R = ½ (the published forms build this in:
-//!   c_i = s_i + β(…), R̃ = ½ + β(…), β = 1 − α).
+//!   c_i = s_i + β(…) and R̃ = ½ + β(…) with β = 1 − α).
 //! - θf = 0: P_s depends on θu only (u·t = u·n), which is why the published 6-term fit in
-//!   (u·n, u·t) degenerates and the published fit clamps θf ≥ 0.1.
+//!   (u·n, u·t) degenerates there and the published P̃_s clamps θf ≥ 0.1.
+//!
+//! # Data sets for the published fits
+//! [`ps_grid`] (P_s on an α × θf grid, for each light direction of [`fitting_directions`]) and
+//! [`r_grid`] parallelise over grid points with rayon; results are deterministic.
 
 use crate::integrate::{Estimate, Tolerance, adaptive};
 use rayon::prelude::*;
@@ -96,6 +120,9 @@ pub const PUBLISHED_ALPHA_MIN: f64 = 0.15;
 pub const PUBLISHED_THETA_F_MIN: f64 = 0.1;
 /// Largest density d of the published G and Q fits.
 pub const PUBLISHED_DENSITY_MAX: f64 = 0.5;
+
+/// Smallest error reported for P_s and R (see the module doc).
+const ERROR_FLOOR: f64 = 1e-12;
 
 /// Most adaptive panels in one 1-D integral here (the estimate is returned either way).
 const MAX_PANELS: usize = 2000;
@@ -222,8 +249,14 @@ struct Panel<const N: usize> {
     error: f64,
 }
 
-/// One G10/K21 panel of a vector integrand; the error is that of component 0.
-fn gk21_panel<const N: usize>(a: f64, b: f64, f: &mut impl FnMut(f64) -> [f64; N]) -> Panel<N> {
+/// One G10/K21 panel of a vector integrand. Its error is Σ_i ew[i]·err_i, err_i the QUADPACK
+/// estimate of component i (components with ew[i] = 0 are integrated along, unchecked).
+fn gk21_panel<const N: usize>(
+    a: f64,
+    b: f64,
+    ew: &[f64; N],
+    f: &mut impl FnMut(f64) -> [f64; N],
+) -> Panel<N> {
     let c = 0.5 * (a + b);
     let h = 0.5 * (b - a);
     let mut fv = [[0.0; N]; 21];
@@ -234,36 +267,36 @@ fn gk21_panel<const N: usize>(a: f64, b: f64, f: &mut impl FnMut(f64) -> [f64; N
         fv[20 - j] = f(c + dx);
     }
     let mut value = [0.0; N];
-    for (i, v) in value.iter_mut().enumerate() {
-        let mut s = WGK21[10] * fv[10][i];
+    let mut error = 0.0;
+    let ha = h.abs();
+    for i in 0..N {
+        let mut resk = WGK21[10] * fv[10][i];
+        let mut resg = 0.0;
+        let mut resabs = WGK21[10] * fv[10][i].abs();
         for j in 0..10 {
-            s += WGK21[j] * (fv[j][i] + fv[20 - j][i]);
+            resk += WGK21[j] * (fv[j][i] + fv[20 - j][i]);
+            resabs += WGK21[j] * (fv[j][i].abs() + fv[20 - j][i].abs());
+            if j % 2 == 1 {
+                resg += WG10[j / 2] * (fv[j][i] + fv[20 - j][i]);
+            }
         }
-        *v = s * h;
-    }
-    let resk = value[0] / h;
-    let mut resg = 0.0;
-    let mut resabs = WGK21[10] * fv[10][0].abs();
-    for j in 0..10 {
-        if j % 2 == 1 {
-            resg += WG10[j / 2] * (fv[j][0] + fv[20 - j][0]);
+        value[i] = resk * h;
+        if ew[i] != 0.0 {
+            let mean = 0.5 * resk;
+            let mut resasc = WGK21[10] * (fv[10][i] - mean).abs();
+            for j in 0..10 {
+                resasc += WGK21[j] * ((fv[j][i] - mean).abs() + (fv[20 - j][i] - mean).abs());
+            }
+            error += ew[i] * quadpack_error(((resk - resg) * ha).abs(), resasc * ha, resabs * ha);
         }
-        resabs += WGK21[j] * (fv[j][0].abs() + fv[20 - j][0].abs());
     }
-    let mean = 0.5 * resk;
-    let mut resasc = WGK21[10] * (fv[10][0] - mean).abs();
-    for j in 0..10 {
-        resasc += WGK21[j] * ((fv[j][0] - mean).abs() + (fv[20 - j][0] - mean).abs());
-    }
-    let h = h.abs();
-    let error = quadpack_error(((resk - resg) * h).abs(), resasc * h, resabs * h);
     Panel { a, b, value, error }
 }
 
 /// Globally adaptive integration of a vector integrand over [a, b] with the panel rule
-/// `panel`: bisects the panel with the largest component-0 error until the summed component-0
-/// error is ≤ tol. Returns the component integrals (summed in position order), the
-/// component-0 error and the number of evaluations.
+/// `panel`: bisects the panel with the largest error until the summed panel errors are ≤ tol.
+/// Returns the component integrals (summed in position order), the error and the number of
+/// evaluations.
 fn adaptive_vec<const N: usize, F: FnMut(f64) -> [f64; N]>(
     a: f64,
     b: f64,
@@ -309,51 +342,62 @@ fn adaptive_vec<const N: usize, F: FnMut(f64) -> [f64; N]>(
     }
 }
 
-/// Adaptive G10/K21 (QUADPACK error estimate) of a vector integrand; see [`adaptive_vec`].
+/// Adaptive G10/K21 (QUADPACK error estimates, weighted by `ew`) of a vector integrand; see
+/// [`adaptive_vec`] and [`gk21_panel`].
 fn gk21_adaptive<const N: usize>(
     a: f64,
     b: f64,
     tol: f64,
+    ew: &[f64; N],
     f: impl FnMut(f64) -> [f64; N],
 ) -> ([f64; N], f64, u64) {
-    adaptive_vec(a, b, tol, |a, b, f| (gk21_panel(a, b, f), 21), f)
+    adaptive_vec(a, b, tol, |a, b, f| (gk21_panel(a, b, ew, f), 21), f)
 }
 
-/// Gauss–Legendre 32- and 24-point rules on [-1, 1] (the high-order panel pair of R's outer
-/// integral: for its analytic integrand one 32-point panel usually meets the tolerance, where
+/// A pair of Gauss–Legendre rules (n_hi > n_lo points) on [-1, 1], used as a panel rule:
+/// value from the larger, error from QUADPACK's formula applied to |Q_hi − Q_lo| (conservative:
+/// for analytic integrands the Q_hi error is far below |Q_hi − Q_lo|).
+struct GlPair {
+    hi: (Vec<f64>, Vec<f64>),
+    lo: (Vec<f64>, Vec<f64>),
+}
+
+/// GL32/GL24: the outer A-integral of R (its analytic integrand usually needs one panel, where
 /// G10/K21 needs several bisections because its estimate is the G10 error).
-fn gl_pair() -> &'static ((Vec<f64>, Vec<f64>), (Vec<f64>, Vec<f64>)) {
-    static RULES: std::sync::OnceLock<((Vec<f64>, Vec<f64>), (Vec<f64>, Vec<f64>))> =
-        std::sync::OnceLock::new();
-    RULES.get_or_init(|| (crate::integrate::gauss_legendre(32), crate::integrate::gauss_legendre(24)))
+fn gl_pair_32() -> &'static GlPair {
+    static RULES: std::sync::OnceLock<GlPair> = std::sync::OnceLock::new();
+    RULES.get_or_init(|| GlPair { hi: crate::integrate::gauss_legendre(32), lo: crate::integrate::gauss_legendre(24) })
 }
 
-/// One panel of the GL32/GL24 pair: value GL32, error QUADPACK-style from |GL32 − GL24| with
-/// resasc, resabs from the 32-point rule (conservative: the GL32 error is far below
-/// |GL32 − GL24| for analytic integrands).
-fn gl_pair_panel<const N: usize>(a: f64, b: f64, f: &mut impl FnMut(f64) -> [f64; N]) -> (Panel<N>, u64) {
-    let ((x32, w32), (x24, w24)) = gl_pair();
+/// One panel of a GL pair on [a, b]; error Σ_i ew[i]·err_i as in [`gk21_panel`].
+fn gl_pair_panel<const N: usize>(
+    rules: &GlPair,
+    a: f64,
+    b: f64,
+    ew: &[f64; N],
+    f: &mut impl FnMut(f64) -> [f64; N],
+) -> (Panel<N>, u64) {
+    let (xh, wh) = &rules.hi;
+    let (xl, wl) = &rules.lo;
     let c = 0.5 * (a + b);
     let h = 0.5 * (b - a);
+    let ha = h.abs();
+    let fh: Vec<[f64; N]> = xh.iter().map(|x| f(c + h * x)).collect();
+    let fl: Vec<[f64; N]> = xl.iter().map(|x| f(c + h * x)).collect();
     let mut value = [0.0; N];
-    let mut f0 = [0.0; 32];
-    for (k, (x, w)) in x32.iter().zip(w32).enumerate() {
-        let fx = f(c + h * x);
-        f0[k] = fx[0];
-        for (v, fv) in value.iter_mut().zip(fx) {
-            *v += w * fv * h;
+    let mut error = 0.0;
+    for i in 0..N {
+        let qh: f64 = fh.iter().zip(wh).map(|(fx, w)| w * fx[i]).sum();
+        value[i] = qh * h;
+        if ew[i] != 0.0 {
+            let ql: f64 = fl.iter().zip(wl).map(|(fx, w)| w * fx[i]).sum();
+            let mean = 0.5 * qh;
+            let resasc: f64 = fh.iter().zip(wh).map(|(fx, w)| w * (fx[i] - mean).abs()).sum();
+            let resabs: f64 = fh.iter().zip(wh).map(|(fx, w)| w * fx[i].abs()).sum();
+            error += ew[i] * quadpack_error(((qh - ql) * ha).abs(), resasc * ha, resabs * ha);
         }
     }
-    let mut q24 = 0.0;
-    for (x, w) in x24.iter().zip(w24) {
-        q24 += w * f(c + h * x)[0] * h;
-    }
-    let mean = value[0] / (2.0 * h);
-    let resasc: f64 = f0.iter().zip(w32).map(|(fx, w)| w * (fx - mean).abs()).sum::<f64>() * h.abs();
-    let resabs: f64 = f0.iter().zip(w32).map(|(fx, w)| w * fx.abs()).sum::<f64>() * h.abs();
-    let error = quadpack_error((value[0] - q24).abs(), resasc, resabs);
-    if std::env::var("RDBG").is_ok() { eprintln!("  GLPANEL {a:.5} {b:.5} q32 {:.15} q24 {:.15} err {error:.2e} resasc {resasc:.2e}", value[0], q24); }
-    (Panel { a, b, value, error }, 56)
+    (Panel { a, b, value, error }, (xh.len() + xl.len()) as u64)
 }
 
 // G7/K15 on [-1, 1] (QUADPACK qk15), used for the η_u rule of R.
@@ -408,6 +452,50 @@ fn end_map(t: f64, lo: bool, hi: bool) -> (f64, f64) {
     }
 }
 
+/// arctan(x) for |x| ≤ 1 (Cephes atan: rational minimax in x² after reducing to |x| ≤ 0.66
+/// through atan(x) = π/4 + atan((x−1)/(x+1)); about 1 ulp). Faster than libm's atan2, which
+/// dominated the cost of the arc integrals.
+fn atan_unit(x: f64) -> f64 {
+    const P: [f64; 5] = [
+        -8.750608600031904122785e-1,
+        -1.615753718733365076637e1,
+        -7.500855792314704667340e1,
+        -1.228866684490136173410e2,
+        -6.485021904942025371773e1,
+    ];
+    const Q: [f64; 5] = [
+        2.485846490142306297962e1,
+        1.650270098316988542046e2,
+        4.328810604912902668951e2,
+        4.853903996359136964868e2,
+        1.945506571482613964425e2,
+    ];
+    const MOREBITS: f64 = 6.123233995736765886130e-17;
+    let (sign, ax) = if x < 0.0 { (-1.0, -x) } else { (1.0, x) };
+    let (base, xr, extra) = if ax <= 0.66 {
+        (0.0, ax, 0.0)
+    } else {
+        (std::f64::consts::FRAC_PI_4, (ax - 1.0) / (ax + 1.0), 0.5 * MOREBITS)
+    };
+    let z = xr * xr;
+    let p = (((P[0] * z + P[1]) * z + P[2]) * z + P[3]) * z + P[4];
+    let q = ((((z + Q[0]) * z + Q[1]) * z + Q[2]) * z + Q[3]) * z + Q[4];
+    sign * (base + (xr * (z * p / q) + xr + extra))
+}
+
+/// atan2(y, x) for y ≥ 0 (result in [0, π]) via [`atan_unit`].
+fn atan2_upper(y: f64, x: f64) -> f64 {
+    if y == 0.0 {
+        return if x >= 0.0 { 0.0 } else { PI };
+    }
+    if x.abs() >= y {
+        let t = atan_unit(y / x.abs());
+        if x > 0.0 { t } else { PI - t }
+    } else {
+        FRAC_PI_2 - atan_unit(x / y)
+    }
+}
+
 /// acos(c/b) for b > 0, |c| < b, accurate near both ends: 2·atan2(sqrt(b − c), sqrt(b + c)),
 /// with the smaller of b ∓ c recomputed from (b − c)(b + c) = prod when given.
 fn half_width(b: f64, c: f64, prod: f64) -> f64 {
@@ -417,7 +505,7 @@ fn half_width(b: f64, c: f64, prod: f64) -> f64 {
     } else {
         bm = prod / bp;
     }
-    2.0 * bm.max(0.0).sqrt().atan2(bp.max(0.0).sqrt())
+    2.0 * atan2_upper(bm.max(0.0).sqrt(), bp.max(0.0).sqrt())
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -567,7 +655,7 @@ impl Layer {
     }
 
     /// Width of the specular peak in w around −a.
-    fn peak_scale(&self, _a: f64, sa: f64) -> f64 {
+    fn peak_scale(&self, sa: f64) -> f64 {
         if self.k2 <= 0.0 {
             return 4.0;
         }
@@ -604,7 +692,7 @@ impl Layer {
     /// Lower edge of the grazing band: the band s ≤ |ε| ≤ L/2 gets the logarithmic map (so a
     /// feature at any scale in it spans O(1) in ξ); None when s is not well below the peak.
     fn graze_band(&self, a: f64, sa: f64, s: f64) -> Option<f64> {
-        let scale = self.peak_scale(a, sa);
+        let scale = self.peak_scale(sa);
         let s = s.max(1e-12 * scale);
         if s < scale / 16.0 { Some(s) } else { None }
     }
@@ -613,7 +701,7 @@ impl Layer {
     /// cone w = −a and, with a grazing band [s, L/2], at −a ± s and −a ± L/2.
     fn pieces(&self, a: f64, sa: f64, band: Option<f64>) -> Vec<Piece> {
         let w0 = -a;
-        let scale = self.peak_scale(a, sa);
+        let scale = self.peak_scale(sa);
         let st = self.st;
         let mut cuts: Vec<f64> = vec![-1.0, -st, st, w0];
         if let Some(s) = band {
@@ -715,10 +803,11 @@ impl Layer {
         // Φ(y_hi) − Φ(y_lo) with Φ(y) = arg(cos y + iτ sin y), in (0, π) since η₀ < π:
         // one atan2 of the product (cos y_hi + iτ sin y_hi)(cos y_lo − iτ sin y_lo).
         let tau = wp.tau;
-        let mut dphi = (tau * (s_hi * c_lo - c_hi * s_lo)).atan2(c_hi * c_lo + tau * tau * s_hi * s_lo);
-        if dphi < -FRAC_PI_2 {
-            dphi += 2.0 * PI;
-        }
+        // The imaginary part τ sin η₀ is ≥ 0 (η₀ ∈ (0, π)), so the angle lies in [0, π].
+        let dphi = atan2_upper(
+            (tau * (s_hi * c_lo - c_hi * s_lo)).max(0.0),
+            c_hi * c_lo + tau * tau * s_hi * s_lo,
+        );
         // sin Δ / z(Δ), z = (R − S) + 2S cos²(Δ/2)
         let q = |s: f64, c: f64| 2.0 * s * c / (wp.rms + wp.s2 * c * c);
         let sig = q(s_hi, c_hi) - q(s_lo, c_lo);
@@ -735,7 +824,7 @@ impl Layer {
         let mut error = 0.0;
         let mut evals = 0;
         for piece in &pieces {
-            let (v, e, n) = gk21_adaptive(0.0, 1.0, share, |t| {
+            let (v, e, n) = gk21_adaptive(0.0, 1.0, share, &[1.0], |t| {
                 let (eps, jac) = piece.map(t);
                 if jac == 0.0 {
                     return [0.0];
@@ -754,10 +843,130 @@ impl Layer {
             error += e;
             evals += n;
         }
-        Estimate { value: value * norm, error: error * norm, evals }
+        Estimate { value: value * norm, error: (error * norm).max(ERROR_FLOOR), evals }
+    }
+
+    /// ∫ I dw over the arc region only, for one light with the grazing band given:
+    /// (value, error, evals), in the raw units of `ps` (before the 1/(4σπα) factor).
+    fn arc_part(&self, l: &Light, band: Option<f64>, tol: f64) -> (f64, f64, u64) {
+        let pieces = self.pieces(l.a, l.sa, band);
+        let n = pieces.iter().filter(|p| p.region == Region::Arc).count().max(1);
+        let (mut value, mut error, mut evals) = (0.0, 0.0, 0);
+        for piece in pieces.iter().filter(|p| p.region == Region::Arc) {
+            let (v, e, k) = gk21_adaptive(0.0, 1.0, tol / n as f64, &[1.0], |t| {
+                let (eps, jac) = piece.map(t);
+                if jac == 0.0 {
+                    return [0.0];
+                }
+                let wp = self.wpoint(l.a, l.sa, eps);
+                let (eta0, s0, c0) = self.arc_half_width(wp.w);
+                [Self::arc(&wp, eta0, s0, c0, l.sh, l.ch) * jac]
+            });
+            value += v[0];
+            error += e;
+            evals += k;
+        }
+        (value, error, evals)
+    }
+
+    /// One G7/K15 panel [lo, hi] in η_u of the arc part of J (raw units):
+    /// (lo, hi, Σ k_j μ_j ∫_arc I(w; η_j) dw, its w-error, the rule's error estimate).
+    /// `share` bounds the w-error; the shared vector integration controls every node.
+    #[allow(clippy::too_many_arguments)]
+    fn eta_panel(
+        &self,
+        a: f64,
+        sa: f64,
+        lo: f64,
+        hi: f64,
+        share: f64,
+        pieces: &[Piece],
+        n_arc: usize,
+        evals: &mut u64,
+    ) -> (f64, f64, f64, f64, f64) {
+        let rule = k15_rule();
+        let (b, c) = (sa * self.st, a * self.ct);
+        let hl = 0.5 * (hi - lo);
+        let c_eta = 0.5 * (hi + lo);
+        let mut lights = [self.light_fiber(a, sa, 0.0); 15];
+        let mut mu = [0.0; 15];
+        let mut grazing = [false; 15];
+        let mut bands = [None; 15];
+        let mut ew = [0.0; 15];
+        for j in 0..15 {
+            let eta = c_eta + hl * rule[j].0;
+            lights[j] = self.light_fiber(a, sa, eta);
+            mu[j] = (c - b * eta.cos()).max(0.0);
+            // A grazing feature below scale s changes the node's arc integral by at most
+            // ≈ 4π s²/(α s_a) (within |ε| < s the arc integral departs from its smooth
+            // continuation by ≤ 2π f1 ≤ 4π sqrt(1−α²)|ε|/(α s_a)); the node needs its own
+            // banded integration only when that, weighted, could exceed a part of the share.
+            // Scales below s_f are harmless: cut the band there.
+            let wj = hl * rule[j].1 * mu[j];
+            let s_f = if wj > 0.0 {
+                (0.05 * share / 15.0 * self.alpha * sa / (4.0 * PI * wj)).sqrt()
+            } else {
+                f64::INFINITY
+            };
+            bands[j] = self.graze_band(a, sa, self.graze_scale(a, sa, eta).max(s_f));
+            grazing[j] = bands[j].is_some();
+            ew[j] = if grazing[j] { 0.0 } else { wj };
+        }
+        let n_graze = grazing.iter().filter(|&&g| g).count();
+        // Node integrals ∫_arc I(w; η_j) dw.
+        let (mut node, mut err) = ([0.0; 15], 0.0);
+        if n_graze < 15 {
+            for piece in pieces.iter().filter(|p| p.region == Region::Arc) {
+                let (v, e, n) = gk21_adaptive(0.0, 1.0, 0.5 * share / n_arc as f64, &ew, |t| {
+                    let mut out = [0.0; 15];
+                    let (eps, jac) = piece.map(t);
+                    if jac == 0.0 {
+                        return out;
+                    }
+                    let wp = self.wpoint(a, sa, eps);
+                    let (eta0, s0, c0) = self.arc_half_width(wp.w);
+                    for j in 0..15 {
+                        if !grazing[j] {
+                            let l = &lights[j];
+                            out[j] = Self::arc(&wp, eta0, s0, c0, l.sh, l.ch) * jac;
+                        }
+                    }
+                    out
+                });
+                for (nv, vv) in node.iter_mut().zip(v) {
+                    *nv += vv;
+                }
+                err += e;
+                *evals += (15 - n_graze) as u64 * n;
+            }
+        }
+        for j in (0..15).filter(|&j| grazing[j]) {
+            let wj = hl * rule[j].1 * mu[j];
+            if wj <= 0.0 {
+                continue;
+            }
+            let (v, e, n) = self.arc_part(&lights[j], bands[j], 0.5 * share / (n_graze as f64 * wj));
+            node[j] = v;
+            err += wj * e;
+            *evals += n;
+        }
+        // η_u-rule value and error (QUADPACK estimate).
+        let f: Vec<f64> = (0..15).map(|j| mu[j] * node[j]).collect();
+        let resk: f64 = (0..15).map(|j| rule[j].1 * f[j]).sum();
+        let resg: f64 = (0..15).map(|j| rule[j].2 * f[j]).sum();
+        let mean = 0.5 * resk;
+        let resasc: f64 = (0..15).map(|j| rule[j].1 * (f[j] - mean).abs()).sum();
+        let resabs: f64 = (0..15).map(|j| rule[j].1 * f[j].abs()).sum();
+        let ee = quadpack_error(((resk - resg) * hl).abs(), resasc * hl, resabs * hl);
+        (lo, hi, resk * hl, err, ee)
     }
 
     /// J(A) = ∫_{η_min}^{π} μu P_s dη_u for u·t = a = cos A: (value, error, evals).
+    ///
+    /// J = 1/(4σπα) [M ∫_full I dw + Σ_j k_j μ_j ∫_arc I(w; η_j) dw], M = ∫ μu dη_u (closed
+    /// form), k_j the G7/K15 weights on [η_min, π] (split in 2, 4, … panels while the rule's
+    /// estimate exceeds its share). The non-grazing nodes share one adaptive w-integration
+    /// (error control on every node); nodes whose grazing band is active get their own.
     fn j_of_a(&self, a: f64, sa: f64, tol: f64) -> (f64, f64, u64) {
         // u above the horizon: s_a sin θf cos η_u < a cos θf.
         let b = sa * self.st;
@@ -771,11 +980,12 @@ impl Layer {
             half_width(b, c, (self.st - a) * (self.st + a))
         };
         let m_eta = a * self.ct * (PI - eta_min) + b * eta_min.sin();
-        let l0 = self.light_fiber(a, sa, 0.0);
-        let norm = 1.0 / (4.0 * l0.sigma * PI * self.alpha);
+        let sigma = self.light_fiber(a, sa, 0.0).sigma;
+        let norm = 1.0 / (4.0 * sigma * PI * self.alpha);
         let pieces = self.pieces(a, sa, None);
         let n_full = pieces.iter().filter(|p| p.region == Region::Full).count();
         let n_arc = pieces.len() - n_full;
+        // Raw-unit budget, a third each for the full part, the arc part and the η_u rule.
         let budget = tol / norm / 3.0;
         let mut evals = 0;
 
@@ -783,7 +993,7 @@ impl Layer {
         let (mut w_full, mut e_full) = (0.0, 0.0);
         if m_eta > 0.0 {
             for piece in pieces.iter().filter(|p| p.region == Region::Full) {
-                let (v, e, n) = gk21_adaptive(0.0, 1.0, budget / m_eta / n_full as f64, |t| {
+                let (v, e, n) = gk21_adaptive(0.0, 1.0, budget / m_eta / n_full as f64, &[1.0], |t| {
                     let (eps, jac) = piece.map(t);
                     if jac == 0.0 {
                         return [0.0];
@@ -796,84 +1006,34 @@ impl Layer {
             }
         }
 
-        // Arc part: all η_u nodes of a G7/K15 rule at once.
+        // Arc part: G7/K15 panels in η_u, the worst bisected while the rule's estimate exceeds
+        // its share (at most 16 panels).
         let (mut w_arc, mut e_arc, mut e_eta) = (0.0, 0.0, 0.0);
         if n_arc > 0 {
-            let rule = k15_rule();
-            let mut n_eta = 1usize;
+            let span = PI - eta_min;
+            // (lo, hi, value, w-error, η-error)
+            let mut panels = vec![self.eta_panel(a, sa, eta_min, PI, budget, &pieces, n_arc, &mut evals)];
             loop {
-                let (mut wa, mut ea, mut ee) = (0.0, 0.0, 0.0);
-                let width = (PI - eta_min) / n_eta as f64;
-                for k in 0..n_eta {
-                    let c_eta = eta_min + width * (k as f64 + 0.5);
-                    let hl = 0.5 * width;
-                    // (μu, sin η_u/2, cos η_u/2) per node
-                    let mut nodes = [(0.0, 0.0, 0.0); 15];
-                    for (node, &(x, _, _)) in nodes.iter_mut().zip(&rule) {
-                        let eta = c_eta + hl * x;
-                        let mu = (a * self.ct - b * eta.cos()).max(0.0);
-                        let (s, c) = (0.5 * eta).sin_cos();
-                        *node = (mu, s, c);
-                    }
-                    // Grazing features of the nodes near the horizon. Within |ε| < s the arc
-                    // integral departs from its smooth continuation by at most ≈ 2π f1 ≤
-                    // 4π sqrt(1−α²)|ε|/(α s_a), so a feature below s changes node j's integral
-                    // by ≤ 4π s²/(α s_a); cuts are needed only down to where that, weighted by
-                    // μ_j k_j hl, is a share of the budget (factor 4 margin).
-                    let share = budget / (15 * n_eta * n_arc) as f64;
-                    let mut s_min = f64::INFINITY;
-                    for j in 0..15 {
-                        let eta = c_eta + hl * rule[j].0;
-                        let wj = nodes[j].0 * rule[j].1 * hl * 16.0 * PI / (self.alpha * sa);
-                        let floor = if wj > 0.0 { (share / wj).sqrt() } else { f64::INFINITY };
-                        s_min = s_min.min(self.graze_scale(a, sa, eta).max(floor));
-                    }
-                    let arc_pieces = self.pieces(a, sa, self.graze_band(a, sa, s_min));
-                    let n_arc = arc_pieces.iter().filter(|p| p.region == Region::Arc).count();
-                    let mut comp = [0.0; 16];
-                    for piece in arc_pieces.iter().filter(|p| p.region == Region::Arc) {
-                        let (v, e, n) =
-                            gk21_adaptive(0.0, 1.0, budget / (n_eta * n_arc) as f64, |t| {
-                                let mut out = [0.0; 16];
-                                let (eps, jac) = piece.map(t);
-                                if jac == 0.0 {
-                                    return out;
-                                }
-                                let wp = self.wpoint(a, sa, eps);
-                                let (eta0, s0, c0) = self.arc_half_width(wp.w);
-                                let mut ctl = 0.0;
-                                for j in 0..15 {
-                                    let (mu, s, c) = nodes[j];
-                                    let f = mu * Self::arc(&wp, eta0, s0, c0, s, c) * jac;
-                                    out[1 + j] = f;
-                                    ctl += rule[j].1 * f;
-                                }
-                                out[0] = hl * ctl;
-                                out
-                            });
-                        for (cv, vv) in comp.iter_mut().zip(v) {
-                            *cv += vv;
-                        }
-                        ea += e;
-                        evals += n;
-                    }
-                    // η_u-rule error of this panel (QUADPACK estimate on the node integrals).
-                    let f = &comp[1..];
-                    let resk: f64 = (0..15).map(|j| rule[j].1 * f[j]).sum();
-                    let resg: f64 = (0..15).map(|j| rule[j].2 * f[j]).sum();
-                    let mean = 0.5 * resk;
-                    let resasc: f64 = (0..15).map(|j| rule[j].1 * (f[j] - mean).abs()).sum();
-                    let resabs: f64 = (0..15).map(|j| rule[j].1 * f[j].abs()).sum();
-                    wa += comp[0];
-                    ee += quadpack_error(((resk - resg) * hl).abs(), resasc * hl, resabs * hl);
-                }
-                if ee <= budget || n_eta >= 16 {
-                    w_arc = wa;
-                    e_arc = ea;
-                    e_eta = ee;
+                let ee: f64 = panels.iter().map(|p| p.4).sum();
+                if ee <= budget || panels.len() >= 16 {
                     break;
                 }
-                n_eta *= 2;
+                let (worst, _) = panels
+                    .iter()
+                    .enumerate()
+                    .max_by(|(_, p), (_, q)| p.4.total_cmp(&q.4).then(q.0.total_cmp(&p.0)))
+                    .unwrap_or((0, &panels[0]));
+                let p = panels.swap_remove(worst);
+                let mid = 0.5 * (p.0 + p.1);
+                let share = budget * (mid - p.0) / span;
+                panels.push(self.eta_panel(a, sa, p.0, mid, share, &pieces, n_arc, &mut evals));
+                panels.push(self.eta_panel(a, sa, mid, p.1, share, &pieces, n_arc, &mut evals));
+            }
+            panels.sort_by(|p, q| p.0.total_cmp(&q.0));
+            for p in &panels {
+                w_arc += p.2;
+                e_arc += p.3;
+                e_eta += p.4;
             }
         }
         let value = norm * (m_eta * w_full + w_arc);
@@ -881,7 +1041,7 @@ impl Layer {
         (value, error, evals)
     }
 
-        /// R = (2/π) ∫ sin A J(A) dA.
+    /// R = (2/π) ∫ sin A J(A) dA.
     fn r(&self, tol: f64) -> Estimate {
         let theta = self.theta();
         let split = FRAC_PI_2 - theta;
@@ -892,32 +1052,34 @@ impl Layer {
         if theta > 0.0 {
             pieces.push((split, FRAC_PI_2 + theta, true, true));
         }
-        // (2/π) ∫ sin A dA over the range = (2/π)(1 + sin θf): inner budget so that the
-        // propagated inner errors stay below tol/2.
-        let tol_j = 0.5 * tol / ((2.0 / PI) * (1.0 + self.st));
-        let tol_o = tol;
+        // Inner budget: the propagated inner error ∫₀¹ (2/π) sin A (dA/dt) e_J dt stays below
+        // tol/2 when each node's e_J ≤ tol/(2 n_pieces (2/π) sin A dA/dt) (loose where the
+        // outer weight is small); the outer panels get the other tol/2.
         let mut value = 0.0;
         let mut error = 0.0;
         let mut evals = 0;
         for &(lo, hi, ls, hs) in &pieces {
             let d = hi - lo;
-            let (v, e, _) = adaptive_vec(0.0, 1.0, 0.5 * tol_o / pieces.len() as f64, gl_pair_panel, |t| {
+            let ew = [1.0, 0.0];
+            let rules = gl_pair_32();
+            let panel = |a: f64, b: f64, f: &mut _| gl_pair_panel(rules, a, b, &ew, f);
+            let (v, e, _) = adaptive_vec(0.0, 1.0, 0.5 * tol / pieces.len() as f64, panel, |t| {
                 let (g, gp) = end_map(t, ls, hs);
                 let jac = d * gp;
                 if jac == 0.0 {
                     return [0.0, 0.0];
                 }
                 let (sa, a) = (lo + d * g).sin_cos();
+                let wgt = 2.0 / PI * sa * jac;
+                let tol_j = (0.5 * tol / pieces.len() as f64 / wgt).min(1.0);
                 let (j, ej, n) = self.j_of_a(a, sa, tol_j);
                 evals += n;
-                let wgt = 2.0 / PI * sa * jac;
                 [wgt * j, wgt * ej]
             });
-            if std::env::var("RDBG").is_ok() { eprintln!("RPIECE {lo:.4} {hi:.4} v {:.15} e {e:.2e} inner {:.2e}", v[0], v[1]); }
             value += v[0];
             error += e + v[1];
         }
-        Estimate { value, error, evals }
+        Estimate { value, error: error.max(ERROR_FLOOR), evals }
     }
 }
 
@@ -1137,73 +1299,3 @@ pub fn expn(n: u32, x: f64) -> f64 {
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn scratch_one() {
-        let (al, tf, mu, pu) = (0.15, 1.2, 2f64.powi(-12), PI * 4.5 / 16.0);
-        let layer = Layer::new(al, tf);
-        let l = layer.light(f64::acos(mu), pu);
-        println!("a {} w0 {} L {}", l.a, -l.a, layer.peak_scale(l.a, l.sa));
-        let d = ps(al, tf, mu.acos(), pu, 1e-9);
-        println!("{:?}", d);
-        let t = ps(al, tf, mu.acos(), pu, 1e-15);
-        println!("{:?} diff {:e}", t, d.value - t.value);
-    }
-
-    #[test]
-    fn scratch_graze() {
-        for &(al, tf) in &[(0.5, 0.3), (0.15, 0.3), (0.15, 1.2), (0.05, 0.8)] {
-            let mut worst: f64 = 0.0;
-            for k in 1..=12 {
-                let mu = 2f64.powi(-k);
-                for j in 0..16 {
-                    let pu = PI * (j as f64 + 0.5) / 16.0;
-                    let d = ps(al, tf, mu.acos(), pu, 1e-9);
-                    let t = ps(al, tf, mu.acos(), pu, 1e-14);
-                    let ratio = (d.value - t.value).abs() / d.error;
-                    worst = worst.max(ratio);
-                    if ratio > 1.0 { println!("BAD {al} {tf} mu {mu:e} phi {pu:.3}: diff {:.2e} err {:.2e} evals {}", d.value - t.value, d.error, d.evals); }
-                }
-            }
-            println!("{al} {tf}: worst ratio {worst:.3}");
-        }
-    }
-
-    #[test]
-    fn scratch_j() {
-        for &(al, tf) in &[(0.5f64, 0.3f64), (0.15, 1.0), (0.05, 0.8)] {
-        let layer = Layer::new(al, tf);
-        let split = FRAC_PI_2 - tf;
-        let ((x32, _), _) = gl_pair();
-        let mut worst: f64 = 0.0;
-        for piece in 0..2 {
-            for &x in x32.iter() {
-                let t = 0.5 + 0.5 * x;
-                let (aa, _) = if piece == 1 { let (g, gp) = end_map(t, true, true); (split + 2.0 * tf * g, gp) } else { (split * t, 1.0) };
-                let (sa, a) = aa.sin_cos();
-                let tol_j = 0.5e-9 / ((2.0 / PI) * (1.0 + tf.sin()));
-                let d = layer.j_of_a(a, sa, tol_j);
-                let tt = layer.j_of_a(a, sa, 1e-15);
-                let ratio = (d.0 - tt.0).abs() / d.1;
-                worst = worst.max(ratio);
-                if ratio > 1.0 { println!("{al} {tf} A {aa:.6} J {:.15} err {:.2e} actual {:.2e} BAD", d.0, d.1, d.0 - tt.0); }
-            }
-        }
-        println!("{al} {tf} worst {worst}");
-        }
-    }
-
-    #[test]
-    fn scratch_r() {
-        for &(al, tf) in &[(1.0, 0.3), (0.5, 0.3), (0.15, 0.3), (0.15, 0.0), (0.15, 1.5707963267948966), (0.15, 0.1), (0.05, 0.8), (0.15, 1.0), (0.3, 0.7)] {
-            let t0 = std::time::Instant::now();
-            let e = r(al, tf, 1e-9);
-            let dt = t0.elapsed();
-            let e2 = r(al, tf, 1e-12);
-            println!("R {al} {tf}: {:.15} err {:.2e} evals {} {:?}  tight {:.15} err {:.1e} diff {:.1e}", e.value, e.error, e.evals, dt, e2.value, e2.error, e.value - e2.value);
-        }
-    }
-}

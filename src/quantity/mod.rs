@@ -68,7 +68,9 @@ static REGISTRY: &[QuantityDef] = &[
         doc: "GGX average (shortened) normal length for a gloss, or for a GGX alpha",
         params: &[GLOSS],
         aliases: &[(
-            ParamSpec { name: "alpha", min: 0.002762135, max: 1.0, doc: "GGX alpha" },
+            // α at gloss 1 is sqrt(2/262145) = 0.00276213059566896…; the bound sits just below it
+            // and the converted gloss is clamped to 1.
+            ParamSpec { name: "alpha", min: 0.0027621305956689, max: 1.0, doc: "GGX alpha" },
             0,
             gloss::gloss_from_alpha,
         )],
