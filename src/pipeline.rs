@@ -141,8 +141,9 @@ fn domain_f32(spec: &Spec) -> Vec<(f32, f32)> {
     domain(spec).iter().map(|&(a, b)| (a as f32, b as f32)).collect()
 }
 
+/// Argument names of the emitted function.
 fn args(spec: &Spec) -> Vec<String> {
-    spec.file.axis.iter().map(|a| a.name.clone()).collect()
+    spec.file.emit.args.clone().unwrap_or_else(|| spec.file.axis.iter().map(|a| a.name.clone()).collect())
 }
 
 fn build_fit(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> {
@@ -231,11 +232,12 @@ fn build_fit(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> 
         "axes": axes_json(spec),
         "model": {
             "form": "offset + factor * P / Q, Q = denominator_lead + sum(den)",
-            "features": a,
+            "features": model.features,
+            "arguments": a,
             "numerator": model.numerator.iter().map(|t| t.label.clone()).collect::<Vec<_>>(),
             "denominator": model.denominator.iter().map(|t| t.label.clone()).collect::<Vec<_>>(),
             "denominator_lead": model.lead.as_ref().map_or("1".to_string(), |t| t.label.clone()),
-            "derived": model.derived.iter().map(|d| json!({"name": d.name, "definition": d.describe(&a)})).collect::<Vec<_>>(),
+            "derived": model.derived.iter().map(|d| json!({"name": d.name, "definition": d.describe(&model.features)})).collect::<Vec<_>>(),
             "offset": model.offset,
             "factor": model.factor.as_ref().map(|t| t.label.clone()),
             "clamp": model.clamp.map(|(a, b)| [a, b]),

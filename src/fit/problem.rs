@@ -176,16 +176,3 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Residuals<'_> {
         j.iter().all(|v| v.is_finite()).then_some(j)
     }
 }
-
-/// Max-abs residual as an argmin cost (for derivative-free polishing of minimax fits).
-pub struct MaxAbs<'a>(pub &'a Residuals<'a>);
-
-impl CostFunction for MaxAbs<'_> {
-    type Param = DVector<f64>;
-    type Output = f64;
-    fn cost(&self, theta: &Self::Param) -> Result<f64, ArgminError> {
-        let r = self.0.raw(theta);
-        let m = r.iter().fold(0.0_f64, |m, v| if v.is_nan() { f64::INFINITY } else { m.max(v.abs()) });
-        Ok(m)
-    }
-}

@@ -570,49 +570,76 @@ enum Region {
 }
 
 /// One piece of the w-range, mapped from t ∈ [0, 1].
+///
+/// Whole-circle pieces use x = ε = w + a directly. Arc pieces use x = φ with
+/// w = −sin θf cos φ, φ ∈ [0, π]: the arc opens and closes like sqrt(w ± sin θf), which is
+/// analytic in φ, wherever the cone lies (an end map would only help at the piece ends).
+/// Within a piece, x = c + L_x tan ξ (the peak around the cone, with its tails) or, in the
+/// grazing band, x = c ± e^ξ (multi-scale), ξ linear in t.
 #[derive(Debug, Clone, Copy)]
 struct Piece {
     region: Region,
-    lo_sing: bool,
-    hi_sing: bool,
-    /// ε = L tan ξ (the peak and its tails) or, in the grazing band, ε = ±e^ξ (multi-scale).
+    /// Logarithmic (grazing band) rather than tan map.
     log: bool,
-    /// L, or the sign of ε for a log piece.
+    /// Map centre c (0 for ε; φ of the cone, or the arc end nearest to it, for φ).
+    center: f64,
+    /// L_x, or the sign of x − c for a log piece.
     scale: f64,
     xa: f64,
     dx: f64,
+    /// The cone −a and sin θf (to turn φ into ε without cancellation).
+    w0: f64,
+    st: f64,
+    /// φ of the cone when it lies in the arc region.
+    phi0: Option<f64>,
 }
 
 impl Piece {
-    /// Piece for w ∈ [lo, hi] (not containing the cone w0 = −a in its interior).
-    fn new(region: Region, lo: f64, hi: f64, w0: f64, scale: f64, log: bool, sing: (bool, bool)) -> Self {
-        let (ls, hs) = sing;
+    /// Piece for x ∈ [lo, hi] (x = ε or φ), not containing the map centre in its interior.
+    #[allow(clippy::too_many_arguments)]
+    fn new(region: Region, lo: f64, hi: f64, center: f64, scale: f64, log: bool, w0: f64, st: f64, phi0: Option<f64>) -> Self {
+        let base = Piece { region, log, center, scale, xa: 0.0, dx: 0.0, w0, st, phi0 };
         if log {
-            // ε keeps one sign; ξ = ln|ε| runs from the end nearer the cone.
-            let (el, eh) = (lo - w0, hi - w0);
+            // x − c keeps one sign; ξ = ln|x − c| runs from the end nearer the centre.
+            let (el, eh) = (lo - center, hi - center);
             if el > 0.0 {
-                Piece { region, lo_sing: ls, hi_sing: hs, log, scale: 1.0, xa: el.ln(), dx: eh.ln() - el.ln() }
+                Piece { scale: 1.0, xa: el.ln(), dx: eh.ln() - el.ln(), ..base }
             } else {
                 let (xa, xb) = ((-eh).ln(), (-el).ln());
-                Piece { region, lo_sing: hs, hi_sing: ls, log, scale: -1.0, xa, dx: xb - xa }
+                Piece { scale: -1.0, xa, dx: xb - xa, ..base }
             }
         } else {
-            let xa = ((lo - w0) / scale).atan();
-            let xb = ((hi - w0) / scale).atan();
-            Piece { region, lo_sing: ls, hi_sing: hs, log, scale, xa, dx: xb - xa }
+            let xa = ((lo - center) / scale).atan();
+            let xb = ((hi - center) / scale).atan();
+            Piece { xa, dx: xb - xa, ..base }
         }
     }
 
-    /// (ε = a + w, |dw/dt|) at t ∈ [0, 1].
-    fn map(&self, t: f64) -> (f64, f64) {
-        let (g, gp) = end_map(t, self.lo_sing, self.hi_sing);
-        let xi = self.xa + self.dx * g;
-        if self.log {
+    /// (ε = a + w, |dw/dt|, sin²θf − w² (exact from φ on arc pieces)) at t ∈ [0, 1].
+    fn map(&self, t: f64) -> (f64, f64, f64) {
+        let xi = self.xa + self.dx * t;
+        let (x, dxdt) = if self.log {
             let e = xi.exp();
-            (self.scale * e, e * self.dx * gp)
+            (self.center + self.scale * e, e * self.dx)
         } else {
             let tn = xi.tan();
-            (self.scale * tn, self.scale * (1.0 + tn * tn) * self.dx * gp)
+            (self.center + self.scale * tn, self.scale * (1.0 + tn * tn) * self.dx)
+        };
+        match self.region {
+            Region::Full => {
+                let w = self.w0 + x;
+                (x, dxdt, (self.st - w) * (self.st + w))
+            }
+            Region::Arc => {
+                let (sp, cp) = x.sin_cos();
+                let eps = match self.phi0 {
+                    // −sin θf (cos φ − cos φ₀), without cancellation near the cone.
+                    Some(p0) => 2.0 * self.st * (0.5 * (x + p0)).sin() * (0.5 * (x - p0)).sin(),
+                    None => -self.st * cp - self.w0,
+                };
+                let ss = self.st * sp;
+                (eps, ss * dxdt, ss * ss)
+            }
         }
     }
 }
@@ -680,7 +707,7 @@ impl Layer {
         if den > 0.0 {
             s = (-self.st * ce / den - w0).abs();
         }
-        let (eta0, _, _) = self.arc_half_width(w0);
+        let (eta0, _, _) = self.arc_half_width(w0, (self.st - w0) * (self.st + w0));
         if eta0 > 0.0 && eta0 < PI {
             let dist = |x: f64| (x - PI).rem_euclid(2.0 * PI).min((PI - x).rem_euclid(2.0 * PI));
             let delta = dist(-eta_u - eta0).min(dist(-eta_u + eta0));
@@ -691,40 +718,72 @@ impl Layer {
 
     /// Lower edge of the grazing band: the band s ≤ |ε| ≤ L/2 gets the logarithmic map (so a
     /// feature at any scale in it spans O(1) in ξ); None when s is not well below the peak.
-    fn graze_band(&self, a: f64, sa: f64, s: f64) -> Option<f64> {
+    fn graze_band(&self, sa: f64, s: f64) -> Option<f64> {
         let scale = self.peak_scale(sa);
         let s = s.max(1e-12 * scale);
-        if s < scale / 16.0 { Some(s) } else { None }
+        if s < scale / 2.0 { Some(s) } else { None }
     }
 
-    /// The pieces of the w-range [−1, sin θf] for a light with u·t = a: split at ±sin θf, at the
-    /// cone w = −a and, with a grazing band [s, L/2], at −a ± s and −a ± L/2.
+    /// The pieces of the w-range [−1, sin θf] for a light with u·t = a: the whole-circle part
+    /// [−1, −sin θf] in ε, the arc part in φ (see [`Piece`]); both split at the cone w = −a and,
+    /// with a grazing band [s, L/2], at −a ± s and −a ± L/2 (log-mapped between).
     fn pieces(&self, a: f64, sa: f64, band: Option<f64>) -> Vec<Piece> {
         let w0 = -a;
         let scale = self.peak_scale(sa);
         let st = self.st;
-        let mut cuts: Vec<f64> = vec![-1.0, -st, st, w0];
+        let mut wcuts: Vec<f64> = vec![w0];
         if let Some(s) = band {
-            cuts.extend_from_slice(&[w0 - s, w0 + s, w0 - 0.5 * scale, w0 + 0.5 * scale]);
+            wcuts.extend_from_slice(&[w0 - s, w0 + s, w0 - 0.5 * scale, w0 + 0.5 * scale]);
         }
-        cuts.retain(|&c| c >= -1.0 && c <= st);
-        cuts.sort_by(|x, y| x.total_cmp(y));
-        cuts.dedup();
-        let mut out = Vec::with_capacity(cuts.len());
-        for win in cuts.windows(2) {
-            let (lo, hi) = (win[0], win[1]);
-            if hi <= lo {
-                continue;
+        let in_band = |el: f64, eh: f64| {
+            band.is_some_and(|s| {
+                el * eh > 0.0
+                    && el.abs().min(eh.abs()) >= s * (1.0 - 1e-9)
+                    && el.abs().max(eh.abs()) <= 0.5 * scale * (1.0 + 1e-9)
+            })
+        };
+        let mut out = Vec::with_capacity(8);
+        // Whole circle: w ∈ [−1, −sin θf], x = ε.
+        if st < 1.0 {
+            let mut cuts: Vec<f64> = vec![-1.0, -st];
+            cuts.extend(wcuts.iter().copied().filter(|&c| c > -1.0 && c < -st));
+            cuts.sort_by(|x, y| x.total_cmp(y));
+            cuts.dedup();
+            for win in cuts.windows(2) {
+                let (el, eh) = (win[0] - w0, win[1] - w0);
+                if eh > el {
+                    out.push(Piece::new(Region::Full, el, eh, 0.0, scale, in_band(el, eh), w0, st, None));
+                }
             }
-            let region = if hi <= -st { Region::Full } else { Region::Arc };
-            // Square-root behaviour at ±sin θf, seen from the arc side only.
-            let ls = region == Region::Arc && lo == -st && st > 0.0;
-            let hs = region == Region::Arc && hi == st && st > 0.0;
-            let log = band.is_some_and(|s| {
-                let (el, eh) = ((lo - w0).abs(), (hi - w0).abs());
-                (lo - w0) * (hi - w0) > 0.0 && el.min(eh) >= s * (1.0 - 1e-12) && el.max(eh) <= 0.5 * scale * (1.0 + 1e-12)
-            });
-            out.push(Piece::new(region, lo, hi, w0, scale, log, (ls, hs)));
+        }
+        // Arc: w = −sin θf cos φ, φ ∈ [0, π].
+        if st > 0.0 {
+            let phi_of = |w: f64| (-w / st).clamp(-1.0, 1.0).acos();
+            let inside = w0 > -st && w0 < st;
+            let phi0 = if inside { Some(phi_of(w0)) } else { None };
+            // Peak width in φ: dw/dφ = sin θf sin φ, and w − w0 ≈ sin θf (φ² − φ₀²)/2 near the
+            // ends; outside the arc region, the tail reaching the nearer end.
+            let (center, lphi) = match phi0 {
+                Some(p0) => (p0, scale / (st * (p0.sin().powi(2) + 2.0 * scale / st).sqrt())),
+                None => {
+                    let dist = w0.abs() - st;
+                    (if w0 <= -st { 0.0 } else { PI }, (2.0 * (scale + dist) / st).sqrt())
+                }
+            };
+            let lphi = lphi.clamp(1e-12, 4.0);
+            let mut cuts: Vec<f64> = vec![0.0, PI];
+            cuts.extend(wcuts.iter().copied().filter(|&c| c > -st && c < st).map(phi_of));
+            cuts.sort_by(|x, y| x.total_cmp(y));
+            cuts.dedup();
+            for win in cuts.windows(2) {
+                let (lo, hi) = (win[0], win[1]);
+                if hi <= lo {
+                    continue;
+                }
+                let (wl, wh) = (-st * lo.cos(), -st * hi.cos());
+                let log = phi0.is_some() && in_band(wl - w0, wh - w0);
+                out.push(Piece::new(Region::Arc, lo, hi, center, lphi, log, w0, st, phi0));
+            }
         }
         out
     }
@@ -766,8 +825,9 @@ impl Layer {
         2.0 * PI - PI * wp.f1 + wp.f2 * wp.f3 * PI
     }
 
-    /// Half-width η₀ of the arc (in η) below the horizon at this w, with sin, cos of η₀/2.
-    fn arc_half_width(&self, w: f64) -> (f64, f64, f64) {
+    /// Half-width η₀ of the arc (in η) below the horizon at this w, with sin, cos of η₀/2;
+    /// `prod` = sin²θf − w² (passed in exactly where known).
+    fn arc_half_width(&self, w: f64, prod: f64) -> (f64, f64, f64) {
         let sw = ((1.0 - w) * (1.0 + w)).max(0.0).sqrt();
         let b = sw * self.st;
         let c = w * self.ct;
@@ -779,7 +839,7 @@ impl Layer {
             0.0
         } else {
             // (b − c)(b + c) = sin²θf − w²
-            half_width(b, c, (self.st - w) * (self.st + w))
+            half_width(b, c, prod)
         };
         let (s0, c0) = (0.5 * eta0).sin_cos();
         (eta0, s0, c0)
@@ -816,7 +876,7 @@ impl Layer {
 
     /// P_s for one light.
     fn ps(&self, l: &Light, tol: f64) -> Estimate {
-        let band = self.graze_band(l.a, l.sa, self.graze_scale(l.a, l.sa, l.eta));
+        let band = self.graze_band(l.sa, self.graze_scale(l.a, l.sa, l.eta));
         let pieces = self.pieces(l.a, l.sa, band);
         let norm = 1.0 / (4.0 * l.sigma * PI * self.alpha);
         let share = tol / norm / pieces.len().max(1) as f64;
@@ -825,7 +885,7 @@ impl Layer {
         let mut evals = 0;
         for piece in &pieces {
             let (v, e, n) = gk21_adaptive(0.0, 1.0, share, &[1.0], |t| {
-                let (eps, jac) = piece.map(t);
+                let (eps, jac, prod) = piece.map(t);
                 if jac == 0.0 {
                     return [0.0];
                 }
@@ -833,7 +893,7 @@ impl Layer {
                 let val = match piece.region {
                     Region::Full => Self::full_circle(&wp),
                     Region::Arc => {
-                        let (eta0, s0, c0) = self.arc_half_width(wp.w);
+                        let (eta0, s0, c0) = self.arc_half_width(wp.w, prod);
                         Self::arc(&wp, eta0, s0, c0, l.sh, l.ch)
                     }
                 };
@@ -854,12 +914,12 @@ impl Layer {
         let (mut value, mut error, mut evals) = (0.0, 0.0, 0);
         for piece in pieces.iter().filter(|p| p.region == Region::Arc) {
             let (v, e, k) = gk21_adaptive(0.0, 1.0, tol / n as f64, &[1.0], |t| {
-                let (eps, jac) = piece.map(t);
+                let (eps, jac, prod) = piece.map(t);
                 if jac == 0.0 {
                     return [0.0];
                 }
                 let wp = self.wpoint(l.a, l.sa, eps);
-                let (eta0, s0, c0) = self.arc_half_width(wp.w);
+                let (eta0, s0, c0) = self.arc_half_width(wp.w, prod);
                 [Self::arc(&wp, eta0, s0, c0, l.sh, l.ch) * jac]
             });
             value += v[0];
@@ -908,7 +968,7 @@ impl Layer {
             } else {
                 f64::INFINITY
             };
-            bands[j] = self.graze_band(a, sa, self.graze_scale(a, sa, eta).max(s_f));
+            bands[j] = self.graze_band(sa, self.graze_scale(a, sa, eta).max(s_f));
             grazing[j] = bands[j].is_some();
             ew[j] = if grazing[j] { 0.0 } else { wj };
         }
@@ -917,14 +977,15 @@ impl Layer {
         let (mut node, mut err) = ([0.0; 15], 0.0);
         if n_graze < 15 {
             for piece in pieces.iter().filter(|p| p.region == Region::Arc) {
-                let (v, e, n) = gk21_adaptive(0.0, 1.0, 0.5 * share / n_arc as f64, &ew, |t| {
+                let frac = (15 - n_graze) as f64 / 15.0;
+                let (v, e, n) = gk21_adaptive(0.0, 1.0, frac * share / n_arc as f64, &ew, |t| {
                     let mut out = [0.0; 15];
-                    let (eps, jac) = piece.map(t);
+                    let (eps, jac, prod) = piece.map(t);
                     if jac == 0.0 {
                         return out;
                     }
                     let wp = self.wpoint(a, sa, eps);
-                    let (eta0, s0, c0) = self.arc_half_width(wp.w);
+                    let (eta0, s0, c0) = self.arc_half_width(wp.w, prod);
                     for j in 0..15 {
                         if !grazing[j] {
                             let l = &lights[j];
@@ -936,6 +997,7 @@ impl Layer {
                 for (nv, vv) in node.iter_mut().zip(v) {
                     *nv += vv;
                 }
+                if std::env::var("EDBG").is_ok() { eprintln!("EDBG eta [{lo:.4},{hi:.4}] piece log {} c {:.4} L {:.3e} xa {:.4} dx {:.4} n {n} e {e:.1e} share {:.1e} ngraze {n_graze}", piece.log, piece.center, piece.scale, piece.xa, piece.dx, 0.5 * share / n_arc as f64); }
                 err += e;
                 *evals += (15 - n_graze) as u64 * n;
             }
@@ -945,7 +1007,7 @@ impl Layer {
             if wj <= 0.0 {
                 continue;
             }
-            let (v, e, n) = self.arc_part(&lights[j], bands[j], 0.5 * share / (n_graze as f64 * wj));
+            let (v, e, n) = self.arc_part(&lights[j], bands[j], share / (15.0 * wj));
             node[j] = v;
             err += wj * e;
             *evals += n;
@@ -985,16 +1047,17 @@ impl Layer {
         let pieces = self.pieces(a, sa, None);
         let n_full = pieces.iter().filter(|p| p.region == Region::Full).count();
         let n_arc = pieces.len() - n_full;
-        // Raw-unit budget, a third each for the full part, the arc part and the η_u rule.
-        let budget = tol / norm / 3.0;
+        // Raw-unit budgets: 10% for the whole-circle part (one panel or two, its estimate
+        // tiny), 45% each for the arc w-integrations and the η_u rule.
+        let budget = 0.45 * tol / norm;
         let mut evals = 0;
 
         // Whole-circle part: independent of η_u.
         let (mut w_full, mut e_full) = (0.0, 0.0);
         if m_eta > 0.0 {
             for piece in pieces.iter().filter(|p| p.region == Region::Full) {
-                let (v, e, n) = gk21_adaptive(0.0, 1.0, budget / m_eta / n_full as f64, &[1.0], |t| {
-                    let (eps, jac) = piece.map(t);
+                let (v, e, n) = gk21_adaptive(0.0, 1.0, 0.1 * tol / norm / m_eta / n_full as f64, &[1.0], |t| {
+                    let (eps, jac, prod) = piece.map(t);
                     if jac == 0.0 {
                         return [0.0];
                     }
@@ -1053,8 +1116,8 @@ impl Layer {
             pieces.push((split, FRAC_PI_2 + theta, true, true));
         }
         // Inner budget: the propagated inner error ∫₀¹ (2/π) sin A (dA/dt) e_J dt stays below
-        // tol/2 when each node's e_J ≤ tol/(2 n_pieces (2/π) sin A dA/dt) (loose where the
-        // outer weight is small); the outer panels get the other tol/2.
+        // 0.9 tol when each node's e_J ≤ 0.9 tol/(n_pieces (2/π) sin A dA/dt) (loose where the
+        // outer weight is small); the outer panels (whose estimates are tiny) get 0.1 tol.
         let mut value = 0.0;
         let mut error = 0.0;
         let mut evals = 0;
@@ -1063,7 +1126,7 @@ impl Layer {
             let ew = [1.0, 0.0];
             let rules = gl_pair_32();
             let panel = |a: f64, b: f64, f: &mut _| gl_pair_panel(rules, a, b, &ew, f);
-            let (v, e, _) = adaptive_vec(0.0, 1.0, 0.5 * tol / pieces.len() as f64, panel, |t| {
+            let (v, e, _) = adaptive_vec(0.0, 1.0, 0.1 * tol / pieces.len() as f64, panel, |t| {
                 let (g, gp) = end_map(t, ls, hs);
                 let jac = d * gp;
                 if jac == 0.0 {
@@ -1071,7 +1134,7 @@ impl Layer {
                 }
                 let (sa, a) = (lo + d * g).sin_cos();
                 let wgt = 2.0 / PI * sa * jac;
-                let tol_j = (0.5 * tol / pieces.len() as f64 / wgt).min(1.0);
+                let tol_j = (0.9 * tol / pieces.len() as f64 / wgt).min(1.0);
                 let (j, ej, n) = self.j_of_a(a, sa, tol_j);
                 evals += n;
                 [wgt * j, wgt * ej]
@@ -1161,10 +1224,40 @@ pub fn r_grid(alphas: &[f64], thetas: &[f64], tol: f64) -> Vec<Estimate> {
 // ---------------------------------------------------------------------------------------------
 // G, Q and the exponential integrals.
 
+/// ∫ f over [0, 1] split at the given interior points: the first piece linear, the others in
+/// x = ln μ (features at the scale of each cut then span O(1) in x), each by the adaptive
+/// G10/K21 of `crate::integrate` at tol / (number of pieces).
+fn graded_unit_integral(cuts: &[f64], tol: f64, f: impl Fn(f64) -> f64) -> Estimate {
+    let mut pts = vec![0.0];
+    let mut sorted: Vec<f64> = cuts.iter().copied().filter(|&c| c > 0.0 && c < 1.0).collect();
+    sorted.sort_by(|a, b| a.total_cmp(b));
+    sorted.dedup();
+    pts.extend(sorted);
+    pts.push(1.0);
+    let tl = Tolerance { abs: tol / (pts.len() - 1) as f64, rel: 0.0, max_panels: MAX_PANELS };
+    let mut out = Estimate::exact(0.0);
+    for w in pts.windows(2) {
+        let e = if w[0] == 0.0 {
+            adaptive(0.0, w[1], tl, &f)
+        } else {
+            let (l0, span) = (w[0].ln(), (w[1] / w[0]).ln());
+            adaptive(0.0, 1.0, tl, |x| {
+                let mu = (l0 + span * x).exp();
+                f(mu) * mu * span
+            })
+        };
+        out.value += e.value;
+        out.error += e.error;
+        out.evals += e.evals;
+    }
+    out
+}
+
 /// G(d, μv) by adaptive quadrature of ∫₀¹ (1 − e^{−d(1/μv + 1/μ)}) μ/(μ + μv) dμ.
 ///
-/// The range is split at μ = d and μ = μv (the scales of e^{−d/μ} and of μ/(μ + μv)).
-/// G(d, 0) = 1 (the limit μv → 0, d > 0); G(0, μv) = 0. NaN for d < 0 or μv < 0.
+/// The range is split at μ = d and μ = μv (the scales of e^{−d/μ} and of μ/(μ + μv)) and
+/// graded logarithmically above the first cut. G(d, 0) = 1 (the limit μv → 0, d > 0);
+/// G(0, μv) = 0. NaN for d < 0 or μv < 0.
 pub fn g(d: f64, mu_v: f64, tol: f64) -> Estimate {
     if !(d >= 0.0 && mu_v >= 0.0) {
         return invalid();
@@ -1175,31 +1268,12 @@ pub fn g(d: f64, mu_v: f64, tol: f64) -> Estimate {
     if mu_v == 0.0 {
         return Estimate::exact(1.0);
     }
-    let tol = clean_tol(tol);
-    let f = |mu: f64| {
+    graded_unit_integral(&[d, mu_v], clean_tol(tol), |mu| {
         if mu <= 0.0 {
             return 0.0;
         }
         -(-d * (1.0 / mu_v + 1.0 / mu)).exp_m1() * mu / (mu + mu_v)
-    };
-    let mut cuts = vec![0.0];
-    let (b1, b2) = (d.min(mu_v), d.max(mu_v));
-    for b in [b1, b2] {
-        if b > *cuts.last().unwrap_or(&0.0) && b < 1.0 {
-            cuts.push(b);
-        }
-    }
-    cuts.push(1.0);
-    let n = (cuts.len() - 1) as f64;
-    let tl = Tolerance { abs: tol / n, rel: 0.0, max_panels: MAX_PANELS };
-    let mut out = Estimate::exact(0.0);
-    for w in cuts.windows(2) {
-        let e = adaptive(w[0], w[1], tl, f);
-        out.value += e.value;
-        out.error += e.error;
-        out.evals += e.evals;
-    }
-    out
+    })
 }
 
 /// G(d, μv) in closed form (see the module doc), for d > 0, μv > 0:
@@ -1220,14 +1294,13 @@ pub fn g_exact(d: f64, mu_v: f64) -> f64 {
     1.0 - c * (1.0 / c).ln_1p() - ed * expn(2, d) + c * ed * expn(1, d) - c * expn(1, d * (1.0 + c) / c)
 }
 
-/// Q(d) = 2 ∫₀¹ e^{−d/μ} μ dμ by adaptive quadrature. NaN for d < 0.
+/// Q(d) = 2 ∫₀¹ e^{−d/μ} μ dμ by adaptive quadrature (split at μ = d, graded logarithmically
+/// above it). NaN for d < 0.
 pub fn q(d: f64, tol: f64) -> Estimate {
     if !(d >= 0.0) {
         return invalid();
     }
-    let tol = clean_tol(tol);
-    let tl = Tolerance { abs: tol, rel: 0.0, max_panels: MAX_PANELS };
-    adaptive(0.0, 1.0, tl, |mu| if mu <= 0.0 { 0.0 } else { 2.0 * (-d / mu).exp() * mu })
+    graded_unit_integral(&[d], clean_tol(tol), |mu| if mu <= 0.0 { 0.0 } else { 2.0 * (-d / mu).exp() * mu })
 }
 
 /// Q(d) = 2 E₃(d) exactly.
@@ -1299,3 +1372,370 @@ pub fn expn(n: u32, x: f64) -> f64 {
     }
 }
 
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sph(theta: f64, phi: f64) -> [f64; 3] {
+        [theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos()]
+    }
+
+    /// Deterministic uniform numbers in [0, 1) (64-bit LCG, top 53 bits).
+    struct Lcg(u64);
+    impl Lcg {
+        fn next(&mut self) -> f64 {
+            self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (self.0 >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
+    /// Independent brute force: ∫ f(v) dω_v over the sphere (or its lower half) by nested
+    /// adaptive G10/K21 from `crate::integrate`, in polar coordinates (β, ψ) about −u. There
+    /// the phase function is smooth at its one singular point v = −u (the pole), and for each ψ
+    /// the lower half is an interval of β found in closed form. Shares no code with the
+    /// reduction above except `sggx_phase`.
+    fn brute_force(u: [f64; 3], f: &dyn Fn([f64; 3]) -> f64, lower_only: bool, tol: f64) -> f64 {
+        let e = [-u[0], -u[1], -u[2]];
+        let cross = |a: [f64; 3], b: [f64; 3]| {
+            [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+        };
+        let tmp = if e[0].abs() < 0.9 { [1.0, 0.0, 0.0] } else { [0.0, 1.0, 0.0] };
+        let c = cross(e, tmp);
+        let n = (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
+        let b1 = [c[0] / n, c[1] / n, c[2] / n];
+        let b2 = cross(e, b1);
+        let tl = Tolerance { abs: tol, rel: 0.0, max_panels: 20000 };
+        adaptive(0.0, 2.0 * PI, tl, |psi| {
+            let (sp, cp) = psi.sin_cos();
+            let d = [cp * b1[0] + sp * b2[0], cp * b1[1] + sp * b2[1], cp * b1[2] + sp * b2[2]];
+            let g = |b: f64| {
+                let (sb, cb) = b.sin_cos();
+                f([cb * e[0] + sb * d[0], cb * e[1] + sb * d[1], cb * e[2] + sb * d[2]]) * sb
+            };
+            if !lower_only {
+                return adaptive(0.0, PI, tl, g).value;
+            }
+            // v_z = e_z cos β + d_z sin β = C cos(β − β*) < 0 for β − β* ∈ (π/2, 3π/2) mod 2π.
+            let bs = d[2].atan2(e[2]);
+            let mut total = 0.0;
+            for k in -2..=2 {
+                let lo = (bs + 0.5 * PI + 2.0 * PI * k as f64).max(0.0);
+                let hi = (bs + 1.5 * PI + 2.0 * PI * k as f64).min(PI);
+                if hi > lo {
+                    total += adaptive(lo, hi, tl, g).value;
+                }
+            }
+            total
+        })
+        .value
+    }
+
+    /// (α, θf, θu, φu) cases for the brute-force checks: small α, θf = 0 and π/2, light along
+    /// the fiber, near-grazing and below-horizon lights.
+    const CASES: [(f64, f64, f64, f64); 9] = [
+        (0.05, 0.0, 0.3, 0.0),
+        (0.05, 0.8, 1.0, 2.0),
+        (0.15, 0.3, 0.4, 0.5),
+        (0.15, 1.2, 1.55, 0.3),
+        (0.3, FRAC_PI_2, 1.3, 0.2),
+        (0.5, 0.7, 0.7, 0.0),
+        (0.2, 0.7, 2.0, 1.0),
+        (0.8, 0.1, 0.05, 3.0),
+        (1.0, 0.3, 0.4, 0.5),
+    ];
+
+    #[test]
+    fn phase_function_integrates_to_one() {
+        // Brute force at 1e-11 per level: ≤ 2π·1e-11 + 1e-11 quadrature error, so 1e-9 bounds it.
+        for &(al, tf, tu, pu) in &CASES {
+            let (t, u) = (sph(tf, 0.0), sph(tu, pu));
+            let total = brute_force(u, &|v| sggx_phase(al, t, u, v), false, 1e-11);
+            assert!((total - 1.0).abs() < 1e-9, "α={al} θf={tf} θu={tu} φu={pu}: ∫p = {total}");
+        }
+    }
+
+    #[test]
+    fn ps_matches_brute_force() {
+        // Brute force error ≤ ~1e-10 (as above); P_s at 1e-11: 1e-9 bounds the sum.
+        for &(al, tf, tu, pu) in &CASES {
+            let (t, u) = (sph(tf, 0.0), sph(tu, pu));
+            let bf = brute_force(u, &|v| sggx_phase(al, t, u, v), true, 1e-11);
+            let e = ps(al, tf, tu, pu, 1e-11);
+            assert!((e.value - bf).abs() < 1e-9, "α={al} θf={tf} θu={tu} φu={pu}: {} vs {bf}", e.value);
+        }
+    }
+
+    #[test]
+    fn ps_range_and_symmetries() {
+        let mut rng = Lcg(7);
+        for _ in 0..100 {
+            let al = 0.05 + 0.95 * rng.next();
+            let tf = FRAC_PI_2 * rng.next();
+            let tu = PI * rng.next();
+            let pu = 2.0 * PI * rng.next();
+            let p = ps(al, tf, tu, pu, DEFAULT_TOL);
+            // Each comparison: two estimates, each within its error (≤ 1e-9) of the truth.
+            let close = |q: Estimate, target: f64, what: &str| {
+                assert!(
+                    (q.value - target).abs() <= p.error + q.error,
+                    "{what}: α={al} θf={tf} θu={tu} φu={pu}: {} vs {target}",
+                    q.value
+                );
+            };
+            assert!(p.error <= DEFAULT_TOL);
+            assert!(p.value >= -p.error && p.value <= 1.0 + p.error, "range: {}", p.value);
+            close(ps(al, tf, tu, -pu, DEFAULT_TOL), p.value, "φu → −φu");
+            close(ps(al, tf, PI - tu, pu + PI, DEFAULT_TOL), 1.0 - p.value, "u → −u");
+            close(ps(al, PI - tf, tu, PI - pu, DEFAULT_TOL), p.value, "(θf, φu) → (π−θf, π−φu)");
+            close(ps(al, 0.0, tu, pu, DEFAULT_TOL), ps(al, 0.0, tu, 0.0, DEFAULT_TOL).value, "θf = 0");
+            // α = 1: the phase function is the constant 1/(4π), P_s = ½ (the quadrature of the
+            // horizon arc lengths is exact to within its estimate).
+            let half = ps(1.0, tf, tu, pu, DEFAULT_TOL);
+            assert!((half.value - 0.5).abs() <= half.error, "α = 1: {half:?}");
+        }
+    }
+
+    #[test]
+    fn ps_default_tolerance_is_honest() {
+        // Default-tolerance values against 1e-13 ones: the difference must stay within the
+        // two error estimates, which must meet the default tolerance.
+        let mut rng = Lcg(11);
+        for i in 0..60 {
+            let al = if i % 3 == 0 { 0.05 + 0.1 * rng.next() } else { 0.05 + 0.95 * rng.next() };
+            let tf = if i % 5 == 0 { 0.0 } else { FRAC_PI_2 * rng.next() };
+            // Every fourth light grazes the horizon (μ from 1e-6 to 1e-2).
+            let tu = if i % 4 == 0 {
+                (10f64.powf(-6.0 + 4.0 * rng.next())).acos()
+            } else {
+                PI * rng.next()
+            };
+            let pu = 2.0 * PI * rng.next();
+            let d = ps(al, tf, tu, pu, DEFAULT_TOL);
+            let t = ps(al, tf, tu, pu, 1e-13);
+            assert!(d.error <= DEFAULT_TOL, "estimate above tolerance: {d:?}");
+            assert!(
+                (d.value - t.value).abs() <= d.error + t.error,
+                "α={al} θf={tf} θu={tu} φu={pu}: {d:?} vs {t:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn ps_directions_matches_ps() {
+        let dirs = fitting_directions(4, 5);
+        let batch = ps_directions(0.3, 0.9, &dirs, DEFAULT_TOL);
+        for (&(tu, pu), b) in dirs.iter().zip(&batch) {
+            assert_eq!(b.value.to_bits(), ps(0.3, 0.9, tu, pu, DEFAULT_TOL).value.to_bits());
+        }
+        assert!(ps(0.0, 0.9, 0.1, 0.1, DEFAULT_TOL).value.is_nan());
+        assert!(ps(1.5, 0.9, 0.1, 0.1, DEFAULT_TOL).value.is_nan());
+        assert!(ps(0.5, f64::NAN, 0.1, 0.1, DEFAULT_TOL).value.is_nan());
+    }
+
+    #[test]
+    fn r_special_values() {
+        // α = 1: R = ½ up to rounding.
+        for tf in [0.0, 0.4, FRAC_PI_2] {
+            assert!((r(1.0, tf, DEFAULT_TOL).value - 0.5).abs() < 1e-12);
+        }
+        // θf = 0: P_s depends on μ only, so R = 2 ∫₀¹ μ P_s(μ) dμ (independent 1-D check;
+        // nested error ≤ 1e-11 + 1e-11, R's ≤ 1e-9).
+        for al in [0.05, 0.15, 0.6] {
+            let direct = adaptive(0.0, 1.0, Tolerance { abs: 1e-11, rel: 0.0, max_panels: 2000 }, |mu| {
+                2.0 * mu * ps(al, 0.0, mu.acos(), 0.0, 1e-12).value
+            });
+            let e = r(al, 0.0, DEFAULT_TOL);
+            assert!((e.value - direct.value).abs() < 1e-9, "α={al}: {e:?} vs {direct:?}");
+        }
+    }
+
+    #[test]
+    fn r_matches_nested_quadrature() {
+        // Independent nesting over (μ, φ) of P_s (adaptive from crate::integrate):
+        // outer 1e-9, inner 1e-9·π, P_s 1e-11 → error ≲ 2e-9; R at 1e-10; 5e-9 bounds both.
+        for &(al, tf) in &[(0.5, 0.3), (0.2, 1.1)] {
+            let tl = Tolerance { abs: 1e-9, rel: 0.0, max_panels: 2000 };
+            let nested = adaptive(0.0, 1.0, tl, |mu| {
+                let inner = adaptive(0.0, PI, Tolerance { abs: 1e-9 * PI, ..tl }, |phi| {
+                    ps(al, tf, mu.acos(), phi, 1e-11).value
+                });
+                2.0 / PI * mu * inner.value
+            });
+            let e = r(al, tf, 1e-10);
+            assert!((e.value - nested.value).abs() < 5e-9, "α={al} θf={tf}: {e:?} vs {nested:?}");
+        }
+    }
+
+    #[test]
+    fn r_default_tolerance_is_honest() {
+        for &(al, tf) in &[(0.05, 0.8), (0.15, 0.1), (0.15, FRAC_PI_2), (0.4, 0.6), (0.9, 1.3)] {
+            let d = r(al, tf, DEFAULT_TOL);
+            let t = r(al, tf, 1e-12);
+            assert!(d.error <= DEFAULT_TOL, "{d:?}");
+            assert!((d.value - t.value).abs() <= d.error + t.error, "α={al} θf={tf}: {d:?} vs {t:?}");
+            assert!(d.value > 0.0 && d.value < 1.0);
+        }
+    }
+
+    #[test]
+    fn exponential_integrals() {
+        // Reference values (Abramowitz & Stegun 5.1, to 17 digits); a few ulps relative.
+        let close = |a: f64, b: f64| (a - b).abs() <= 4.0 * f64::EPSILON * b.abs();
+        assert!(close(expn(1, 1.0), 0.219_383_934_395_520_27));
+        assert!(close(expn(2, 1.0), 0.148_495_506_775_922_05));
+        assert!(close(e3(1.0), 0.109_691_967_197_760_13), "{}", e3(1.0));
+        assert_eq!(e3(0.0), 0.5);
+        assert!(expn(1, 0.0).is_nan() && expn(3, -1.0).is_nan());
+        // Recurrence n E_{n+1}(x) = e^{−x} − x E_n(x), across the series/fraction switch at 1.
+        for &x in &[1e-8, 0.01, 0.3, 0.999, 1.0, 1.001, 2.5, 10.0, 50.0] {
+            for n in 1..5u32 {
+                let lhs = n as f64 * expn(n + 1, x);
+                let rhs = (-x).exp() - x * expn(n, x);
+                assert!((lhs - rhs).abs() <= 1e-14 * lhs.abs().max((-x).exp()), "n={n} x={x}");
+            }
+        }
+        // Large x: E₃(x) x e^x = 1 − 3/x + 12/x² − 60/x³ + 360/x⁴ − …; at x = 500 the next term
+        // is 2520/x⁵ = 8e-11.
+        let x: f64 = 500.0;
+        let s = e3(x) * x.exp() * x;
+        let series = 1.0 - 3.0 / x + 12.0 / x.powi(2) - 60.0 / x.powi(3) + 360.0 / x.powi(4);
+        assert!((s - series).abs() < 1e-10, "{s} vs {series}");
+    }
+
+    #[test]
+    fn q_matches_two_e3() {
+        // Quadrature at 1e-14: 1e-12 bounds quadrature plus rounding.
+        assert!((q(0.0, DEFAULT_TOL).value - 1.0).abs() < 1e-15);
+        assert_eq!(q_exact(0.0), 1.0);
+        for &d in &[1e-9, 1e-6, 0.01, 0.1, 0.25, 0.5, 1.0, 2.0, 5.0, 30.0] {
+            let e = q(d, 1e-14);
+            assert!((e.value - q_exact(d)).abs() < 1e-12, "d={d}: {e:?} vs {}", q_exact(d));
+            let dflt = q(d, DEFAULT_TOL);
+            assert!((dflt.value - q_exact(d)).abs() <= dflt.error.max(1e-15), "d={d}: {dflt:?} vs {}", q_exact(d));
+        }
+    }
+
+    #[test]
+    fn g_matches_closed_form_and_limits() {
+        // Quadrature at 1e-13 against the E₁/E₂ closed form: 1e-12 bounds both. The closed form
+        // cancels terms of size ~|ln d|: its rounding allowance is 1e-15 (1 + |ln d|).
+        for &d in &[1e-7, 1e-4, 0.01, 0.1, 0.3, 0.5] {
+            for &mu in &[1e-6, 0.01, 0.2, 0.5, 0.9, 1.0] {
+                let e = g(d, mu, 1e-13);
+                let x = g_exact(d, mu);
+                let rounding = 1e-15 * (1.0 + d.ln().abs());
+                assert!((e.value - x).abs() < 1e-12, "d={d} μv={mu}: {e:?} vs {x}");
+                let dflt = g(d, mu, DEFAULT_TOL);
+                assert!((dflt.value - x).abs() <= dflt.error + rounding, "d={d} μv={mu}: {dflt:?} vs {x}");
+                assert!(dflt.error <= DEFAULT_TOL);
+            }
+        }
+        // μv → 0: 1 − G ≈ μv ln(1/μv) (the first two closed-form terms); 2μv(1 + ln(1/μv))
+        // bounds it for d = 0.3.
+        assert_eq!(g(0.3, 0.0, DEFAULT_TOL).value, 1.0);
+        for &mu in &[1e-3, 1e-5, 1e-8] {
+            let e = g(0.3, mu, 1e-13);
+            assert!(1.0 - e.value >= 0.0 && 1.0 - e.value <= 2.0 * mu * (1.0 - mu.ln()), "μv={mu}: {e:?}");
+        }
+        // d → 0: G = d/μv − (d²/2μv) ln(1/d) + O(d²): the remainder over d² stays bounded
+        // (by (1 + 1/μv)/μv for these μv) while the log term grows.
+        for &mu in &[0.2, 0.5, 1.0] {
+            for &d in &[1e-3, 1e-4, 1e-5, 1e-6] {
+                let x = g_exact(d, mu);
+                let rem = (x - d / mu + d * d / (2.0 * mu) * (1.0 / d).ln()) / (d * d);
+                assert!(rem.abs() <= (1.0 + 1.0 / mu) / mu, "μv={mu} d={d}: remainder/d² = {rem}");
+            }
+        }
+    }
+
+    /// Time the data sets of the published fitting method: 65 × 65 (α, θf) grids, P_s at 16 × 16
+    /// light directions per grid point, and R. `cargo test --release -- --ignored --nocapture`.
+    #[test]
+    #[ignore]
+    fn timing_published_data_sets() {
+        let alphas = linspace(PUBLISHED_ALPHA_MIN, 1.0, 65);
+        let dirs = fitting_directions(16, 16);
+        let t0 = std::time::Instant::now();
+        let ps_set = ps_grid(&alphas, &linspace(PUBLISHED_THETA_F_MIN, FRAC_PI_2, 65), &dirs, DEFAULT_TOL);
+        let t_ps = t0.elapsed();
+        let t1 = std::time::Instant::now();
+        let r_set = r_grid(&alphas, &linspace(0.0, FRAC_PI_2, 65), DEFAULT_TOL);
+        let t_r = t1.elapsed();
+        let max_ps = ps_set.iter().flatten().map(|e| e.error).fold(0.0, f64::max);
+        let max_r = r_set.iter().map(|e| e.error).fold(0.0, f64::max);
+        let ev_ps: u64 = ps_set.iter().flatten().map(|e| e.evals).sum();
+        let ev_r: u64 = r_set.iter().map(|e| e.evals).sum();
+        println!(
+            "threads {}: P_s 65x65x{} in {:.2?} (max error {max_ps:.1e}, {} evals/P_s); \
+             R 65x65 in {:.2?} (max error {max_r:.1e}, {} evals/R)",
+            rayon::current_num_threads(),
+            dirs.len(),
+            t_ps,
+            ev_ps / ps_set.len() as u64 / dirs.len() as u64,
+            t_r,
+            ev_r / r_set.len() as u64
+        );
+    }
+}
+#[cfg(test)]
+mod scratch {
+    use super::*;
+    #[test]
+    fn scratch_jone() {
+        let layer = Layer::new(0.15, 0.3);
+        for &aa in &[0.5f64, 0.9, 1.2] {
+            let (sa, a) = aa.sin_cos();
+            let r = layer.j_of_a(a, sa, 3e-10);
+            eprintln!("A {aa}: {r:?} pieces {:?}", layer.pieces(a, sa, None).iter().map(|p| (p.region, p.center, p.scale, p.xa, p.dx)).collect::<Vec<_>>());
+        }
+    }
+
+    #[test]
+    fn scratch_one() {
+        let (al, tf, mu, pu) = (0.05, FRAC_PI_2, 1.5625e-2f64, PI * 3.5 / 16.0);
+        let layer = Layer::new(al, tf);
+        let l = layer.light(mu.acos(), pu);
+        eprintln!("a {} sa {} eta {} L {} graze {}", l.a, l.sa, l.eta, layer.peak_scale(l.sa), layer.graze_scale(l.a, l.sa, l.eta));
+        for &t in &[1e-9, 1e-13] { eprintln!("tol {t}"); let e = ps(al, tf, mu.acos(), pu, t); eprintln!("{e:?}"); }
+    }
+
+    #[test]
+    fn scratch_rgrid() {
+        let n = 9;
+        let alphas = linspace(0.15, 1.0, n);
+        let thetas = linspace(0.0, FRAC_PI_2, n);
+        for tol in [1e-7, 1e-8, 1e-9] {
+        let t0 = std::time::Instant::now();
+        let rs = r_grid(&alphas, &thetas, tol);
+        let ev: u64 = rs.iter().map(|e| e.evals).sum();
+        let maxe = rs.iter().map(|e| e.error).fold(0.0, f64::max);
+        println!("RGRID {tol:e} {:?} evals/R {} maxerr {maxe:.1e}", t0.elapsed(), ev / 81);
+        }
+        let dirs = fitting_directions(16, 16);
+        let t0 = std::time::Instant::now();
+        let ps = ps_grid(&alphas, &linspace(0.1, FRAC_PI_2, n), &dirs, 1e-9);
+        let ev: u64 = ps.iter().flatten().map(|e| e.evals).sum();
+        let maxe = ps.iter().flatten().map(|e| e.error).fold(0.0, f64::max);
+        println!("PSGRID {:?} evals/ps {} maxerr {maxe:.1e}", t0.elapsed(), ev / (81 * 256));
+    }
+    #[test]
+    fn scratch_graze() {
+        for &(al, tf) in &[(0.5, 0.3), (0.15, 0.3), (0.15, 1.2), (0.05, 0.8), (0.05, 1.5707963267948966)] {
+            let mut worst: f64 = 0.0;
+            let mut ev = 0;
+            for k in 1..=14 {
+                let mu = 2f64.powi(-k);
+                for j in 0..16 {
+                    let pu = PI * (j as f64 + 0.5) / 16.0;
+                    let d = ps(al, tf, mu.acos(), pu, 1e-9);
+                    let t = ps(al, tf, mu.acos(), pu, 1e-13);
+                    ev += d.evals;
+                    let ratio = (d.value - t.value).abs() / (d.error + t.error);
+                    worst = worst.max(ratio);
+                    if ratio > 1.0 { println!("BAD {al} {tf} mu {mu:e} phi {pu:.3}: diff {:.2e} err {:.2e} evals {}", d.value - t.value, d.error, d.evals); }
+                }
+            }
+            println!("GRAZE {al} {tf}: worst ratio {worst:.3} evals/ps {}", ev / (14 * 16));
+        }
+    }
+}

@@ -29,6 +29,7 @@
 //!
 //! [emit]
 //! function = "gloss_to_normal_length"
+//! args = ["gloss"]                # optional: argument names (default: the axis names)
 //! ```
 
 pub mod data;
@@ -263,6 +264,8 @@ pub struct FitSection {
 pub struct EmitSection {
     /// Name of the emitted function (WGSL and Rust).
     pub function: String,
+    /// Argument names of the emitted function, one per axis (default: the axis names).
+    pub args: Option<Vec<String>>,
 }
 
 #[derive(Debug, Clone, Deserialize, PartialEq)]
@@ -320,6 +323,11 @@ impl Spec {
         }
         if !is_identifier(&file.emit.function) {
             return Err(at("function", format!("'{}' is not a valid function name", file.emit.function)));
+        }
+        if let Some(args) = &file.emit.args
+            && (args.len() != file.axis.len() || args.iter().any(|a| !is_identifier(a)))
+        {
+            return Err(at("args", format!("needs {} lowercase identifiers, one per axis", file.axis.len())));
         }
         if !(file.tolerance > 0.0 && file.tolerance < 1.0) {
             return Err(at("tolerance", format!("{} must be in (0, 1)", file.tolerance)));
