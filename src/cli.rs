@@ -283,3 +283,13 @@ pub fn validate(paths: &Paths, as_json: bool) -> Result<()> {
     }
     Ok(())
 }
+
+/// Figures (PNG and SVG) of every family with committed outputs.
+pub fn plot(paths: &Paths, out: &Path) -> Result<()> {
+    let files = crate::plot::gloss_figures(out, &paths.generated)?;
+    for f in &files {
+        println!("{}", f.display());
+    }
+    println!("{} file(s) written", files.len());
+    Ok(())
+}

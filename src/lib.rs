@@ -8,5 +8,6 @@ pub mod quantity;
 pub mod cli;
 pub mod emit;
 pub mod pipeline;
+pub mod plot;
 pub mod spec;
 pub mod validate;

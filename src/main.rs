@@ -69,6 +69,12 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Write figures (PNG and SVG): the quantities, the published and refitted forms, error maps.
+    Plot {
+        /// Output folder.
+        #[arg(long, default_value = "plots")]
+        out: PathBuf,
+    },
     /// Measure published tables and approximations against the integrals.
     Validate {
         #[arg(long)]
@@ -85,6 +91,7 @@ fn main() -> ExitCode {
         Command::Build { only, check } => cli::build(&paths, &only, check),
         Command::Fit { data, x, y, model, objective, json } => cli::fit_data(&data, &x, &y, &model, objective, json),
         Command::Samples { name, json } => cli::samples(&paths, &name, json),
+        Command::Plot { out } => cli::plot(&paths, &out),
         Command::Validate { json } => cli::validate(&paths, json),
     };
     match result {

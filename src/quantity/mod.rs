@@ -1,6 +1,7 @@
 //! Quantity families: each module holds an integrand, its conventions and its reference
 //! evaluator. This file is the registry the CLI and the spec layer look quantities up in.
 
+pub mod fuzz;
 pub mod gloss;
 pub mod skin;
 
@@ -60,9 +61,74 @@ fn gloss_combine(p: &[f64], _tol: f64) -> Estimate {
     Estimate { value: gloss::combine(p[0], p[1]), error: 1e5 * 8.0 * f64::EPSILON, evals: 130 }
 }
 
+fn fuzz_ps(p: &[f64], tol: f64) -> Estimate {
+    fuzz::ps(p[0], p[1], p[2], p[3], tol)
+}
+
+fn fuzz_g(p: &[f64], tol: f64) -> Estimate {
+    // Canonical order (mu_v, d), the emitted function's (n_dot_v, density).
+    fuzz::g(p[1], p[0], tol)
+}
+
+fn fuzz_q(p: &[f64], _tol: f64) -> Estimate {
+    // 2·E₃(d) from the series / continued fraction: a few ulps (tested against quadrature).
+    Estimate { value: fuzz::q_exact(p[0]), error: 8.0 * f64::EPSILON, evals: 1 }
+}
+
+fn fuzz_r(p: &[f64], tol: f64) -> Estimate {
+    fuzz::r(p[0], p[1], tol)
+}
+
+const HALF_PI: f64 = std::f64::consts::FRAC_PI_2;
+const ALPHA: ParamSpec = ParamSpec { name: "alpha", min: 0.01, max: 1.0, doc: "SGGX fiber alpha" };
+const THETA_F: ParamSpec = ParamSpec { name: "theta_f", min: 0.0, max: HALF_PI, doc: "fiber polar angle (rad)" };
+const DENSITY: ParamSpec = ParamSpec { name: "d", min: 0.0, max: 50.0, doc: "fuzz density (optical thickness)" };
+
 const GLOSS: ParamSpec = ParamSpec { name: "gloss", min: 0.0, max: 1.0, doc: "gloss g" };
 
 static REGISTRY: &[QuantityDef] = &[
+    QuantityDef {
+        name: "fuzz-ps",
+        doc: "fraction of light the fuzz layer scatters toward the base layer, P_s(u)",
+        params: &[
+            ALPHA,
+            THETA_F,
+            ParamSpec { name: "theta_u", min: 0.0, max: std::f64::consts::PI, doc: "light polar angle (rad)" },
+            ParamSpec {
+                name: "phi_u",
+                min: -std::f64::consts::PI,
+                max: 2.0 * std::f64::consts::PI,
+                doc: "light azimuth from the fiber azimuth (rad)",
+            },
+        ],
+        aliases: &[],
+        eval: fuzz_ps,
+        inverse: None,
+    },
+    QuantityDef {
+        name: "fuzz-g",
+        doc: "hemispherical average G(d, mu_v) of the single-scattering fuzz layer",
+        params: &[ParamSpec { name: "mu_v", min: 0.0, max: 1.0, doc: "n·v" }, DENSITY],
+        aliases: &[],
+        eval: fuzz_g,
+        inverse: None,
+    },
+    QuantityDef {
+        name: "fuzz-q",
+        doc: "cosine-weighted average penetration Q(d) = 2 E3(d)",
+        params: &[DENSITY],
+        aliases: &[],
+        eval: fuzz_q,
+        inverse: None,
+    },
+    QuantityDef {
+        name: "fuzz-r",
+        doc: "cosine-weighted average of P_s over the hemisphere, R(alpha, theta_f)",
+        params: &[ALPHA, THETA_F],
+        aliases: &[],
+        eval: fuzz_r,
+        inverse: None,
+    },
     QuantityDef {
         name: "gloss-length",
         doc: "GGX average (shortened) normal length for a gloss, or for a GGX alpha",
