@@ -3,7 +3,15 @@
 //! Each emitted module holds the f32 coefficients (or table) of one fit and a CPU version of
 //! its WGSL function; [`wgsl::module`] returns the WGSL library of the same name and
 //! [`FUNCTIONS`] lists every emitted function. Everything but this file, `Cargo.toml`,
-//! `tests/` and the folders under `src/` is written by `shadefit build`.
+//! `tests/`, `examples/` and the folders under `src/` is written by `shadefit build`.
+//!
+//! Hand-written runtime (in `src/runtime/`):
+//! - [`compose`] / [`compose_shader`]: concatenate WGSL libraries, resolving
+//!   `#import shadefit::NAME` lines (no dependencies, always available);
+//! - [`lut`]: the lookup-table modules as R32Float textures and WGSL accessors for them
+//!   (texture creation needs the `gpu` feature, which brings in wgpu);
+//! - `gpu` (feature `gpu`): a headless wgpu adapter and device chosen from the environment
+//!   (`WGPU_BACKEND`, `WGPU_ADAPTER_NAME`).
 
 #![allow(clippy::excessive_precision, clippy::approx_constant)]
 
@@ -24,5 +32,12 @@ pub struct EmittedFunction {
     pub domain: &'static [[f32; 2]],
     pub cpu: Cpu,
 }
+
+mod runtime;
+
+pub use runtime::compose::{ComposeError, compose, compose_shader};
+#[cfg(feature = "gpu")]
+pub use runtime::gpu;
+pub use runtime::lut;
 
 include!("emitted.rs");

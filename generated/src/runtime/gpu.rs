@@ -1,0 +1,77 @@
+//! A headless wgpu device chosen from the environment, for tests, tools and examples.
+//!
+//! - `WGPU_BACKEND` (comma list: `vulkan`, `metal`, `dx12`, ...) restricts the backends
+//!   (`wgpu::InstanceDescriptor::with_env`, i.e. `Backends::from_env`); CI sets `vulkan` to
+//!   run on Mesa's lavapipe (see `scripts/setup-vulkan`).
+//! - `WGPU_ADAPTER_NAME` picks an adapter by name substring, `WGPU_POWER_PREF` (`low`/`high`)
+//!   the preference otherwise (`wgpu::util::initialize_adapter_from_env_or_default`).
+//!
+//! This crate enables wgpu's native backends only (Vulkan, Metal, DX12), not GLES or WebGPU.
+
+use std::fmt;
+
+/// Instance, adapter, device and queue of a headless wgpu context.
+#[derive(Debug, Clone)]
+pub struct Gpu {
+    pub instance: wgpu::Instance,
+    pub adapter: wgpu::Adapter,
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+}
+
+/// Why no device could be made.
+#[derive(Debug)]
+pub enum GpuError {
+    /// No adapter for the enabled backends (`WGPU_BACKEND`): no GPU, no driver, no ICD.
+    NoAdapter(wgpu::RequestAdapterError),
+    /// An adapter was found but refused the device.
+    Device(wgpu::RequestDeviceError),
+}
+
+impl fmt::Display for GpuError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let backends = std::env::var("WGPU_BACKEND").unwrap_or_else(|_| "all".into());
+        match self {
+            GpuError::NoAdapter(e) => write!(f, "no wgpu adapter (WGPU_BACKEND={backends}): {e}"),
+            GpuError::Device(e) => write!(f, "wgpu adapter refused a device: {e}"),
+        }
+    }
+}
+
+impl std::error::Error for GpuError {}
+
+/// A wgpu instance for the backends named by `WGPU_BACKEND` (all enabled ones if unset), with
+/// the other `WGPU_*` instance settings from the environment too.
+pub fn instance() -> wgpu::Instance {
+    wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env())
+}
+
+/// Adapter (from the environment, see the module documentation) and a device with default
+/// limits and no optional features.
+pub async fn headless(label: &str) -> Result<Gpu, GpuError> {
+    let instance = instance();
+    let adapter = wgpu::util::initialize_adapter_from_env_or_default(&instance, None)
+        .await
+        .map_err(GpuError::NoAdapter)?;
+    let (device, queue) = adapter
+        .request_device(&wgpu::DeviceDescriptor {
+            label: Some(label),
+            required_limits: wgpu::Limits::default().using_resolution(adapter.limits()),
+            ..Default::default()
+        })
+        .await
+        .map_err(GpuError::Device)?;
+    Ok(Gpu { instance, adapter, device, queue })
+}
+
+/// One line about an adapter: name, backend, device type, driver and driver version.
+pub fn describe(info: &wgpu::AdapterInfo) -> String {
+    format!(
+        "{} ({:?}, {:?}, driver {} {})",
+        info.name,
+        info.backend,
+        info.device_type,
+        if info.driver.is_empty() { "?" } else { &info.driver },
+        info.driver_info
+    )
+}

@@ -1,0 +1,284 @@
+//! Lookup tables of the table modules as textures, with WGSL accessors.
+//!
+//! The emitted table functions (`gloss_to_normal_length_lut`, `combine_gloss_lut`, ...) read
+//! their table from a WGSL `const` array, which is simple but puts the whole table in the
+//! shader (a 64×64 table is 4096 constants, dynamically indexed). For real shaders the same
+//! values can live in a texture: [`Table::wgsl`] writes an accessor `FUNCTION_tex(...)` doing
+//! exactly the arithmetic of the emitted function (same clamp, same index and weight
+//! computation, same interpolation order) but reading the values with `textureLoad`, and
+//! (feature `gpu`) [`Table::create_texture`] uploads the table.
+//!
+//! # Layout
+//! A table with axes of `n0 (× n1)` points, first axis fastest (the emitted layout), is a 2-D
+//! texture of width `n0` and height `n1` (1 for a one-argument table): `gloss_table` is
+//! 256×1, `gloss_inverse_table` 1024×1, `gloss_combine_lut` 64×64. The axis counts are read
+//! from the emitted WGSL (`min(u32(tK), LASTu)` gives `nK = LAST + 2`) and checked against the
+//! `*_TABLE` length and the number of domain axes, so the texture always matches the indexing.
+//!
+//! # Format and filtering
+//! [`FORMAT`] is `R32Float`: the f32 table values exactly, so the texture accessor agrees
+//! with the CPU function and the const-array WGSL. WebGPU classes R32Float as
+//! *unfilterable-float* (linear filtering needs the optional `float32-filterable` feature),
+//! so the accessor uses `textureLoad` on texel indices and interpolates in the shader, bound
+//! as `TextureSampleType::Float { filterable: false }`. Hardware linear filtering was rejected
+//! on precision grounds too: a filterable R16Float keeps 11 significant bits (relative error
+//! 2^-11 ≈ 4.9e-4, fifty times the 8.4e-6 error of the `gloss_table` fit), and texture units
+//! compute bilinear weights in fixed point (Vulkan guarantees only 4 bits of sub-texel
+//! precision, most GPUs use 8), so a filtered lookup could be off by a sizeable fraction of a
+//! table step. The [`LutTexture::sampler`] made alongside (nearest, clamp-to-edge,
+//! `SamplerBindingType::NonFiltering`) is for shaders that prefer `textureSampleLevel` at
+//! texel centres; the accessor itself needs no sampler.
+
+/// Texture format of the lookup tables (see the module documentation).
+#[cfg(feature = "gpu")]
+pub const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
+
+/// One emitted lookup table: the module, the function that interpolates it, the domain of
+/// its arguments and the values (uniform grid over the domain, first axis fastest).
+#[derive(Clone, Copy, Debug)]
+pub struct Table {
+    pub module: &'static str,
+    pub function: &'static str,
+    pub domain: &'static [[f32; 2]],
+    pub values: &'static [f32],
+}
+
+/// Every table module compiled in.
+///
+/// Hand-written: emitted.rs lists the functions, not the tables; the test
+/// `every_table_module_is_listed` fails when a new table module is emitted but not added here.
+pub const TABLES: &[Table] = &[
+    #[cfg(feature = "gloss")]
+    Table {
+        module: "gloss_combine_lut",
+        function: "combine_gloss_lut",
+        domain: &crate::gloss_combine_lut::GLOSS_COMBINE_LUT_DOMAIN,
+        values: &crate::gloss_combine_lut::GLOSS_COMBINE_LUT_TABLE,
+    },
+    #[cfg(feature = "gloss")]
+    Table {
+        module: "gloss_inverse_table",
+        function: "normal_length_to_gloss_lut",
+        domain: &crate::gloss_inverse_table::GLOSS_INVERSE_TABLE_DOMAIN,
+        values: &crate::gloss_inverse_table::GLOSS_INVERSE_TABLE_TABLE,
+    },
+    #[cfg(feature = "gloss")]
+    Table {
+        module: "gloss_table",
+        function: "gloss_to_normal_length_lut",
+        domain: &crate::gloss_table::GLOSS_TABLE_DOMAIN,
+        values: &crate::gloss_table::GLOSS_TABLE_TABLE,
+    },
+];
+
+/// The table of a module, if it is a table module compiled in.
+pub fn table(module: &str) -> Option<&'static Table> {
+    TABLES.iter().find(|t| t.module == module)
+}
+
+/// Text between `start` (included) and the first following line that is exactly `}`.
+fn wgsl_fn<'a>(src: &'a str, start: &str) -> &'a str {
+    let i = src.find(start).unwrap_or_else(|| panic!("emitted WGSL lacks `{start}`"));
+    let len = src[i..].find("\n}\n").unwrap_or_else(|| panic!("unterminated `{start}`")) + 3;
+    &src[i..i + len]
+}
+
+impl Table {
+    /// The emitted WGSL library of the module.
+    pub fn emitted_wgsl(&self) -> &'static str {
+        crate::wgsl::module(self.module).expect("table modules have WGSL")
+    }
+
+    /// Points per axis, read from the emitted WGSL and checked against the table length and
+    /// the domain (panics if the emitted code has another shape, which a test rules out).
+    pub fn counts(&self) -> Vec<u32> {
+        let src = self.emitted_wgsl();
+        let counts: Vec<u32> = (0..self.domain.len())
+            .map(|k| {
+                let pat = format!("let i{k} = min(u32(t{k}), ");
+                let at = src.find(&pat).unwrap_or_else(|| panic!("{}: no `{pat}` in the WGSL", self.module));
+                let rest = &src[at + pat.len()..];
+                let last: u32 = rest[..rest.find("u)").expect("`LASTu)`")].parse().expect("integer LAST");
+                last + 2
+            })
+            .collect();
+        assert!(
+            !src.contains(&format!("let i{} = min(", self.domain.len())),
+            "{}: more table axes than domain arguments",
+            self.module
+        );
+        assert_eq!(counts.iter().product::<u32>() as usize, self.values.len(), "{}: axis counts vs table length", self.module);
+        counts
+    }
+
+    /// Texture size (width, height): first axis across, second axis (if any) down.
+    pub fn size(&self) -> (u32, u32) {
+        let c = self.counts();
+        assert!(c.len() <= 2, "{}: tables of more than 2 axes need a 3-D texture", self.module);
+        (c[0], c.get(1).copied().unwrap_or(1))
+    }
+
+    /// Name of the texture variable declared by [`Table::wgsl`]: `MODULE_tex`.
+    pub fn texture_name(&self) -> String {
+        format!("{}_tex", self.module)
+    }
+
+    /// Name of the WGSL accessor declared by [`Table::wgsl`]: `FUNCTION_tex`.
+    pub fn accessor_name(&self) -> String {
+        format!("{}_tex", self.function)
+    }
+
+    /// Self-contained WGSL for the texture version of the table function: the declaration
+    /// `@group(group) @binding(binding) var MODULE_tex: texture_2d<f32>;`, a copy of the module's
+    /// input clamp, a texel-fetch helper and `FUNCTION_tex(args) -> f32`, which is the emitted
+    /// function with every `TABLE[i]` replaced by a `textureLoad` of texel `(i % width, i / width)`.
+    /// Needs no import; it can sit next to the emitted library in the same shader.
+    pub fn wgsl(&self, group: u32, binding: u32) -> String {
+        let src = self.emitted_wgsl();
+        let m = self.module;
+        let (width, _) = self.size();
+        let tex = self.texture_name();
+        let load = format!("{m}_tex_load");
+        let input = wgsl_fn(src, &format!("fn {m}_input(")).replace(&format!("{m}_input("), &format!("{m}_tex_input("));
+        let func = wgsl_fn(src, &format!("fn {}(", self.function))
+            .replace(&format!("fn {}(", self.function), &format!("fn {}(", self.accessor_name()))
+            .replace(&format!("{m}_input("), &format!("{m}_tex_input("));
+        // TABLE[expr] -> load(expr); the index expressions contain no brackets.
+        let array = format!("{}_TABLE[", m.to_uppercase());
+        let mut body = String::new();
+        let mut rest = func.as_str();
+        while let Some(i) = rest.find(&array) {
+            let close = rest[i..].find(']').expect("closing bracket") + i;
+            body.push_str(&rest[..i]);
+            body.push_str(&format!("{load}({})", &rest[i + array.len()..close]));
+            rest = &rest[close + 1..];
+        }
+        body.push_str(rest);
+        format!(
+            "// Texture version of shadefit::{m}::{f} (values in `{tex}`, R32Float, {w}x{h} texels).\n\
+             @group({group}) @binding({binding}) var {tex}: texture_2d<f32>;\n\n\
+             {input}\n\
+             fn {load}(i: u32) -> f32 {{\n    return textureLoad({tex}, vec2<u32>(i % {width}u, i / {width}u), 0).x;\n}}\n\n\
+             {body}",
+            f = self.function,
+            w = width,
+            h = self.values.len() as u32 / width,
+        )
+    }
+}
+
+#[cfg(feature = "gpu")]
+mod gpu {
+    use super::{FORMAT, Table};
+    use wgpu::util::DeviceExt;
+
+    /// A table uploaded to the GPU: the texture (R32Float, [`Table::size`]), a view of it, and a
+    /// nearest, clamp-to-edge sampler (non-filtering; the WGSL accessor does not use it).
+    #[derive(Debug, Clone)]
+    pub struct LutTexture {
+        pub table: &'static Table,
+        pub texture: wgpu::Texture,
+        pub view: wgpu::TextureView,
+        pub sampler: wgpu::Sampler,
+    }
+
+    impl Table {
+        /// Upload the table as an R32Float texture (one mip level, `TEXTURE_BINDING | COPY_DST`).
+        pub fn create_texture(&'static self, device: &wgpu::Device, queue: &wgpu::Queue) -> LutTexture {
+            let (width, height) = self.size();
+            let texture = device.create_texture_with_data(
+                queue,
+                &wgpu::TextureDescriptor {
+                    label: Some(self.module),
+                    size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+                    mip_level_count: 1,
+                    sample_count: 1,
+                    dimension: wgpu::TextureDimension::D2,
+                    format: FORMAT,
+                    usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+                    view_formats: &[],
+                },
+                wgpu::util::TextureDataOrder::LayerMajor,
+                bytemuck::cast_slice(self.values),
+            );
+            let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
+            let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+                label: Some(self.module),
+                address_mode_u: wgpu::AddressMode::ClampToEdge,
+                address_mode_v: wgpu::AddressMode::ClampToEdge,
+                address_mode_w: wgpu::AddressMode::ClampToEdge,
+                mag_filter: wgpu::FilterMode::Nearest,
+                min_filter: wgpu::FilterMode::Nearest,
+                mipmap_filter: wgpu::MipmapFilterMode::Nearest,
+                ..Default::default()
+            });
+            LutTexture { table: self, texture, view, sampler }
+        }
+    }
+
+    impl LutTexture {
+        /// Bind group layout entry for the texture (`texture_2d<f32>`, unfilterable float).
+        pub fn texture_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
+            wgpu::BindGroupLayoutEntry {
+                binding,
+                visibility,
+                ty: wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                    multisampled: false,
+                },
+                count: None,
+            }
+        }
+
+        /// Bind group layout entry for [`LutTexture::sampler`] (non-filtering).
+        pub fn sampler_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
+            wgpu::BindGroupLayoutEntry {
+                binding,
+                visibility,
+                ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::NonFiltering),
+                count: None,
+            }
+        }
+    }
+}
+
+#[cfg(feature = "gpu")]
+pub use gpu::LutTexture;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_table_module_is_listed() {
+        for name in crate::wgsl::NAMES {
+            let src = crate::wgsl::module(name).unwrap();
+            let is_table = src.contains(&format!("const {}_TABLE:", name.to_uppercase()));
+            assert_eq!(is_table, table(name).is_some(), "{name}: table module not in lut::TABLES (or listed but not one)");
+        }
+        for t in TABLES {
+            let f = crate::FUNCTIONS.iter().find(|f| f.module == t.module).expect("table module has a function");
+            assert_eq!((f.name, f.domain), (t.function, t.domain), "{}", t.module);
+        }
+    }
+
+    #[cfg(feature = "gloss")]
+    #[test]
+    fn sizes_follow_the_emitted_tables() {
+        assert_eq!(table("gloss_table").unwrap().size(), (256, 1));
+        assert_eq!(table("gloss_inverse_table").unwrap().size(), (1024, 1));
+        assert_eq!(table("gloss_combine_lut").unwrap().size(), (64, 64));
+    }
+
+    #[test]
+    fn accessors_read_the_texture_only() {
+        for t in TABLES {
+            let w = t.wgsl(1, 2);
+            assert!(w.contains(&format!("@group(1) @binding(2) var {}: texture_2d<f32>;", t.texture_name())));
+            assert!(w.contains(&format!("fn {}(", t.accessor_name())));
+            assert!(!w.contains("_TABLE"), "{w}");
+            assert!(!w.contains(&format!("{}_input(", t.module)), "{w}");
+        }
+    }
+}

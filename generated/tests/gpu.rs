@@ -1,0 +1,334 @@
+//! Every emitted function, run on a GPU through wgpu, equals its CPU version within a bound
+//! derived from f32 rounding; so does the texture version of every lookup table.
+//!
+//! For each entry of `FUNCTIONS` a compute shader is composed from the function's WGSL
+//! library and a generated entry point that reads each argument as a `u32` bit pattern from a
+//! storage buffer (`bitcast<f32>`: WGSL literals cannot spell NaN, ±inf or every subnormal) and
+//! writes the result's bits. Inputs per argument (tests/support/grid.rs): the domain edges and
+//! their f32 neighbours, values outside, ±0, subnormals, ±MIN_POSITIVE, ±1, ±MAX, ±inf, five
+//! NaN patterns, a dense grid over the domain (2^16 points for one argument, 256 per axis for
+//! two) and, for tables, every node and cell centre; all combinations for two arguments.
+//!
+//! # Bound
+//! Per point, |GPU − CPU| ≤ d, with d computed by interpreting the same WGSL (naga IR) in f32
+//! and carrying, in affine form so that correlated deviations cancel, what the WGSL spec (and
+//! Vulkan) allow a GPU to do differently (tests/support/bound.rs): `+ − ×` correctly rounded
+//! (1 ulp of the result once the operands differ), FMA contraction of any `a*b ± c` (½ ulp of
+//! the product + 1 ulp of the result), division within 2.5 ulp on the GPU versus 0.5 ulp on
+//! the CPU (3 ulp of the quotient, plus the operands' deviations through (Δa − qΔb)/b),
+//! subnormals possibly flushed to zero. Over this grid d is at most 4.5 ulp of the value for
+//! the `gloss_table` lerp and 19 ulp for the `gloss_length` rational (a dozen operations, one
+//! divide), more in ulps only where a value is small or a table step large: the index math
+//! `t − f32(i)` may itself be fused on a GPU, which moves the lerp weight by ½ ulp of t.
+//! The interpreter's value is the CPU value bit for bit, and d holds for simulated GPUs that
+//! fuse everything, misround divisions by 2 ulp and flush subnormals (tests/wgsl_cpu.rs). A
+//! GPU NaN or inf is always a failure: the emitted functions are finite for every input.
+//!
+//! # Tables on software adapters
+//! On a CPU adapter (lavapipe in CI) the table functions run with their `const` table moved to
+//! a storage buffer (same values, parsed from the WGSL; function body unchanged), because
+//! lavapipe needs minutes per shader for a dynamically indexed 4096-entry `const` array (see
+//! `table_in_buffer`). Hardware adapters run the emitted text as it is. The texture version
+//! of each table (`lut::Table::wgsl`, R32Float) is checked against the same bound everywhere.
+//!
+//! # Adapter
+//! wgpu picks the adapter from the environment (`WGPU_BACKEND=vulkan` in CI, where lavapipe
+//! from scripts/setup-vulkan provides it; `WGPU_ADAPTER_NAME` to choose among several). With
+//! no adapter the test fails if `CI` is set (non-empty, not `0`/`false`) and is skipped with
+//! a message otherwise. The adapter, the counts and the deviations are written to stderr
+//! directly (not captured by the test harness, so they appear in `scripts/test`'s log).
+
+#[path = "support/bound.rs"]
+mod bound;
+#[path = "support/grid.rs"]
+mod grid;
+
+use shadefit_runtime::lut::{self, LutTexture};
+use shadefit_runtime::{EmittedFunction, FUNCTIONS, compose, gpu};
+use std::io::Write;
+use wgpu::util::DeviceExt;
+
+/// A line on the real stderr, past the test harness's output capture.
+fn report(line: &str) {
+    let _ = writeln!(std::io::stderr().lock(), "{line}");
+}
+
+fn in_ci() -> bool {
+    std::env::var("CI").is_ok_and(|v| !v.is_empty() && v != "0" && !v.eq_ignore_ascii_case("false"))
+}
+
+const WORKGROUP: u32 = 64;
+
+/// WGSL entry point: `out[i] = bits(call(in[i*arity .. i*arity+arity]))`. No bounds test: the
+/// inputs are padded to whole workgroups (a branch around a call that indexes a large `const`
+/// array makes lavapipe's LLVM coroutine lowering take many minutes).
+fn entry_point(call: &str, arity: usize) -> String {
+    let args: Vec<String> = (0..arity).map(|k| format!("bitcast<f32>(shadefit_in[i * {arity}u + {k}u])")).collect();
+    format!(
+        "\n@group(0) @binding(0) var<storage, read> shadefit_in: array<u32>;\n\
+         @group(0) @binding(1) var<storage, read_write> shadefit_out: array<u32>;\n\n\
+         @compute @workgroup_size({WORKGROUP})\n\
+         fn shadefit_main(@builtin(global_invocation_id) id: vec3<u32>) {{\n    \
+             let i = id.x;\n    \
+             shadefit_out[i] = bitcast<u32>({call}({}));\n}}\n",
+        args.join(", ")
+    )
+}
+
+/// The library with its `const NAME_TABLE: array<f32, N> = array<f32, N>(...);` replaced by
+/// `@group(0) @binding(3) var<storage, read> NAME_TABLE: array<f32, N>;`, and the values of the
+/// const (parsed from the WGSL literals) to put in that buffer. The function body is unchanged.
+///
+/// Why: naga compiles a dynamic index into a `const` array by copying the whole array into a
+/// function-local variable at each indexing expression, and lavapipe (Mesa 22.3) keeps those
+/// copies: 4 × 4096 stores per invocation for the 64×64 table. Measured here on 2 cores: 569 s
+/// for `combine_gloss_lut` (even with `var<private>`), 54 s for `normal_length_to_gloss_lut`.
+/// Used on software adapters only; hardware adapters run the emitted text as it is.
+fn table_in_buffer(library: &str, module: &str) -> (String, Vec<f32>) {
+    let upper = module.to_uppercase();
+    let head = format!("const {upper}_TABLE: array<f32, ");
+    let start = library.find(&head).unwrap_or_else(|| panic!("{module}: no `{head}`"));
+    let open = library[start..].find('(').unwrap() + start;
+    let close = library[open..].find(");").unwrap() + open;
+    let n = &library[start + head.len()..library[start..].find('>').unwrap() + start];
+    let values: Vec<f32> = library[open + 1..close]
+        .split(',')
+        .map(str::trim)
+        .filter(|v| !v.is_empty())
+        .map(|v| v.trim_end_matches('f').parse().unwrap_or_else(|e| panic!("{module}: table literal {v:?}: {e}")))
+        .collect();
+    assert_eq!(values.len().to_string(), n, "{module}: table length");
+    let decl = format!("@group(0) @binding(3) var<storage, read> {upper}_TABLE: array<f32, {n}>;");
+    (format!("{}{decl}{}", &library[..start], &library[close + 2..]), values)
+}
+
+/// What a shader binds besides its input and output buffers.
+enum Extra<'a> {
+    None,
+    /// A lookup texture at binding 2.
+    Lut(&'a LutTexture),
+    /// A read-only f32 storage buffer at binding 3.
+    Table(&'a [f32]),
+}
+
+struct Runner {
+    gpu: gpu::Gpu,
+}
+
+impl Runner {
+    /// Run `shader` (entry `shadefit_main`) over `inputs` (arity words per point); `lut` is
+    /// bound at binding 2 when given.
+    fn run(&self, label: &str, shader: &str, arity: usize, inputs: &[u32], extra: Extra) -> Vec<u32> {
+        let device = &self.gpu.device;
+        let n = inputs.len() / arity;
+        let padded = (n as u32).div_ceil(WORKGROUP) as usize * WORKGROUP as usize;
+        let mut inputs = inputs.to_vec();
+        for _ in n..padded {
+            inputs.extend_from_within(..arity);
+        }
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some(label),
+            source: wgpu::ShaderSource::Wgsl(shader.into()),
+        });
+        let storage = |binding, read_only| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only },
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        };
+        let mut entries = vec![storage(0, true), storage(1, false)];
+        match extra {
+            Extra::None => {}
+            Extra::Lut(_) => entries.push(LutTexture::texture_entry(2, wgpu::ShaderStages::COMPUTE)),
+            Extra::Table(_) => entries.push(storage(3, true)),
+        }
+        let bgl = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries: &entries });
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some(label),
+            bind_group_layouts: &[Some(&bgl)],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(label),
+            layout: Some(&layout),
+            module: &module,
+            entry_point: Some("shadefit_main"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        let input = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("inputs"),
+            contents: bytemuck::cast_slice(&inputs),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        let size = (padded * 4) as u64;
+        let output = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("outputs"),
+            size,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let readback = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut bind = vec![
+            wgpu::BindGroupEntry { binding: 0, resource: input.as_entire_binding() },
+            wgpu::BindGroupEntry { binding: 1, resource: output.as_entire_binding() },
+        ];
+        let table = match extra {
+            Extra::Table(values) => Some(device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("table"),
+                contents: bytemuck::cast_slice(values),
+                usage: wgpu::BufferUsages::STORAGE,
+            })),
+            _ => None,
+        };
+        match (&extra, &table) {
+            (Extra::Lut(l), _) => {
+                bind.push(wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&l.view) })
+            }
+            (Extra::Table(_), Some(b)) => bind.push(wgpu::BindGroupEntry { binding: 3, resource: b.as_entire_binding() }),
+            _ => {}
+        }
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(label), layout: &bgl, entries: &bind });
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(label), timestamp_writes: None });
+            pass.set_pipeline(&pipeline);
+            pass.set_bind_group(0, &bind_group, &[]);
+            pass.dispatch_workgroups(padded as u32 / WORKGROUP, 1, 1);
+        }
+        encoder.copy_buffer_to_buffer(&output, 0, &readback, 0, size);
+        self.gpu.queue.submit([encoder.finish()]);
+        let (tx, rx) = std::sync::mpsc::channel();
+        readback.slice(..).map_async(wgpu::MapMode::Read, move |r| tx.send(r).unwrap());
+        self.gpu.device.poll(wgpu::PollType::wait_indefinitely()).expect("device poll");
+        rx.recv().unwrap().expect("map readback buffer");
+        let out = bytemuck::cast_slice::<u8, u32>(&readback.slice(..).get_mapped_range().expect("mapped range")).to_vec();
+        readback.unmap();
+        out[..n].to_vec()
+    }
+}
+
+/// Deviations of one run: the largest |GPU − CPU| (and the CPU value there), and the largest
+/// ratio deviation / bound over the points.
+struct Stats {
+    max_abs: f64,
+    value_at_max: f32,
+    max_ratio: f64,
+}
+
+impl std::fmt::Display for Stats {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        if self.max_abs == 0.0 {
+            write!(f, "max |GPU-CPU| 0 (bit-identical), max deviation/bound 0")
+        } else {
+            write!(
+                f,
+                "max |GPU-CPU| {:.3e} (= {:.1} ulp of the CPU value {:.3e}), max deviation/bound {:.2}",
+                self.max_abs,
+                self.max_abs / bound::ulp(self.value_at_max as f64),
+                self.value_at_max,
+                self.max_ratio
+            )
+        }
+    }
+}
+
+/// Compare GPU results with the CPU at every point against the bound; panics listing the
+/// first points out of bound.
+fn check(f: &EmittedFunction, what: &str, pts: &[u32], gpu_bits: &[u32], program: &bound::Program) -> Stats {
+    let h = program.function(f.name);
+    let arity = f.domain.len();
+    let mut st = Stats { max_abs: 0.0, value_at_max: 0.0, max_ratio: 0.0 };
+    let mut failures = Vec::new();
+    for (p, &g) in pts.chunks(arity).zip(gpu_bits) {
+        let args: Vec<f32> = p.iter().map(|&b| f32::from_bits(b)).collect();
+        let c = grid::cpu(f, p);
+        let (_, d) = program.eval(h, &args);
+        let gv = f32::from_bits(g);
+        let dev = (gv as f64 - c as f64).abs();
+        if !(gv.is_finite() && dev <= d) {
+            failures.push(format!("{} [{what}]: GPU {gv:e}, CPU {c:e}, deviation {dev:e} > bound {d:e}", grid::show(f, p)));
+            continue;
+        }
+        if dev > st.max_abs {
+            st.max_abs = dev;
+            st.value_at_max = c;
+        }
+        if d > 0.0 {
+            st.max_ratio = st.max_ratio.max(dev / d);
+        }
+    }
+    assert!(
+        failures.is_empty(),
+        "{} of {} points out of bound, first ones:\n{}",
+        failures.len(),
+        gpu_bits.len(),
+        failures[..failures.len().min(20)].join("\n")
+    );
+    st
+}
+
+#[test]
+fn every_emitted_function_equals_its_cpu_version_on_the_gpu() {
+    let gpu = match pollster::block_on(gpu::headless("shadefit-runtime gpu test")) {
+        Ok(g) => g,
+        Err(e) if in_ci() => panic!("CI is set, so the GPU test must run, but: {e} (run scripts/setup-vulkan, set WGPU_BACKEND=vulkan)"),
+        Err(e) => {
+            report(&format!("gpu test SKIPPED: {e} (install lavapipe with scripts/setup-vulkan; CI=true makes this a failure)"));
+            return;
+        }
+    };
+    let info = gpu.adapter.get_info();
+    report(&format!("gpu adapter: {}", gpu::describe(&info)));
+    let software = info.device_type == wgpu::DeviceType::Cpu;
+    let runner = Runner { gpu };
+    let (mut functions, mut points, mut runs) = (0, 0, 0);
+    for f in FUNCTIONS {
+        let library = compose(&[f.module]).unwrap();
+        let program = bound::Program::new(&library);
+        let table = lut::table(f.module);
+        let counts = table.map(|t| t.counts()).unwrap_or_default();
+        let pts = grid::points(f, &counts);
+        let arity = f.domain.len();
+        let n = pts.len() / arity;
+
+        let moved = table.filter(|_| software).map(|t| table_in_buffer(&library, t.module));
+        let (shader, extra, note) = match &moved {
+            Some((lib, values)) => (lib.clone(), Extra::Table(values), " (table in a storage buffer)"),
+            None => (library.clone(), Extra::None, ""),
+        };
+        let shader = shader + &entry_point(f.name, arity);
+        let t0 = std::time::Instant::now();
+        let out = runner.run(f.name, &shader, arity, &pts, extra);
+        let secs = t0.elapsed().as_secs_f64();
+        let st = check(f, "const", &pts, &out, &program);
+        report(&format!("gpu {:<30} {n:>7} points: {st}{note} [{secs:.1} s]", f.name));
+        functions += 1;
+        points += n;
+        runs += 1;
+
+        if let Some(t) = table {
+            let lut = t.create_texture(&runner.gpu.device, &runner.gpu.queue);
+            let shader = t.wgsl(0, 2) + &entry_point(&t.accessor_name(), arity);
+            let t0 = std::time::Instant::now();
+            let out = runner.run(&t.accessor_name(), &shader, arity, &pts, Extra::Lut(&lut));
+            let secs = t0.elapsed().as_secs_f64();
+            // Same arithmetic as the emitted function, values fetched from the texture: same bound.
+            let st = check(f, "texture", &pts, &out, &program);
+            let (w, h) = t.size();
+            report(&format!("gpu {:<30} {n:>7} points: {st} (R32Float {w}x{h} texture) [{secs:.1} s]", t.accessor_name()));
+            points += n;
+            runs += 1;
+        }
+    }
+    report(&format!("gpu: {functions} emitted functions + {} texture versions, {points} points, all within bound", runs - functions));
+}

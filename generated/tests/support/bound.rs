@@ -1,0 +1,509 @@
+//! Reference evaluation of an emitted WGSL function, with a bound on how far a conforming GPU
+//! may be from it.
+//!
+//! The WGSL is parsed with naga and interpreted on the CPU in f32 with the operations the
+//! source spells out (so the result must equal the Rust CPU version bit for bit: same
+//! expressions, same order). Alongside each value the interpreter carries its possible
+//! deviation Δ = GPU value − CPU value, for a GPU that follows the WGSL / Vulkan accuracy
+//! rules, in affine form: Σ cᵢ·εᵢ + r with independent unknowns |εᵢ| ≤ 1 (one per rounding
+//! event, so deviations that cancel, like the two weights of a lerp, do cancel) and a
+//! remainder |r| ≤ rem for second-order and non-linear effects. The bound is Σ|cᵢ| + rem.
+//!
+//! - `+ − ×` are correctly rounded (WGSL "Floating Point Accuracy"): equal inputs give equal
+//!   results, so Δ stays 0 until one of the rules below makes it non-zero. With deviating
+//!   inputs, Δ(a ± b) = Δa ± Δb and Δ(ab) = aΔb + bΔa + ΔaΔb (the last term in `rem`), plus
+//!   a new ε of 1 ulp of the result (each side rounds its own exact result by ≤ ½ ulp).
+//! - FMA contraction: a GPU may fuse `a*b ± c` (skipping the product's rounding), so a sum
+//!   or difference with a product operand gets a new ε of ½ ulp of that product, and the
+//!   1 ulp rounding ε of the result.
+//! - Division: within 2.5 ulp on the GPU (WGSL and Vulkan, for |divisor| in [2^-126, 2^126])
+//!   and 0.5 ulp on the CPU: Δq = (Δa − qΔb)/b to first order (the rest in `rem`), plus a new
+//!   ε of 3 ulp of the quotient.
+//! - Subnormals may be flushed to zero: an argument or result below f32::MIN_POSITIVE in
+//!   magnitude gets a new ε of its own magnitude.
+//! - clamp/min/max: if the two sides cannot straddle a limit, Δ passes through (or is 0 when
+//!   both are clamped); otherwise they are 1-Lipschitz: a new ε of the old bound. select
+//!   needs an exact condition. Integer operations are exact; bitcasts and float→u32
+//!   conversions must see the same value / integer on both sides (a bitcast of a subnormal,
+//!   possibly flushed to ±0, is let through: the emitted code only tests its bits for NaN),
+//!   otherwise the evaluation panics (an index that could differ between CPU and GPU would
+//!   make the bound meaningless).
+//!
+//! "ulp" is the spacing of f32 at the larger magnitude either side may reach (|v| + bound).
+//! For the emitted rationals (a dozen operations and one divide on O(1) values) the bound is
+//! a few ulps of the result; for the table lerps about one ulp.
+
+use naga::{BinaryOperator as B, Expression as E, Handle, Literal, MathFunction as M, ScalarKind, Statement};
+use std::cell::{Cell, RefCell};
+use std::collections::HashMap;
+use std::rc::Rc;
+
+/// Deviation GPU − CPU of one value: Σ cᵢ·εᵢ (|εᵢ| ≤ 1, ids sorted) + r, |r| ≤ rem.
+#[derive(Clone, Debug, Default)]
+struct Dev {
+    terms: Vec<(u32, f64)>,
+    rem: f64,
+}
+
+impl Dev {
+    fn radius(&self) -> f64 {
+        self.terms.iter().map(|t| t.1.abs()).sum::<f64>() + self.rem
+    }
+    fn is_zero(&self) -> bool {
+        self.terms.is_empty() && self.rem == 0.0
+    }
+    /// k·a + l·b (exact linear combination).
+    fn lin(k: f64, a: &Dev, l: f64, b: &Dev) -> Dev {
+        let (mut i, mut j) = (0, 0);
+        let mut terms = Vec::with_capacity(a.terms.len() + b.terms.len());
+        while i < a.terms.len() || j < b.terms.len() {
+            let ia = a.terms.get(i).map_or(u32::MAX, |t| t.0);
+            let ib = b.terms.get(j).map_or(u32::MAX, |t| t.0);
+            let (id, c) = if ia == ib {
+                i += 1;
+                j += 1;
+                (ia, k * a.terms[i - 1].1 + l * b.terms[j - 1].1)
+            } else if ia < ib {
+                i += 1;
+                (ia, k * a.terms[i - 1].1)
+            } else {
+                j += 1;
+                (ib, l * b.terms[j - 1].1)
+            };
+            if c != 0.0 {
+                terms.push((id, c));
+            }
+        }
+        Dev { terms, rem: k.abs() * a.rem + l.abs() * b.rem }
+    }
+}
+
+#[derive(Clone, Debug)]
+enum V {
+    /// f32 value on the CPU, the same value on a simulated GPU (see [`Gpu`]), the bound on
+    /// their deviation, and for a product its simulated-GPU operands (fusable into an add).
+    F { v: f32, g: f32, d: Dev, prod: Option<(f32, f32)> },
+    U(u32),
+    I(i32),
+    B(bool),
+    Arr(Rc<Vec<V>>),
+}
+
+/// Spacing of f32 numbers at magnitude `m` (subnormal spacing below MIN_POSITIVE).
+pub fn ulp(m: f64) -> f64 {
+    let m = m.abs().max(f32::MIN_POSITIVE as f64);
+    if !m.is_finite() {
+        return f64::INFINITY;
+    }
+    // log2 may round up just below a power of two: a larger ulp is the safe side.
+    2f64.powf(m.log2().floor() - 23.0)
+}
+
+/// A conforming GPU to simulate next to the bound, to test the bound itself: it may fuse
+/// every `a*b ± c` into an FMA, return divisions off by whole ulps, flush subnormals.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Gpu {
+    pub fuse: bool,
+    /// Ulps added to every quotient (|div_ulps| ≤ 2 stays within the 2.5 ulp allowance).
+    pub div_ulps: i32,
+    pub flush_subnormals: bool,
+}
+
+/// A parsed and validated WGSL module whose functions can be evaluated.
+pub struct Program {
+    module: naga::Module,
+    globals: RefCell<HashMap<Handle<E>, V>>,
+    next: Cell<u32>,
+    gpu: Cell<Gpu>,
+}
+
+/// `x` moved by `n` ulps (toward +inf for n > 0).
+fn step_ulps(x: f32, n: i32) -> f32 {
+    let mut x = x;
+    for _ in 0..n.unsigned_abs() {
+        x = if n > 0 { x.next_up() } else { x.next_down() };
+    }
+    x
+}
+
+impl Program {
+    pub fn new(wgsl: &str) -> Program {
+        let module = naga::front::wgsl::parse_str(wgsl).unwrap_or_else(|e| panic!("{}", e.emit_to_string(wgsl)));
+        naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all())
+            .validate(&module)
+            .unwrap_or_else(|e| panic!("{}", e.emit_to_string(wgsl)));
+        Program { module, globals: RefCell::new(HashMap::new()), next: Cell::new(0), gpu: Cell::new(Gpu::default()) }
+    }
+
+    pub fn function(&self, name: &str) -> Handle<naga::Function> {
+        self.module
+            .functions
+            .iter()
+            .find(|(_, f)| f.name.as_deref() == Some(name))
+            .unwrap_or_else(|| panic!("no fn {name}"))
+            .0
+    }
+
+    /// Evaluate `h` at `args`: the f32 value (CPU semantics) and the bound on |GPU − CPU|.
+    pub fn eval(&self, h: Handle<naga::Function>, args: &[f32]) -> (f32, f64) {
+        let (v, _, d) = self.simulate(h, args, Gpu::default());
+        (v, d)
+    }
+
+    /// [`Program::eval`], plus the value on a simulated conforming GPU.
+    pub fn simulate(&self, h: Handle<naga::Function>, args: &[f32], gpu: Gpu) -> (f32, f32, f64) {
+        self.next.set(0);
+        self.gpu.set(gpu);
+        let a: Vec<V> = args.iter().map(|&x| self.f(x, x, Dev::default(), None)).collect();
+        match self.call(h, a) {
+            V::F { v, g, d, .. } => (v, g, d.radius()),
+            other => panic!("function returned {other:?}"),
+        }
+    }
+
+    /// A new independent unknown of magnitude `mag` added to `d`.
+    fn fresh(&self, mut d: Dev, mag: f64) -> Dev {
+        if mag > 0.0 {
+            let id = self.next.get();
+            self.next.set(id + 1);
+            d.terms.push((id, mag)); // ids grow, so the list stays sorted
+        }
+        d
+    }
+
+    /// An f32 value; a subnormal may be flushed to zero on the GPU.
+    fn f(&self, v: f32, g: f32, d: Dev, prod: Option<(f32, f32)>) -> V {
+        let d = if v != 0.0 && v.abs() < f32::MIN_POSITIVE { self.fresh(d, v.abs() as f64) } else { d };
+        let g = if self.gpu.get().flush_subnormals && g.abs() < f32::MIN_POSITIVE { 0.0 * g.signum() } else { g };
+        V::F { v, g, d, prod }
+    }
+
+    fn exact(&self, v: f32) -> V {
+        self.f(v, v, Dev::default(), None)
+    }
+
+    fn call(&self, h: Handle<naga::Function>, args: Vec<V>) -> V {
+        let func = &self.module.functions[h];
+        let mut memo: Vec<Option<V>> = vec![None; func.expressions.len()];
+        let mut frame = Frame { p: self, func, args, memo: &mut memo };
+        frame.block(&func.body).expect("function returns a value")
+    }
+
+    fn global(&self, h: Handle<E>) -> V {
+        if let Some(v) = self.globals.borrow().get(&h) {
+            return v.clone();
+        }
+        let v = match &self.module.global_expressions[h] {
+            // Built directly (not through `f`): cached values must not depend on the simulated
+            // GPU or carry deviation ids of one evaluation.
+            E::Literal(Literal::F32(x)) => {
+                assert!(*x == 0.0 || x.abs() >= f32::MIN_POSITIVE || !x.is_finite(), "subnormal constant");
+                V::F { v: *x, g: *x, d: Dev::default(), prod: None }
+            }
+            E::Literal(l) => self.literal(l),
+            E::Compose { components, .. } => V::Arr(Rc::new(components.iter().map(|c| self.global(*c)).collect())),
+            E::Constant(c) => self.global(self.module.constants[*c].init),
+            other => panic!("unsupported global expression {other:?}"),
+        };
+        self.globals.borrow_mut().insert(h, v.clone());
+        v
+    }
+
+    fn literal(&self, l: &Literal) -> V {
+        match *l {
+            Literal::F32(x) => self.exact(x),
+            Literal::AbstractFloat(x) => self.exact(x as f32),
+            Literal::U32(x) => V::U(x),
+            Literal::I32(x) => V::I(x),
+            Literal::AbstractInt(x) => V::I(x as i32),
+            Literal::Bool(b) => V::B(b),
+            other => panic!("unsupported literal {other:?}"),
+        }
+    }
+
+    fn binary(&self, op: B, a: V, b: V) -> V {
+        match (a, b) {
+            (V::F { v: x, g: gx, d: dx, prod: px }, V::F { v: y, g: gy, d: dy, prod: py }) => {
+                let fuse = self.gpu.get().fuse;
+                let (x64, y64) = (x as f64, y as f64);
+                let (rx, ry) = (dx.radius(), dy.radius());
+                match op {
+                    B::Add | B::Subtract => {
+                        let (r, sign) = if op == B::Add { (x + y, 1.0) } else { (x - y, -1.0) };
+                        let g = match (px, py) {
+                            (Some((a, b)), _) if fuse => a.mul_add(b, sign as f32 * gy),
+                            (_, Some((a, b))) if fuse => (sign as f32 * a).mul_add(b, gx),
+                            _ => if op == B::Add { gx + gy } else { gx - gy },
+                        };
+                        let mut d = Dev::lin(1.0, &dx, sign, &dy);
+                        let mut inexact = !d.is_zero();
+                        for (is_mul, v, rv) in [(px.is_some(), x64, rx), (py.is_some(), y64, ry)] {
+                            if is_mul {
+                                d = self.fresh(d, 0.5 * ulp(v.abs() + rv)); // fused: unrounded product
+                                inexact = true;
+                            }
+                        }
+                        if inexact {
+                            let rad = d.radius();
+                            d = self.fresh(d, ulp(r.abs() as f64 + rad));
+                        }
+                        self.f(r, g, d, None)
+                    }
+                    B::Multiply => {
+                        let r = x * y;
+                        let mut d = Dev::lin(y64, &dx, x64, &dy);
+                        d.rem += rx * ry;
+                        if !d.is_zero() {
+                            let rad = d.radius();
+                            d = self.fresh(d, ulp(r.abs() as f64 + rad));
+                        }
+                        self.f(r, gx * gy, d, Some((gx, gy)))
+                    }
+                    B::Divide => {
+                        let r = x / y;
+                        let den = y64.abs() - ry;
+                        assert!(
+                            den >= 2f64.powi(-126) && y64.abs() + ry <= 2f64.powi(126),
+                            "divisor {y:e} ± {ry:e} outside the range of the WGSL division accuracy"
+                        );
+                        let q = x64 / y64;
+                        // Δq = (Δx − qΔy)/y' = (Δx − qΔy)/y − (Δx − qΔy)Δy/(y y').
+                        let num = Dev::lin(1.0, &dx, -q, &dy);
+                        let mut d = Dev::lin(1.0 / y64, &num, 0.0, &Dev::default());
+                        d.rem += num.radius() * ry / (y64.abs() * den);
+                        let rad = d.radius();
+                        d = self.fresh(d, 3.0 * ulp(q.abs() + rad));
+                        self.f(r, step_ulps(gx / gy, self.gpu.get().div_ulps), d, None)
+                    }
+                    B::Less | B::LessEqual | B::Greater | B::GreaterEqual | B::Equal | B::NotEqual => {
+                        let cmp = |x: f64, y: f64| match op {
+                            B::Less => x < y,
+                            B::LessEqual => x <= y,
+                            B::Greater => x > y,
+                            B::GreaterEqual => x >= y,
+                            B::Equal => x == y,
+                            _ => x != y,
+                        };
+                        let c = cmp(x64, y64);
+                        assert_eq!(cmp(gx as f64, gy as f64), c, "simulated GPU compares {gx} and {gy} differently");
+                        assert!(
+                            [(-rx, -ry), (-rx, ry), (rx, -ry), (rx, ry)].iter().all(|&(p, q)| cmp(x64 + p, y64 + q) == c),
+                            "comparison of {x} and {y} may differ between CPU and GPU"
+                        );
+                        V::B(c)
+                    }
+                    other => panic!("unsupported f32 operator {other:?}"),
+                }
+            }
+            (V::U(x), V::U(y)) => match op {
+                B::Add => V::U(x.wrapping_add(y)),
+                B::Subtract => V::U(x.wrapping_sub(y)),
+                B::Multiply => V::U(x.wrapping_mul(y)),
+                B::Divide => V::U(x / y),
+                B::Modulo => V::U(x % y),
+                B::And => V::U(x & y),
+                B::InclusiveOr => V::U(x | y),
+                B::ExclusiveOr => V::U(x ^ y),
+                B::ShiftLeft => V::U(x << (y & 31)),
+                B::ShiftRight => V::U(x >> (y & 31)),
+                B::Less => V::B(x < y),
+                B::LessEqual => V::B(x <= y),
+                B::Greater => V::B(x > y),
+                B::GreaterEqual => V::B(x >= y),
+                B::Equal => V::B(x == y),
+                B::NotEqual => V::B(x != y),
+                other => panic!("unsupported u32 operator {other:?}"),
+            },
+            (V::B(x), V::B(y)) => match op {
+                B::LogicalAnd | B::And => V::B(x && y),
+                B::LogicalOr | B::InclusiveOr => V::B(x || y),
+                B::Equal => V::B(x == y),
+                B::NotEqual => V::B(x != y),
+                other => panic!("unsupported bool operator {other:?}"),
+            },
+            (a, b) => panic!("unsupported operands {a:?} {op:?} {b:?}"),
+        }
+    }
+
+    /// clamp(x, lo, hi) (Rust semantics on the CPU side: NaN stays NaN; the emitted code
+    /// selects NaN away before using the result).
+    #[allow(clippy::too_many_arguments)]
+    fn clamp(&self, x: f32, gx: f32, dx: Dev, lo: f32, glo: f32, dlo: &Dev, hi: f32, ghi: f32, dhi: &Dev) -> V {
+        if x.is_nan() {
+            return self.f(x, gx, Dev::default(), None);
+        }
+        let r = x.max(lo).min(hi);
+        let g = gx.max(glo).min(ghi);
+        let (rx, rl, rh) = (dx.radius(), dlo.radius(), dhi.radius());
+        let (x64, lo64, hi64) = (x as f64, lo as f64, hi as f64);
+        let d = if x64 - rx > lo64 + rl && x64 + rx < hi64 - rh {
+            dx // inside on both sides
+        } else if (x64 + rx < lo64 - rl && rl == 0.0) || (x64 - rx > hi64 + rh && rh == 0.0) {
+            Dev::default() // clamped to the same exact limit on both sides
+        } else {
+            self.fresh(Dev::default(), rx.max(rl).max(rh)) // 1-Lipschitz
+        };
+        self.f(r, g, d, None)
+    }
+
+    fn math(&self, fun: M, a: V, b: Option<V>, c: Option<V>) -> V {
+        let inf = Dev::default();
+        match (fun, a, b, c) {
+            (
+                M::Clamp,
+                V::F { v, g, d, .. },
+                Some(V::F { v: lo, g: glo, d: dl, .. }),
+                Some(V::F { v: hi, g: ghi, d: dh, .. }),
+            ) => self.clamp(v, g, d, lo, glo, &dl, hi, ghi, &dh),
+            (M::Min, V::F { v, g, d, .. }, Some(V::F { v: w, g: gw, d: dw, .. }), None) => {
+                self.clamp(v, g, d, f32::NEG_INFINITY, f32::NEG_INFINITY, &inf, w, gw, &dw)
+            }
+            (M::Max, V::F { v, g, d, .. }, Some(V::F { v: w, g: gw, d: dw, .. }), None) => {
+                self.clamp(v, g, d, w, gw, &dw, f32::INFINITY, f32::INFINITY, &inf)
+            }
+            (M::Min, V::U(x), Some(V::U(y)), None) => V::U(x.min(y)),
+            (M::Max, V::U(x), Some(V::U(y)), None) => V::U(x.max(y)),
+            (M::Clamp, V::U(x), Some(V::U(lo)), Some(V::U(hi))) => V::U(x.max(lo).min(hi)),
+            (M::Abs, V::F { v, g, d, .. }, None, None) => {
+                if v.abs() as f64 > d.radius() {
+                    let s = if v < 0.0 { -1.0 } else { 1.0 };
+                    self.f(v.abs(), g.abs(), Dev::lin(s, &d, 0.0, &inf), None)
+                } else {
+                    let r = d.radius();
+                    self.f(v.abs(), g.abs(), self.fresh(Dev::default(), r), None)
+                }
+            }
+            (fun, a, b, c) => panic!("unsupported {fun:?}({a:?}, {b:?}, {c:?})"),
+        }
+    }
+}
+
+struct Frame<'p, 'm> {
+    p: &'p Program,
+    func: &'p naga::Function,
+    args: Vec<V>,
+    memo: &'m mut Vec<Option<V>>,
+}
+
+fn index(v: &V) -> usize {
+    match v {
+        V::U(u) => *u as usize,
+        V::I(i) => *i as usize,
+        other => panic!("expected an index, got {other:?}"),
+    }
+}
+
+impl Frame<'_, '_> {
+    fn block(&mut self, block: &naga::Block) -> Option<V> {
+        for s in block.iter() {
+            match s {
+                Statement::Emit(_) => {}
+                Statement::Block(b) => {
+                    if let Some(v) = self.block(b) {
+                        return Some(v);
+                    }
+                }
+                Statement::Call { function, arguments, result } => {
+                    let args = arguments.iter().map(|a| self.expr(*a)).collect();
+                    let v = self.p.call(*function, args);
+                    if let Some(r) = result {
+                        self.memo[r.index()] = Some(v);
+                    }
+                }
+                Statement::Return { value: Some(v) } => return Some(self.expr(*v)),
+                other => panic!("unsupported statement {other:?}"),
+            }
+        }
+        None
+    }
+
+    fn expr(&mut self, h: Handle<E>) -> V {
+        if let Some(v) = &self.memo[h.index()] {
+            return v.clone();
+        }
+        let v = self.compute(h);
+        self.memo[h.index()] = Some(v.clone());
+        v
+    }
+
+    fn compute(&mut self, h: Handle<E>) -> V {
+        let p = self.p;
+        match &self.func.expressions[h] {
+            E::Literal(l) => p.literal(l),
+            E::Constant(c) => p.global(p.module.constants[*c].init),
+            E::FunctionArgument(i) => self.args[*i as usize].clone(),
+            E::Compose { components, .. } => V::Arr(Rc::new(components.iter().map(|c| self.expr(*c)).collect())),
+            E::Access { base, index: i } => {
+                let (b, i) = (self.expr(*base), self.expr(*i));
+                match b {
+                    V::Arr(a) => a[index(&i)].clone(),
+                    other => panic!("indexing {other:?}"),
+                }
+            }
+            E::AccessIndex { base, index: i } => match self.expr(*base) {
+                V::Arr(a) => a[*i as usize].clone(),
+                other => panic!("indexing {other:?}"),
+            },
+            E::CallResult(_) => panic!("call result used before the call"),
+            E::Unary { op: naga::UnaryOperator::Negate, expr } => match self.expr(*expr) {
+                V::F { v, g, d, prod } => {
+                    V::F { v: -v, g: -g, d: Dev::lin(-1.0, &d, 0.0, &Dev::default()), prod: prod.map(|(a, b)| (-a, b)) }
+                }
+                V::I(i) => V::I(i.wrapping_neg()),
+                other => panic!("negating {other:?}"),
+            },
+            E::Binary { op, left, right } => {
+                let (a, b) = (self.expr(*left), self.expr(*right));
+                p.binary(*op, a, b)
+            }
+            E::Select { condition, accept, reject } => match self.expr(*condition) {
+                V::B(c) => {
+                    if c {
+                        self.expr(*accept)
+                    } else {
+                        self.expr(*reject)
+                    }
+                }
+                other => panic!("select on {other:?}"),
+            },
+            E::Math { fun, arg, arg1, arg2, .. } => {
+                let a = self.expr(*arg);
+                let b = arg1.map(|x| self.expr(x));
+                let c = arg2.map(|x| self.expr(x));
+                p.math(*fun, a, b, c)
+            }
+            E::As { expr, kind, convert } => {
+                let v = self.expr(*expr);
+                match (v, kind, convert) {
+                    (V::F { v, g, d, .. }, ScalarKind::Uint, None) => {
+                        // Exact unless the value is subnormal and may have been flushed to ±0;
+                        // the emitted code only tests the bits for NaN, which neither is.
+                        let r = d.radius();
+                        assert!(
+                            r == 0.0 || (v.abs() < f32::MIN_POSITIVE && r <= f32::MIN_POSITIVE as f64),
+                            "bitcast of an inexact value"
+                        );
+                        let nan = |x: f32| (x.to_bits() & 0x7fff_ffff) > 0x7f80_0000;
+                        assert_eq!(nan(g), nan(v), "simulated GPU bitcast differs in NaN-ness");
+                        V::U(v.to_bits())
+                    }
+                    (V::U(u), ScalarKind::Float, None) => p.exact(f32::from_bits(u)),
+                    (V::F { v, g, d, .. }, ScalarKind::Uint, Some(4)) => {
+                        let i = v as u32; // saturating, like WGSL
+                        let r = d.radius();
+                        let (lo, hi) = ((v as f64 - r) as f32 as u32, (v as f64 + r) as f32 as u32);
+                        assert!(lo == i && hi == i, "u32({v}) may differ between CPU and GPU (deviation {r:e})");
+                        assert_eq!(g as u32, i, "simulated GPU: u32({g}) != u32({v})");
+                        V::U(i)
+                    }
+                    (V::U(u), ScalarKind::Float, Some(4)) => p.exact(u as f32),
+                    (V::I(i), ScalarKind::Float, Some(4)) => p.exact(i as f32),
+                    (V::U(u), ScalarKind::Sint, _) => V::I(u as i32),
+                    (V::I(i), ScalarKind::Uint, _) => V::U(i as u32),
+                    (v, k, c) => panic!("unsupported conversion of {v:?} to {k:?} ({c:?})"),
+                }
+            }
+            other => panic!("unsupported expression {other:?}"),
+        }
+    }
+}
