@@ -46,9 +46,17 @@ impl FitReport {
             .map(|(r, y)| (r / y).abs())
             .fold(0.0, f64::max);
         let j = problem.jacobian_at(theta);
-        let sv = j.singular_values();
-        let smax = sv.iter().cloned().fold(0.0, f64::max);
-        let smin = sv.iter().cloned().fold(f64::INFINITY, f64::min);
+        // nalgebra's SVD can loop forever on non-finite entries: check first, and cap the
+        // iterations (no convergence ⇒ report an infinite condition number).
+        let sv = if j.iter().all(|v| v.is_finite()) {
+            j.try_svd(false, false, f64::EPSILON, 10_000).map(|s| s.singular_values)
+        } else {
+            None
+        };
+        let (smax, smin) = match &sv {
+            Some(sv) => (sv.iter().cloned().fold(0.0, f64::max), sv.iter().cloned().fold(f64::INFINITY, f64::min)),
+            None => (f64::INFINITY, 0.0),
+        };
         FitReport {
             objective: opts.objective,
             samples: n,

@@ -199,7 +199,10 @@ pub fn linearised_starts(model: &RationalModel, data: &Data, what: &str) -> Resu
         for (j, s) in scale.iter().enumerate() {
             a_s.column_mut(j).scale_mut(1.0 / s);
         }
-        let svd = a_s.svd(true, true);
+        if !a_s.iter().chain(rhs.iter()).all(|v| v.is_finite()) {
+            continue;
+        }
+        let Some(svd) = a_s.try_svd(true, true, f64::EPSILON, 10_000) else { continue };
         let Ok(t) = svd.solve(&rhs, 1e-13) else { continue };
         let t = DVector::from_iterator(t.len(), t.iter().zip(&scale).map(|(v, s)| v / s));
         if !t.iter().all(|v| v.is_finite()) {

@@ -3,6 +3,7 @@
 //! Each item gives its domain, the points measured, max abs and rms error, the worst point and
 //! findings: what the numbers say about the published constants (noise, typos, conventions).
 
+pub mod fuzz;
 pub mod gloss;
 
 use serde::Serialize;
@@ -37,5 +38,7 @@ pub fn measure(points: &[Vec<f64>], truth: &[f64], approx: &[f64]) -> (f64, f64,
 
 /// Every item known to the project.
 pub fn all(generated: &std::path::Path) -> Vec<Item> {
-    gloss::items(generated)
+    let mut items = gloss::items(generated);
+    items.extend(fuzz::items(generated));
+    items
 }
