@@ -115,8 +115,8 @@ impl FixedRule {
     }
 }
 
-// Gauss–Kronrod 10/21 abscissae and weights (QUADPACK qk21), nodes on [0, 1] half.
-const XGK21: [f64; 11] = [
+/// Gauss–Kronrod 10/21 abscissae (QUADPACK qk21), the non-negative half of [-1, 1].
+pub const XGK21: [f64; 11] = [
     0.995657163025808080735527280689003,
     0.973906528517171720077964012084452,
     0.930157491355708226001207180059508,
@@ -129,7 +129,8 @@ const XGK21: [f64; 11] = [
     0.148874338981631210884826001129720,
     0.000000000000000000000000000000000,
 ];
-const WGK21: [f64; 11] = [
+/// Kronrod 21-point weights for [`XGK21`].
+pub const WGK21: [f64; 11] = [
     0.011694638867371874278064396062192,
     0.032558162307964727478818972459390,
     0.054755896574351996031381300244580,
@@ -142,8 +143,8 @@ const WGK21: [f64; 11] = [
     0.147739104901338491374841515972068,
     0.149445554002916905664936468389821,
 ];
-// Gauss 10-point weights for the odd-indexed Kronrod nodes 1, 3, 5, 7, 9.
-const WG10: [f64; 5] = [
+/// Gauss 10-point weights for the odd-indexed Kronrod nodes 1, 3, 5, 7, 9.
+pub const WG10: [f64; 5] = [
     0.066671344308688137593568809893332,
     0.149451349150580593145776339657697,
     0.219086362515982043995534934228163,
