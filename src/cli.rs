@@ -42,6 +42,25 @@ pub fn eval(name: &str, params: &[String], as_json: bool) -> Result<()> {
         }
     }
     let canonical = q.resolve(&named).map_err(input_err)?;
+    if let Some(multi) = q.eval_channels {
+        let est = multi(&canonical, 1e-12);
+        let values: Vec<f64> = est.iter().map(|e| e.value).collect();
+        let error = est.iter().map(|e| e.error).fold(0.0, f64::max);
+        if as_json {
+            let out = json!({
+                "quantity": q.name,
+                "params": named,
+                "value": values,
+                "channels": q.channels,
+                "error_estimate": error,
+            });
+            println!("{out}");
+        } else {
+            let parts: Vec<String> = q.channels.iter().zip(&values).map(|(c, v)| format!("{c} {v:.17e}")).collect();
+            println!("{} = {}  (error estimate {error:.1e})", q.name, parts.join(", "));
+        }
+        return Ok(());
+    }
     let est = (q.eval)(&canonical, 1e-12);
     if as_json {
         let out = json!({

@@ -15,6 +15,8 @@ pub struct ParamSpec {
     pub min: f64,
     pub max: f64,
     pub doc: &'static str,
+    /// Only whole numbers are accepted (e.g. an SH band).
+    pub integer: bool,
 }
 
 /// A quantity `shadefit eval` serves and specs sample.
@@ -31,6 +33,10 @@ pub struct QuantityDef {
     /// For 1-D quantities: the inverse map value → parameter, used to report a fit's error in
     /// parameter units (e.g. gloss recovered from a fitted length).
     pub inverse: Option<fn(f64) -> f64>,
+    /// Vector-valued quantities (e.g. RGB): channel names and the evaluator of all channels.
+    /// Their `eval` returns channel 0; specs do not take them yet.
+    pub channels: &'static [&'static str],
+    pub eval_channels: Option<fn(&[f64], f64) -> Vec<Estimate>>,
 }
 
 #[derive(Debug, thiserror::Error, PartialEq)]
@@ -43,6 +49,8 @@ pub enum QuantityError {
     MissingParam { quantity: String, param: String },
     #[error("{quantity}: parameter '{param}' = {value} is outside its domain [{min}, {max}]")]
     OutOfDomain { quantity: String, param: String, value: f64, min: f64, max: f64 },
+    #[error("{quantity}: parameter '{param}' = {value} must be a whole number")]
+    NotInteger { quantity: String, param: String, value: f64 },
     #[error("{quantity}: parameter '{param}' is given twice (directly or through an alias)")]
     Duplicate { quantity: String, param: String },
 }
@@ -79,39 +87,95 @@ fn fuzz_r(p: &[f64], tol: f64) -> Estimate {
     fuzz::r(p[0], p[1], tol)
 }
 
-const HALF_PI: f64 = std::f64::consts::FRAC_PI_2;
-const ALPHA: ParamSpec = ParamSpec { name: "alpha", min: 0.01, max: 1.0, doc: "SGGX fiber alpha" };
-const THETA_F: ParamSpec = ParamSpec { name: "theta_f", min: 0.0, max: HALF_PI, doc: "fiber polar angle (rad)" };
-const DENSITY: ParamSpec = ParamSpec { name: "d", min: 0.0, max: 50.0, doc: "fuzz density (optical thickness)" };
+fn skin_channels(r: Result<[Estimate; 3], skin::ProfileError>) -> Vec<Estimate> {
+    // The default profile is valid and the arguments are inside the domain, so the only
+    // error left would be a bug: report it as NaN with infinite error rather than panic.
+    r.map(|e| e.to_vec()).unwrap_or_else(|_| vec![Estimate { value: f64::NAN, error: f64::INFINITY, evals: 0 }; 3])
+}
 
-const GLOSS: ParamSpec = ParamSpec { name: "gloss", min: 0.0, max: 1.0, doc: "gloss g" };
+fn skin_tolerance(tol: f64) -> crate::integrate::Tolerance {
+    crate::integrate::Tolerance { abs: tol.min(skin::DEFAULT_TOLERANCE.abs), ..skin::DEFAULT_TOLERANCE }
+}
+
+fn skin_punctual_rgb(p: &[f64], tol: f64) -> Vec<Estimate> {
+    let profile = skin::default_skin_profile();
+    skin_channels(skin::punctual(&profile, skin::Kernel::Linear, p[0], p[1], skin_tolerance(tol)))
+}
+
+fn skin_punctual(p: &[f64], tol: f64) -> Estimate {
+    skin_punctual_rgb(p, tol)[0]
+}
+
+fn skin_sh_rgb(p: &[f64], tol: f64) -> Vec<Estimate> {
+    let profile = skin::default_skin_profile();
+    skin_channels(skin::sh_band(&profile, p[0], p[1] as u32, skin_tolerance(tol)))
+}
+
+fn skin_sh(p: &[f64], tol: f64) -> Estimate {
+    skin_sh_rgb(p, tol)[0]
+}
+
+const CURVATURE: ParamSpec =
+    ParamSpec { name: "curvature", min: 0.0, max: 100.0, doc: "curvature (1/mm)", integer: false };
+
+const HALF_PI: f64 = std::f64::consts::FRAC_PI_2;
+const ALPHA: ParamSpec = ParamSpec { name: "alpha", min: 0.01, max: 1.0, doc: "SGGX fiber alpha", integer: false };
+const THETA_F: ParamSpec = ParamSpec { name: "theta_f", min: 0.0, max: HALF_PI, doc: "fiber polar angle (rad)", integer: false };
+const DENSITY: ParamSpec = ParamSpec { name: "d", min: 0.0, max: 50.0, doc: "fuzz density (optical thickness)", integer: false };
+
+const GLOSS: ParamSpec = ParamSpec { name: "gloss", min: 0.0, max: 1.0, doc: "gloss g", integer: false };
 
 static REGISTRY: &[QuantityDef] = &[
+    QuantityDef {
+        name: "skin-punctual",
+        doc: "pre-integrated skin diffusion for a punctual light (linear profile on a ring), RGB",
+        params: &[CURVATURE, ParamSpec { name: "n_dot_l", min: -1.0, max: 1.0, doc: "n·l", integer: false }],
+        aliases: &[],
+        eval: skin_punctual,
+        inverse: None,
+        channels: &["red", "green", "blue"],
+        eval_channels: Some(skin_punctual_rgb),
+    },
+    QuantityDef {
+        name: "skin-sh",
+        doc: "per-band factor scaling clamped-cosine SH irradiance by skin scattering (sphere), RGB",
+        params: &[CURVATURE, ParamSpec { name: "band", min: 0.0, max: 2.0, doc: "SH band l", integer: true }],
+        aliases: &[],
+        eval: skin_sh,
+        inverse: None,
+        channels: &["red", "green", "blue"],
+        eval_channels: Some(skin_sh_rgb),
+    },
     QuantityDef {
         name: "fuzz-ps",
         doc: "fraction of light the fuzz layer scatters toward the base layer, P_s(u)",
         params: &[
             ALPHA,
             THETA_F,
-            ParamSpec { name: "theta_u", min: 0.0, max: std::f64::consts::PI, doc: "light polar angle (rad)" },
+            ParamSpec { name: "theta_u", min: 0.0, max: std::f64::consts::PI, doc: "light polar angle (rad)", integer: false },
             ParamSpec {
                 name: "phi_u",
                 min: -std::f64::consts::PI,
                 max: 2.0 * std::f64::consts::PI,
                 doc: "light azimuth from the fiber azimuth (rad)",
+                integer: false,
             },
         ],
         aliases: &[],
         eval: fuzz_ps,
         inverse: None,
+        channels: &[],
+        eval_channels: None,
     },
     QuantityDef {
         name: "fuzz-g",
         doc: "hemispherical average G(d, mu_v) of the single-scattering fuzz layer",
-        params: &[ParamSpec { name: "mu_v", min: 0.0, max: 1.0, doc: "n·v" }, DENSITY],
+        params: &[ParamSpec { name: "mu_v", min: 0.0, max: 1.0, doc: "n·v", integer: false }, DENSITY],
         aliases: &[],
         eval: fuzz_g,
         inverse: None,
+        channels: &[],
+        eval_channels: None,
     },
     QuantityDef {
         name: "fuzz-q",
@@ -120,6 +184,8 @@ static REGISTRY: &[QuantityDef] = &[
         aliases: &[],
         eval: fuzz_q,
         inverse: None,
+        channels: &[],
+        eval_channels: None,
     },
     QuantityDef {
         name: "fuzz-r",
@@ -128,6 +194,8 @@ static REGISTRY: &[QuantityDef] = &[
         aliases: &[],
         eval: fuzz_r,
         inverse: None,
+        channels: &[],
+        eval_channels: None,
     },
     QuantityDef {
         name: "gloss-length",
@@ -136,31 +204,37 @@ static REGISTRY: &[QuantityDef] = &[
         aliases: &[(
             // α at gloss 1 is sqrt(2/262145) = 0.00276213059566896…; the bound sits just below it
             // and the converted gloss is clamped to 1.
-            ParamSpec { name: "alpha", min: 0.0027621305956689, max: 1.0, doc: "GGX alpha" },
+            ParamSpec { name: "alpha", min: 0.0027621305956689, max: 1.0, doc: "GGX alpha", integer: false },
             0,
             gloss::gloss_from_alpha,
         )],
         eval: gloss_length,
         inverse: Some(gloss::gloss_from_length),
+        channels: &[],
+        eval_channels: None,
     },
     QuantityDef {
         name: "gloss-from-length",
         doc: "gloss whose GGX average normal length is `length` (clamped to the table ends)",
-        params: &[ParamSpec { name: "length", min: 0.0, max: 1.0, doc: "normal length" }],
+        params: &[ParamSpec { name: "length", min: 0.0, max: 1.0, doc: "normal length", integer: false }],
         aliases: &[],
         eval: gloss_from_length,
         inverse: None,
+        channels: &[],
+        eval_channels: None,
     },
     QuantityDef {
         name: "gloss-combine",
         doc: "gloss of two combined glosses (Reoriented Normal Mapping of their NDFs)",
         params: &[
-            ParamSpec { name: "x", min: 0.0, max: 1.0, doc: "first gloss" },
-            ParamSpec { name: "y", min: 0.0, max: 1.0, doc: "second gloss" },
+            ParamSpec { name: "x", min: 0.0, max: 1.0, doc: "first gloss", integer: false },
+            ParamSpec { name: "y", min: 0.0, max: 1.0, doc: "second gloss", integer: false },
         ],
         aliases: &[],
         eval: gloss_combine,
         inverse: None,
+        channels: &[],
+        eval_channels: None,
     },
 ];
 
@@ -205,6 +279,9 @@ impl QuantityDef {
                     min: spec.min,
                     max: spec.max,
                 });
+            }
+            if spec.integer && value.fract() != 0.0 {
+                return Err(QuantityError::NotInteger { quantity: self.name.into(), param: key.clone(), value });
             }
             if out[idx].is_some() {
                 return Err(QuantityError::Duplicate { quantity: self.name.into(), param: key.clone() });

@@ -333,6 +333,12 @@ impl Spec {
             return Err(at("tolerance", format!("{} must be in (0, 1)", file.tolerance)));
         }
         let quantity = quantity::lookup(&file.quantity).map_err(|e| at("quantity", e.to_string()))?;
+        if !quantity.channels.is_empty() {
+            return Err(at(
+                "quantity",
+                format!("'{}' has {} channels; specs take scalar quantities only (for now)", quantity.name, quantity.channels.len()),
+            ));
+        }
         let names: Vec<&str> = quantity.params.iter().map(|p| p.name).collect();
         let axis_names: Vec<&str> = file.axis.iter().map(|a| a.name.as_str()).collect();
         if axis_names != names {
