@@ -111,7 +111,6 @@ pub fn published_r(alpha: f64, theta_f: f64) -> f64 {
 use super::{measure, Item};
 use crate::quantity::fuzz;
 use rayon::prelude::*;
-use serde_json::Value;
 use std::path::Path;
 
 /// Eq. 1 with the published table's rows 3 and 4 exchanged: row 3 multiplying (u·n)(u·t) and
@@ -127,32 +126,6 @@ fn grid(lo0: f64, hi0: f64, n0: usize, lo1: f64, hi1: f64, n1: usize) -> Vec<Vec
     b.iter().flat_map(|&y| a.iter().map(move |&x| vec![x, y])).collect()
 }
 
-/// Committed refit: coefficients and the model's clamp from generated/json/NAME.json,
-/// evaluated through the same model the build used.
-fn refit(generated: &Path, name: &str) -> Option<(crate::spec::Spec, nalgebra::DVector<f64>)> {
-    let text = std::fs::read_to_string(generated.join("json").join(format!("{name}.json"))).ok()?;
-    let v: Value = serde_json::from_str(&text).ok()?;
-    let c: Vec<f64> = v["model"]["coefficients"].as_array()?.iter().map(Value::as_f64).collect::<Option<_>>()?;
-    let spec_path = generated.parent()?.join(v["spec"].as_str()?);
-    let spec = crate::spec::Spec::load(&spec_path).ok()?;
-    Some((spec, nalgebra::DVector::from_vec(c)))
-}
-
-fn refit_finding(generated: &Path, name: &str, pts: &[Vec<f64>], truth: &[f64], published_max: f64, extra: &mut Vec<(String, f64)>, findings: &mut Vec<String>) {
-    if let Some((spec, c)) = refit(generated, name)
-        && let Some(model) = &spec.model
-    {
-        let approx: Vec<f64> = pts.iter().map(|x| model.eval_clamped(&c, x)).collect();
-        let (m, r, _) = measure(pts, truth, &approx);
-        extra.push(("refit_max_abs_error".into(), m));
-        extra.push(("refit_rms_error".into(), r));
-        findings.push(format!(
-            "shadefit's refit (fits/{name}.toml, same form): max {m:.3e} ({:.2}× the published), rms {r:.3e}.",
-            m / published_max
-        ));
-    }
-}
-
 pub fn items(generated: &Path) -> Vec<Item> {
     let mut out = Vec::new();
 
@@ -160,29 +133,17 @@ pub fn items(generated: &Path) -> Vec<Item> {
     let pts: Vec<Vec<f64>> = fuzz::linspace(0.0, 0.5, 2049).into_iter().map(|d| vec![d]).collect();
     let truth: Vec<f64> = pts.iter().map(|p| fuzz::q_exact(p[0])).collect();
     let approx: Vec<f64> = pts.iter().map(|p| published_q(p[0])).collect();
-    let (max, rms, worst) = measure(&pts, &truth, &approx);
-    let mut extra = vec![];
-    let mut findings = vec!["Q = 2·E₃(d) exactly; Q̃ is a quadratic fit of it (convention agrees).".to_string()];
-    refit_finding(generated, "fuzz_q", &pts, &truth, max, &mut extra, &mut findings);
-    out.push(Item {
-        name: "fuzz_q (Listing 4)".into(),
-        source: "Ghost of Tsushima supplemental, Eq. 4".into(),
-        domain: "d ∈ [0, 0.5], 2049 points".into(),
-        points: pts.len(),
-        max_abs_error: max,
-        rms_error: rms,
-        worst_point: worst,
-        extra,
-        findings,
-    });
+    let mut item = Item::measured("fuzz_q (Listing 4)", "Ghost of Tsushima supplemental, Eq. 4", "d ∈ [0, 0.5], 2049 points", &pts, &truth, &approx);
+    item.findings = vec!["Q = 2·E₃(d) exactly; Q̃ is a quadratic fit of it (convention agrees).".to_string()];
+    item.add_refit(generated, "fuzz_q", &pts, &truth);
+    out.push(item);
 
     // G̃ on μv ∈ [0.001, 1], d ∈ [0, 0.5] (the grid of fits/fuzz_g.toml's verification).
     let pts = grid(0.001, 1.0, 257, 0.0, 0.5, 257);
     let truth: Vec<f64> = pts.par_iter().map(|p| fuzz::g(p[1], p[0], 1e-12).value).collect();
     let approx: Vec<f64> = pts.iter().map(|p| published_g(p[0], p[1])).collect();
-    let (max, rms, worst) = measure(&pts, &truth, &approx);
-    let mut extra = vec![];
-    let mut findings = vec![
+    let mut item = Item::measured("fuzz_g (Listing 3)", "Ghost of Tsushima supplemental, Eq. 3", "μv ∈ [0.001, 1] × d ∈ [0, 0.5], 257×257", &pts, &truth, &approx);
+    item.findings = vec![
         "The supplemental's G exponent is garbled ((u+v)·n/(u+v)·n); the Koenderink–Pont form \
          d(μu+μv)/(μu μv) is what G̃ fits (a refit of the same form from it reproduces the published error)."
             .to_string(),
@@ -190,42 +151,21 @@ pub fn items(generated: &Path) -> Vec<Item> {
          depends on d/μv and the form cannot follow it."
             .to_string(),
     ];
-    refit_finding(generated, "fuzz_g", &pts, &truth, max, &mut extra, &mut findings);
-    out.push(Item {
-        name: "fuzz_g (Listing 3)".into(),
-        source: "Ghost of Tsushima supplemental, Eq. 3".into(),
-        domain: "μv ∈ [0.001, 1] × d ∈ [0, 0.5], 257×257".into(),
-        points: pts.len(),
-        max_abs_error: max,
-        rms_error: rms,
-        worst_point: worst,
-        extra,
-        findings,
-    });
+    item.add_refit(generated, "fuzz_g", &pts, &truth);
+    out.push(item);
 
     // R̃ on α ∈ [0.15, 1], θf ∈ [0, π/2].
     let pts = grid(0.15, 1.0, 25, 0.0, std::f64::consts::FRAC_PI_2, 25);
     let truth: Vec<f64> = pts.par_iter().map(|p| fuzz::r(p[0], p[1], 1e-9).value).collect();
     let approx: Vec<f64> = pts.iter().map(|p| published_r(p[0], p[1])).collect();
-    let (max, rms, worst) = measure(&pts, &truth, &approx);
-    let mut extra = vec![];
-    let mut findings = vec![
+    let mut item = Item::measured("fuzz_r (Listing 5)", "Ghost of Tsushima supplemental, Eq. 5", "α ∈ [0.15, 1] × θf ∈ [0, π/2], 25×25", &pts, &truth, &approx);
+    item.findings = vec![
         "Listing 5 redeclares `alpha` from an undefined `uSpread` (GSggxAlphaFromFuzzSpread): a leftover \
          of engine code; evaluated here with the function's alpha."
             .to_string(),
     ];
-    refit_finding(generated, "fuzz_r", &pts, &truth, max, &mut extra, &mut findings);
-    out.push(Item {
-        name: "fuzz_r (Listing 5)".into(),
-        source: "Ghost of Tsushima supplemental, Eq. 5".into(),
-        domain: "α ∈ [0.15, 1] × θf ∈ [0, π/2], 25×25".into(),
-        points: pts.len(),
-        max_abs_error: max,
-        rms_error: rms,
-        worst_point: worst,
-        extra,
-        findings,
-    });
+    item.add_refit(generated, "fuzz_r", &pts, &truth);
+    out.push(item);
 
     // P̃_s (Listings 1–2 with Eq. 1) on a 9×9 (α, θf) grid × 256 light directions.
     let alphas = fuzz::linspace(0.15, 1.0, 9);

@@ -3,7 +3,6 @@
 
 use super::{measure, Item};
 use crate::quantity::gloss::{combine, gloss_from_length, length_from_gloss};
-use serde_json::Value;
 use std::path::Path;
 
 /// The table rows printed on the slides: (gloss, ‖n_s‖), 6 decimals.
@@ -54,14 +53,6 @@ fn uniform(n: usize) -> Vec<f64> {
     (0..n).map(|i| i as f64 / (n - 1) as f64).collect()
 }
 
-/// Committed refit coefficients from generated/json/NAME.json, if present.
-fn committed(generated: &Path, name: &str) -> Option<(Vec<f64>, String)> {
-    let text = std::fs::read_to_string(generated.join("json").join(format!("{name}.json"))).ok()?;
-    let v: Value = serde_json::from_str(&text).ok()?;
-    let c = v["model"]["coefficients"].as_array()?.iter().map(Value::as_f64).collect::<Option<Vec<f64>>>()?;
-    Some((c, v["model"]["objective"].as_str().unwrap_or("?").to_string()))
-}
-
 pub fn items(generated: &Path) -> Vec<Item> {
     let mut out = Vec::new();
 
@@ -71,17 +62,24 @@ pub fn items(generated: &Path) -> Vec<Item> {
     let exact_g: Vec<f64> = PUBLISHED_TABLE.iter().map(|r| (r.0 * 255.0).round() / 255.0).collect();
     let truth: Vec<f64> = exact_g.iter().map(|&g| length_from_gloss(g)).collect();
     let approx: Vec<f64> = PUBLISHED_TABLE.iter().map(|r| r.1).collect();
-    let (max, rms, worst) = measure(&pts, &truth, &approx);
-    let mut findings = vec![format!(
+    let mut item = Item::measured(
+        "gloss_table (published rows)",
+        "COD: WWII, 'Importance sample our NDF' table",
+        "gloss ∈ [0, 1], 8 printed rows of 256",
+        &pts,
+        &truth,
+        &approx,
+    );
+    item.findings.push(format!(
         "g = 0 is α = 1, where ‖n_s‖ = 2/3 exactly; the table prints 0.666670 ({:+.1e}).",
         0.666670 - 2.0 / 3.0
-    )];
+    ));
     let dev: Vec<f64> = truth.iter().zip(&approx).map(|(t, a)| a - t).collect();
     let all_positive = dev.iter().all(|d| *d > 0.0);
     // The length of a mean of N unit vectors is biased upward by the transverse variance:
     // E‖mean‖ ≈ L + E[sin²θ]/(2 L N). At α = 1, E[sin²θ] = 1/2 and L = 2/3: bias ≈ 0.375/N.
     let n_implied = 0.375 / dev[0];
-    findings.push(format!(
+    item.findings.push(format!(
         "Deviations ({}) exceed the 5e-7 rounding of 6 printed decimals{}. Near g = 0 they match the \
          upward bias of the length of a sample mean, E[sin²θ]/(2·L·N) = 0.375/N at α = 1, for N ≈ {:.1e} \
          samples. Near g = 1 that bias is below 1e-9: the deviations there are the print rounding (≤ 5e-7) \
@@ -90,17 +88,7 @@ pub fn items(generated: &Path) -> Vec<Item> {
         if all_positive { ", all of one sign: a systematic bias of the sampling estimator, not noise" } else { "" },
         n_implied
     ));
-    out.push(Item {
-        name: "gloss_table (published rows)".into(),
-        source: "COD: WWII, 'Importance sample our NDF' table".into(),
-        domain: "gloss ∈ [0, 1], 8 printed rows of 256".into(),
-        points: pts.len(),
-        max_abs_error: max,
-        rms_error: rms,
-        worst_point: worst,
-        extra: vec![],
-        findings,
-    });
+    out.push(item);
 
     // Published 1-D fit, on 256 uniform gloss samples.
     let g = uniform(256);
@@ -108,12 +96,20 @@ pub fn items(generated: &Path) -> Vec<Item> {
     let truth: Vec<f64> = g.iter().map(|&x| length_from_gloss(x)).collect();
     let c = published_fit_coefficients(PUBLISHED_ENDS.1);
     let approx: Vec<f64> = g.iter().map(|&x| rational_1d(&c, x)).collect();
-    let (max, rms, worst) = measure(&pts, &truth, &approx);
+    let mut item = Item::measured(
+        "gloss_length (published fit)",
+        "COD: WWII, 'Rational function fitting' FindFit result",
+        "gloss ∈ [0, 1], 256 uniform samples",
+        &pts,
+        &truth,
+        &approx,
+    );
+    let max = item.max_abs_error;
     let gloss_err = g.iter().zip(&approx).map(|(&x, &v)| (gloss_from_length(v) - x).abs()).fold(0.0, f64::max);
     let typo = published_fit_coefficients(0.99958);
     let typo_approx: Vec<f64> = g.iter().map(|&x| rational_1d(&typo, x)).collect();
     let (typo_max, _, _) = measure(&pts, &truth, &typo_approx);
-    let mut findings = vec![
+    item.findings = vec![
         format!("c0 = {:.7}, c3 = {:.7} from the constraints (the slide rounds c3 to 0.56).", c[0], c[3]),
         format!(
             "The slide's text writes the end constraint with 0.99958 (a dropped digit); the FindFit code uses \
@@ -125,68 +121,28 @@ pub fn items(generated: &Path) -> Vec<Item> {
             length_from_gloss(1.0)
         ),
     ];
-    let mut extra = vec![("max_abs_error_in_gloss".to_string(), gloss_err)];
-    if let Some((rc, objective)) = committed(generated, "gloss_length").filter(|v| v.0.len() == 6) {
-        let rc: [f64; 6] = [rc[0], rc[1], rc[2], rc[3], rc[4], rc[5]];
-        let ra: Vec<f64> = g.iter().map(|&x| rational_1d(&rc, x)).collect();
-        let (rmax, rrms, _) = measure(&pts, &truth, &ra);
+    item.extra.push(("max_abs_error_in_gloss".to_string(), gloss_err));
+    if let Some(ra) = item.add_refit(generated, "gloss_length", &pts, &truth) {
         let rg = g.iter().zip(&ra).map(|(&x, &v)| (gloss_from_length(v) - x).abs()).fold(0.0, f64::max);
-        extra.push(("refit_max_abs_error".into(), rmax));
-        extra.push(("refit_rms_error".into(), rrms));
-        extra.push(("refit_max_abs_error_in_gloss".into(), rg));
-        findings.push(format!(
-            "shadefit's refit (fits/gloss_length.toml, same form and constraints, {objective}): max {rmax:.2e} ({:.2}× the published), rms {rrms:.2e} ({:.2}×), in gloss units {rg:.2e}.",
-            rmax / max,
-            rrms / rms
-        ));
+        item.extra.push(("refit_max_abs_error_in_gloss".into(), rg));
+        item.findings.push(format!("The refit's error in recovered gloss units: {rg:.2e}."));
     }
-    out.push(Item {
-        name: "gloss_length (published fit)".into(),
-        source: "COD: WWII, 'Rational function fitting' FindFit result".into(),
-        domain: "gloss ∈ [0, 1], 256 uniform samples".into(),
-        points: pts.len(),
-        max_abs_error: max,
-        rms_error: rms,
-        worst_point: worst,
-        extra,
-        findings,
-    });
+    out.push(item);
 
     // Published combine fit, 65×65 grid.
     let a = uniform(65);
     let pts: Vec<Vec<f64>> = a.iter().flat_map(|&y| a.iter().map(move |&x| vec![x, y])).collect();
     let truth: Vec<f64> = pts.iter().map(|p| combine(p[0], p[1])).collect();
     let approx: Vec<f64> = pts.iter().map(|p| published_combine(p[0], p[1])).collect();
-    let (max, rms, worst) = measure(&pts, &truth, &approx);
-    let mut findings = vec![];
-    let mut extra = vec![];
-    if let Some((rc, objective)) = committed(generated, "gloss_combine").filter(|v| v.0.len() == 7) {
-        let f = |x: f64, y: f64| {
-            let (s, s2, xy) = (x + y, x * x + y * y, x * y);
-            let p = rc[0] + rc[1] * s + rc[2] * s2 + rc[3] * xy;
-            let q = 1.0 + rc[4] * s + rc[5] * s2 + rc[6] * xy;
-            (p / q).clamp(0.0, 1.0)
-        };
-        let ra: Vec<f64> = pts.iter().map(|p| f(p[0], p[1])).collect();
-        let (rmax, rrms, _) = measure(&pts, &truth, &ra);
-        extra.push(("refit_max_abs_error".into(), rmax));
-        extra.push(("refit_rms_error".into(), rrms));
-        findings.push(format!(
-            "shadefit's refit (fits/gloss_combine.toml, same form, clamp-aware {objective}): max {rmax:.2e} ({:.2}× the published), rms {rrms:.2e} ({:.2}×).",
-            rmax / max,
-            rrms / rms
-        ));
-    }
-    out.push(Item {
-        name: "gloss_combine (published fit)".into(),
-        source: "COD: WWII, 'Rational function fit' of the RNM combine table".into(),
-        domain: "x, y ∈ [0, 1], 65×65 grid".into(),
-        points: pts.len(),
-        max_abs_error: max,
-        rms_error: rms,
-        worst_point: worst,
-        extra,
-        findings,
-    });
+    let mut item = Item::measured(
+        "gloss_combine (published fit)",
+        "COD: WWII, 'Rational function fit' of the RNM combine table",
+        "x, y ∈ [0, 1], 65×65 grid",
+        &pts,
+        &truth,
+        &approx,
+    );
+    item.add_refit(generated, "gloss_combine", &pts, &truth);
+    out.push(item);
     out
 }

@@ -7,6 +7,7 @@ pub mod fuzz;
 pub mod gloss;
 
 use serde::Serialize;
+use std::path::Path;
 
 #[derive(Debug, Clone, Serialize)]
 pub struct Item {
@@ -34,6 +35,53 @@ pub fn measure(points: &[Vec<f64>], truth: &[f64], approx: &[f64]) -> (f64, f64,
         ss += e * e;
     }
     (worst.1, (ss / truth.len().max(1) as f64).sqrt(), points.get(worst.0).cloned().unwrap_or_default())
+}
+
+impl Item {
+    /// An item measured from `approx − truth` over `points`, with no extras or findings yet.
+    pub fn measured(name: &str, source: &str, domain: &str, points: &[Vec<f64>], truth: &[f64], approx: &[f64]) -> Item {
+        let (max_abs_error, rms_error, worst_point) = measure(points, truth, approx);
+        Item {
+            name: name.into(),
+            source: source.into(),
+            domain: domain.into(),
+            points: points.len(),
+            max_abs_error,
+            rms_error,
+            worst_point,
+            extra: vec![],
+            findings: vec![],
+        }
+    }
+
+    /// Measure the committed refit `generated/json/NAME.json` on the same points, through the
+    /// model of its spec, and add it side by side. Returns the refit's values (None when the
+    /// refit is not committed).
+    pub fn add_refit(&mut self, generated: &Path, name: &str, points: &[Vec<f64>], truth: &[f64]) -> Option<Vec<f64>> {
+        let (spec, c) = committed_refit(generated, name)?;
+        let model = spec.model.as_ref()?;
+        let approx: Vec<f64> = points.iter().map(|x| model.eval_clamped(&c, x)).collect();
+        let (m, r, _) = measure(points, truth, &approx);
+        let objective = spec.file.fit.as_ref().map_or("?".to_string(), |f| format!("{:?}", f.objective).to_lowercase());
+        self.extra.push(("refit_max_abs_error".into(), m));
+        self.extra.push(("refit_rms_error".into(), r));
+        self.findings.push(format!(
+            "shadefit's refit (fits/{name}.toml, same form, {objective}): max {m:.3e} ({:.2}× the published), rms {r:.3e} ({:.2}×).",
+            m / self.max_abs_error,
+            r / self.rms_error
+        ));
+        Some(approx)
+    }
+}
+
+/// The committed refit NAME: its spec (read from the path its JSON names) and coefficients.
+pub fn committed_refit(generated: &Path, name: &str) -> Option<(crate::spec::Spec, nalgebra::DVector<f64>)> {
+    let text = std::fs::read_to_string(generated.join("json").join(format!("{name}.json"))).ok()?;
+    let v: serde_json::Value = serde_json::from_str(&text).ok()?;
+    let c: Vec<f64> =
+        v["model"]["coefficients"].as_array()?.iter().map(serde_json::Value::as_f64).collect::<Option<_>>()?;
+    let spec = crate::spec::Spec::load(&generated.parent()?.join(v["spec"].as_str()?)).ok()?;
+    (spec.model.as_ref()?.n_full() == c.len()).then(|| (spec, nalgebra::DVector::from_vec(c)))
 }
 
 /// Every item known to the project.
