@@ -106,7 +106,7 @@ pub fn fit(model: &RationalModel, data: &Data, opts: &FitOptions, what: &str) ->
     let starts = linearised_starts(model, data, what)?;
     let domain = data.bounds();
     let lsq = FitOptions { objective: Objective::Lsq, ..*opts };
-    let mut best: Option<(bool, f64, DVector<f64>)> = None;
+    let mut best: Option<(bool, Fit)> = None;
     for theta0 in starts {
         let Ok(f) = fit_from(model, data, theta0, &lsq, what) else { continue };
         let valid = matches!(
@@ -115,14 +115,18 @@ pub fn fit(model: &RationalModel, data: &Data, opts: &FitOptions, what: &str) ->
         );
         let better = match &best {
             None => true,
-            Some((bv, brss, _)) => (valid && !bv) || (valid == *bv && f.report.rss < *brss),
+            Some((bv, b)) => (valid && !bv) || (valid == *bv && f.report.rss < b.report.rss),
         };
         if better {
-            best = Some((valid, f.report.rss, f.theta));
+            best = Some((valid, f));
         }
     }
-    let (_, _, theta0) = best.ok_or_else(|| FitError::SingularStart { what: what.into() })?;
-    fit_from(model, data, theta0, opts, what)
+    let (_, best) = best.ok_or_else(|| FitError::SingularStart { what: what.into() })?;
+    // The least-squares optimum is the answer for lsq; other objectives start from it.
+    match opts.objective {
+        Objective::Lsq => Ok(best),
+        _ => fit_from(model, data, best.theta, opts, what),
+    }
 }
 
 /// Fit from given free parameters.
