@@ -9,12 +9,14 @@
 //! bytes depend only on the inputs: ticks, colours and legend placement are computed here
 //! without clocks, hashing or randomness, which the tests check by rendering twice.
 //!
-//! Figure families built on these primitives: [`gloss_figures`].
+//! Figure families built on these primitives: [`gloss_figures`], [`fuzz_figures`].
 
 mod colormap;
+mod fuzz;
 mod gloss;
 mod ticks;
 
+pub use fuzz::{FuzzResolution, fuzz_figures, fuzz_figures_with};
 pub use gloss::gloss_figures;
 
 use plotters::coord::Shift;
@@ -60,17 +62,27 @@ pub enum SeriesStyle {
     Points,
 }
 
-/// One labelled series of a line plot. An empty label keeps it out of the legend.
+/// One labelled series of a line plot. An empty label keeps it out of the legend; a labelled
+/// series without points is a legend key only (e.g. saying what a line style stands for).
 #[derive(Clone, Debug)]
 pub struct Series {
     pub label: String,
     pub points: Vec<(f64, f64)>,
     pub style: SeriesStyle,
+    /// Index into the tab10 palette; `None` takes the series' position in the plot.
+    pub color: Option<usize>,
 }
 
 impl Series {
     pub fn new(label: impl Into<String>, points: Vec<(f64, f64)>, style: SeriesStyle) -> Self {
-        Self { label: label.into(), points, style }
+        Self { label: label.into(), points, style, color: None }
+    }
+
+    /// The same series drawn in tab10 colour `index` (mod 10), so that series belonging
+    /// together (a quantity and its fits at one parameter value) share a colour.
+    pub fn color(mut self, index: usize) -> Self {
+        self.color = Some(index);
+        self
     }
 }
 
@@ -196,7 +208,8 @@ fn data_err(stem: &Path, message: impl Into<String>) -> PlotError {
 /// logarithmic and points with y ≤ 0 (or non-finite) are left out; non-finite points are left
 /// out in any case. Series take the tab10 colours in order; labelled ones enter a legend put in
 /// the first corner (upper right, upper left, lower right, lower left) where it covers no data,
-/// or, if there is none, above the data in headroom added to the y axis.
+/// or, if there is none, above the data in headroom added to the y axis. Series with no
+/// points are legend keys only; at least one series must have a plottable point.
 pub fn line_plot(
     path_stem: &Path,
     title: &str,
@@ -382,7 +395,7 @@ impl Figure for LineFigure<'_> {
             .map_err(de)?;
 
         for (i, (s, pts)) in self.series.iter().zip(&self.kept).enumerate() {
-            let color = PALETTE[i % PALETTE.len()];
+            let color = PALETTE[s.color.unwrap_or(i) % PALETTE.len()];
             let line = ShapeStyle { color: color.to_rgba(), filled: false, stroke_width: 2 };
             let anno = match s.style {
                 SeriesStyle::Line => chart.draw_series(LineSeries::new(pts.iter().copied(), line)),
