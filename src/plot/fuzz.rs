@@ -15,7 +15,9 @@
 //! - App. H, R(α, θf): `fuzz_r` (reference, published R̃ and refit on one colour scale),
 //!   `fuzz_r_errors` and `fuzz_r_curves` (against θf for the α of App. B).
 //!
-//! Errors are signed, approximation − reference. Angles are in radians, with the conventions of
+//! Errors are signed, approximation − reference. Figure text names the approximations in words
+//! ("published fit", "refit"): the embedded rasteriser draws no combining marks, so P̃ would
+//! show a detached tilde. Angles are in radians, with the conventions of
 //! [`crate::quantity::fuzz`] (normal +z, fiber t = (sin θf, 0, cos θf), φu from the fiber
 //! azimuth). The refits are `GENERATED/json/fuzz_{g,q,r}.json`, evaluated through the model of
 //! the spec each names, whose axis order is checked here: (μv, d) for G, (d) for Q, (α, θf)
@@ -97,9 +99,7 @@ pub fn fuzz_figures_with(
     let g_refit = Refit::load(generated, "fuzz_g", &["mu_v", "d"])?;
     let q_refit = Refit::load(generated, "fuzz_q", &["d"])?;
     let r_refit = Refit::load(generated, "fuzz_r", &["alpha", "theta_f"])?;
-    if [res.ps_theta_u, res.ps_phi_u, res.r_alpha, res.r_theta_f, res.g_mu_v, res.g_d, res.curve]
-        .iter()
-        .any(|&n| n < 2)
+    if [res.ps_theta_u, res.ps_phi_u, res.r_alpha, res.r_theta_f, res.g_mu_v, res.g_d, res.curve].iter().any(|&n| n < 2)
     {
         return Err(PlotError::Data {
             path: out_dir.to_path_buf(),
@@ -155,12 +155,12 @@ fn ps_figures(
             let published = eq1(&published_ps_coeffs(alpha, tf), ps_from_coeffs_swapped);
             let err = difference(&published, &exact);
             error_rows[0].push((format!("published, θf = {tf_label}: {}", stats(&err)), err));
-            rows[1].push((format!("published P̃_s, θf = {tf_label}"), published));
+            rows[1].push((format!("published fit, θf = {tf_label}"), published));
             if let Some(f) = refit {
                 let fitted = eq1(&f(alpha, tf), ps_from_coeffs);
                 let err = difference(&fitted, &exact);
                 error_rows[1].push((format!("refit, θf = {tf_label}: {}", stats(&err)), err));
-                rows[2].push((format!("refit P̃_s, θf = {tf_label}"), fitted));
+                rows[2].push((format!("refit, θf = {tf_label}"), fitted));
             }
             rows[0].push((format!("reference P_s, θf = {tf_label}"), exact));
         }
@@ -170,7 +170,7 @@ fn ps_figures(
         let value_panels: Vec<Panel> = values.iter().map(|(t, v)| Panel { title: t, values: v }).collect();
         out.extend(super::grid_of_heatmaps(
             &out_dir.join(format!("fuzz_ps_alpha_{alpha:.2}")),
-            &format!("P_s at α = {alpha:.2}: reference and published P̃_s (Listing 1, rows 3/4 swapped){refit_note}"),
+            &format!("P_s at α = {alpha:.2}: reference, published fit (Listing 1 with rows 3/4 swapped){refit_note}"),
             x_label,
             y_label,
             &phis,
@@ -184,14 +184,14 @@ fn ps_figures(
         let error_panels: Vec<Panel> = errors.iter().map(|(t, v)| Panel { title: t, values: v }).collect();
         out.extend(super::grid_of_heatmaps(
             &out_dir.join(format!("fuzz_ps_error_alpha_{alpha:.2}")),
-            &format!("P̃_s − P_s at α = {alpha:.2}: published (Listing 1, rows 3/4 swapped){refit_note}"),
+            &format!("Error of the P_s fits at α = {alpha:.2} (fit − reference): published (Listing 1 with rows 3/4 swapped){refit_note}"),
             x_label,
             y_label,
             &phis,
             &thetas,
             &error_panels,
             PS_THETA_F.len(),
-            "P̃_s − P_s",
+            "fit − reference P_s",
             true,
             None,
         )?);
@@ -213,15 +213,20 @@ fn g_figures(out_dir: &Path, res: &FuzzResolution, refit: &Refit) -> Result<Vec<
         })
         .collect();
     let marks = linspace(G_MU_V_MIN, 1.0, G_MARKS);
-    let mut series = style_keys("reference G", "published G̃ (Listing 3)", "refit (fuzz_g.json)");
+    let mut series = style_keys("reference G", "published fit (Listing 3)", "refit (fuzz_g.json)");
     for (i, &d) in G_DENSITIES.iter().enumerate() {
-        series.push(Series::new(format!("d = {d}"), marks.iter().map(|&m| (m, g_exact(d, m))).collect(), SeriesStyle::Points).color(i));
+        series.push(
+            Series::new(format!("d = {d}"), marks.iter().map(|&m| (m, g_exact(d, m))).collect(), SeriesStyle::Points)
+                .color(i),
+        );
         series.push(Series::new("", mus.iter().map(|&m| (m, published_g(m, d))).collect(), SeriesStyle::Line).color(i));
-        series.push(Series::new("", mus.iter().map(|&m| (m, refit.eval(&[m, d]))).collect(), SeriesStyle::Dashed).color(i));
+        series.push(
+            Series::new("", mus.iter().map(|&m| (m, refit.eval(&[m, d]))).collect(), SeriesStyle::Dashed).color(i),
+        );
     }
     out.extend(super::line_plot(
         &out_dir.join("fuzz_g"),
-        "Fuzz layer hemispherical average G(d, μv): reference, published G̃, refit",
+        "Fuzz layer hemispherical average G(d, μv): reference, published fit, refit",
         "μv = n·v (cosine of the view angle)",
         "G",
         &series,
@@ -239,7 +244,7 @@ fn g_figures(out_dir: &Path, res: &FuzzResolution, refit: &Refit) -> Result<Vec<
     let refitted = difference(&over_grid(&|m, d| refit.eval(&[m, d])), &exact);
     out.extend(super::grid_of_heatmaps(
         &out_dir.join("fuzz_g_errors"),
-        "Error of the G̃ fits (fit − reference G)",
+        "Error of the G fits (fit − reference G)",
         "μv = n·v",
         "density d (optical thickness)",
         &mu_grid,
@@ -249,7 +254,7 @@ fn g_figures(out_dir: &Path, res: &FuzzResolution, refit: &Refit) -> Result<Vec<
             Panel { title: &format!("refit (fuzz_g.json): {}", stats(&refitted)), values: &refitted },
         ],
         2,
-        "G̃ − G",
+        "fit − reference G",
         true,
         None,
     )?);
@@ -264,12 +269,12 @@ fn q_figures(out_dir: &Path, res: &FuzzResolution, refit: &Refit) -> Result<Vec<
     let curve = |f: &dyn Fn(f64) -> f64| -> Vec<(f64, f64)> { ds.iter().map(|&d| (d, f(d))).collect() };
     let mut out = super::line_plot(
         &out_dir.join("fuzz_q"),
-        "Fuzz layer average penetration Q(d) = 2E₃(d): reference, published Q̃, refit",
+        "Fuzz layer average penetration Q(d) = 2E₃(d): reference, published fit, refit",
         "density d (optical thickness)",
         "Q",
         &[
             Series::new("reference 2E₃(d)", curve(&q_exact), SeriesStyle::Line),
-            Series::new("published Q̃ (Listing 4)", curve(&published_q), SeriesStyle::Dashed),
+            Series::new("published fit (Listing 4)", curve(&published_q), SeriesStyle::Dashed),
             Series::new("refit (fuzz_q.json)", curve(&|d| refit.eval(&[d])), SeriesStyle::Dashed),
         ],
         false,
@@ -279,12 +284,20 @@ fn q_figures(out_dir: &Path, res: &FuzzResolution, refit: &Refit) -> Result<Vec<
     let max_abs = |s: &[(f64, f64)]| s.iter().fold(0.0_f64, |m, p| m.max(p.1.abs()));
     out.extend(super::line_plot(
         &out_dir.join("fuzz_q_error"),
-        "Error of the Q̃ fits (fit − 2E₃(d))",
+        "Error of the Q fits (fit − 2E₃(d))",
         "density d (optical thickness)",
-        "Q̃ − Q",
+        "fit − reference Q",
         &[
-            Series::new(format!("published (Listing 4), max |err| {:.2e}", max_abs(&published)), published, SeriesStyle::Line),
-            Series::new(format!("refit (fuzz_q.json), max |err| {:.2e}", max_abs(&refitted)), refitted, SeriesStyle::Line),
+            Series::new(
+                format!("published (Listing 4), max |err| {:.2e}", max_abs(&published)),
+                published,
+                SeriesStyle::Line,
+            ),
+            Series::new(
+                format!("refit (fuzz_q.json), max |err| {:.2e}", max_abs(&refitted)),
+                refitted,
+                SeriesStyle::Line,
+            ),
         ],
         false,
     )?);
@@ -306,14 +319,14 @@ fn r_figures(out_dir: &Path, res: &FuzzResolution, refit: &Refit) -> Result<Vec<
 
     let mut out = super::grid_of_heatmaps(
         &out_dir.join("fuzz_r"),
-        "Cosine-weighted average of P_s, R(α, θf): reference, published R̃, refit",
+        "Cosine-weighted average of P_s, R(α, θf): reference, published fit, refit",
         x_label,
         y_label,
         &tfs,
         &alphas,
         &[
             Panel { title: "reference R", values: &exact },
-            Panel { title: "published R̃ (Listing 5)", values: &published },
+            Panel { title: "published fit (Listing 5)", values: &published },
             Panel { title: "refit (fuzz_r.json)", values: &refitted },
         ],
         3,
@@ -325,7 +338,7 @@ fn r_figures(out_dir: &Path, res: &FuzzResolution, refit: &Refit) -> Result<Vec<
     let refit_err = difference(&refitted, &exact);
     out.extend(super::grid_of_heatmaps(
         &out_dir.join("fuzz_r_errors"),
-        &format!("Error of the R̃ fits (fit − reference R), {}×{} grid", alphas.len(), tfs.len()),
+        &format!("Error of the R fits (fit − reference R), {}×{} grid", alphas.len(), tfs.len()),
         x_label,
         y_label,
         &tfs,
@@ -335,7 +348,7 @@ fn r_figures(out_dir: &Path, res: &FuzzResolution, refit: &Refit) -> Result<Vec<
             Panel { title: &format!("refit (fuzz_r.json): {}", stats(&refit_err)), values: &refit_err },
         ],
         2,
-        "R̃ − R",
+        "fit − reference R",
         true,
         None,
     )?);
@@ -349,19 +362,20 @@ fn r_figures(out_dir: &Path, res: &FuzzResolution, refit: &Refit) -> Result<Vec<
         .collect();
     rows.dedup();
     let dense = linspace(0.0, FRAC_PI_2, res.curve);
-    let mut series = style_keys("reference R", "published R̃ (Listing 5)", "refit (fuzz_r.json)");
+    let mut series = style_keys("reference R", "published fit (Listing 5)", "refit (fuzz_r.json)");
     for (k, &i) in rows.iter().enumerate() {
         let a = alphas[i];
         let reference = tfs.iter().zip(&exact[i * tfs.len()..(i + 1) * tfs.len()]).map(|(&t, &r)| (t, r)).collect();
         series.push(Series::new(format!("α = {a:.2}"), reference, SeriesStyle::Points).color(k));
-        series.push(Series::new("", dense.iter().map(|&t| (t, published_r(a, t))).collect(), SeriesStyle::Line).color(k));
+        series
+            .push(Series::new("", dense.iter().map(|&t| (t, published_r(a, t))).collect(), SeriesStyle::Line).color(k));
         series.push(
             Series::new("", dense.iter().map(|&t| (t, refit.eval(&[a, t]))).collect(), SeriesStyle::Dashed).color(k),
         );
     }
     out.extend(super::line_plot(
         &out_dir.join("fuzz_r_curves"),
-        "R against the fiber angle: reference, published R̃, refit",
+        "R against the fiber angle: reference, published fit, refit",
         x_label,
         "R",
         &series,
