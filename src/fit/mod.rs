@@ -1,6 +1,7 @@
 //! Fitting: model forms (`model`), the problem on data (`problem`), solvers (`solve`),
 //! reports (`report`) and the denominator positivity proof (`positivity`).
 
+pub mod fields;
 pub mod minimax;
 pub mod model;
 pub mod positivity;

@@ -1,0 +1,476 @@
+//! Two-stage fits of a function f(x, u) ≈ Σ_k c_k(x) b_k(u): at every grid point x_g a linear
+//! basis b_k in the inner variables u (stage 1), and every coefficient c_k(x) a rational field
+//! over the grid (stage 2), refined jointly so that what is minimised is the error of f itself.
+//!
+//! Stage 1 at x_g is the linear least-squares system B_g c ≈ y_g (rows: inner samples u_j,
+//! columns: b_k(u_j)). A thin Householder QR, B_g = Q_g R_g, reduces it exactly to k equations:
+//! ```text
+//! ‖B_g c − y_g‖² = ‖R_g c − z_g‖² + ‖y_g‖² − ‖z_g‖²,    z_g = Q_gᵀ y_g
+//! ```
+//! for every c, whether or not B_g has full rank. So fitting the fields c_k(x; θ_k) to
+//! minimise Σ_g ‖R_g c(x_g; θ) − z_g‖² is exactly least squares of f over all (x_g, u_j)
+//! samples, with k residuals per grid point instead of one per sample. Where the basis is
+//! nearly collinear (the stage-1 condition number is large) the per-point optimum ĉ_g is
+//! ill-determined along the near-null direction, but R_g gives that direction a weight as
+//! small as its effect on f: the fields need not follow ĉ_g there, and stay smooth.
+//!
+//! Minimax (and Σr⁴) objectives reweight the samples (Lawson's iteration for minimax) and
+//! recompute the reduced systems from the weighted B_g, y_g; the joint problem is then solved
+//! again from the previous optimum.
+//!
+//! Stage 2 starts from independent fits of each field to the per-point coefficients ĉ_k(x_g)
+//! (minimum-norm solutions, rank cut at [`RCOND`]) through [`super::fit`], on the grid points
+//! whose stage-1 condition number is below [`START_COND`]; the joint Levenberg–Marquardt
+//! solve (MINPACK, `levenberg-marquardt` crate) then moves all fields together.
+
+use super::model::{Basis, RationalModel};
+use super::positivity::{prove_denominator_positive, Positivity};
+use super::solve::{linearised_starts, FitError, Objective};
+use super::Data;
+use nalgebra::{DMatrix, DVector};
+use serde::Serialize;
+
+/// Relative singular-value cut-off of the minimum-norm stage-1 coefficients.
+pub const RCOND: f64 = 1e-12;
+/// Grid points whose stage-1 condition number exceeds this are left out of the starting fits
+/// (their ĉ are not determined to better than ~1e-9·cond by data accurate to ~1e-9).
+pub const START_COND: f64 = 1e5;
+
+/// Smallest relative sample weight of the reweighted objectives: with weights far below it
+/// the grid points away from the worst errors stop constraining the fields, which then run
+/// away there (seen as max errors of 10³ after a few IRLS steps at floor 1e-12).
+pub const WEIGHT_FLOOR: f64 = 1e-2;
+
+/// The stage-1 system of one grid point reduced to k equations (see the module doc).
+#[derive(Debug, Clone)]
+pub struct Reduced {
+    pub r: DMatrix<f64>,
+    pub z: DVector<f64>,
+    /// ‖y‖² − ‖z‖²: what no coefficient vector can fit (weighted when weights were given).
+    pub floor: f64,
+}
+
+/// Reduce B c ≈ y (rows weighted by `sqrt_w` when given) by a thin QR.
+pub fn reduce(b: &DMatrix<f64>, y: &DVector<f64>, sqrt_w: Option<&[f64]>) -> Reduced {
+    let (mut b, mut y) = (b.clone(), y.clone());
+    if let Some(w) = sqrt_w {
+        for (i, &s) in w.iter().enumerate() {
+            b.row_mut(i).scale_mut(s);
+            y[i] *= s;
+        }
+    }
+    let k = b.ncols();
+    let qr = b.qr();
+    let mut qty = y.clone();
+    qr.q_tr_mul(&mut qty);
+    let z = qty.rows(0, k).into_owned();
+    let floor = (y.norm_squared() - z.norm_squared()).max(0.0);
+    Reduced { r: qr.r(), z, floor }
+}
+
+/// Stage-1 result of one grid point: the minimum-norm least-squares coefficients and the
+/// 2-norm condition number σ_max/σ_min of the column-unscaled basis (∞ when rank-deficient).
+#[derive(Debug, Clone, Serialize)]
+pub struct Stage1 {
+    pub coefficients: Vec<f64>,
+    pub condition: f64,
+    pub rms: f64,
+}
+
+pub fn stage1(b: &DMatrix<f64>, y: &DVector<f64>) -> Stage1 {
+    let svd = b.clone().svd(true, true);
+    let s = &svd.singular_values;
+    let smax = s.max();
+    let smin = s.min();
+    let condition = if smin > 0.0 { smax / smin } else { f64::INFINITY };
+    let c = svd.solve(y, RCOND * smax).unwrap_or_else(|_| DVector::zeros(b.ncols()));
+    let rms = ((b * &c - y).norm_squared() / y.len().max(1) as f64).sqrt();
+    Stage1 { coefficients: c.iter().copied().collect(), condition, rms }
+}
+
+/// The joint stage-2 problem: residuals R_g c(x_g; θ) − z_g for all grid points.
+#[derive(Debug, Clone)]
+pub struct Fields<'a> {
+    pub models: &'a [RationalModel],
+    /// basis[k][g]: basis values of field k at grid point g.
+    basis: Vec<Vec<Basis>>,
+    pub systems: Vec<Reduced>,
+    /// Offsets of θ_k in the concatenated parameter vector.
+    starts: Vec<usize>,
+    pub theta: DVector<f64>,
+}
+
+impl<'a> Fields<'a> {
+    pub fn new(models: &'a [RationalModel], x: &[Vec<f64>], systems: Vec<Reduced>, theta: DVector<f64>) -> Self {
+        let basis = models.iter().map(|m| x.iter().map(|p| m.basis(p)).collect()).collect();
+        let mut starts = Vec::with_capacity(models.len() + 1);
+        let mut s = 0;
+        for m in models {
+            starts.push(s);
+            s += m.n_free();
+        }
+        starts.push(s);
+        Fields { models, basis, systems, starts, theta }
+    }
+
+    pub fn n_params(&self) -> usize {
+        *self.starts.last().unwrap_or(&0)
+    }
+
+    /// Full coefficients of every field from the concatenated θ.
+    pub fn full(&self, theta: &DVector<f64>) -> Vec<DVector<f64>> {
+        self.models
+            .iter()
+            .enumerate()
+            .map(|(k, m)| m.full(&theta.rows(self.starts[k], m.n_free()).into_owned()))
+            .collect()
+    }
+
+    /// Split θ into the per-field free parameters.
+    pub fn split(&self, theta: &DVector<f64>) -> Vec<DVector<f64>> {
+        self.models
+            .iter()
+            .enumerate()
+            .map(|(k, m)| theta.rows(self.starts[k], m.n_free()).into_owned())
+            .collect()
+    }
+
+    /// Field values c_k(x_g) at every grid point: values[g][k].
+    pub fn values(&self, theta: &DVector<f64>) -> Vec<Vec<f64>> {
+        let full = self.full(theta);
+        let ng = self.systems.len();
+        (0..ng)
+            .map(|g| {
+                self.models.iter().enumerate().map(|(k, m)| self.basis[k][g].value(&full[k], m.offset)).collect()
+            })
+            .collect()
+    }
+
+    fn residuals_at(&self, theta: &DVector<f64>) -> DVector<f64> {
+        let nk = self.models.len();
+        let vals = self.values(theta);
+        let mut out = DVector::zeros(self.systems.len() * nk);
+        for (g, (s, c)) in self.systems.iter().zip(&vals).enumerate() {
+            let c = DVector::from_column_slice(c);
+            out.rows_mut(g * nk, nk).copy_from(&(&s.r * c - &s.z));
+        }
+        out
+    }
+
+    /// Gauss–Newton normal equations at θ: (JᵀJ, Jᵀr, ‖r‖²). J is block-sparse: the rows of
+    /// grid point g are R_g·D_g with D_g holding ∂c_k(x_g)/∂θ_k in row k, so
+    /// (JᵀJ)[k, l] = Σ_g (R_gᵀR_g)[k, l] · d_k(g) d_l(g)ᵀ and (Jᵀr)[k] = Σ_g (R_gᵀ r_g)[k] d_k(g):
+    /// k² small outer products per point instead of a dense product of J.
+    fn normal_equations(&self, theta: &DVector<f64>) -> (DMatrix<f64>, DVector<f64>, f64) {
+        let nk = self.models.len();
+        let full = self.full(theta);
+        let np = self.n_params();
+        let mut a = DMatrix::zeros(np, np);
+        let mut grad = DVector::zeros(np);
+        let mut cost = 0.0;
+        let mut d: Vec<DVector<f64>> = self.models.iter().map(|m| DVector::zeros(m.n_free())).collect();
+        let mut c = DVector::zeros(nk);
+        for (g, s) in self.systems.iter().enumerate() {
+            for (k, m) in self.models.iter().enumerate() {
+                let nn = m.numerator.len();
+                let b = &self.basis[k][g];
+                let (p, q) = b.pq(&full[k]);
+                c[k] = m.offset + b.factor * p / q;
+                let f = b.factor / q;
+                let mut dfull = DVector::zeros(m.n_full());
+                for (i, phi) in b.phi.iter().enumerate() {
+                    dfull[i] = f * phi;
+                }
+                for (i, psi) in b.psi.iter().enumerate() {
+                    dfull[nn + i] = -f * p / q * psi;
+                }
+                d[k] = m.map().tr_mul(&dfull);
+            }
+            let r = &s.r * &c - &s.z;
+            cost += r.norm_squared();
+            let mg = s.r.tr_mul(&s.r);
+            let v = s.r.tr_mul(&r);
+            for k in 0..nk {
+                let (sk, nkf) = (self.starts[k], self.models[k].n_free());
+                grad.rows_mut(sk, nkf).axpy(v[k], &d[k], 1.0);
+                for l in k..nk {
+                    let w = mg[(k, l)];
+                    if w == 0.0 {
+                        continue;
+                    }
+                    let (sl, nlf) = (self.starts[l], self.models[l].n_free());
+                    let mut blk = a.view_mut((sk, sl), (nkf, nlf));
+                    blk.ger(w, &d[k], &d[l], 1.0);
+                }
+            }
+        }
+        // Fill the lower triangle of blocks from the upper.
+        for k in 0..nk {
+            for l in 0..k {
+                let (sk, nkf) = (self.starts[k], self.models[k].n_free());
+                let (sl, nlf) = (self.starts[l], self.models[l].n_free());
+                let t = a.view((sl, sk), (nlf, nkf)).transpose();
+                a.view_mut((sk, sl), (nkf, nlf)).copy_from(&t);
+            }
+        }
+        (a, grad, cost)
+    }
+
+    pub fn cost(&self, theta: &DVector<f64>) -> f64 {
+        self.residuals_at(theta).norm_squared()
+    }
+}
+
+/// The samples of one grid point: the stage-1 design matrix (inner samples × basis) and the
+/// values of f there.
+#[derive(Debug, Clone)]
+pub struct PointData {
+    pub design: DMatrix<f64>,
+    pub y: DVector<f64>,
+}
+
+/// Options of a two-stage fit.
+#[derive(Debug, Clone, Copy)]
+pub struct FieldOptions {
+    pub objective: Objective,
+    /// Outer reweighting iterations (minimax, l4).
+    pub outer_iters: usize,
+    /// LM iterations per outer iteration (each starts from the previous optimum, and the
+    /// reweighting only needs to move it, not converge it).
+    pub inner_iters: usize,
+    /// Minimax under a cap on the rms error: the iterate with the lowest max error among
+    /// those whose rms is at most this.
+    pub max_rms: Option<f64>,
+}
+
+impl Default for FieldOptions {
+    fn default() -> Self {
+        FieldOptions { objective: Objective::Lsq, outer_iters: 60, inner_iters: 25, max_rms: None }
+    }
+}
+
+/// Result of a two-stage fit.
+#[derive(Debug, Clone)]
+pub struct FieldsFit {
+    /// Full coefficients of every field.
+    pub coefficients: Vec<DVector<f64>>,
+    pub stage1: Vec<Stage1>,
+    /// Max and rms error of f over all samples of the fitting grid.
+    pub max_abs_error: f64,
+    pub rms_error: f64,
+    /// Same for the per-point stage-1 optimum (the floor of the inner basis in the rms sense).
+    pub stage1_max_abs_error: f64,
+    pub stage1_rms_error: f64,
+    pub lm_evaluations: usize,
+    pub outer_iterations: usize,
+}
+
+/// Errors of the fields at θ over all samples: (max abs, rms, per-sample residuals).
+fn sample_errors(fields: &Fields<'_>, theta: &DVector<f64>, data: &[PointData]) -> (f64, f64, Vec<DVector<f64>>) {
+    let vals = fields.values(theta);
+    let (mut max, mut ss, mut n) = (0.0f64, 0.0, 0usize);
+    let res: Vec<DVector<f64>> = data
+        .iter()
+        .zip(&vals)
+        .map(|(d, c)| {
+            let e = &d.design * DVector::from_column_slice(c) - &d.y;
+            for v in e.iter() {
+                max = if v.is_nan() { f64::INFINITY } else { max.max(v.abs()) };
+                ss += v * v;
+            }
+            n += e.len();
+            e
+        })
+        .collect();
+    (max, (ss / n.max(1) as f64).sqrt(), res)
+}
+
+/// Levenberg–Marquardt on the normal equations (JᵀJ + λ·diag(JᵀJ)) δ = −Jᵀr, solved by
+/// Cholesky. The joint system is small in parameters (a few hundred) and tall in residuals;
+/// forming JᵀJ with a blocked product is far cheaper than a column-pivoted QR of J each
+/// iteration, and the Marquardt scaling keeps the solve well-posed. Returns the number of
+/// residual evaluations.
+fn solve_joint(fields: &mut Fields<'_>, max_iters: usize, what: &str) -> Result<usize, FitError> {
+    let mut theta = fields.theta.clone();
+    let mut cost = fields.cost(&theta);
+    if !cost.is_finite() {
+        return Err(FitError::Diverged { what: what.into(), iters: 0, residual: cost });
+    }
+    let mut lambda = 1e-4;
+    let mut evals = 1;
+    let mut small_steps = 0;
+    for _ in 0..max_iters {
+        let (a, g, _) = fields.normal_equations(&theta);
+        let d: Vec<f64> = (0..a.nrows()).map(|i| a[(i, i)].max(1e-300)).collect();
+        let mut accepted = false;
+        while lambda < 1e16 {
+            let mut m = a.clone();
+            for (i, di) in d.iter().enumerate() {
+                m[(i, i)] += lambda * di;
+            }
+            let Some(ch) = m.cholesky() else {
+                lambda *= 10.0;
+                continue;
+            };
+            let step = ch.solve(&(-&g));
+            let trial = &theta + &step;
+            evals += 1;
+            let ct = fields.cost(&trial);
+            if ct.is_finite() && ct < cost {
+                let gain = (cost - ct) / cost.max(f64::MIN_POSITIVE);
+                theta = trial;
+                cost = ct;
+                lambda = (lambda / 3.0).max(1e-12);
+                accepted = true;
+                small_steps = if gain < 1e-10 { small_steps + 1 } else { 0 };
+                break;
+            }
+            lambda *= 4.0;
+        }
+        if !accepted || small_steps >= 3 {
+            break;
+        }
+    }
+    fields.theta.copy_from(&theta);
+    Ok(evals)
+}
+
+/// Fit the fields `models` (one per basis function) over the grid points `x` to the samples
+/// `data` (one [`PointData`] per grid point, same order).
+pub fn fit_fields(
+    models: &[RationalModel],
+    x: &[Vec<f64>],
+    data: &[PointData],
+    opts: &FieldOptions,
+    what: &str,
+) -> Result<FieldsFit, FitError> {
+    let nk = models.len();
+    if data.is_empty() || data.len() != x.len() {
+        return Err(FitError::NoData { what: what.into() });
+    }
+    // Stage 1.
+    let stage1: Vec<Stage1> = data.iter().map(|d| stage1(&d.design, &d.y)).collect();
+    let (mut s1max, mut s1ss, mut s1n) = (0.0f64, 0.0, 0usize);
+    for (d, s) in data.iter().zip(&stage1) {
+        let e = &d.design * DVector::from_column_slice(&s.coefficients) - &d.y;
+        s1max = s1max.max(e.amax());
+        s1ss += e.norm_squared();
+        s1n += e.len();
+    }
+    // Starting fields: each fitted alone to the well-conditioned ĉ_k.
+    let good: Vec<usize> = (0..x.len()).filter(|&g| stage1[g].condition < START_COND).collect();
+    let systems: Vec<Reduced> = data.iter().map(|d| reduce(&d.design, &d.y, None)).collect();
+    // Candidate starts per field: the linearised ones (polynomial, Loeb, Sanathanan–Koerner)
+    // of the field fitted alone; every field takes the candidate of the same index (or its
+    // last one), and the joint cost picks the set.
+    let mut per_field = Vec::with_capacity(models.len());
+    for (k, m) in models.iter().enumerate() {
+        let d = Data {
+            x: good.iter().map(|&g| x[g].clone()).collect(),
+            y: good.iter().map(|&g| stage1[g].coefficients[k]).collect(),
+        };
+        per_field.push(linearised_starts(m, &d, &format!("{what} (start of field {k})"))?);
+    }
+    let n_cand = per_field.iter().map(Vec::len).max().unwrap_or(0);
+    let probe = Fields::new(models, x, systems.clone(), DVector::zeros(0));
+    let mut theta = DVector::zeros(0);
+    let mut best_cost = f64::INFINITY;
+    for c in 0..n_cand {
+        let t: Vec<f64> = per_field.iter().flat_map(|s| s[c.min(s.len() - 1)].iter().copied()).collect();
+        let t = DVector::from_vec(t);
+        let cost = probe.cost(&t);
+        if cost < best_cost {
+            best_cost = cost;
+            theta = t;
+        }
+    }
+    if !best_cost.is_finite() {
+        return Err(FitError::SingularStart { what: what.into() });
+    }
+    let mut fields = Fields::new(models, x, systems, theta);
+    let mut evals = solve_joint(&mut fields, 500, what)?;
+    let mut outer = 0;
+    if opts.objective != Objective::Lsq {
+        // IRLS for Σ|e|^p: weights |e|^(p−2) at the previous optimum. Minimax continues p
+        // upward (the L_p optimum tends to the minimax one as p → ∞); jumping straight to
+        // Lawson's multiplicative weights concentrates them on a few grid points and lets
+        // the fields run away elsewhere. The iterate with the lowest max error (or, for L4,
+        // the last one) is kept; with an rms cap, only iterates under it qualify.
+        let n_outer = match opts.objective {
+            Objective::L4 => opts.outer_iters.min(4),
+            _ => opts.outer_iters,
+        };
+        let (m0, r0, _) = sample_errors(&fields, &fields.theta, data);
+        let admissible = |rms: f64| opts.max_rms.is_none_or(|cap| rms <= cap);
+        let mut best = (if admissible(r0) { m0 } else { f64::INFINITY }, fields.theta.clone());
+        let mut w: Vec<Vec<f64>> = data.iter().map(|d| vec![1.0; d.y.len()]).collect();
+        let mut since_best = 0;
+        for _ in 0..n_outer {
+            outer += 1;
+            let (_, _, res) = sample_errors(&fields, &fields.theta, data);
+            // Lawson: w ← w·|e| (L4: w = e²), scaled to max 1 and floored.
+            for (wg, eg) in w.iter_mut().zip(&res) {
+                for (wi, ei) in wg.iter_mut().zip(eg.iter()) {
+                    *wi = match opts.objective {
+                        Objective::L4 => ei * ei,
+                        _ => *wi * ei.abs(),
+                    };
+                }
+            }
+            let top = w.iter().flatten().fold(0.0f64, |m, v| m.max(*v));
+            if !(top > 0.0) || !top.is_finite() {
+                break;
+            }
+            w.iter_mut().flatten().for_each(|wi| *wi = (*wi / top).max(WEIGHT_FLOOR));
+            fields.systems = data
+                .iter()
+                .zip(&w)
+                .map(|(d, wg)| {
+                    let s: Vec<f64> = wg.iter().map(|v| v.sqrt()).collect();
+                    reduce(&d.design, &d.y, Some(&s))
+                })
+                .collect();
+            evals += match solve_joint(&mut fields, opts.inner_iters, what) {
+                Ok(e) => e,
+                Err(_) => break,
+            };
+            let (m, rr, _) = sample_errors(&fields, &fields.theta, data);
+            if opts.objective == Objective::L4 || (admissible(rr) && m < best.0) {
+                best = (m, fields.theta.clone());
+                since_best = 0;
+            } else {
+                since_best += 1;
+                if since_best >= 6 {
+                    break;
+                }
+            }
+        }
+        if !best.0.is_finite() {
+            return Err(FitError::Solver {
+                what: what.into(),
+                msg: format!("no iterate met the rms cap {:e}", opts.max_rms.unwrap_or(f64::NAN)),
+            });
+        }
+        fields.theta = best.1;
+    }
+    let (max, rms, _) = sample_errors(&fields, &fields.theta, data);
+    if !max.is_finite() {
+        return Err(FitError::Diverged { what: what.into(), iters: evals, residual: max });
+    }
+    let _ = nk;
+    Ok(FieldsFit {
+        coefficients: fields.full(&fields.theta),
+        stage1,
+        max_abs_error: max,
+        rms_error: rms,
+        stage1_max_abs_error: s1max,
+        stage1_rms_error: (s1ss / s1n.max(1) as f64).sqrt(),
+        lm_evaluations: evals,
+        outer_iterations: outer,
+    })
+}
+
+/// Whether every field's denominator is proven positive on the box `domain`.
+pub fn fields_positive(models: &[RationalModel], coefficients: &[DVector<f64>], domain: &[(f64, f64)]) -> Vec<Positivity> {
+    models.iter().zip(coefficients).map(|(m, c)| prove_denominator_positive(m, c, domain)).collect()
+}
