@@ -799,6 +799,50 @@ pub fn lut_curvature(j: usize, n: usize, kappa_max_per_mm: f64) -> f64 {
     kappa_max_per_mm * j as f64 / (n - 1) as f64
 }
 
+/// How LUT rows spread over κ ∈ [0, κ_max]: row j of n sits at the mapped coordinate
+/// t_j = j/(n − 1) (ends included), and a lookup interpolates linearly in t.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Deserialize, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum CurvatureMapping {
+    /// t = κ/κ_max: uniform in curvature (Penner's LUT, uniform in 1/r).
+    #[default]
+    Linear,
+    /// t = √(κ/κ_max): rows denser at small κ, where most of a face's curvature lies (a quarter
+    /// of the rows below κ_max/16); costs a square root per lookup.
+    Sqrt,
+}
+
+impl CurvatureMapping {
+    /// t of κ/κ_max ∈ [0, 1].
+    pub fn to_unit(self, kappa_over_max: f64) -> f64 {
+        match self {
+            CurvatureMapping::Linear => kappa_over_max,
+            CurvatureMapping::Sqrt => kappa_over_max.sqrt(),
+        }
+    }
+
+    /// κ/κ_max of t ∈ [0, 1].
+    pub fn from_unit(self, t: f64) -> f64 {
+        match self {
+            CurvatureMapping::Linear => t,
+            CurvatureMapping::Sqrt => t * t,
+        }
+    }
+
+    /// The spec name ("linear", "sqrt").
+    pub fn name(self) -> &'static str {
+        match self {
+            CurvatureMapping::Linear => "linear",
+            CurvatureMapping::Sqrt => "sqrt",
+        }
+    }
+}
+
+/// κ (1/mm) at the mapped coordinate `t` ∈ [0, 1] (t = 1 gives κ_max exactly).
+pub fn mapped_curvature(t: f64, kappa_max_per_mm: f64, mapping: CurvatureMapping) -> f64 {
+    if t >= 1.0 { kappa_max_per_mm } else { kappa_max_per_mm * mapping.from_unit(t) }
+}
+
 /// Punctual-light LUT with per-texel estimates; row-major: index = j·n_nl + i, row j at
 /// κ = [`lut_curvature`]`(j, n_kappa, κ_max)`, column i at n·l = [`lut_n_dot_l`]`(i, n_nl)`.
 /// Samples sit on the grid points (ends included): a shader sampling with bilinear filtering
@@ -817,22 +861,41 @@ pub fn punctual_lut_estimates(
         kappa_max_per_mm.is_finite() && kappa_max_per_mm >= 0.0,
         "κ_max must be finite and >= 0, got {kappa_max_per_mm}"
     );
+    let nls: Vec<f64> = (0..n_nl).map(|i| lut_n_dot_l(i, n_nl)).collect();
+    let kappas: Vec<f64> = (0..n_kappa).map(|j| lut_curvature(j, n_kappa, kappa_max_per_mm)).collect();
+    punctual_grid_estimates(profile, kernel, &nls, &kappas, tol)
+}
+
+/// [`punctual`] on the tensor grid `n_dot_l` × `curvature_per_mm` (any points, e.g. a
+/// non-uniform curvature mapping or a verification grid): index = j·n_dot_l.len() + i for
+/// n·l = `n_dot_l[i]` and κ = `curvature_per_mm[j]`. One ring (kernel normalisation) per
+/// curvature, rows in parallel, collected in order: the result does not depend on the thread
+/// count. Panics on the arguments [`punctual`] panics on.
+pub fn punctual_grid_estimates(
+    profile: &Profile,
+    kernel: Kernel,
+    n_dot_l: &[f64],
+    curvature_per_mm: &[f64],
+    tol: Tolerance,
+) -> Result<Vec<[Estimate; 3]>, ProfileError> {
+    let nls: Vec<f64> = n_dot_l.iter().map(|&nl| check_args(0.0, nl)).collect();
+    for &kappa in curvature_per_mm {
+        check_args(kappa, 0.0);
+    }
     profile.validate()?;
     let k = PreparedKernel::new(profile, kernel);
     let support = profile.support_mm();
-    let rows: Vec<Result<Vec<[Estimate; 3]>, ProfileError>> = (0..n_kappa)
-        .into_par_iter()
-        .map(|j| {
-            let kappa = lut_curvature(j, n_kappa, kappa_max_per_mm);
-            let nls = (0..n_nl).map(|i| lut_n_dot_l(i, n_nl));
+    let rows: Vec<Result<Vec<[Estimate; 3]>, ProfileError>> = curvature_per_mm
+        .par_iter()
+        .map(|&kappa| {
             if is_flat(kappa, support) {
-                return Ok(nls.map(|nl| [Estimate::exact(nl.max(0.0)); 3]).collect());
+                return Ok(nls.iter().map(|nl| [Estimate::exact(nl.max(0.0)); 3]).collect());
             }
             let ring = Ring::new(&k, kappa, tol)?;
-            Ok(nls.map(|nl| ring.eval(nl, tol)).collect())
+            Ok(nls.iter().map(|&nl| ring.eval(nl, tol)).collect())
         })
         .collect();
-    let mut out = Vec::with_capacity(n_nl * n_kappa);
+    let mut out = Vec::with_capacity(n_dot_l.len() * curvature_per_mm.len());
     for row in rows {
         out.extend(row?);
     }
@@ -936,19 +999,40 @@ pub fn sh_lut(
 ) -> Result<Vec<[[f64; 3]; 3]>, ProfileError> {
     assert!(n_kappa >= 2, "a LUT needs at least 2 samples");
     assert!(kappa_max_per_mm.is_finite() && kappa_max_per_mm >= 0.0);
+    let kappas: Vec<f64> = (0..n_kappa).map(|j| lut_curvature(j, n_kappa, kappa_max_per_mm)).collect();
+    Ok(sh_bands_estimates(profile, &kappas, &[1, 2], tol)?
+        .into_iter()
+        .map(|b| [[1.0; 3], b[0].map(|e| e.value), b[1].map(|e| e.value)])
+        .collect())
+}
+
+/// [`sh_band`] for each of `bands` at each curvature (any points): entry j holds the bands in
+/// the order given, at κ = `curvature_per_mm[j]`. Curvatures in parallel, collected in order.
+pub fn sh_bands_estimates(
+    profile: &Profile,
+    curvature_per_mm: &[f64],
+    bands: &[u32],
+    tol: Tolerance,
+) -> Result<Vec<Vec<[Estimate; 3]>>, ProfileError> {
+    for &kappa in curvature_per_mm {
+        check_args(kappa, 0.0);
+    }
     profile.validate()?;
     let k = PreparedKernel::new(profile, Kernel::Radial);
     let support = profile.support_mm();
-    (0..n_kappa)
-        .into_par_iter()
-        .map(|j| {
-            let kappa = lut_curvature(j, n_kappa, kappa_max_per_mm);
-            if is_flat(kappa, support) {
-                return Ok([[1.0; 3]; 3]);
-            }
-            let b1 = sh_band_prepared(profile, &k, kappa, 1, tol)?.map(|e| e.value);
-            let b2 = sh_band_prepared(profile, &k, kappa, 2, tol)?.map(|e| e.value);
-            Ok([[1.0; 3], b1, b2])
+    curvature_per_mm
+        .par_iter()
+        .map(|&kappa| {
+            bands
+                .iter()
+                .map(|&band| {
+                    if band == 0 || is_flat(kappa, support) {
+                        Ok([Estimate::exact(1.0); 3])
+                    } else {
+                        sh_band_prepared(profile, &k, kappa, band, tol)
+                    }
+                })
+                .collect()
         })
         .collect()
 }
