@@ -251,9 +251,9 @@ fn build_fit(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> 
         "verification": verification,
     });
     let artifacts = vec![
-        Artifact { path: format!("wgsl/{name}.wgsl").into(), contents: wgsl::render_module(&header, &func) },
-        Artifact { path: format!("src/{name}.rs").into(), contents: rust::render_module(&header, &func, &doc) },
-        Artifact { path: format!("json/{name}.json").into(), contents: json_text(&json) },
+        Artifact { path: format!("wgsl/{name}.wgsl").into(), contents: wgsl::render_module(&header, &func).into() },
+        Artifact { path: format!("src/{name}.rs").into(), contents: rust::render_module(&header, &func, &doc).into() },
+        Artifact { path: format!("json/{name}.json").into(), contents: json_text(&json).into() },
     ];
     Ok(Built { name, artifacts, verification, fit: report })
 }
@@ -393,10 +393,10 @@ fn build_table(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError
         csv.push_str(&format!("{},{v:?}\n", cols.join(",")));
     }
     let artifacts = vec![
-        Artifact { path: format!("wgsl/{name}.wgsl").into(), contents: wgsl::render_module(&header, &func) },
-        Artifact { path: format!("src/{name}.rs").into(), contents: rust::render_module(&header, &func, &doc) },
-        Artifact { path: format!("json/{name}.json").into(), contents: json_text(&json) },
-        Artifact { path: format!("data/{name}.csv").into(), contents: csv },
+        Artifact { path: format!("wgsl/{name}.wgsl").into(), contents: wgsl::render_module(&header, &func).into() },
+        Artifact { path: format!("src/{name}.rs").into(), contents: rust::render_module(&header, &func, &doc).into() },
+        Artifact { path: format!("json/{name}.json").into(), contents: json_text(&json).into() },
+        Artifact { path: format!("data/{name}.csv").into(), contents: csv.into() },
     ];
     Ok(Built { name, artifacts, verification, fit: None })
 }
@@ -462,7 +462,7 @@ pub fn runtime_index(specs: &[Spec]) -> Artifact {
         ));
     }
     s.push_str("];\n");
-    Artifact { path: "src/emitted.rs".into(), contents: s }
+    Artifact { path: "src/emitted.rs".into(), contents: s.into() }
 }
 
 /// Feature family of a spec: the quantity name up to its first '-'.
@@ -474,7 +474,7 @@ pub fn family(spec: &Spec) -> &str {
 pub fn stale(root: &Path, artifacts: &[Artifact]) -> Vec<String> {
     artifacts
         .iter()
-        .filter(|a| std::fs::read(root.join(&a.path)).map_or(true, |old| old != a.contents.as_bytes()))
+        .filter(|a| std::fs::read(root.join(&a.path)).map_or(true, |old| old != a.contents))
         .map(|a| a.path.display().to_string())
         .collect()
 }
