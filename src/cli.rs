@@ -305,7 +305,8 @@ pub fn validate(paths: &Paths, as_json: bool) -> Result<()> {
 
 /// Figures (PNG and SVG) of every family with committed outputs.
 pub fn plot(paths: &Paths, out: &Path) -> Result<()> {
-    let files = crate::plot::gloss_figures(out, &paths.generated)?;
+    let mut files = crate::plot::gloss_figures(out, &paths.generated)?;
+    files.extend(crate::plot::skin_figures(out, &paths.generated)?);
     for f in &files {
         println!("{}", f.display());
     }

@@ -9,13 +9,15 @@
 //! bytes depend only on the inputs: ticks, colours and legend placement are computed here
 //! without clocks, hashing or randomness, which the tests check by rendering twice.
 //!
-//! Figure families built on these primitives: [`gloss_figures`].
+//! Figure families built on these primitives: [`gloss_figures`], [`skin_figures`].
 
 mod colormap;
 mod gloss;
+mod skin;
 mod ticks;
 
 pub use gloss::gloss_figures;
+pub use skin::skin_figures;
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
