@@ -234,6 +234,17 @@ pub enum Kind {
     SkinLut,
 }
 
+impl Kind {
+    /// The spec's spelling ("fit", "table", "skin-lut").
+    pub fn name(self) -> &'static str {
+        match self {
+            Kind::Fit => "fit",
+            Kind::Table => "table",
+            Kind::SkinLut => "skin-lut",
+        }
+    }
+}
+
 #[derive(Debug, Clone, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct AxisSpec {
