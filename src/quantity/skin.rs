@@ -73,6 +73,15 @@
 //! κ ≤ 1/mm takes ≈ 0.6 s on one core. The estimate is pessimistic: the reported estimates stay
 //! ≤ 3e-11 and the actual difference to abs-1e-14 results is at rounding level (~1e-15).
 //!
+//! # LUTs and specs
+//! [`punctual_grid_estimates`] and [`sh_bands_estimates`] tabulate the two quantities on any
+//! grid (rows in parallel, collected in order); [`CurvatureMapping`] spreads the curvature
+//! rows (linear or sqrt). The specs `fits/skin_punctual_lut.toml` (D, 65 n·l × 64 κ ≤ 1/mm) and
+//! `fits/skin_sh_lut.toml` (k_1, k_2, 64 κ ≤ 1/mm) are `kind = "skin-lut"` (`spec::skin`, with
+//! the profile from `spec::profile`), built by `pipeline::skin` into textures and lookups. The
+//! curvature to look them up with is the directional one along the light (shadefit-runtime's
+//! `skin::skin_curvature_from_light*`).
+//!
 //! # Seed notes
 //! The seed's slide formula D(r, cos θ_l) = ∫ cos(θ_l − θ) R(2r sin(θ/2)) dθ / ∫ R(…) dθ omits the
 //! clamp max(·, 0) on the cosine (Penner's code saturates it); the speaker notes say to use the
