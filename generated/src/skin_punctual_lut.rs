@@ -15,8 +15,8 @@ pub const SKIN_PUNCTUAL_LUT_CURVATURE_MAX: f32 = 1e0_f32;
 pub const SKIN_PUNCTUAL_LUT_FORMAT: &str = "rgba16float";
 /// The LUT as a KTX2 texture (linear RGBA, alpha 1, row 0 first), as written by `shadefit build`.
 pub const SKIN_PUNCTUAL_LUT_KTX2: &[u8] = include_bytes!("../data/skin_punctual_lut.ktx2");
-/// Texels (RGB), row-major: `SKIN_PUNCTUAL_LUT_RGB[y * 65 + x]`.
-pub const SKIN_PUNCTUAL_LUT_RGB: [[f32; 3]; 4160] = [
+/// Texels (RGB), row-major: `SKIN_PUNCTUAL_LUT_RGB[y * 65 + x]` (a static: one copy, not inlined at each use).
+pub static SKIN_PUNCTUAL_LUT_RGB: [[f32; 3]; 4160] = [
     [0e0, 0e0, 0e0],
     [0e0, 0e0, 0e0],
     [0e0, 0e0, 0e0],

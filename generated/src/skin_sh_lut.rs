@@ -15,8 +15,8 @@ pub const SKIN_SH_LUT_CURVATURE_MAX: f32 = 1e0_f32;
 pub const SKIN_SH_LUT_FORMAT: &str = "rgba16float";
 /// The LUT as a KTX2 texture (linear RGBA, alpha 1, row 0 first), as written by `shadefit build`.
 pub const SKIN_SH_LUT_KTX2: &[u8] = include_bytes!("../data/skin_sh_lut.ktx2");
-/// Texels (RGB), row-major: `SKIN_SH_LUT_RGB[y * 64 + x]`.
-pub const SKIN_SH_LUT_RGB: [[f32; 3]; 128] = [
+/// Texels (RGB), row-major: `SKIN_SH_LUT_RGB[y * 64 + x]` (a static: one copy, not inlined at each use).
+pub static SKIN_SH_LUT_RGB: [[f32; 3]; 128] = [
     [1e0, 1e0, 1e0],
     [9.996516e-1, 9.9998283e-1, 9.9999374e-1],
     [9.986063e-1, 9.9993134e-1, 9.99975e-1],

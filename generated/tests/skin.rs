@@ -3,6 +3,9 @@
 //! emitted lookups against their own texels and the κ = 0 limit, the KTX2 bytes against the
 //! const arrays, and naga validation of a shader using the const-array and texture versions.
 
+// Channel loops index several arrays.
+#![allow(clippy::needless_range_loop)]
+
 use shadefit_runtime::skin::{
     Ktx2Image, LutFormat, skin_curvature_from_light, skin_curvature_from_light_normalized,
 };
@@ -217,7 +220,8 @@ fn sh_lookup_limits() {
 
 #[test]
 fn ktx2_textures_hold_the_const_texels() {
-    let cases: [(&[u8], &str, [u32; 2], &[[f32; 3]]); 2] = [
+    type Case<'a> = (&'a [u8], &'a str, [u32; 2], &'a [[f32; 3]]);
+    let cases: [Case; 2] = [
         (punctual::SKIN_PUNCTUAL_LUT_KTX2, punctual::SKIN_PUNCTUAL_LUT_FORMAT, punctual::SKIN_PUNCTUAL_LUT_SIZE, &punctual::SKIN_PUNCTUAL_LUT_RGB),
         (sh::SKIN_SH_LUT_KTX2, sh::SKIN_SH_LUT_FORMAT, sh::SKIN_SH_LUT_SIZE, &sh::SKIN_SH_LUT_RGB),
     ];

@@ -147,7 +147,7 @@ impl SkinLutCode<'_> {
         match self.layout {
             Layout::Punctual { .. } => vec![
                 format!("Texels: {w} n·l columns × {h} curvature rows, row-major, n·l fastest; texel (i, j) holds"),
-                format!("D (RGB) at n·l = -1 + 2i/{} and {}.", w - 1, self.mapping_doc().replace('j', "j")),
+                format!("D (RGB) at n·l = -1 + 2i/{} and {}.", w - 1, self.mapping_doc()),
             ],
             Layout::Sh { .. } => vec![
                 format!("Texels: {w} curvature columns × 2 rows (row 0: band 1, row 1: band 2; band 0 is 1);"),
@@ -303,7 +303,7 @@ impl SkinLutCode<'_> {
              pub const {up}_KTX2: &[u8] = include_bytes!(\"../data/{m}.ktx2\");\n"
         ));
         s.push_str(&format!(
-            "/// Texels (RGB), row-major: `{up}_RGB[y * {w} + x]`.\npub const {up}_RGB: [[f32; 3]; {n}] = [\n",
+            "/// Texels (RGB), row-major: `{up}_RGB[y * {w} + x]` (a static: one copy, not inlined at each use).\npub static {up}_RGB: [[f32; 3]; {n}] = [\n",
             n = self.values.len()
         ));
         for v in self.values {
@@ -432,7 +432,7 @@ mod tests {
 
     #[test]
     fn emitted_code_names_itself_and_declares_its_functions() {
-        let vals = vec![[0.5f32; 3]; 12];
+        let vals = [[0.5f32; 3]; 12];
         for (layout, n) in [(Layout::Punctual { n_dot_l: 4, curvature: 3 }, 12), (Layout::Sh { curvature: 6 }, 12)] {
             let c = code(layout, CurvatureMapping::Sqrt, &vals[..n]);
             let w = c.render_wgsl(&["h1".into()], "doc");

@@ -172,7 +172,8 @@ impl SkinLut {
         // The ring and the sphere of curvature κ reach chord 2/κ: each channel needs some of
         // its profile within 2/κ_max, or the largest-κ texels cannot be normalised.
         let reach = profile.profile.mass_within(2.0 / k);
-        if let Some(c) = (0..3).find(|&c| !(reach[c] > 0.0)) {
+        // (NaN compares false: a NaN mass is no mass.)
+        if let Some(c) = (0..3).find(|&c| reach[c].partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)) {
             return Err(at(
                 "curvature_max",
                 format!(
