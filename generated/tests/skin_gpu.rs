@@ -12,6 +12,9 @@
 //! unchanged) because a software adapter (lavapipe) copies a dynamically indexed `const` array
 //! per access (see tests/gpu.rs). With no adapter the test is skipped, unless `CI` is set.
 
+// Channel loops index several arrays.
+#![allow(clippy::needless_range_loop)]
+
 use shadefit_runtime::{compose, gpu, skin, skin_punctual_lut as punctual, skin_sh_lut as sh};
 use std::io::Write;
 use wgpu::util::DeviceExt;
@@ -310,11 +313,11 @@ fn skin_luts_and_curvature_on_the_gpu() {
     };
     let mut inputs = Vec::new();
     for _ in 0..4096 {
-        let phi = 6.283 * rnd();
+        let phi = std::f64::consts::TAU * rnd();
         let t = [phi.cos(), phi.sin(), 0.0];
         let b = [-phi.sin(), phi.cos(), 0.0];
         let c = [2.0 * rnd() - 0.5, rnd() - 0.5, 2.0 * rnd() - 0.5];
-        let (az, z) = (6.283 * rnd(), 1.98 * rnd() - 0.99);
+        let (az, z) = (std::f64::consts::TAU * rnd(), 1.98 * rnd() - 0.99);
         let r = (1.0 - z * z).sqrt();
         let l = [r * az.cos(), r * az.sin(), z];
         inputs.extend(t.iter().chain(&b).chain(&c).chain(&l).map(|&v| v as f32));
