@@ -26,8 +26,8 @@ pub struct Paths {
     pub generated: PathBuf,
 }
 
-pub fn eval(name: &str, params: &[String], as_json: bool) -> Result<()> {
-    let q = quantity::lookup(name).map_err(input_err)?;
+/// `name=value` arguments as a map (each name once, each value a number).
+fn parse_params(params: &[String]) -> Result<BTreeMap<String, f64>> {
     let mut named = BTreeMap::new();
     for p in params {
         let (k, v) = p
@@ -41,6 +41,12 @@ pub fn eval(name: &str, params: &[String], as_json: bool) -> Result<()> {
             return Err(input_err(format!("parameter '{}' is given twice", k.trim())));
         }
     }
+    Ok(named)
+}
+
+pub fn eval(name: &str, params: &[String], as_json: bool) -> Result<()> {
+    let q = quantity::lookup(name).map_err(input_err)?;
+    let named = parse_params(params)?;
     let canonical = q.resolve(&named).map_err(input_err)?;
     if let Some(multi) = q.eval_channels {
         let est = multi(&canonical, 1e-12);
@@ -140,10 +146,63 @@ pub fn build(paths: &Paths, only: &[String], check: bool) -> Result<()> {
     Ok(())
 }
 
+/// A skin quantity with a diffusion profile of your own (`--profile`: a TOML file with a
+/// `[profile]` section, or a CSV radial profile) and/or the ring kernel (`--kernel`).
+pub fn eval_skin(name: &str, params: &[String], as_json: bool, profile: Option<&Path>, kernel: Option<&str>) -> Result<()> {
+    use crate::quantity::skin::{self, Kernel};
+    let q = quantity::lookup(name).map_err(input_err)?;
+    if !matches!(q.name, "skin-punctual" | "skin-sh") {
+        return Err(input_err(format!("--profile and --kernel apply to skin-punctual and skin-sh, not '{}'", q.name)));
+    }
+    let kernel = match (q.name, kernel) {
+        (_, None) | ("skin-punctual", Some("linear")) => Kernel::Linear,
+        ("skin-punctual", Some("radial")) => Kernel::Radial,
+        ("skin-punctual", Some(other)) => return Err(input_err(format!("--kernel '{other}': expected linear or radial"))),
+        (_, Some(_)) => return Err(input_err("--kernel applies to skin-punctual (skin-sh integrates the radial profile over the sphere)")),
+    };
+    let named = parse_params(params)?;
+    let p = q.resolve(&named).map_err(input_err)?;
+    let loaded = match profile {
+        Some(path) => spec::profile::load_profile_file(path).map_err(input_err)?,
+        None => spec::profile::LoadedProfile::deon_luebke(),
+    };
+    let tol = crate::integrate::Tolerance { abs: 1e-12, ..skin::DEFAULT_TOLERANCE };
+    let est = match q.name {
+        "skin-punctual" => skin::punctual(&loaded.profile, kernel, p[0], p[1], tol),
+        _ => skin::sh_band(&loaded.profile, p[0], p[1] as u32, tol),
+    };
+    let where_ = profile.map_or("the default profile".to_string(), |p| p.display().to_string());
+    let est = est.map_err(|e| input_err(format!("{where_}: {e}")))?;
+    let values: Vec<f64> = est.iter().map(|e| e.value).collect();
+    let error = est.iter().map(|e| e.error).fold(0.0, f64::max);
+    let kernel_name = if kernel == Kernel::Linear { "linear" } else { "radial" };
+    if as_json {
+        let out = json!({
+            "quantity": q.name,
+            "params": named,
+            "value": values,
+            "channels": q.channels,
+            "error_estimate": error,
+            "profile": loaded.provenance(),
+            "kernel": if q.name == "skin-punctual" { kernel_name } else { "radial (sphere)" },
+        });
+        println!("{out}");
+    } else {
+        let parts: Vec<String> = q.channels.iter().zip(&values).map(|(c, v)| format!("{c} {v:.17e}")).collect();
+        println!("{} = {}  (error estimate {error:.1e}; profile: {where_})", q.name, parts.join(", "));
+    }
+    Ok(())
+}
+
 /// The fitting samples of one spec (its grid and the integral there), as JSON or CSV.
 pub fn samples(paths: &Paths, name: &str, as_json: bool) -> Result<()> {
     let specs = load_specs(paths, &[name.to_string()])?;
     let s = specs.iter().find(|s| s.file.name == name).expect("load_specs checked the name");
+    if s.file.kind == spec::Kind::SkinLut {
+        return Err(input_err(format!(
+            "{name} is a skin LUT: its samples are its texels, \"values\" in generated/json/{name}.json (RGB, with the axes)"
+        )));
+    }
     let counts: Vec<usize> = s.file.axis.iter().map(|a| a.count).collect();
     let x = pipeline::grid(s, &counts);
     let y = pipeline::sample(s, &x);
@@ -180,7 +239,7 @@ pub fn samples(paths: &Paths, name: &str, as_json: bool) -> Result<()> {
 
 pub fn list(paths: &Paths) -> Result<()> {
     let specs = spec::load_dir(&paths.fits).map_err(input_err)?;
-    println!("{:<22} {:<6} {:<18} {:<28} status", "name", "kind", "quantity", "function");
+    println!("{:<22} {:<8} {:<18} {:<28} status", "name", "kind", "quantity", "function");
     for s in &specs {
         let status = match pipeline::build_spec(s, Mode::Committed, &paths.generated) {
             Ok(b) if pipeline::stale(&paths.generated, &b.artifacts).is_empty() => "up to date".to_string(),
@@ -188,9 +247,9 @@ pub fn list(paths: &Paths) -> Result<()> {
             Err(e) => format!("stale ({})", short(&e.to_string())),
         };
         println!(
-            "{:<22} {:<6} {:<18} {:<28} {status}",
+            "{:<22} {:<8} {:<18} {:<28} {status}",
             s.file.name,
-            format!("{:?}", s.file.kind).to_lowercase(),
+            s.file.kind.name(),
             s.file.quantity,
             s.file.emit.function
         );
@@ -307,6 +366,7 @@ pub fn validate(paths: &Paths, as_json: bool) -> Result<()> {
 pub fn plot(paths: &Paths, out: &Path) -> Result<()> {
     let mut files = crate::plot::gloss_figures(out, &paths.generated)?;
     files.extend(crate::plot::fuzz_figures(out, &paths.generated)?);
+    files.extend(crate::plot::skin_figures(out, &paths.generated)?);
     for f in &files {
         println!("{}", f.display());
     }

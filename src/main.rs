@@ -25,13 +25,20 @@ enum Command {
     /// Tables and fits known from the specs, with whether generated/ is up to date.
     List,
     /// Evaluate an integral (not a fit) at one point: QUANTITY name=value ...
-    #[command(after_help = "Quantities:\n  gloss-length       gloss=G | alpha=A   GGX average normal length\n  gloss-from-length  length=L            gloss with that average normal length\n  gloss-combine      x=G1 y=G2           combined gloss (RNM)")]
+    #[command(after_help = "Quantities:\n  gloss-length       gloss=G | alpha=A   GGX average normal length\n  gloss-from-length  length=L            gloss with that average normal length\n  gloss-combine      x=G1 y=G2           combined gloss (RNM)\n  skin-punctual      curvature=K n_dot_l=C   skin diffusion for a punctual light (RGB)\n  skin-sh            curvature=K band=L      SH band factor of skin scattering (RGB)")]
     Eval {
         quantity: String,
         /// Parameters as name=value.
         params: Vec<String>,
         #[arg(long)]
         json: bool,
+        /// Skin quantities: the diffusion profile, a TOML file with a [profile] section or a
+        /// CSV radial profile (radius_mm,red,green,blue); default d'Eon–Luebke.
+        #[arg(long)]
+        profile: Option<PathBuf>,
+        /// skin-punctual: the ring kernel, linear (default) or radial.
+        #[arg(long)]
+        kernel: Option<String>,
     },
     /// Integrate, fit, verify and emit every spec (or the named ones) into generated/.
     Build {
@@ -87,7 +94,10 @@ fn main() -> ExitCode {
     let paths = Paths { fits: cli.fits, generated: cli.generated };
     let result = match cli.command {
         Command::List => cli::list(&paths),
-        Command::Eval { quantity, params, json } => cli::eval(&quantity, &params, json),
+        Command::Eval { quantity, params, json, profile: None, kernel: None } => cli::eval(&quantity, &params, json),
+        Command::Eval { quantity, params, json, profile, kernel } => {
+            cli::eval_skin(&quantity, &params, json, profile.as_deref(), kernel.as_deref())
+        }
         Command::Build { only, check } => cli::build(&paths, &only, check),
         Command::Fit { data, x, y, model, objective, json } => cli::fit_data(&data, &x, &y, &model, objective, json),
         Command::Samples { name, json } => cli::samples(&paths, &name, json),

@@ -20,6 +20,8 @@ use serde_json::{json, Value};
 use sha2::{Digest, Sha256};
 use std::path::Path;
 
+pub mod skin;
+
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Mode {
     Fit,
@@ -36,6 +38,10 @@ pub enum BuildError {
     SpecChanged { spec: String, committed: String, current: String },
     #[error("{spec}: the f32 code returns a non-finite value at {at:?}")]
     NonFinite { spec: String, at: Vec<f64> },
+    #[error(transparent)]
+    Spec(#[from] crate::spec::SpecError),
+    #[error("{spec}: {msg}")]
+    Skin { spec: String, msg: String },
 }
 
 /// Errors of an emitted function against the integral on the verification grid.
@@ -130,6 +136,7 @@ pub fn build_spec(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildEr
     match spec.file.kind {
         Kind::Fit => build_fit(spec, mode, root),
         Kind::Table => build_table(spec, mode, root),
+        Kind::SkinLut => skin::build(spec, mode, root),
     }
 }
 
@@ -251,9 +258,9 @@ fn build_fit(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> 
         "verification": verification,
     });
     let artifacts = vec![
-        Artifact { path: format!("wgsl/{name}.wgsl").into(), contents: wgsl::render_module(&header, &func) },
-        Artifact { path: format!("src/{name}.rs").into(), contents: rust::render_module(&header, &func, &doc) },
-        Artifact { path: format!("json/{name}.json").into(), contents: json_text(&json) },
+        Artifact { path: format!("wgsl/{name}.wgsl").into(), contents: wgsl::render_module(&header, &func).into() },
+        Artifact { path: format!("src/{name}.rs").into(), contents: rust::render_module(&header, &func, &doc).into() },
+        Artifact { path: format!("json/{name}.json").into(), contents: json_text(&json).into() },
     ];
     Ok(Built { name, artifacts, verification, fit: report })
 }
@@ -393,10 +400,10 @@ fn build_table(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError
         csv.push_str(&format!("{},{v:?}\n", cols.join(",")));
     }
     let artifacts = vec![
-        Artifact { path: format!("wgsl/{name}.wgsl").into(), contents: wgsl::render_module(&header, &func) },
-        Artifact { path: format!("src/{name}.rs").into(), contents: rust::render_module(&header, &func, &doc) },
-        Artifact { path: format!("json/{name}.json").into(), contents: json_text(&json) },
-        Artifact { path: format!("data/{name}.csv").into(), contents: csv },
+        Artifact { path: format!("wgsl/{name}.wgsl").into(), contents: wgsl::render_module(&header, &func).into() },
+        Artifact { path: format!("src/{name}.rs").into(), contents: rust::render_module(&header, &func, &doc).into() },
+        Artifact { path: format!("json/{name}.json").into(), contents: json_text(&json).into() },
+        Artifact { path: format!("data/{name}.csv").into(), contents: csv.into() },
     ];
     Ok(Built { name, artifacts, verification, fit: None })
 }
@@ -440,7 +447,8 @@ pub fn runtime_index(specs: &[Spec]) -> Artifact {
     }
     s.push_str("    ];\n}\n");
     s.push_str("\n/// Every emitted function with its domain and CPU version (for GPU verification).\npub const FUNCTIONS: &[EmittedFunction] = &[\n");
-    for spec in specs {
+    // Skin LUT lookups return RGB (see emit::skin): not scalar functions of this list.
+    for spec in specs.iter().filter(|s| s.file.kind != Kind::SkinLut) {
         let arity = spec.file.axis.len();
         let domain: Vec<String> = spec
             .file
@@ -462,7 +470,7 @@ pub fn runtime_index(specs: &[Spec]) -> Artifact {
         ));
     }
     s.push_str("];\n");
-    Artifact { path: "src/emitted.rs".into(), contents: s }
+    Artifact { path: "src/emitted.rs".into(), contents: s.into() }
 }
 
 /// Feature family of a spec: the quantity name up to its first '-'.
@@ -474,7 +482,7 @@ pub fn family(spec: &Spec) -> &str {
 pub fn stale(root: &Path, artifacts: &[Artifact]) -> Vec<String> {
     artifacts
         .iter()
-        .filter(|a| std::fs::read(root.join(&a.path)).map_or(true, |old| old != a.contents.as_bytes()))
+        .filter(|a| std::fs::read(root.join(&a.path)).map_or(true, |old| old != a.contents))
         .map(|a| a.path.display().to_string())
         .collect()
 }

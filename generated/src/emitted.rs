@@ -25,6 +25,12 @@ pub mod gloss_length;
 #[cfg(feature = "gloss")]
 #[path = "gloss_table.rs"]
 pub mod gloss_table;
+#[cfg(feature = "skin")]
+#[path = "skin_punctual_lut.rs"]
+pub mod skin_punctual_lut;
+#[cfg(feature = "skin")]
+#[path = "skin_sh_lut.rs"]
+pub mod skin_sh_lut;
 
 /// WGSL libraries by module name (each starts with `#define_import_path shadefit::NAME`).
 pub mod wgsl {
@@ -44,6 +50,10 @@ pub mod wgsl {
     pub const GLOSS_LENGTH: &str = include_str!("../wgsl/gloss_length.wgsl");
     #[cfg(feature = "gloss")]
     pub const GLOSS_TABLE: &str = include_str!("../wgsl/gloss_table.wgsl");
+    #[cfg(feature = "skin")]
+    pub const SKIN_PUNCTUAL_LUT: &str = include_str!("../wgsl/skin_punctual_lut.wgsl");
+    #[cfg(feature = "skin")]
+    pub const SKIN_SH_LUT: &str = include_str!("../wgsl/skin_sh_lut.wgsl");
 
     /// The WGSL library of a module, if its feature is enabled.
     pub fn module(name: &str) -> Option<&'static str> {
@@ -64,6 +74,10 @@ pub mod wgsl {
             "gloss_length" => Some(GLOSS_LENGTH),
             #[cfg(feature = "gloss")]
             "gloss_table" => Some(GLOSS_TABLE),
+            #[cfg(feature = "skin")]
+            "skin_punctual_lut" => Some(SKIN_PUNCTUAL_LUT),
+            #[cfg(feature = "skin")]
+            "skin_sh_lut" => Some(SKIN_SH_LUT),
             _ => None,
         }
     }
@@ -86,6 +100,10 @@ pub mod wgsl {
         "gloss_length",
         #[cfg(feature = "gloss")]
         "gloss_table",
+        #[cfg(feature = "skin")]
+        "skin_punctual_lut",
+        #[cfg(feature = "skin")]
+        "skin_sh_lut",
     ];
 }
 

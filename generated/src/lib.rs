@@ -11,7 +11,9 @@
 //! - [`lut`]: the lookup-table modules as R32Float textures and WGSL accessors for them
 //!   (texture creation needs the `gpu` feature, which brings in wgpu);
 //! - `gpu` (feature `gpu`): a headless wgpu adapter and device chosen from the environment
-//!   (`WGPU_BACKEND`, `WGPU_ADAPTER_NAME`).
+//!   (`WGPU_BACKEND`, `WGPU_ADAPTER_NAME`);
+//! - [`skin`]: the directional curvature the skin LUTs take (Rust, and the WGSL library
+//!   `shadefit::skin_curvature`), and the skin LUTs' KTX2 textures (upload with `gpu`).
 
 #![allow(clippy::excessive_precision, clippy::approx_constant)]
 
@@ -39,5 +41,6 @@ pub use runtime::compose::{ComposeError, compose, compose_shader};
 #[cfg(feature = "gpu")]
 pub use runtime::gpu;
 pub use runtime::lut;
+pub use runtime::skin;
 
 include!("emitted.rs");

@@ -5,6 +5,8 @@
 
 pub mod expr;
 pub mod rust;
+pub mod skin;
+pub mod texture;
 pub mod wgsl;
 
 use std::io::Write;
@@ -12,11 +14,11 @@ use std::path::{Path, PathBuf};
 
 pub const GENERATOR: &str = concat!("shadefit ", env!("CARGO_PKG_VERSION"));
 
-/// One output file, relative to the generated/ root.
+/// One output file, relative to the generated/ root: text (UTF-8) or binary (textures).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Artifact {
     pub path: PathBuf,
-    pub contents: String,
+    pub contents: Vec<u8>,
 }
 
 /// Shortest decimal that parses back to the same f32, in scientific notation.
@@ -48,7 +50,7 @@ pub fn write_all(root: &Path, artifacts: &[Artifact]) -> Result<usize, WriteErro
     let mut written = 0;
     for a in artifacts {
         let path = root.join(&a.path);
-        if std::fs::read(&path).is_ok_and(|old| old == a.contents.as_bytes()) {
+        if std::fs::read(&path).is_ok_and(|old| old == a.contents) {
             continue;
         }
         let err = |e| WriteError { path: path.display().to_string(), source: e };
@@ -61,7 +63,7 @@ pub fn write_all(root: &Path, artifacts: &[Artifact]) -> Result<usize, WriteErro
         ));
         let result = (|| {
             let mut f = std::fs::File::create(&tmp)?;
-            f.write_all(a.contents.as_bytes())?;
+            f.write_all(&a.contents)?;
             f.sync_all()?;
             std::fs::rename(&tmp, &path)
         })();

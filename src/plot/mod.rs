@@ -9,15 +9,17 @@
 //! bytes depend only on the inputs: ticks, colours and legend placement are computed here
 //! without clocks, hashing or randomness, which the tests check by rendering twice.
 //!
-//! Figure families built on these primitives: [`gloss_figures`], [`fuzz_figures`].
+//! Figure families built on these primitives: [`gloss_figures`], [`fuzz_figures`], [`skin_figures`].
 
 mod colormap;
 mod fuzz;
 mod gloss;
+mod skin;
 mod ticks;
 
 pub use fuzz::{FuzzResolution, fuzz_figures, fuzz_figures_with};
 pub use gloss::gloss_figures;
+pub use skin::skin_figures;
 
 use plotters::coord::Shift;
 use plotters::prelude::*;

@@ -33,6 +33,8 @@
 //! ```
 
 pub mod data;
+pub mod profile;
+pub mod skin;
 
 use crate::fit::model::{Derived, ModelError, ModelParts, Pin, RationalModel, Term};
 use crate::fit::Objective;
@@ -227,6 +229,20 @@ impl ModelSpec {
 pub enum Kind {
     Fit,
     Table,
+    /// Skin LUT textures (RGB): checked and spelled out by [`skin`].
+    #[serde(rename = "skin-lut")]
+    SkinLut,
+}
+
+impl Kind {
+    /// The spec's spelling ("fit", "table", "skin-lut").
+    pub fn name(self) -> &'static str {
+        match self {
+            Kind::Fit => "fit",
+            Kind::Table => "table",
+            Kind::SkinLut => "skin-lut",
+        }
+    }
 }
 
 #[derive(Debug, Clone, Deserialize, PartialEq)]
@@ -313,7 +329,10 @@ impl Spec {
     }
 
     pub fn parse(path: &Path, text: String) -> Result<Spec, SpecError> {
-        let file: SpecFile = parse_toml(path, &text)?;
+        let file: SpecFile = match skin::spec_file(path, &text)? {
+            Some(f) => f,
+            None => parse_toml(path, &text)?,
+        };
         let at = |field: &str, msg: String| SpecError::new(path, line_of(&text, field), field, msg);
         if !is_identifier(&file.name) {
             return Err(at("name", format!("'{}' must be a lowercase identifier (a-z, 0-9, _)", file.name)));
@@ -333,10 +352,10 @@ impl Spec {
             return Err(at("tolerance", format!("{} must be in (0, 1)", file.tolerance)));
         }
         let quantity = quantity::lookup(&file.quantity).map_err(|e| at("quantity", e.to_string()))?;
-        if !quantity.channels.is_empty() {
+        if !quantity.channels.is_empty() && file.kind != Kind::SkinLut {
             return Err(at(
                 "quantity",
-                format!("'{}' has {} channels; specs take scalar quantities only (for now)", quantity.name, quantity.channels.len()),
+                format!("'{}' has {} channels; fits and tables take scalar quantities only (skin: kind = \"skin-lut\")", quantity.name, quantity.channels.len()),
             ));
         }
         let names: Vec<&str> = quantity.params.iter().map(|p| p.name).collect();
@@ -380,6 +399,7 @@ impl Spec {
             (Kind::Fit, None) => return Err(at("model", "kind = \"fit\" needs a [model] section".into())),
             (Kind::Table, Some(_)) => return Err(at("model", "kind = \"table\" takes no [model]".into())),
             (Kind::Table, None) => None,
+            (Kind::SkinLut, _) => None,
         };
         if file.kind == Kind::Table && file.axis.len() > 2 {
             return Err(at("axis", "tables have one or two axes".into()));

@@ -87,3 +87,74 @@ def test_skin_sh_matches_scipy(kappa, band):
         ref = num / den
         tol = got["error_estimate"] + (e1 + e2) / den + 1e-9
         assert abs(got["value"][ch] - ref) <= tol, (kappa, band, ch, got["value"][ch], ref)
+
+
+# --- The committed skin LUTs (generated/json/skin_*_lut.json, generated/data/*.ktx2) -----------
+
+LUT_POINTS = 12  # texels per LUT checked against scipy, chosen by a seeded generator
+
+
+def lut(name: str):
+    g = sf_cli.generated(name)
+    w, h = g["texture"]["width"], g["texture"]["height"]
+    values = np.array(g["values"], dtype=float)
+    assert values.shape == (w * h, 3)
+    return g, w, h, values
+
+
+def test_punctual_lut_texels_match_scipy():
+    g, w, h, values = lut("skin_punctual_lut")
+    assert g["kernel"] == "linear" and g["profile"]["preset"] == "deon-luebke"
+    kappas = g["axes"][1]["values"]
+    pick = np.random.default_rng(11).integers(0, w * h, LUT_POINTS)
+    for k in pick:
+        i, j = int(k) % w, int(k) // w
+        nl, kappa = -1.0 + 2.0 * i / (w - 1), kappas[j]
+        for ch in range(3):
+            if kappa == 0.0:
+                assert values[k, ch] == max(nl, 0.0)
+                continue
+            ref, err = ring(kappa, nl, ch)
+            # The LUT's tolerance per texel, quad's estimate, and 1e-9 for quad's estimate
+            # being an estimate (as above).
+            assert abs(values[k, ch] - ref) <= g["tolerance"] + err + 1e-9, (i, j, ch, values[k, ch], ref)
+
+
+def test_sh_lut_texels_match_scipy():
+    g, w, h, values = lut("skin_sh_lut")
+    assert h == 2
+    kappas = g["axes"][0]["values"]
+    for k in np.random.default_rng(12).integers(0, w * h, LUT_POINTS):
+        i, band = int(k) % w, int(k) // w + 1
+        kappa = kappas[i]
+        for ch in range(3):
+            if kappa == 0.0:
+                assert values[k, ch] == 1.0
+                continue
+            r = 1.0 / kappa
+            kern = lambda gam: radial_profile(2 * r * math.sin(gam / 2), ch) * math.sin(gam)
+            num, e1 = integrate.quad(lambda gam: kern(gam) * special.eval_legendre(band, math.cos(gam)), 0, math.pi,
+                                     limit=400, epsabs=1e-13, epsrel=1e-13)
+            den, e2 = integrate.quad(kern, 0, math.pi, limit=400, epsabs=1e-13, epsrel=1e-13)
+            assert abs(values[k, ch] - num / den) <= g["tolerance"] + (e1 + e2) / den + 1e-9, (i, band, ch)
+
+
+@pytest.mark.parametrize("name", ["skin_punctual_lut", "skin_sh_lut"])
+def test_ktx2_holds_the_texels(name):
+    """Header fields read with struct (KTX 2.0 layout), texels against the JSON values rounded
+    as the generator rounds them (f64 → f32 → f16, each round-to-nearest-even): bit for bit."""
+    import struct
+
+    g, w, h, values = lut(name)
+    data = (sf_cli.ROOT / "generated" / "data" / f"{name}.ktx2").read_bytes()
+    assert data[:12] == b"\xabKTX 20\xbb\r\n\x1a\n"
+    vk, type_size, pw, ph, depth, layers, faces, levels, scheme = struct.unpack_from("<9I", data, 12)
+    fmt = g["texture"]["format"]
+    assert (vk, type_size) == {"rgba16float": (97, 2), "rgba32float": (109, 4)}[fmt]
+    assert (pw, ph, depth, layers, faces, levels, scheme) == (w, h, 0, 0, 1, 1, 0)
+    offset, length, _ = struct.unpack_from("<3Q", data, 80)
+    dtype = np.dtype("<f2") if fmt == "rgba16float" else np.dtype("<f4")
+    texels = np.frombuffer(data[offset:offset + length], dtype=dtype).reshape(w * h, 4)
+    want = values.astype(np.float32).astype(dtype)
+    assert np.array_equal(texels[:, :3], want)
+    assert np.all(texels[:, 3] == 1.0)

@@ -13,6 +13,9 @@
 //! trailing `;` is accepted). Any other `#import` form (items, aliases, braces, another
 //! namespace) is an error rather than silently ignored; other lines are copied unchanged.
 //! The result is plain WGSL for `wgpu::ShaderSource::Wgsl` or naga.
+//!
+//! Names resolve to the emitted libraries (`wgsl::module`) first, then to the hand-written
+//! ones of this crate (`runtime::library`: `skin_curvature`).
 
 use std::fmt;
 
@@ -68,7 +71,12 @@ impl std::error::Error for ComposeError {}
 /// # }
 /// ```
 pub fn compose(names: &[&str]) -> Result<String, ComposeError> {
-    compose_with(&crate::wgsl::module, names, None)
+    compose_with(&module_or_library, names, None)
+}
+
+/// An emitted library, else a hand-written one (`runtime::library`, e.g. `skin_curvature`).
+fn module_or_library(name: &str) -> Option<&'static str> {
+    crate::wgsl::module(name).or_else(|| super::library(name))
 }
 
 /// A user shader with its `#import shadefit::NAME` lines resolved: the imported libraries
@@ -84,7 +92,7 @@ pub fn compose(names: &[&str]) -> Result<String, ComposeError> {
 /// # }
 /// ```
 pub fn compose_shader(source: &str) -> Result<String, ComposeError> {
-    compose_with(&crate::wgsl::module, &[], Some(source))
+    compose_with(&module_or_library, &[], Some(source))
 }
 
 /// One preprocessed line of a source.

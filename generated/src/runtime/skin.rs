@@ -1,0 +1,240 @@
+//! Skin LUT glue: the directional curvature a LUT lookup needs, and the KTX2 textures.
+//!
+//! # Curvature
+//! The skin LUTs (`skin_punctual_lut`, `skin_sh_lut`, feature `skin`) take the curvature κ
+//! (1/mm) of the surface *along the light*. [`skin_curvature_from_light`] and
+//! [`skin_curvature_from_light_normalized`] compute it from a curvature tensor, on the CPU here
+//! and in WGSL in the library [`CURVATURE_WGSL`] (`#import shadefit::skin_curvature`, resolved
+//! by [`crate::compose_shader`]); both versions do the same f32 operations in the same order.
+//!
+//! `curv_tensor` = (k_tt, k_tb, k_bb) is the symmetric tensor C = [[k_tt, k_tb], [k_tb, k_bb]]
+//! of the surface's second fundamental form in an orthonormal tangent frame (tangent,
+//! bitangent), positive where the surface bends away from its normal (a sphere of radius r:
+//! C = I/r). With l_t = (l·t, l·b), the light direction projected onto the tangent plane:
+//! - [`skin_curvature_from_light`]: κ = l_tᵀ C l_t = (curvature along l_t)·(1 − (n·l)²), which
+//!   fades to 0 as the light nears the normal (where the LUTs depend least on κ); no division;
+//! - [`skin_curvature_from_light_normalized`]: κ = l_tᵀ C l_t / |l_t|², the normal curvature
+//!   along the projected light direction (Euler's k₁cos²ψ + k₂sin²ψ), the curvature of the
+//!   cylinder the punctual LUT's ring integral assumes; the mean curvature (k_tt + k_bb)/2 when
+//!   |l_t|² < 1e-8 (the light along the normal has no tangent direction).
+//!
+//! Units: the LUTs tabulate κ in 1/mm; a tensor estimated in a mesh's units (1/m, 1/cm) must be
+//! scaled (×0.001, ×0.1). Neither function clamps: the LUT lookups map concave κ < 0 to the
+//! κ = 0 row, i.e. max(n·l, 0).
+//!
+//! # Textures
+//! Each skin LUT module carries its texture as KTX2 bytes (`NAME_KTX2`: linear RGBA16F or
+//! RGBA32F, alpha 1, one level). [`Ktx2Image::parse`] reads the header this crate's generator
+//! writes (no supercompression, one 2-D level); with the `gpu` feature [`create_lut_texture`]
+//! uploads it and [`lut_sampler`] makes the linear, clamp-to-edge sampler the emitted
+//! `NAME_sample` functions expect. RGBA16F is filterable in core WebGPU; RGBA32F needs the
+//! `FLOAT32_FILTERABLE` feature for a linear sampler (or use the const-array lookup `NAME`).
+
+/// The WGSL library `shadefit::skin_curvature` (hand-written, see the module docs).
+pub const CURVATURE_WGSL: &str = include_str!("skin_curvature.wgsl");
+
+#[inline]
+fn dot(a: [f32; 3], b: [f32; 3]) -> f32 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// κ = l_tᵀ C l_t: the curvature along the projected light direction times 1 − (n·l)² (see the
+/// module docs). CPU version of the WGSL function of the same name.
+pub fn skin_curvature_from_light(tangent: [f32; 3], bitangent: [f32; 3], curv_tensor: [f32; 3], light_dir: [f32; 3]) -> f32 {
+    let x = dot(light_dir, tangent);
+    let y = dot(light_dir, bitangent);
+    curv_tensor[0] * x * x + 2.0 * curv_tensor[1] * x * y + curv_tensor[2] * y * y
+}
+
+/// κ = l_tᵀ C l_t / |l_t|²: the normal curvature along the projected light direction (mean
+/// curvature when the light is within ~1e-4 rad of the normal). CPU version of the WGSL
+/// function of the same name.
+pub fn skin_curvature_from_light_normalized(
+    tangent: [f32; 3],
+    bitangent: [f32; 3],
+    curv_tensor: [f32; 3],
+    light_dir: [f32; 3],
+) -> f32 {
+    let x = dot(light_dir, tangent);
+    let y = dot(light_dir, bitangent);
+    let q = curv_tensor[0] * x * x + 2.0 * curv_tensor[1] * x * y + curv_tensor[2] * y * y;
+    let len2 = x * x + y * y;
+    if len2 > 1e-8 { q / len2 } else { 0.5 * (curv_tensor[0] + curv_tensor[2]) }
+}
+
+/// Why KTX2 bytes were not read.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Ktx2Error {
+    /// Not a KTX2 file, or shorter than its header says.
+    Malformed(&'static str),
+    /// A `VkFormat` other than RGBA16F (97) and RGBA32F (109).
+    Format(u32),
+    /// Supercompressed, layered, cube, 3-D or mipmapped: not what shadefit writes.
+    Unsupported(&'static str),
+}
+
+impl std::fmt::Display for Ktx2Error {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Ktx2Error::Malformed(why) => write!(f, "malformed KTX2: {why}"),
+            Ktx2Error::Format(v) => write!(f, "KTX2 VkFormat {v} is not RGBA16F (97) or RGBA32F (109)"),
+            Ktx2Error::Unsupported(what) => write!(f, "unsupported KTX2: {what}"),
+        }
+    }
+}
+
+impl std::error::Error for Ktx2Error {}
+
+/// Texel format of a skin LUT texture.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LutFormat {
+    Rgba16Float,
+    Rgba32Float,
+}
+
+/// One 2-D level of a KTX2 file: size, format and the texels (little-endian, row 0 first).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Ktx2Image<'a> {
+    pub width: u32,
+    pub height: u32,
+    pub format: LutFormat,
+    pub data: &'a [u8],
+}
+
+impl<'a> Ktx2Image<'a> {
+    /// Read the header and the level index of an uncompressed, single-level 2-D KTX2 file.
+    pub fn parse(bytes: &'a [u8]) -> Result<Ktx2Image<'a>, Ktx2Error> {
+        const ID: [u8; 12] = [0xAB, 0x4B, 0x54, 0x58, 0x20, 0x32, 0x30, 0xBB, 0x0D, 0x0A, 0x1A, 0x0A];
+        if bytes.len() < 104 || bytes[..12] != ID {
+            return Err(Ktx2Error::Malformed("no KTX 20 identifier"));
+        }
+        let u32_at = |o: usize| u32::from_le_bytes(bytes[o..o + 4].try_into().expect("4 bytes"));
+        let u64_at = |o: usize| u64::from_le_bytes(bytes[o..o + 8].try_into().expect("8 bytes"));
+        let format = match u32_at(12) {
+            97 => LutFormat::Rgba16Float,
+            109 => LutFormat::Rgba32Float,
+            other => return Err(Ktx2Error::Format(other)),
+        };
+        let (width, height, depth, layers, faces, levels, scheme) =
+            (u32_at(20), u32_at(24), u32_at(28), u32_at(32), u32_at(36), u32_at(40), u32_at(44));
+        if scheme != 0 {
+            return Err(Ktx2Error::Unsupported("supercompression"));
+        }
+        if depth != 0 || layers > 1 || faces != 1 || levels > 1 || height == 0 {
+            return Err(Ktx2Error::Unsupported("not a single-level 2-D image"));
+        }
+        let (offset, length) = (u64_at(80) as usize, u64_at(88) as usize);
+        let texel = match format {
+            LutFormat::Rgba16Float => 8,
+            LutFormat::Rgba32Float => 16,
+        };
+        if length != width as usize * height as usize * texel {
+            return Err(Ktx2Error::Malformed("level length differs from width × height × texel size"));
+        }
+        let data = bytes.get(offset..offset + length).ok_or(Ktx2Error::Malformed("level data beyond the end"))?;
+        Ok(Ktx2Image { width, height, format, data })
+    }
+
+    /// Texel (x, y) as f32 RGBA (f16 widened exactly).
+    pub fn texel(&self, x: u32, y: u32) -> [f32; 4] {
+        let k = (y * self.width + x) as usize;
+        std::array::from_fn(|c| match self.format {
+            LutFormat::Rgba16Float => {
+                let o = 8 * k + 2 * c;
+                f16_to_f32(u16::from_le_bytes([self.data[o], self.data[o + 1]]))
+            }
+            LutFormat::Rgba32Float => {
+                let o = 16 * k + 4 * c;
+                f32::from_le_bytes(self.data[o..o + 4].try_into().expect("4 bytes"))
+            }
+        })
+    }
+}
+
+/// IEEE binary16 bits to f32 (exact: every half is an f32).
+pub fn f16_to_f32(h: u16) -> f32 {
+    let sign = if h & 0x8000 != 0 { -1.0 } else { 1.0 };
+    let exp = ((h >> 10) & 0x1f) as i32;
+    let man = (h & 0x3ff) as f32;
+    sign * match exp {
+        0 => man * 2f32.powi(-24),
+        31 if man == 0.0 => f32::INFINITY,
+        31 => f32::NAN,
+        e => (1.0 + man / 1024.0) * 2f32.powi(e - 15),
+    }
+}
+
+#[cfg(feature = "gpu")]
+mod gpu {
+    use super::{Ktx2Error, Ktx2Image, LutFormat};
+    use wgpu::util::DeviceExt;
+
+    /// Upload a skin LUT's KTX2 bytes (`NAME_KTX2`) as a 2-D texture (`Rgba16Float` or
+    /// `Rgba32Float`, one level, `TEXTURE_BINDING | COPY_DST`).
+    pub fn create_lut_texture(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        label: &str,
+        ktx2: &[u8],
+    ) -> Result<wgpu::Texture, Ktx2Error> {
+        let img = Ktx2Image::parse(ktx2)?;
+        let format = match img.format {
+            LutFormat::Rgba16Float => wgpu::TextureFormat::Rgba16Float,
+            LutFormat::Rgba32Float => wgpu::TextureFormat::Rgba32Float,
+        };
+        Ok(device.create_texture_with_data(
+            queue,
+            &wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d { width: img.width, height: img.height, depth_or_array_layers: 1 },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+                view_formats: &[],
+            },
+            wgpu::util::TextureDataOrder::LayerMajor,
+            img.data,
+        ))
+    }
+
+    /// The sampler the emitted `NAME_sample` functions expect: linear, clamp-to-edge, one level
+    /// (bind as `SamplerBindingType::Filtering`).
+    pub fn lut_sampler(device: &wgpu::Device) -> wgpu::Sampler {
+        device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("shadefit skin LUT"),
+            address_mode_u: wgpu::AddressMode::ClampToEdge,
+            address_mode_v: wgpu::AddressMode::ClampToEdge,
+            address_mode_w: wgpu::AddressMode::ClampToEdge,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            mipmap_filter: wgpu::MipmapFilterMode::Nearest,
+            ..Default::default()
+        })
+    }
+}
+
+#[cfg(feature = "gpu")]
+pub use gpu::{create_lut_texture, lut_sampler};
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn half_decoding() {
+        assert_eq!(f16_to_f32(0x3C00), 1.0);
+        assert_eq!(f16_to_f32(0xC000), -2.0);
+        assert_eq!(f16_to_f32(0x3555), 0.333_251_95);
+        assert_eq!(f16_to_f32(0x0001), 2f32.powi(-24));
+        assert_eq!(f16_to_f32(0x7BFF), 65504.0);
+        assert_eq!(f16_to_f32(0x7C00), f32::INFINITY);
+        assert!(f16_to_f32(0x7E00).is_nan());
+    }
+
+    #[test]
+    fn malformed_ktx2_is_refused() {
+        assert!(matches!(Ktx2Image::parse(b"not a texture"), Err(Ktx2Error::Malformed(_))));
+    }
+}

@@ -1,0 +1,336 @@
+//! Texture files: KTX2 containers of linear RGBA float texels (written here, byte for byte)
+//! and sRGB-encoded PNG previews. Both are pure functions of their inputs (no clocks, no
+//! randomness, fixed compression settings), so a build is byte-identical on every run.
+//!
+//! # KTX2 (Khronos KTX 2.0 specification, with the Khronos Data Format 1.3 descriptor)
+//! One 2-D image, one mip level, one layer, one face, no supercompression:
+//!
+//! | bytes      | contents |
+//! |------------|----------|
+//! | 0..12      | identifier «KTX 20»\r\n\x1A\n |
+//! | 12..48     | vkFormat, typeSize, width, height, depth 0, layers 0, faces 1, levels 1, supercompression 0 |
+//! | 48..80     | index: DFD offset/length, key/value offset/length, no supercompression global data |
+//! | 80..104    | level 0: byte offset, byte length, uncompressed byte length |
+//! | 104..196   | DFD: total size, basic block (RGBSDA model, BT.709 primaries, *linear* transfer, straight alpha), 4 samples (R, G, B, A: float, signed) |
+//! | 196..      | key/value data (sorted by key): `KTXorientation` = `rd`, `KTXwriter`, `shadefit` (the generated-file header lines) |
+//! | aligned    | level 0 texels, row by row from the top (row 0 first), little-endian |
+//!
+//! The level data starts at a multiple of the texel size (8 bytes for RGBA16F, 16 for RGBA32F,
+//! both multiples of 4 as the specification requires). Texel values are written as given:
+//! no tonemapping, no gamma (the DFD says so with `KHR_DF_TRANSFER_LINEAR`).
+
+use serde::{Deserialize, Serialize};
+
+/// Texel format of a KTX2 texture (WebGPU names).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum TextureFormat {
+    /// RGBA, 16-bit IEEE half floats (`VK_FORMAT_R16G16B16A16_SFLOAT`): filterable in core
+    /// WebGPU, 11 significant bits (relative rounding ≤ 2⁻¹¹ ≈ 4.9e-4).
+    #[default]
+    Rgba16float,
+    /// RGBA, 32-bit floats (`VK_FORMAT_R32G32B32A32_SFLOAT`): the f32 values exactly; linear
+    /// filtering needs WebGPU's optional `float32-filterable` feature.
+    Rgba32float,
+}
+
+impl TextureFormat {
+    /// `VkFormat` enumerant.
+    pub fn vk_format(self) -> u32 {
+        match self {
+            TextureFormat::Rgba16float => 97,
+            TextureFormat::Rgba32float => 109,
+        }
+    }
+
+    /// Bytes per channel.
+    pub fn type_size(self) -> u32 {
+        match self {
+            TextureFormat::Rgba16float => 2,
+            TextureFormat::Rgba32float => 4,
+        }
+    }
+
+    /// Bytes per texel (4 channels).
+    pub fn texel_size(self) -> u32 {
+        4 * self.type_size()
+    }
+
+    /// The WebGPU name (`rgba16float`, `rgba32float`).
+    pub fn name(self) -> &'static str {
+        match self {
+            TextureFormat::Rgba16float => "rgba16float",
+            TextureFormat::Rgba32float => "rgba32float",
+        }
+    }
+
+    /// The value a texel channel holds for `v` (f32 → f16 rounds to nearest, ties to even).
+    pub fn stored(self, v: f32) -> f32 {
+        match self {
+            TextureFormat::Rgba16float => half::f16::from_f32(v).to_f32(),
+            TextureFormat::Rgba32float => v,
+        }
+    }
+
+    fn push(self, out: &mut Vec<u8>, v: f32) {
+        match self {
+            TextureFormat::Rgba16float => out.extend_from_slice(&half::f16::from_f32(v).to_le_bytes()),
+            TextureFormat::Rgba32float => out.extend_from_slice(&v.to_le_bytes()),
+        }
+    }
+}
+
+const KTX2_IDENTIFIER: [u8; 12] = [0xAB, 0x4B, 0x54, 0x58, 0x20, 0x32, 0x30, 0xBB, 0x0D, 0x0A, 0x1A, 0x0A];
+/// Header (48) + index (32) + one level-index entry (24).
+const LEVEL_INDEX_END: usize = 104;
+
+fn put_u32(out: &mut Vec<u8>, v: u32) {
+    out.extend_from_slice(&v.to_le_bytes());
+}
+
+fn put_u64(out: &mut Vec<u8>, v: u64) {
+    out.extend_from_slice(&v.to_le_bytes());
+}
+
+fn pad_to(out: &mut Vec<u8>, align: usize) {
+    while !out.len().is_multiple_of(align) {
+        out.push(0);
+    }
+}
+
+/// The data format descriptor: total size, then one basic descriptor block (KDF 1.3 §5).
+fn data_format_descriptor(format: TextureFormat) -> Vec<u8> {
+    const SAMPLES: u32 = 4;
+    let block_size = 24 + 16 * SAMPLES;
+    let mut d = Vec::with_capacity(4 + block_size as usize);
+    put_u32(&mut d, 4 + block_size); // dfdTotalSize
+    put_u32(&mut d, 0); // vendorId KHR (0), descriptorType BASICFORMAT (0)
+    put_u32(&mut d, 2 | (block_size << 16)); // versionNumber KHR_DF_VERSIONNUMBER_1_3 = 2
+    // colorModel RGBSDA (1), primaries BT709 (1), transfer LINEAR (1), flags ALPHA_STRAIGHT (0).
+    d.extend_from_slice(&[1, 1, 1, 0]);
+    d.extend_from_slice(&[0, 0, 0, 0]); // texelBlockDimension 1×1×1×1 (stored minus one)
+    d.extend_from_slice(&[format.texel_size() as u8, 0, 0, 0, 0, 0, 0, 0]); // bytesPlane0..7
+    let bits = 8 * format.type_size();
+    // Channel ids R = 0, G = 1, B = 2, A = 15, with the FLOAT (0x80) and SIGNED (0x40)
+    // qualifiers; sampleLower/Upper are −1.0 and 1.0 as f32 bit patterns (the convention for
+    // float samples of any width).
+    for (k, channel) in [0u32, 1, 2, 15].into_iter().enumerate() {
+        let offset = k as u32 * bits;
+        put_u32(&mut d, offset | ((bits - 1) << 16) | ((channel | 0xC0) << 24));
+        put_u32(&mut d, 0); // samplePosition0..3
+        put_u32(&mut d, 0xBF80_0000);
+        put_u32(&mut d, 0x3F80_0000);
+    }
+    d
+}
+
+/// Key/value data: entries sorted by key, each `length, key NUL value, padding to 4`.
+fn key_value_data(entries: &[(&str, &str)]) -> Vec<u8> {
+    let mut sorted: Vec<&(&str, &str)> = entries.iter().collect();
+    sorted.sort_by(|a, b| a.0.as_bytes().cmp(b.0.as_bytes()));
+    let mut out = Vec::new();
+    for (k, v) in sorted {
+        let len = k.len() + 1 + v.len() + 1;
+        put_u32(&mut out, len as u32);
+        out.extend_from_slice(k.as_bytes());
+        out.push(0);
+        out.extend_from_slice(v.as_bytes());
+        out.push(0);
+        pad_to(&mut out, 4);
+    }
+    out
+}
+
+/// A KTX2 file holding one `width`×`height` RGBA image, texels row by row from the top
+/// (`texels[y * width + x]`), in `format`. `metadata` are extra key/value entries (after
+/// `KTXorientation` = `rd` and `KTXwriter` = the generator).
+pub fn ktx2_rgba(
+    width: u32,
+    height: u32,
+    texels: &[[f32; 4]],
+    format: TextureFormat,
+    metadata: &[(&str, &str)],
+) -> Vec<u8> {
+    assert_eq!(texels.len(), (width * height) as usize, "texel count differs from width × height");
+    let dfd = data_format_descriptor(format);
+    let mut kv = vec![("KTXorientation", "rd"), ("KTXwriter", super::GENERATOR)];
+    kv.extend_from_slice(metadata);
+    let kvd = key_value_data(&kv);
+    let dfd_offset = LEVEL_INDEX_END;
+    let kvd_offset = dfd_offset + dfd.len();
+    let mut level = Vec::with_capacity(texels.len() * format.texel_size() as usize);
+    for t in texels {
+        for &c in t {
+            format.push(&mut level, c);
+        }
+    }
+    let align = format.texel_size() as usize; // lcm(texel size, 4) = texel size here
+    let level_offset = (kvd_offset + kvd.len()).next_multiple_of(align);
+
+    let mut out = Vec::with_capacity(level_offset + level.len());
+    out.extend_from_slice(&KTX2_IDENTIFIER);
+    for v in [format.vk_format(), format.type_size(), width, height, 0, 0, 1, 1, 0] {
+        put_u32(&mut out, v);
+    }
+    put_u32(&mut out, dfd_offset as u32);
+    put_u32(&mut out, dfd.len() as u32);
+    put_u32(&mut out, kvd_offset as u32);
+    put_u32(&mut out, kvd.len() as u32);
+    put_u64(&mut out, 0); // sgdByteOffset
+    put_u64(&mut out, 0); // sgdByteLength
+    put_u64(&mut out, level_offset as u64);
+    put_u64(&mut out, level.len() as u64);
+    put_u64(&mut out, level.len() as u64);
+    debug_assert_eq!(out.len(), LEVEL_INDEX_END);
+    out.extend_from_slice(&dfd);
+    out.extend_from_slice(&kvd);
+    pad_to(&mut out, align);
+    debug_assert_eq!(out.len(), level_offset);
+    out.extend_from_slice(&level);
+    out
+}
+
+/// The sRGB transfer function (IEC 61966-2-1) of a linear value clamped to [0, 1], as 8 bits.
+pub fn srgb8(linear: f64) -> u8 {
+    let v = linear.clamp(0.0, 1.0);
+    let e = if v <= 0.003_130_8 { 12.92 * v } else { 1.055 * v.powf(1.0 / 2.4) - 0.055 };
+    (e * 255.0).round() as u8
+}
+
+/// An 8-bit sRGB PNG preview of linear RGB data (`rgb[y * width + x]`, clamped to [0, 1], no
+/// tonemapping), each texel drawn as a `scale_x`×`scale_y` block, with an sRGB chunk and
+/// `text` as tEXt chunks (Latin-1 keywords and text).
+pub fn png_srgb_preview(
+    width: usize,
+    height: usize,
+    rgb: &[[f64; 3]],
+    scale_x: usize,
+    scale_y: usize,
+    text: &[(&str, String)],
+) -> Vec<u8> {
+    assert_eq!(rgb.len(), width * height, "texel count differs from width × height");
+    let (w, h) = (width * scale_x, height * scale_y);
+    let mut pixels = Vec::with_capacity(w * h * 3);
+    for y in 0..h {
+        for x in 0..w {
+            let t = rgb[(y / scale_y) * width + x / scale_x];
+            pixels.extend(t.iter().map(|&c| srgb8(c)));
+        }
+    }
+    let mut out = Vec::new();
+    {
+        let mut enc = png::Encoder::new(&mut out, w as u32, h as u32);
+        enc.set_color(png::ColorType::Rgb);
+        enc.set_depth(png::BitDepth::Eight);
+        enc.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
+        enc.set_compression(png::Compression::Balanced);
+        for (k, v) in text {
+            enc.add_text_chunk(k.to_string(), v.clone()).expect("Latin-1 keyword and text");
+        }
+        let mut wr = enc.write_header().expect("PNG header into memory");
+        wr.write_image_data(&pixels).expect("PNG data into memory");
+        wr.finish().expect("PNG end into memory");
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn texels(w: u32, h: u32) -> Vec<[f32; 4]> {
+        (0..w * h).map(|k| [k as f32 / 7.0, 0.25, -(k as f32), 1.0]).collect()
+    }
+
+    #[test]
+    fn ktx2_reads_back_with_the_ktx2_crate() {
+        for format in [TextureFormat::Rgba16float, TextureFormat::Rgba32float] {
+            let (w, h) = (5, 3);
+            let t = texels(w, h);
+            let bytes = ktx2_rgba(w, h, &t, format, &[("shadefit", "spec: fits/x.toml")]);
+            let r = ktx2::Reader::new(&bytes[..]).expect("a valid KTX2 file");
+            let hd = r.header();
+            assert_eq!(hd.format.map(|f| f.value()), Some(format.vk_format()));
+            assert_eq!((hd.pixel_width, hd.pixel_height, hd.pixel_depth), (w, h, 0));
+            assert_eq!((hd.layer_count, hd.face_count, hd.level_count), (0, 1, 1));
+            assert_eq!(hd.type_size, format.type_size());
+            assert!(hd.supercompression_scheme.is_none());
+            assert_eq!(r.transfer_function(), Some(ktx2::TransferFunction::Linear));
+            assert_eq!(r.color_model(), Some(ktx2::ColorModel::RGBSDA));
+            assert_eq!(r.color_primaries(), Some(ktx2::ColorPrimaries::BT709));
+            assert_eq!(r.is_alpha_premultiplied(), Some(false));
+            // KTX2 string values are NUL-terminated.
+            assert_eq!(r.writer(), Some(format!("{}\0", crate::emit::GENERATOR).as_str()));
+            let basic = r.basic_dfd().expect("a basic DFD block");
+            assert_eq!(basic.bytes_planes[0] as u32, format.texel_size());
+            let samples = &basic.sample_information;
+            assert_eq!(samples.len(), 4);
+            for (k, s) in samples.iter().enumerate() {
+                assert_eq!(s.bit_offset as u32, k as u32 * 8 * format.type_size());
+                assert_eq!(s.bit_length.get() as u32, 8 * format.type_size());
+                assert_eq!(s.channel_type, [0, 1, 2, 15][k]);
+                assert!(s.channel_type_qualifiers.contains(ktx2::dfd::ChannelTypeQualifiers::FLOAT));
+                assert!(s.channel_type_qualifiers.contains(ktx2::dfd::ChannelTypeQualifiers::SIGNED));
+                assert_eq!((s.lower, s.upper), (0xBF80_0000, 0x3F80_0000));
+            }
+            let kv: Vec<(&str, &[u8])> = r.key_value_data().collect();
+            let keys: Vec<&str> = kv.iter().map(|e| e.0).collect();
+            assert_eq!(keys, ["KTXorientation", "KTXwriter", "shadefit"]);
+            assert_eq!(kv[0].1, b"rd\0");
+            assert_eq!(kv[2].1, b"spec: fits/x.toml\0");
+            let levels: Vec<_> = r.levels().collect();
+            assert_eq!(levels.len(), 1);
+            let data = levels[0].data;
+            assert_eq!(data.len(), t.len() * format.texel_size() as usize);
+            // The level starts at a multiple of the texel size.
+            let at = data.as_ptr() as usize - bytes.as_ptr() as usize;
+            assert_eq!(at % format.texel_size() as usize, 0);
+            let ts = format.type_size() as usize;
+            for (k, texel) in t.iter().enumerate() {
+                for c in 0..4 {
+                    let b = &data[(4 * k + c) * ts..(4 * k + c + 1) * ts];
+                    let v = match format {
+                        TextureFormat::Rgba16float => half::f16::from_le_bytes([b[0], b[1]]).to_f32(),
+                        TextureFormat::Rgba32float => f32::from_le_bytes([b[0], b[1], b[2], b[3]]),
+                    };
+                    assert_eq!(v.to_bits(), format.stored(texel[c]).to_bits());
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn srgb_encoding_matches_the_standard() {
+        // IEC 61966-2-1 reference points: 0 → 0, 1 → 255, 0.5 → 0.7354 → 188, 0.0031308 (the
+        // break) → 0.04045 → 10, 0.18 → 0.4614 → 118.
+        assert_eq!(srgb8(0.0), 0);
+        assert_eq!(srgb8(1.0), 255);
+        assert_eq!(srgb8(0.5), 188);
+        assert_eq!(srgb8(0.003_130_8), 10);
+        assert_eq!(srgb8(0.18), 118);
+        assert_eq!(srgb8(-1.0), 0);
+        assert_eq!(srgb8(f64::NAN.max(2.0)), 255);
+    }
+
+    #[test]
+    fn png_preview_decodes_to_the_encoded_values() {
+        let rgb: Vec<[f64; 3]> = (0..6).map(|k| [k as f64 / 5.0, 0.5, 1.0 - k as f64 / 5.0]).collect();
+        let bytes = png_srgb_preview(3, 2, &rgb, 2, 3, &[("Comment", "spec: x".into())]);
+        assert_eq!(bytes, png_srgb_preview(3, 2, &rgb, 2, 3, &[("Comment", "spec: x".into())]));
+        let dec = png::Decoder::new(std::io::Cursor::new(&bytes[..]));
+        let mut reader = dec.read_info().unwrap();
+        let info = reader.info();
+        assert_eq!((info.width, info.height), (6, 6));
+        assert!(info.srgb.is_some());
+        assert_eq!(info.uncompressed_latin1_text[0].text, "spec: x");
+        let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+        reader.next_frame(&mut buf).unwrap();
+        for y in 0..6 {
+            for x in 0..6 {
+                let t = rgb[(y / 3) * 3 + x / 2];
+                let p = &buf[(y * 6 + x) * 3..][..3];
+                assert_eq!(p, [srgb8(t[0]), srgb8(t[1]), srgb8(t[2])]);
+            }
+        }
+    }
+}

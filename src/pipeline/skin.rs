@@ -1,0 +1,449 @@
+//! The build of a skin LUT spec (`kind = "skin-lut"`, see `spec::skin`): tabulate, verify,
+//! emit.
+//!
+//! - tabulate: every texel is the integral of `quantity::skin` (punctual: the ring, RGB, with
+//!   the spec's kernel; SH: bands 1 and 2 of the sphere) at the grid point, to the spec's
+//!   tolerance per channel; curvature rows in parallel, collected in order (byte-identical at
+//!   any thread count);
+//! - verify: the integral again on the grid that adds every midpoint (2n − 1 per axis, in the
+//!   mapped coordinates), against bilinear interpolation of the f64 texels and against the
+//!   emitted f32 lookup; the texture's storage error (f16 or f32 rounding of the texels); the
+//!   largest quadrature error estimate;
+//! - emit: `wgsl/NAME.wgsl` and `src/NAME.rs` (const arrays and lookups, `emit::skin`),
+//!   `data/NAME.ktx2` (linear RGBA, alpha 1), `data/NAME.png` (sRGB preview, κ = 0 row at the
+//!   top) and `json/NAME.json` (provenance: profile, kernel, mapping, tolerance, texel values in
+//!   f64, measured errors).
+//!
+//! `Mode::Committed` (build --check) takes the texel values and the measured errors from the
+//! committed JSON and re-renders every file without integrating.
+
+use super::{BuildError, Built, Mode, Verification, fmt_err, json_text, spec_rel_path};
+use crate::emit::skin::{Layout, SkinLutCode};
+use crate::emit::texture::{ktx2_rgba, png_srgb_preview};
+use crate::emit::{Artifact, GENERATOR, header_lines};
+use crate::integrate::{Estimate, Tolerance};
+use crate::quantity::skin::{
+    self, DEFAULT_TOLERANCE, Kernel, lut_n_dot_l, punctual_grid_estimates, sh_bands_estimates,
+};
+use crate::spec::Spec;
+use crate::spec::skin::{SkinLut, SkinLutKind};
+use serde_json::{Value, json};
+use sha2::{Digest, Sha256};
+use std::path::Path;
+
+/// Quadrature work and the largest error estimate over the texels.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Quadrature {
+    max_error_estimate: f64,
+    evals_per_texel: f64,
+}
+
+/// Input hash of a skin LUT: the generator, the spec text and, for a CSV profile, its bytes.
+pub fn input_hash(spec: &Spec, lut: &SkinLut) -> String {
+    let mut h = Sha256::new();
+    h.update(GENERATOR.as_bytes());
+    h.update(b"\n");
+    h.update(spec.text.as_bytes());
+    let extra = lut.profile.hash_input();
+    if !extra.is_empty() {
+        h.update(b"\n");
+        h.update(extra);
+    }
+    format!("sha256:{}", h.finalize().iter().map(|b| format!("{b:02x}")).collect::<String>())
+}
+
+fn layout(lut: &SkinLut) -> Layout {
+    match lut.kind {
+        SkinLutKind::Punctual { n_dot_l, .. } => Layout::Punctual { n_dot_l, curvature: lut.curvature_count },
+        SkinLutKind::Sh => Layout::Sh { curvature: lut.curvature_count },
+    }
+}
+
+fn tolerance(lut: &SkinLut) -> Tolerance {
+    Tolerance { abs: lut.tolerance, rel: 0.0, max_panels: DEFAULT_TOLERANCE.max_panels }
+}
+
+fn profile_err(spec: &Spec, e: skin::ProfileError) -> BuildError {
+    BuildError::Skin { spec: spec.file.name.clone(), msg: e.to_string() }
+}
+
+/// The integrals at n·l ∈ `nls` × κ ∈ `kappas` (punctual) or at κ ∈ `kappas` for bands 1, 2
+/// (SH: `nls` unused), in texel order (rows: κ for punctual, band for SH).
+fn integrate(
+    spec: &Spec,
+    lut: &SkinLut,
+    nls: &[f64],
+    kappas: &[f64],
+) -> Result<Vec<[Estimate; 3]>, BuildError> {
+    let tol = tolerance(lut);
+    let p = &lut.profile.profile;
+    match lut.kind {
+        SkinLutKind::Punctual { kernel, .. } => {
+            punctual_grid_estimates(p, kernel, nls, kappas, tol).map_err(|e| profile_err(spec, e))
+        }
+        SkinLutKind::Sh => {
+            let per_kappa = sh_bands_estimates(p, kappas, &[1, 2], tol).map_err(|e| profile_err(spec, e))?;
+            Ok((0..2).flat_map(|b| per_kappa.iter().map(move |bands| bands[b])).collect())
+        }
+    }
+}
+
+fn lut_n_dot_ls(lut: &SkinLut) -> Vec<f64> {
+    match lut.kind {
+        SkinLutKind::Punctual { n_dot_l, .. } => (0..n_dot_l).map(|i| lut_n_dot_l(i, n_dot_l)).collect(),
+        SkinLutKind::Sh => Vec::new(),
+    }
+}
+
+/// Bilinear interpolation in f64 at continuous texel coordinates (x, y).
+fn bilinear(values: &[[f64; 3]], (w, h): (usize, usize), x: f64, y: f64) -> [f64; 3] {
+    let i = (x.floor() as usize).min(w - 2);
+    let j = if h > 1 { (y.floor() as usize).min(h - 2) } else { 0 };
+    let (fx, fy) = (x - i as f64, if h > 1 { y - j as f64 } else { 0.0 });
+    let at = |a: usize, b: usize| values[b * w + a];
+    std::array::from_fn(|c| {
+        let a = at(i, j)[c] * (1.0 - fx) + at(i + 1, j)[c] * fx;
+        if h == 1 || fy == 0.0 {
+            return a;
+        }
+        let b = at(i, j + 1)[c] * (1.0 - fx) + at(i + 1, j + 1)[c] * fx;
+        a * (1.0 - fy) + b * fy
+    })
+}
+
+/// Measured errors on the grid with every midpoint added (see the module docs).
+fn verify(
+    spec: &Spec,
+    lut: &SkinLut,
+    values: &[[f64; 3]],
+    code: &SkinLutCode<'_>,
+) -> Result<Verification, BuildError> {
+    let n = lut.curvature_count;
+    let m = 2 * n - 1;
+    // Mapped coordinate t = k/(m − 1) of the fine grid: even k are the texels.
+    let kappas: Vec<f64> =
+        (0..m).map(|k| skin::mapped_curvature(k as f64 / (m - 1) as f64, lut.curvature_max, lut.curvature_mapping)).collect();
+    let mut points: Vec<Vec<f64>> = Vec::new();
+    let mut approx64: Vec<[f64; 3]> = Vec::new();
+    let mut approx32: Vec<[f32; 3]> = Vec::new();
+    let truth: Vec<[f64; 3]> = match lut.kind {
+        SkinLutKind::Punctual { n_dot_l, .. } => {
+            let mu = 2 * n_dot_l - 1;
+            let nls: Vec<f64> = (0..mu).map(|i| lut_n_dot_l(i, mu)).collect();
+            for (b, &kappa) in kappas.iter().enumerate() {
+                for (a, &nl) in nls.iter().enumerate() {
+                    points.push(vec![kappa, nl]);
+                    approx64.push(bilinear(values, (n_dot_l, n), a as f64 / 2.0, b as f64 / 2.0));
+                    approx32.push(code.punctual_f32(nl as f32, kappa as f32));
+                }
+            }
+            integrate(spec, lut, &nls, &kappas)?.iter().map(|e| e.map(|x| x.value)).collect()
+        }
+        SkinLutKind::Sh => {
+            let t = integrate(spec, lut, &[], &kappas)?;
+            for band in 1..=2u32 {
+                for (a, &kappa) in kappas.iter().enumerate() {
+                    points.push(vec![kappa, band as f64]);
+                    let row = &values[(band as usize - 1) * n..band as usize * n];
+                    approx64.push(bilinear(row, (n, 1), a as f64 / 2.0, 0.0));
+                    approx32.push(code.sh_f32(kappa as f32, band));
+                }
+            }
+            t.iter().map(|e| e.map(|x| x.value)).collect()
+        }
+    };
+    let mut worst = (0usize, 0.0f64);
+    let (mut ss, mut ss32, mut max32) = (0.0, 0.0, 0.0f64);
+    for (k, want) in truth.iter().enumerate() {
+        for c in 0..3 {
+            let e = (approx64[k][c] - want[c]).abs();
+            if e > worst.1 {
+                worst = (k, e);
+            }
+            ss += e * e;
+            let e32 = (approx32[k][c] as f64 - want[c]).abs();
+            if !e32.is_finite() {
+                return Err(BuildError::NonFinite { spec: spec.file.name.clone(), at: points[k].clone() });
+            }
+            ss32 += e32 * e32;
+            max32 = max32.max(e32);
+        }
+    }
+    let count = (3 * truth.len()) as f64;
+    Ok(Verification {
+        points: truth.len(),
+        max_abs_error: worst.1,
+        rms_error: (ss / count).sqrt(),
+        worst_point: points[worst.0].clone(),
+        max_abs_error_f32: max32,
+        rms_error_f32: (ss32 / count).sqrt(),
+        max_abs_error_in_parameter: None,
+    })
+}
+
+fn committed(root: &Path, spec: &Spec, hash: &str) -> Result<Value, BuildError> {
+    let name = &spec.file.name;
+    let path = root.join("json").join(format!("{name}.json"));
+    let text = std::fs::read_to_string(&path)
+        .map_err(|e| BuildError::NoCommitted { spec: name.clone(), why: e.to_string() })?;
+    let v: Value =
+        serde_json::from_str(&text).map_err(|e| BuildError::NoCommitted { spec: name.clone(), why: e.to_string() })?;
+    let committed = v["input_hash"].as_str().unwrap_or("").to_string();
+    if committed != hash {
+        return Err(BuildError::SpecChanged { spec: name.clone(), committed, current: hash.to_string() });
+    }
+    Ok(v)
+}
+
+fn committed_parts(v: &Value, name: &str, texels: usize) -> Result<(Vec<[f64; 3]>, Verification, Quadrature), BuildError> {
+    let bad = |why: &str| BuildError::NoCommitted { spec: name.into(), why: why.into() };
+    let values: Vec<[f64; 3]> = v["values"]
+        .as_array()
+        .and_then(|a| {
+            a.iter()
+                .map(|t| {
+                    let t = t.as_array()?;
+                    (t.len() == 3).then_some(())?;
+                    Some([t[0].as_f64()?, t[1].as_f64()?, t[2].as_f64()?])
+                })
+                .collect::<Option<Vec<_>>>()
+        })
+        .ok_or_else(|| bad("no array 'values' of [r, g, b] numbers"))?;
+    if values.len() != texels {
+        return Err(bad("texel count differs from the spec"));
+    }
+    let ver = &v["verification"];
+    let num = |x: &Value, k: &str| x[k].as_f64().ok_or_else(|| bad(&format!("no number '{k}'")));
+    let verification = Verification {
+        points: ver["points"].as_u64().ok_or_else(|| bad("no verification.points"))? as usize,
+        max_abs_error: num(ver, "max_abs_error")?,
+        rms_error: num(ver, "rms_error")?,
+        worst_point: ver["worst_point"]
+            .as_array()
+            .and_then(|a| a.iter().map(Value::as_f64).collect())
+            .ok_or_else(|| bad("no verification.worst_point"))?,
+        max_abs_error_f32: num(ver, "max_abs_error_f32")?,
+        rms_error_f32: num(ver, "rms_error_f32")?,
+        max_abs_error_in_parameter: None,
+    };
+    let q = &v["quadrature"];
+    let quadrature =
+        Quadrature { max_error_estimate: num(q, "max_error_estimate")?, evals_per_texel: num(q, "evals_per_texel")? };
+    Ok((values, verification, quadrature))
+}
+
+/// JSON text with every array of numbers on one line (the texel list stays one texel per
+/// line; everything else as serde_json's pretty printer writes it).
+fn compact_json(v: &Value) -> String {
+    let pretty = json_text(v);
+    let lines: Vec<&str> = pretty.lines().collect();
+    let is_number = |s: &str| {
+        let t = s.trim().trim_end_matches(',');
+        !t.is_empty() && t.parse::<f64>().is_ok()
+    };
+    let mut out = String::with_capacity(pretty.len());
+    let mut i = 0;
+    while i < lines.len() {
+        let line = lines[i];
+        if line.ends_with('[') {
+            let mut j = i + 1;
+            while j < lines.len() && is_number(lines[j]) {
+                j += 1;
+            }
+            if j > i + 1 && j < lines.len() && lines[j].trim_start().starts_with(']') {
+                let items: Vec<&str> = lines[i + 1..j].iter().map(|l| l.trim().trim_end_matches(',')).collect();
+                out.push_str(line);
+                out.push_str(&items.join(", "));
+                out.push_str(lines[j].trim_start());
+                out.push('\n');
+                i = j + 1;
+                continue;
+            }
+        }
+        out.push_str(line);
+        out.push('\n');
+        i += 1;
+    }
+    out
+}
+
+/// Build one skin LUT spec (see the module docs).
+pub fn build(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> {
+    let lut = SkinLut::from_spec(spec)?;
+    let name = spec.file.name.clone();
+    let hash = input_hash(spec, &lut);
+    let layout = layout(&lut);
+    let (w, h) = layout.size();
+    let kappas = lut.curvatures();
+    let nls = lut_n_dot_ls(&lut);
+
+    let (values, fresh) = match mode {
+        Mode::Fit => {
+            let est = integrate(spec, &lut, &nls, &kappas)?;
+            let evals: u64 = est.iter().map(|e| e[0].evals).sum();
+            let q = Quadrature {
+                max_error_estimate: est.iter().flat_map(|e| e.iter().map(|x| x.error)).fold(0.0, f64::max),
+                evals_per_texel: (evals as f64 / est.len() as f64).round(),
+            };
+            (est.iter().map(|e| e.map(|x| x.value)).collect::<Vec<[f64; 3]>>(), Some(q))
+        }
+        Mode::Committed => (Vec::new(), None),
+    };
+    let (values, verification, quadrature) = match fresh {
+        Some(q) => {
+            let values32: Vec<[f32; 3]> = values.iter().map(|v| v.map(|x| x as f32)).collect();
+            let code = code(&lut, &name, layout, &values32);
+            let ver = verify(spec, &lut, &values, &code)?;
+            (values, ver, q)
+        }
+        None => committed_parts(&committed(root, spec, &hash)?, &name, w * h)?,
+    };
+    if let Some(k) = values.iter().position(|v| v.iter().any(|x| !x.is_finite())) {
+        return Err(BuildError::NonFinite { spec: name, at: vec![k as f64] });
+    }
+    let values32: Vec<[f32; 3]> = values.iter().map(|v| v.map(|x| x as f32)).collect();
+    let code = code(&lut, &name, layout, &values32);
+    let storage = values
+        .iter()
+        .flat_map(|v| v.iter().map(|&x| (lut.format.stored(x as f32) as f64 - x).abs()))
+        .fold(0.0, f64::max);
+    let (lo, hi) = values.iter().flat_map(|v| v.iter()).fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| (a.min(x), b.max(x)));
+
+    let err_line = format!(
+        "bilinear lookup of the f32 texels: max abs {}, rms {} over {} points x 3 channels; quadrature estimate <= {}; {} storage <= {}",
+        fmt_err(verification.max_abs_error_f32),
+        fmt_err(verification.rms_error_f32),
+        verification.points,
+        fmt_err(quadrature.max_error_estimate),
+        lut.format.name(),
+        fmt_err(storage),
+    );
+    let header = header_lines(&spec_rel_path(spec), &hash, &err_line);
+    let doc = describe(&lut);
+    let wgsl = code.render_wgsl(&header, &doc);
+    let rust = code.render_rust(&header, &doc);
+    let texels: Vec<[f32; 4]> = values32.iter().map(|v| [v[0], v[1], v[2], 1.0]).collect();
+    let provenance = header.join("\n");
+    let ktx2 = ktx2_rgba(w as u32, h as u32, &texels, lut.format, &[("shadefit", &provenance)]);
+    let (sx, sy) = preview_scale(layout);
+    let png = png_srgb_preview(w, h, &values, sx, sy, &[("Software", GENERATOR.to_string()), ("Comment", provenance.clone())]);
+
+    let axes = match lut.kind {
+        SkinLutKind::Punctual { n_dot_l, .. } => json!([
+            {"name": "n_dot_l", "texture_axis": "x", "range": [-1.0, 1.0], "count": n_dot_l, "mapping": "linear"},
+            {"name": "curvature", "unit": "1/mm", "texture_axis": "y", "range": [0.0, lut.curvature_max], "count": lut.curvature_count, "mapping": lut.curvature_mapping.name(), "values": kappas},
+        ]),
+        SkinLutKind::Sh => json!([
+            {"name": "curvature", "unit": "1/mm", "texture_axis": "x", "range": [0.0, lut.curvature_max], "count": lut.curvature_count, "mapping": lut.curvature_mapping.name(), "values": kappas},
+            {"name": "band", "texture_axis": "y", "values": [1, 2]},
+        ]),
+    };
+    let kernel = match lut.kind {
+        SkinLutKind::Punctual { kernel: Kernel::Linear, .. } => "linear",
+        SkinLutKind::Punctual { kernel: Kernel::Radial, .. } => "radial",
+        SkinLutKind::Sh => "radial (sphere)",
+    };
+    let json = json!({
+        "generator": GENERATOR,
+        "spec": spec_rel_path(spec),
+        "input_hash": hash,
+        "name": name,
+        "kind": "skin-lut",
+        "quantity": lut.quantity,
+        "description": lut.description,
+        "function": lut.function,
+        "profile": lut.profile.provenance(),
+        "kernel": kernel,
+        "tolerance": lut.tolerance,
+        "axes": axes,
+        "texture": {
+            "width": w,
+            "height": h,
+            "format": lut.format.name(),
+            "ktx2": format!("data/{name}.ktx2"),
+            "preview": format!("data/{name}.png"),
+            "encoding": "linear RGB, alpha 1, no tonemapping (the PNG preview is sRGB-encoded)",
+            "max_abs_storage_error": storage,
+        },
+        "layout": "row-major, x fastest: values[y * width + x]",
+        "channels": ["red", "green", "blue"],
+        "range": [lo, hi],
+        "quadrature": {
+            "tolerance": lut.tolerance,
+            "max_error_estimate": quadrature.max_error_estimate,
+            "evals_per_texel": quadrature.evals_per_texel,
+        },
+        "verification": verification,
+        "values": values,
+    });
+    let artifacts = vec![
+        Artifact { path: format!("wgsl/{name}.wgsl").into(), contents: wgsl.into() },
+        Artifact { path: format!("src/{name}.rs").into(), contents: rust.into() },
+        Artifact { path: format!("json/{name}.json").into(), contents: compact_json(&json).into() },
+        Artifact { path: format!("data/{name}.ktx2").into(), contents: ktx2 },
+        Artifact { path: format!("data/{name}.png").into(), contents: png },
+    ];
+    Ok(Built { name, artifacts, verification, fit: None })
+}
+
+fn code<'a>(lut: &'a SkinLut, name: &'a str, layout: Layout, values: &'a [[f32; 3]]) -> SkinLutCode<'a> {
+    SkinLutCode {
+        module: name,
+        function: &lut.function,
+        layout,
+        curvature_max: lut.curvature_max,
+        mapping: lut.curvature_mapping,
+        format: lut.format,
+        values,
+    }
+}
+
+/// Preview scale: at least 256 pixels across; SH rows 16 times taller than wide.
+fn preview_scale(layout: Layout) -> (usize, usize) {
+    let (w, _) = layout.size();
+    let s = (256 / w).max(1);
+    match layout {
+        Layout::Punctual { .. } => (s, s),
+        Layout::Sh { .. } => (s, 16 * s),
+    }
+}
+
+fn describe(lut: &SkinLut) -> String {
+    let what = match lut.kind {
+        SkinLutKind::Punctual { kernel, .. } => format!(
+            "pre-integrated skin diffusion D(n·l, κ) for punctual lights ({} profile on a ring)",
+            match kernel {
+                Kernel::Linear => "linear",
+                Kernel::Radial => "radial",
+            }
+        ),
+        SkinLutKind::Sh => "factors k_1(κ), k_2(κ) scaling SH bands 1 and 2 of the irradiance (radial profile on a sphere)".into(),
+    };
+    let desc = if lut.description.is_empty() { String::new() } else { format!("{}: ", lut.description) };
+    format!("{desc}`{}` looks up {what}, quantity `{}`.", lut.function, lut.quantity)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn compact_json_keeps_numbers_on_one_line() {
+        let v = json!({"a": [1.0, 2.5], "b": [[0.1, 0.2, 0.3], [1e-20, 2.0, -3.0]], "c": {"d": []}, "e": ["x", "y"]});
+        let s = compact_json(&v);
+        assert!(s.contains("\"a\": [1.0, 2.5],"), "{s}");
+        assert!(s.contains("    [0.1, 0.2, 0.3],\n    [1e-20, 2.0, -3.0]\n"), "{s}");
+        assert!(s.contains("\"x\",\n"), "{s}");
+        let back: Value = serde_json::from_str(&s).unwrap();
+        assert_eq!(back, v);
+    }
+
+    #[test]
+    fn bilinear_reproduces_planes() {
+        let (w, h) = (4, 3);
+        let v: Vec<[f64; 3]> = (0..w * h).map(|k| [(k % w) as f64, (k / w) as f64, 2.0]).collect();
+        assert_eq!(bilinear(&v, (w, h), 1.5, 0.5), [1.5, 0.5, 2.0]);
+        assert_eq!(bilinear(&v, (w, h), 3.0, 2.0), [3.0, 2.0, 2.0]);
+        assert_eq!(bilinear(&v[..w], (w, 1), 2.5, 0.0), [2.5, 0.0, 2.0]);
+    }
+}

@@ -1,0 +1,300 @@
+//! Skin LUT specs (`kind = "skin-lut"`): pre-integrated skin scattering tabulated as textures.
+//!
+//! ```toml
+//! name = "skin_punctual_lut"       # output stem; must equal the file stem
+//! kind = "skin-lut"
+//! quantity = "skin-punctual"       # D(n·l, κ) for punctual lights; "skin-sh": k_1, k_2 (κ)
+//! description = "..."
+//! resolution = [64, 64]            # skin-punctual: [n·l columns, κ rows]; skin-sh: [κ columns]
+//! curvature_max = 1.0              # κ_max (1/mm): rows cover κ ∈ [0, κ_max], larger κ clamps
+//! curvature_mapping = "linear"     # optional: "linear" (t = κ/κ_max) or "sqrt" (t = √(κ/κ_max))
+//! n_dot_l_mapping = "linear"       # optional: n·l ∈ [−1, 1] uniform (the only mapping)
+//! kernel = "linear"                # optional, skin-punctual only: "linear" (default) or "radial"
+//! tolerance = 1e-10                # optional: quadrature tolerance per texel and channel
+//! texture_format = "rgba16float"   # optional: KTX2 texels, "rgba16float" or "rgba32float"
+//!
+//! [profile]                        # optional (see spec::profile): preset, gaussians or csv
+//! preset = "deon-luebke"
+//!
+//! [emit]
+//! function = "skin_punctual_lut"   # WGSL and Rust function name
+//! ```
+//!
+//! Texel (i, j) of a skin-punctual LUT holds D at n·l = −1 + 2i/(n_u − 1) and at
+//! κ = κ_max·mapping⁻¹(j/(n_v − 1)); a skin-sh LUT has one row per band (1 and 2; band 0 is 1)
+//! and column i at κ = κ_max·mapping⁻¹(i/(n − 1)). See `pipeline::skin` for the outputs.
+//!
+//! The spec is checked here with errors that name the file, the line and the field; it then
+//! enters the common [`SpecFile`] with its axes (curvature, n_dot_l or band) spelled out, so
+//! listing, staleness and the runtime index treat it like any other spec.
+
+use super::profile::{LoadedProfile, ProfileSection};
+use super::{SpecError, SpecFile, line_of, parse_toml};
+use crate::emit::texture::TextureFormat;
+use crate::quantity::skin::{CurvatureMapping, Kernel, mapped_curvature};
+use serde::Deserialize;
+use serde_json::json;
+use std::path::Path;
+
+/// The `kind` value of skin LUT specs.
+pub const KIND: &str = "skin-lut";
+/// Default quadrature tolerance per texel and channel (quantity::skin::DEFAULT_TOLERANCE).
+pub const DEFAULT_TOLERANCE: f64 = 1e-10;
+/// Tolerances accepted: the LUT promises ≤ 1e-6 per channel; below 1e-14 the adaptive rule
+/// cannot converge in f64 on values of order 1.
+pub const TOLERANCE_RANGE: [f64; 2] = [1e-14, 1e-6];
+/// Largest texture side.
+pub const MAX_RESOLUTION: usize = 4096;
+/// Largest κ_max (1/mm): the `curvature` parameter's domain.
+pub const MAX_CURVATURE: f64 = 100.0;
+
+#[derive(Debug, Clone, Copy, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+enum NDotLMapping {
+    #[default]
+    Linear,
+}
+
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+enum KernelName {
+    Linear,
+    Radial,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SkinEmit {
+    function: String,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SkinLutFile {
+    name: String,
+    #[allow(dead_code)] // checked by the caller: "skin-lut"
+    kind: String,
+    quantity: String,
+    #[serde(default)]
+    description: String,
+    tolerance: Option<f64>,
+    resolution: Vec<usize>,
+    curvature_max: f64,
+    #[serde(default)]
+    curvature_mapping: CurvatureMapping,
+    #[serde(default)]
+    #[allow(dead_code)] // one variant: parsing it is the check
+    n_dot_l_mapping: NDotLMapping,
+    kernel: Option<KernelName>,
+    #[serde(default)]
+    texture_format: TextureFormat,
+    profile: Option<ProfileSection>,
+    emit: SkinEmit,
+}
+
+/// What a skin LUT tabulates.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SkinLutKind {
+    /// D(n·l, κ) (RGB) on `n_dot_l` columns × the curvature rows, ring integral with `kernel`.
+    Punctual { kernel: Kernel, n_dot_l: usize },
+    /// k_1(κ), k_2(κ) (RGB): one row per band, the curvature along the columns.
+    Sh,
+}
+
+/// A validated skin LUT spec.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SkinLut {
+    pub name: String,
+    pub quantity: String,
+    pub description: String,
+    pub function: String,
+    pub kind: SkinLutKind,
+    /// Samples along κ (rows of a punctual LUT, columns of an SH LUT).
+    pub curvature_count: usize,
+    pub curvature_max: f64,
+    pub curvature_mapping: CurvatureMapping,
+    pub format: TextureFormat,
+    /// Absolute quadrature tolerance per texel and channel.
+    pub tolerance: f64,
+    pub profile: LoadedProfile,
+}
+
+impl SkinLut {
+    /// Parse and check a skin LUT spec (its `kind` must be "skin-lut").
+    pub fn parse(path: &Path, text: &str) -> Result<SkinLut, SpecError> {
+        let f: SkinLutFile = parse_toml(path, text)?;
+        let at = |field: &str, msg: String| SpecError::new(path, line_of(text, field), field, msg);
+        let punctual = match f.quantity.as_str() {
+            "skin-punctual" => true,
+            "skin-sh" => false,
+            other => {
+                return Err(at("quantity", format!("'{other}': skin LUTs tabulate 'skin-punctual' or 'skin-sh'")));
+            }
+        };
+        let want = if punctual { "[n·l columns, curvature rows]" } else { "[curvature columns]" };
+        if f.resolution.len() != if punctual { 2 } else { 1 } {
+            return Err(at("resolution", format!("{} needs resolution = {want}", f.quantity)));
+        }
+        if let Some(&n) = f.resolution.iter().find(|&&n| !(2..=MAX_RESOLUTION).contains(&n)) {
+            return Err(at("resolution", format!("{n} texels: each side must be in [2, {MAX_RESOLUTION}]")));
+        }
+        let k = f.curvature_max;
+        if !(k.is_finite() && k > 0.0 && k <= MAX_CURVATURE) {
+            return Err(at("curvature_max", format!("{k}/mm must be finite and in (0, {MAX_CURVATURE}]")));
+        }
+        let tolerance = f.tolerance.unwrap_or(DEFAULT_TOLERANCE);
+        let [lo, hi] = TOLERANCE_RANGE;
+        if !(tolerance >= lo && tolerance <= hi) {
+            return Err(at(
+                "tolerance",
+                format!("{tolerance} must be in [{lo:e}, {hi:e}] (the LUT promises 1e-6 per channel; below 1e-14 the quadrature cannot converge)"),
+            ));
+        }
+        let kind = if punctual {
+            let kernel = match f.kernel.unwrap_or(KernelName::Linear) {
+                KernelName::Linear => Kernel::Linear,
+                KernelName::Radial => Kernel::Radial,
+            };
+            SkinLutKind::Punctual { kernel, n_dot_l: f.resolution[0] }
+        } else {
+            if f.kernel.is_some() {
+                return Err(at(
+                    "kernel",
+                    "skin-sh integrates the radial profile over the sphere; 'kernel' applies to skin-punctual only".into(),
+                ));
+            }
+            SkinLutKind::Sh
+        };
+        let profile = match &f.profile {
+            Some(p) => p.load(path, text, line_of(text, "profile"))?,
+            None => LoadedProfile::deon_luebke(),
+        };
+        // The ring and the sphere of curvature κ reach chord 2/κ: each channel needs some of
+        // its profile within 2/κ_max, or the largest-κ texels cannot be normalised.
+        let reach = profile.profile.mass_within(2.0 / k);
+        // (NaN compares false: a NaN mass is no mass.)
+        if let Some(c) = (0..3).find(|&c| reach[c].partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)) {
+            return Err(at(
+                "curvature_max",
+                format!(
+                    "the profile's {} channel has no mass within chord 2/κ_max = {} mm; lower curvature_max",
+                    ["red", "green", "blue"][c],
+                    2.0 / k
+                ),
+            ));
+        }
+        Ok(SkinLut {
+            name: f.name,
+            quantity: f.quantity,
+            description: f.description,
+            function: f.emit.function,
+            kind,
+            curvature_count: *f.resolution.last().expect("checked length"),
+            curvature_max: k,
+            curvature_mapping: f.curvature_mapping,
+            format: f.texture_format,
+            tolerance,
+            profile,
+        })
+    }
+
+    /// The LUT of a loaded spec (parsed again from its text: the spec layer checked it).
+    pub fn from_spec(spec: &super::Spec) -> Result<SkinLut, SpecError> {
+        SkinLut::parse(&spec.path, &spec.text)
+    }
+
+    /// κ (1/mm) of the curvature samples, in order (ends included, mapped).
+    pub fn curvatures(&self) -> Vec<f64> {
+        let n = self.curvature_count;
+        (0..n).map(|j| mapped_curvature(j as f64 / (n - 1) as f64, self.curvature_max, self.curvature_mapping)).collect()
+    }
+
+    /// The common spec this LUT enters the pipeline as: axes in the quantity's parameter order
+    /// (curvature, then n_dot_l or band), counts as tabulated, verification on the grid that
+    /// adds every midpoint (2n − 1).
+    fn spec_file(&self, path: &Path, text: &str) -> Result<SpecFile, SpecError> {
+        let n = self.curvature_count;
+        let mut axes = vec![json!({"name": "curvature", "range": [0.0, self.curvature_max], "count": n, "verify": 2 * n - 1})];
+        axes.push(match self.kind {
+            SkinLutKind::Punctual { n_dot_l, .. } => {
+                json!({"name": "n_dot_l", "range": [-1.0, 1.0], "count": n_dot_l, "verify": 2 * n_dot_l - 1})
+            }
+            SkinLutKind::Sh => json!({"name": "band", "range": [1.0, 2.0], "count": 2, "verify": 2}),
+        });
+        let v = json!({
+            "name": self.name,
+            "kind": KIND,
+            "quantity": self.quantity,
+            "description": self.description,
+            "tolerance": self.tolerance,
+            "axis": axes,
+            "emit": {"function": self.function},
+        });
+        serde_json::from_value(v).map_err(|e| SpecError::new(path, line_of(text, "kind"), "kind", e.to_string()))
+    }
+}
+
+/// For `Spec::parse`: the common spec of a skin LUT spec (checked), or `None` when the text is
+/// not one (its `kind` is not "skin-lut", or it is not TOML: the common parser reports that).
+pub fn spec_file(path: &Path, text: &str) -> Result<Option<SpecFile>, SpecError> {
+    let Ok(table) = text.parse::<toml::Table>() else { return Ok(None) };
+    if table.get("kind").and_then(|k| k.as_str()) != Some(KIND) {
+        return Ok(None);
+    }
+    let lut = SkinLut::parse(path, text)?;
+    lut.spec_file(path, text).map(Some)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const PUNCTUAL: &str = "name = \"skin_x\"\nkind = \"skin-lut\"\nquantity = \"skin-punctual\"\n\
+        resolution = [8, 5]\ncurvature_max = 2.0\n\n[emit]\nfunction = \"skin_x\"\n";
+
+    fn parse(text: &str) -> Result<SkinLut, SpecError> {
+        SkinLut::parse(Path::new("fits/skin_x.toml"), text)
+    }
+
+    #[test]
+    fn defaults_and_grid() {
+        let l = parse(PUNCTUAL).unwrap();
+        assert_eq!(l.kind, SkinLutKind::Punctual { kernel: Kernel::Linear, n_dot_l: 8 });
+        assert_eq!((l.curvature_count, l.curvature_max, l.tolerance), (5, 2.0, DEFAULT_TOLERANCE));
+        assert_eq!(l.format, TextureFormat::Rgba16float);
+        assert_eq!(l.profile, LoadedProfile::deon_luebke());
+        assert_eq!(l.curvatures(), [0.0, 0.5, 1.0, 1.5, 2.0]);
+        let s = parse(&PUNCTUAL.replace("curvature_max = 2.0", "curvature_max = 2.0\ncurvature_mapping = \"sqrt\"")).unwrap();
+        assert_eq!(s.curvatures(), [0.0, 0.125, 0.5, 1.125, 2.0]);
+        let sh = PUNCTUAL.replace("skin-punctual", "skin-sh").replace("[8, 5]", "[5]");
+        assert_eq!(parse(&sh).unwrap().kind, SkinLutKind::Sh);
+        let spec = super::super::Spec::parse(Path::new("fits/skin_x.toml"), PUNCTUAL.to_string()).unwrap();
+        assert_eq!(spec.file.kind, super::super::Kind::SkinLut);
+        let axes: Vec<(&str, usize)> = spec.file.axis.iter().map(|a| (a.name.as_str(), a.count)).collect();
+        assert_eq!(axes, [("curvature", 5), ("n_dot_l", 8)]);
+    }
+
+    #[test]
+    fn errors_name_line_and_field() {
+        let bad = |edit: (&str, &str), line: usize, field: &str, msg: &str| {
+            let text = PUNCTUAL.replace(edit.0, edit.1);
+            let e = super::super::Spec::parse(Path::new("fits/skin_x.toml"), text).unwrap_err();
+            assert_eq!((e.line, e.field.as_str()), (line, field), "{e}");
+            assert!(e.msg.contains(msg), "{e}");
+        };
+        bad(("[8, 5]", "[8]"), 4, "resolution", "[n·l columns, curvature rows]");
+        bad(("[8, 5]", "[8, 1]"), 4, "resolution", "[2, 4096]");
+        bad(("curvature_max = 2.0", "curvature_max = -1.0"), 5, "curvature_max", "(0, 100]");
+        bad(("curvature_max = 2.0", "curvature_max = nan"), 5, "curvature_max", "NaN");
+        bad(("curvature_max = 2.0", "curvature_max = 2.0\ntolerance = 1e-3"), 6, "tolerance", "1e-6");
+        bad(("curvature_max = 2.0", "curvature_max = 2.0\nkernel = \"cubic\""), 6, "kernel", "unknown variant");
+        bad(("curvature_max = 2.0", "curvature_max = 2.0\ncurvature_mapping = \"log\""), 6, "curvature_mapping", "unknown variant");
+        bad(("curvature_max = 2.0", "curvature_max = 2.0\nn_dot_l_mapping = \"angle\""), 6, "n_dot_l_mapping", "unknown variant");
+        bad(("skin-punctual", "skin-diffuse"), 3, "quantity", "skin-punctual' or 'skin-sh'");
+        bad(("name = \"skin_x\"", "name = \"skin_y\""), 1, "name", "must match the file name");
+        bad(("function = \"skin_x\"", "function = \"Skin-X\""), 8, "function", "not a valid function name");
+        let sh = PUNCTUAL.replace("skin-punctual", "skin-sh").replace("[8, 5]", "[5]") ;
+        let e = SkinLut::parse(Path::new("fits/skin_x.toml"), &sh.replace("curvature_max = 2.0", "curvature_max = 2.0\nkernel = \"radial\"")).unwrap_err();
+        assert_eq!((e.line, e.field.as_str()), (6, "kernel"), "{e}");
+    }
+}
