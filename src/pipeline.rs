@@ -20,6 +20,7 @@ use serde_json::{json, Value};
 use sha2::{Digest, Sha256};
 use std::path::Path;
 
+pub mod fields;
 pub mod skin;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -137,6 +138,7 @@ pub fn build_spec(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildEr
         Kind::Fit => build_fit(spec, mode, root),
         Kind::Table => build_table(spec, mode, root),
         Kind::SkinLut => skin::build(spec, mode, root),
+        Kind::Fields => fields::build(spec, mode, root),
     }
 }
 
@@ -447,8 +449,9 @@ pub fn runtime_index(specs: &[Spec]) -> Artifact {
     }
     s.push_str("    ];\n}\n");
     s.push_str("\n/// Every emitted function with its domain and CPU version (for GPU verification).\npub const FUNCTIONS: &[EmittedFunction] = &[\n");
-    // Skin LUT lookups return RGB (see emit::skin): not scalar functions of this list.
-    for spec in specs.iter().filter(|s| s.file.kind != Kind::SkinLut) {
+    // Skin LUT lookups return RGB (see emit::skin) and coefficient fields return arrays (see
+    // emit::fields): not scalar functions of this list.
+    for spec in specs.iter().filter(|s| !matches!(s.file.kind, Kind::SkinLut | Kind::Fields)) {
         let arity = spec.file.axis.len();
         let domain: Vec<String> = spec
             .file

@@ -5,6 +5,9 @@
 #[path = "fuzz_g.rs"]
 pub mod fuzz_g;
 #[cfg(feature = "fuzz")]
+#[path = "fuzz_ps.rs"]
+pub mod fuzz_ps;
+#[cfg(feature = "fuzz")]
 #[path = "fuzz_q.rs"]
 pub mod fuzz_q;
 #[cfg(feature = "fuzz")]
@@ -37,6 +40,8 @@ pub mod wgsl {
     #[cfg(feature = "fuzz")]
     pub const FUZZ_G: &str = include_str!("../wgsl/fuzz_g.wgsl");
     #[cfg(feature = "fuzz")]
+    pub const FUZZ_PS: &str = include_str!("../wgsl/fuzz_ps.wgsl");
+    #[cfg(feature = "fuzz")]
     pub const FUZZ_Q: &str = include_str!("../wgsl/fuzz_q.wgsl");
     #[cfg(feature = "fuzz")]
     pub const FUZZ_R: &str = include_str!("../wgsl/fuzz_r.wgsl");
@@ -60,6 +65,8 @@ pub mod wgsl {
         match name {
             #[cfg(feature = "fuzz")]
             "fuzz_g" => Some(FUZZ_G),
+            #[cfg(feature = "fuzz")]
+            "fuzz_ps" => Some(FUZZ_PS),
             #[cfg(feature = "fuzz")]
             "fuzz_q" => Some(FUZZ_Q),
             #[cfg(feature = "fuzz")]
@@ -86,6 +93,8 @@ pub mod wgsl {
     pub const NAMES: &[&str] = &[
         #[cfg(feature = "fuzz")]
         "fuzz_g",
+        #[cfg(feature = "fuzz")]
+        "fuzz_ps",
         #[cfg(feature = "fuzz")]
         "fuzz_q",
         #[cfg(feature = "fuzz")]

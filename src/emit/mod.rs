@@ -4,6 +4,7 @@
 //! file to a temporary name and renames it, so a failed build leaves generated/ untouched.
 
 pub mod expr;
+pub mod fields;
 pub mod rust;
 pub mod skin;
 pub mod texture;

@@ -41,6 +41,13 @@ pub const START_COND: f64 = 1e5;
 /// away there (seen as max errors of 10³ after a few IRLS steps at floor 1e-12).
 pub const WEIGHT_FLOOR: f64 = 1e-2;
 
+/// Every denominator is kept ≥ Q_MIN at the grid points by a barrier residual
+/// Q_PENALTY·(Q_MIN − Q) where it is below (a field with a pole between samples can fit the
+/// samples and still be useless); positivity on the whole domain is then proven by interval
+/// arithmetic.
+pub const Q_MIN: f64 = 0.05;
+pub const Q_PENALTY: f64 = 100.0;
+
 /// The stage-1 system of one grid point reduced to k equations (see the module doc).
 #[derive(Debug, Clone)]
 pub struct Reduced {
@@ -185,6 +192,19 @@ impl<'a> Fields<'a> {
                     dfull[nn + i] = -f * p / q * psi;
                 }
                 d[k] = m.map().tr_mul(&dfull);
+                if q < Q_MIN {
+                    // Barrier residual Q_PENALTY·(Q_MIN − Q): ∂/∂den_i = −Q_PENALTY·ψ_i.
+                    let mut dq = DVector::zeros(m.n_full());
+                    for (i, psi) in b.psi.iter().enumerate() {
+                        dq[nn + i] = -Q_PENALTY * psi;
+                    }
+                    let dq = m.map().tr_mul(&dq);
+                    let rq = Q_PENALTY * (Q_MIN - q);
+                    cost += rq * rq;
+                    let (sk, nkf) = (self.starts[k], m.n_free());
+                    grad.rows_mut(sk, nkf).axpy(rq, &dq, 1.0);
+                    a.view_mut((sk, sk), (nkf, nkf)).ger(1.0, &dq, &dq, 1.0);
+                }
             }
             let r = &s.r * &c - &s.z;
             cost += r.norm_squared();
@@ -217,7 +237,17 @@ impl<'a> Fields<'a> {
     }
 
     pub fn cost(&self, theta: &DVector<f64>) -> f64 {
-        self.residuals_at(theta).norm_squared()
+        let full = self.full(theta);
+        let mut pen = 0.0;
+        for (k, bk) in self.basis.iter().enumerate() {
+            for b in bk {
+                let q = b.pq(&full[k]).1;
+                if q < Q_MIN {
+                    pen += (Q_PENALTY * (Q_MIN - q)).powi(2);
+                }
+            }
+        }
+        self.residuals_at(theta).norm_squared() + pen
     }
 }
 
@@ -388,6 +418,13 @@ pub fn fit_fields(
         return Err(FitError::SingularStart { what: what.into() });
     }
     let mut fields = Fields::new(models, x, systems, theta);
+    let domain = Data { x: x.to_vec(), y: vec![] }.bounds();
+    let positive = |f: &Fields<'_>, theta: &DVector<f64>| {
+        f.full(theta)
+            .iter()
+            .zip(models)
+            .all(|(c, m)| matches!(prove_denominator_positive(m, c, &domain), Positivity::Proven { .. }))
+    };
     let mut evals = solve_joint(&mut fields, 500, what)?;
     let mut outer = 0;
     if opts.objective != Objective::Lsq {
@@ -401,8 +438,8 @@ pub fn fit_fields(
             _ => opts.outer_iters,
         };
         let (m0, r0, _) = sample_errors(&fields, &fields.theta, data);
-        let admissible = |rms: f64| opts.max_rms.is_none_or(|cap| rms <= cap);
-        let mut best = (if admissible(r0) { m0 } else { f64::INFINITY }, fields.theta.clone());
+        let admissible = |f: &Fields<'_>, rms: f64| opts.max_rms.is_none_or(|cap| rms <= cap) && positive(f, &f.theta);
+        let mut best = (if admissible(&fields, r0) { m0 } else { f64::INFINITY }, fields.theta.clone());
         let mut w: Vec<Vec<f64>> = data.iter().map(|d| vec![1.0; d.y.len()]).collect();
         let mut since_best = 0;
         for _ in 0..n_outer {
@@ -435,7 +472,7 @@ pub fn fit_fields(
                 Err(_) => break,
             };
             let (m, rr, _) = sample_errors(&fields, &fields.theta, data);
-            if opts.objective == Objective::L4 || (admissible(rr) && m < best.0) {
+            if (opts.objective == Objective::L4 || m < best.0) && admissible(&fields, rr) {
                 best = (m, fields.theta.clone());
                 since_best = 0;
             } else {
@@ -448,12 +485,28 @@ pub fn fit_fields(
         if !best.0.is_finite() {
             return Err(FitError::Solver {
                 what: what.into(),
-                msg: format!("no iterate met the rms cap {:e}", opts.max_rms.unwrap_or(f64::NAN)),
+                msg: format!(
+                    "no iterate had every denominator proven positive{}",
+                    opts.max_rms.map_or(String::new(), |c| format!(" and rms ≤ {c:e}"))
+                ),
             });
         }
         fields.theta = best.1;
     }
     let (max, rms, _) = sample_errors(&fields, &fields.theta, data);
+    if !positive(&fields, &fields.theta) {
+        let full = fields.full(&fields.theta);
+        let (k, lower, region) = models
+            .iter()
+            .zip(&full)
+            .enumerate()
+            .find_map(|(k, (m, c))| match prove_denominator_positive(m, c, &domain) {
+                Positivity::NotProven { lower, region, .. } => Some((k, lower, region)),
+                Positivity::Proven { .. } => None,
+            })
+            .unwrap_or((0, f64::NAN, vec![]));
+        return Err(FitError::PoleInDomain { what: format!("{what} (field {k})"), lower, region });
+    }
     if !max.is_finite() {
         return Err(FitError::Diverged { what: what.into(), iters: evals, residual: max });
     }

@@ -37,6 +37,30 @@ pub struct QuantityDef {
     /// Their `eval` returns channel 0; specs do not take them yet.
     pub channels: &'static [&'static str],
     pub eval_channels: Option<fn(&[f64], f64) -> Vec<Estimate>>,
+    /// For two-stage fits (`kind = "fields"`): the linear basis in the quantity's trailing
+    /// ("inner") parameters whose coefficients become fields over the leading ones.
+    pub basis: Option<&'static InnerBasis>,
+}
+
+/// A linear basis f(outer, inner) ≈ Σ_k c_k(outer) b_k(args(outer, inner)): the terms are
+/// monomials in `args`, which the emitted evaluator takes as its arguments (clamped to
+/// `arg_domain`).
+#[derive(Debug)]
+pub struct InnerBasis {
+    /// How many trailing parameters are inner.
+    pub inner: usize,
+    /// Argument names of the emitted evaluator, e.g. `n_dot_u`, `t_dot_u`.
+    pub args: &'static [&'static str],
+    pub arg_domain: &'static [(f64, f64)],
+    /// Basis terms (monomials in `args`), in coefficient order.
+    pub terms: &'static [&'static str],
+    /// (outer, inner) → args.
+    pub to_args: fn(&[f64], &[f64]) -> Vec<f64>,
+    /// The quantity at one outer point and many inner points, to an absolute tolerance
+    /// (batched: per-outer-point set-up is shared).
+    pub sample: fn(&[f64], &[Vec<f64>], f64) -> Vec<Estimate>,
+    /// Range of the evaluator's output (the quantity's own bounds); the emitted code clamps.
+    pub range: (f64, f64),
 }
 
 #[derive(Debug, thiserror::Error, PartialEq)]
@@ -71,6 +95,29 @@ fn gloss_combine(p: &[f64], _tol: f64) -> Estimate {
 
 fn fuzz_ps(p: &[f64], tol: f64) -> Estimate {
     fuzz::ps(p[0], p[1], p[2], p[3], tol)
+}
+
+/// Eq. 1 of the Ghost of Tsushima supplemental: P̃_s = c0 + c1 (u·n) + c2 (u·t) + c3 (u·n)² +
+/// c4 (u·n)(u·t) + c5 (u·t)², over the light direction (θu, φu) at fixed (α, θf).
+static FUZZ_PS_EQ1: InnerBasis = InnerBasis {
+    inner: 2,
+    args: &["n_dot_u", "t_dot_u"],
+    arg_domain: &[(-1.0, 1.0), (-1.0, 1.0)],
+    terms: &["1", "n_dot_u", "t_dot_u", "n_dot_u^2", "n_dot_u*t_dot_u", "t_dot_u^2"],
+    to_args: fuzz_ps_args,
+    sample: fuzz_ps_sample,
+    range: (0.0, 1.0),
+};
+
+fn fuzz_ps_args(outer: &[f64], inner: &[f64]) -> Vec<f64> {
+    let (st, ct) = outer[1].sin_cos();
+    let (su, cu) = inner[0].sin_cos();
+    vec![cu, su * inner[1].cos() * st + cu * ct]
+}
+
+fn fuzz_ps_sample(outer: &[f64], inner: &[Vec<f64>], tol: f64) -> Vec<Estimate> {
+    let dirs: Vec<(f64, f64)> = inner.iter().map(|d| (d[0], d[1])).collect();
+    fuzz::ps_directions(outer[0], outer[1], &dirs, tol)
 }
 
 fn fuzz_g(p: &[f64], tol: f64) -> Estimate {
@@ -134,6 +181,7 @@ static REGISTRY: &[QuantityDef] = &[
         eval: skin_punctual,
         inverse: None,
         channels: &["red", "green", "blue"],
+        basis: None,
         eval_channels: Some(skin_punctual_rgb),
     },
     QuantityDef {
@@ -144,6 +192,7 @@ static REGISTRY: &[QuantityDef] = &[
         eval: skin_sh,
         inverse: None,
         channels: &["red", "green", "blue"],
+        basis: None,
         eval_channels: Some(skin_sh_rgb),
     },
     QuantityDef {
@@ -166,6 +215,7 @@ static REGISTRY: &[QuantityDef] = &[
         inverse: None,
         channels: &[],
         eval_channels: None,
+        basis: Some(&FUZZ_PS_EQ1),
     },
     QuantityDef {
         name: "fuzz-g",
@@ -176,6 +226,7 @@ static REGISTRY: &[QuantityDef] = &[
         inverse: None,
         channels: &[],
         eval_channels: None,
+        basis: None,
     },
     QuantityDef {
         name: "fuzz-q",
@@ -186,6 +237,7 @@ static REGISTRY: &[QuantityDef] = &[
         inverse: None,
         channels: &[],
         eval_channels: None,
+        basis: None,
     },
     QuantityDef {
         name: "fuzz-r",
@@ -196,6 +248,7 @@ static REGISTRY: &[QuantityDef] = &[
         inverse: None,
         channels: &[],
         eval_channels: None,
+        basis: None,
     },
     QuantityDef {
         name: "gloss-length",
@@ -212,6 +265,7 @@ static REGISTRY: &[QuantityDef] = &[
         inverse: Some(gloss::gloss_from_length),
         channels: &[],
         eval_channels: None,
+        basis: None,
     },
     QuantityDef {
         name: "gloss-from-length",
@@ -222,6 +276,7 @@ static REGISTRY: &[QuantityDef] = &[
         inverse: None,
         channels: &[],
         eval_channels: None,
+        basis: None,
     },
     QuantityDef {
         name: "gloss-combine",
@@ -235,6 +290,7 @@ static REGISTRY: &[QuantityDef] = &[
         inverse: None,
         channels: &[],
         eval_channels: None,
+        basis: None,
     },
 ];
 

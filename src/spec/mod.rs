@@ -232,6 +232,9 @@ pub enum Kind {
     /// Skin LUT textures (RGB): checked and spelled out by [`skin`].
     #[serde(rename = "skin-lut")]
     SkinLut,
+    /// Two-stage fit: the quantity's inner basis at every outer grid point, each coefficient
+    /// a rational field over the outer axes (see `fit::fields`).
+    Fields,
 }
 
 impl Kind {
@@ -241,6 +244,7 @@ impl Kind {
             Kind::Fit => "fit",
             Kind::Table => "table",
             Kind::SkinLut => "skin-lut",
+            Kind::Fields => "fields",
         }
     }
 }
@@ -273,6 +277,15 @@ impl AxisSpec {
 #[serde(deny_unknown_fields)]
 pub struct FitSection {
     pub objective: Objective,
+    /// kind = "fields", minimax only: the lowest max error among iterates with rms ≤ this.
+    pub max_rms: Option<f64>,
+}
+
+/// kind = "fields": per-coefficient offsets s_k (c_k = s_k + model), one per basis term.
+#[derive(Debug, Clone, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct FieldsSection {
+    pub offsets: Vec<f64>,
 }
 
 #[derive(Debug, Clone, Deserialize, PartialEq)]
@@ -282,6 +295,9 @@ pub struct EmitSection {
     pub function: String,
     /// Argument names of the emitted function, one per axis (default: the axis names).
     pub args: Option<Vec<String>>,
+    /// kind = "fields": name of the emitted evaluator of the inner basis (`function` then
+    /// names the function returning the coefficients).
+    pub evaluator: Option<String>,
 }
 
 #[derive(Debug, Clone, Deserialize, PartialEq)]
@@ -298,6 +314,7 @@ pub struct SpecFile {
     pub axis: Vec<AxisSpec>,
     pub model: Option<ModelSpec>,
     pub fit: Option<FitSection>,
+    pub fields: Option<FieldsSection>,
     pub emit: EmitSection,
 }
 
@@ -343,15 +360,19 @@ impl Spec {
         if !is_identifier(&file.emit.function) {
             return Err(at("function", format!("'{}' is not a valid function name", file.emit.function)));
         }
+        let quantity = quantity::lookup(&file.quantity).map_err(|e| at("quantity", e.to_string()))?;
+        let n_args = match (file.kind, quantity.basis) {
+            (Kind::Fields, Some(b)) => file.axis.len().saturating_sub(b.inner),
+            _ => file.axis.len(),
+        };
         if let Some(args) = &file.emit.args
-            && (args.len() != file.axis.len() || args.iter().any(|a| !is_identifier(a)))
+            && (args.len() != n_args || args.iter().any(|a| !is_identifier(a)))
         {
-            return Err(at("args", format!("needs {} lowercase identifiers, one per axis", file.axis.len())));
+            return Err(at("args", format!("needs {n_args} lowercase identifiers, one per (outer) axis")));
         }
         if !(file.tolerance > 0.0 && file.tolerance < 1.0) {
             return Err(at("tolerance", format!("{} must be in (0, 1)", file.tolerance)));
         }
-        let quantity = quantity::lookup(&file.quantity).map_err(|e| at("quantity", e.to_string()))?;
         if !quantity.channels.is_empty() && file.kind != Kind::SkinLut {
             return Err(at(
                 "quantity",
@@ -400,12 +421,63 @@ impl Spec {
             (Kind::Table, Some(_)) => return Err(at("model", "kind = \"table\" takes no [model]".into())),
             (Kind::Table, None) => None,
             (Kind::SkinLut, _) => None,
+            (Kind::Fields, m) => Some(fields_model(path, &text, &file, quantity, m.as_ref())?),
         };
+        if file.kind != Kind::Fields && (file.fields.is_some() || file.emit.evaluator.is_some()) {
+            return Err(at("fields", "[fields] and emit.evaluator belong to kind = \"fields\"".into()));
+        }
         if file.kind == Kind::Table && file.axis.len() > 2 {
             return Err(at("axis", "tables have one or two axes".into()));
         }
         Ok(Spec { path: path.to_path_buf(), text, file, quantity, model })
     }
+}
+
+/// The model shared by the coefficient fields of a kind = "fields" spec (features: the outer
+/// axes), with its [fields], [fit] and [emit] sections checked.
+fn fields_model(
+    path: &Path,
+    text: &str,
+    file: &SpecFile,
+    quantity: &QuantityDef,
+    model: Option<&ModelSpec>,
+) -> Result<RationalModel, SpecError> {
+    let at = |field: &str, msg: String| SpecError::new(path, line_of(text, field), field, msg);
+    let basis = quantity
+        .basis
+        .ok_or_else(|| at("quantity", format!("'{}' has no inner basis for kind = \"fields\"", quantity.name)))?;
+    let m = model.ok_or_else(|| at("model", "kind = \"fields\" needs a [model] section".into()))?;
+    let fit = file.fit.as_ref().ok_or_else(|| at("fit", "kind = \"fields\" needs a [fit] section".into()))?;
+    if let Some(cap) = fit.max_rms
+        && !(cap > 0.0 && cap.is_finite() && fit.objective == Objective::Minimax)
+    {
+        return Err(at("max_rms", format!("{cap} must be positive and finite, with objective = \"minimax\"")));
+    }
+    let fields = file.fields.as_ref().ok_or_else(|| at("fields", "kind = \"fields\" needs a [fields] section".into()))?;
+    if fields.offsets.len() != basis.terms.len() || fields.offsets.iter().any(|v| !v.is_finite()) {
+        return Err(at(
+            "offsets",
+            format!("needs {} finite values, one per basis term [{}]", basis.terms.len(), basis.terms.join(", ")),
+        ));
+    }
+    match &file.emit.evaluator {
+        Some(e) if is_identifier(e) && *e != file.emit.function => {}
+        _ => return Err(at("evaluator", "kind = \"fields\" needs emit.evaluator, a function name other than emit.function".into())),
+    }
+    if m.offset != 0.0 {
+        return Err(at("offset", "kind = \"fields\" takes per-coefficient offsets in [fields]".into()));
+    }
+    if !m.pin.is_empty() {
+        return Err(at("pin", "kind = \"fields\" takes no pins".into()));
+    }
+    let n_outer = file.axis.len() - basis.inner;
+    let features: Vec<String> = file.axis[..n_outer].iter().map(|a| a.name.clone()).collect();
+    if let Some(f) = &m.features
+        && f != &features
+    {
+        return Err(at("features", "the fields take their features from the outer axes; remove 'features'".into()));
+    }
+    m.build(path, text, features, &|_| None)
 }
 
 /// All specs in a folder (`*.toml`, sorted by name; `scenes/` is not read).

@@ -84,6 +84,26 @@ pub fn committed_refit(generated: &Path, name: &str) -> Option<(crate::spec::Spe
     (spec.model.as_ref()?.n_full() == c.len()).then(|| (spec, nalgebra::DVector::from_vec(c)))
 }
 
+/// The committed two-stage refit NAME (`kind = "fields"`): the coefficient function
+/// outer point → c_k evaluated in f64 through its spec's model and offsets.
+pub fn committed_fields(generated: &Path, name: &str) -> Option<Box<dyn Fn(&[f64]) -> Vec<f64> + Send + Sync>> {
+    let text = std::fs::read_to_string(generated.join("json").join(format!("{name}.json"))).ok()?;
+    let v: serde_json::Value = serde_json::from_str(&text).ok()?;
+    let spec = crate::spec::Spec::load(&generated.parent()?.join(v["spec"].as_str()?)).ok()?;
+    let model = spec.model.clone()?;
+    let mut fields = Vec::new();
+    for f in v["fields"].as_array()? {
+        let c: Vec<f64> = f["coefficients"].as_array()?.iter().map(serde_json::Value::as_f64).collect::<Option<_>>()?;
+        if c.len() != model.n_full() {
+            return None;
+        }
+        let mut m = model.clone();
+        m.offset = f["offset"].as_f64()?;
+        fields.push((m, nalgebra::DVector::from_vec(c)));
+    }
+    Some(Box::new(move |x: &[f64]| fields.iter().map(|(m, c)| m.eval_full(c, x)).collect()))
+}
+
 /// Every item known to the project.
 pub fn all(generated: &std::path::Path) -> Vec<Item> {
     let mut items = gloss::items(generated);

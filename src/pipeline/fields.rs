@@ -1,0 +1,273 @@
+//! Build of a two-stage fit (`kind = "fields"`): sample the quantity on the outer grid × the
+//! inner grid, fit the coefficient fields jointly (`fit::fields`), prove every denominator
+//! positive on the outer domain, verify on the verification grids in f64 and in the emitted
+//! f32 arithmetic, emit WGSL, Rust and JSON.
+
+use super::{committed_json, fmt_err, input_hash, json_text, spec_rel_path, BuildError, Built, Mode, Verification};
+use crate::emit::expr::{self, model_expr};
+use crate::emit::fields::{self as efields, Field, FieldsFunction};
+use crate::emit::{header_lines, Artifact, GENERATOR};
+use crate::fit::fields::{fit_fields, FieldOptions, PointData};
+use crate::fit::model::Term;
+use crate::fit::positivity::{prove_denominator_positive, Positivity};
+use crate::fit::{FitError, RationalModel};
+use crate::quantity::InnerBasis;
+use crate::spec::{AxisSpec, Spec};
+use nalgebra::{DMatrix, DVector};
+use rayon::prelude::*;
+use serde_json::{json, Value};
+
+/// Tensor grid over some axes with the given counts, first axis fastest.
+fn tensor(axes: &[AxisSpec], counts: &[usize]) -> Vec<Vec<f64>> {
+    let pts: Vec<Vec<f64>> = axes.iter().zip(counts).map(|(a, &n)| a.points(n)).collect();
+    let total: usize = counts.iter().product();
+    (0..total)
+        .map(|mut k| {
+            pts.iter()
+                .map(|p| {
+                    let i = k % p.len();
+                    k /= p.len();
+                    p[i]
+                })
+                .collect()
+        })
+        .collect()
+}
+
+struct Layout<'a> {
+    basis: &'static InnerBasis,
+    outer: &'a [AxisSpec],
+    inner: &'a [AxisSpec],
+    terms: Vec<Term>,
+    models: Vec<RationalModel>,
+}
+
+fn layout(spec: &Spec) -> Layout<'_> {
+    let basis = spec.quantity.basis.expect("fields specs are checked to have a basis");
+    let n_outer = spec.file.axis.len() - basis.inner;
+    let args: Vec<String> = basis.args.iter().map(|s| s.to_string()).collect();
+    let terms = basis.terms.iter().map(|t| Term::parse(t, &args).expect("basis terms are valid monomials")).collect();
+    let model = spec.model.as_ref().expect("fields specs carry a model");
+    let offsets = &spec.file.fields.as_ref().expect("fields specs carry [fields]").offsets;
+    let models = offsets
+        .iter()
+        .map(|&o| {
+            let mut m = model.clone();
+            m.offset = o;
+            m
+        })
+        .collect();
+    Layout { basis, outer: &spec.file.axis[..n_outer], inner: &spec.file.axis[n_outer..], terms, models }
+}
+
+/// Samples of the quantity at every outer point (rows: inner points, in order).
+fn sample(spec: &Spec, l: &Layout<'_>, outer: &[Vec<f64>], inner: &[Vec<f64>]) -> Vec<Vec<f64>> {
+    let tol = spec.file.tolerance;
+    outer.par_iter().map(|o| (l.basis.sample)(o, inner, tol).into_iter().map(|e| e.value).collect()).collect()
+}
+
+fn design(l: &Layout<'_>, o: &[f64], inner: &[Vec<f64>]) -> DMatrix<f64> {
+    let mut b = DMatrix::zeros(inner.len(), l.terms.len());
+    for (i, u) in inner.iter().enumerate() {
+        let a = (l.basis.to_args)(o, u);
+        for (k, t) in l.terms.iter().enumerate() {
+            b[(i, k)] = t.eval(&a);
+        }
+    }
+    b
+}
+
+pub fn build(spec: &Spec, mode: Mode, root: &std::path::Path) -> Result<Built, BuildError> {
+    let name = spec.file.name.clone();
+    let l = layout(spec);
+    let fit_section = spec.file.fit.as_ref().expect("fields specs carry [fit]");
+    let counts = |axes: &[AxisSpec], verify: bool| -> Vec<usize> {
+        axes.iter().map(|a| if verify { a.verify_count() } else { a.count }).collect()
+    };
+    let (coefficients, report): (Vec<DVector<f64>>, Option<Value>) = match mode {
+        Mode::Fit => {
+            let outer = tensor(l.outer, &counts(l.outer, false));
+            let inner = tensor(l.inner, &counts(l.inner, false));
+            let y = sample(spec, &l, &outer, &inner);
+            let data: Vec<PointData> = outer
+                .iter()
+                .zip(y)
+                .map(|(o, y)| PointData { design: design(&l, o, &inner), y: DVector::from_vec(y) })
+                .collect();
+            let opts = FieldOptions { objective: fit_section.objective, max_rms: fit_section.max_rms, ..FieldOptions::default() };
+            let f = fit_fields(&l.models, &outer, &data, &opts, &name)?;
+            let mut conds: Vec<f64> = f.stage1.iter().map(|s| s.condition).collect();
+            conds.sort_by(f64::total_cmp);
+            // Above 1e8 the stage-1 optimum is not determined by data accurate to 1e-9 (θf ≈ 0).
+            let finite: Vec<f64> = conds.iter().copied().filter(|c| *c <= 1e8).collect();
+            let report = json!({
+                "grid_points": outer.len(),
+                "inner_samples": inner.len(),
+                "objective": fit_section.objective,
+                "max_rms": fit_section.max_rms,
+                "max_abs_error": f.max_abs_error,
+                "rms_error": f.rms_error,
+                "stage1_max_abs_error": f.stage1_max_abs_error,
+                "stage1_rms_error": f.stage1_rms_error,
+                "stage1_condition": {
+                    "min": finite.first(),
+                    "median": finite.get(finite.len() / 2),
+                    "max_up_to_1e8": finite.last(),
+                    "points_above_1e8": conds.len() - finite.len(),
+                    "max": conds.last(),
+                },
+                "lm_evaluations": f.lm_evaluations,
+                "outer_iterations": f.outer_iterations,
+            });
+            (f.coefficients, Some(report))
+        }
+        Mode::Committed => {
+            let v = committed_json(root, spec)?;
+            let fields = v["fields"].as_array().ok_or_else(|| BuildError::NoCommitted { spec: name.clone(), why: "no 'fields' array".into() })?;
+            if fields.len() != l.models.len() {
+                return Err(BuildError::NoCommitted { spec: name, why: "field count differs from the spec".into() });
+            }
+            let mut c = Vec::new();
+            for (fv, m) in fields.iter().zip(&l.models) {
+                let v = super::f64_array(fv, &name, "coefficients")?;
+                if v.len() != m.n_full() {
+                    return Err(BuildError::NoCommitted { spec: name, why: "coefficient count differs from the spec".into() });
+                }
+                c.push(DVector::from_vec(v));
+            }
+            (c, v.get("fit").cloned())
+        }
+    };
+    let dom: Vec<(f64, f64)> = l.outer.iter().map(|a| (a.range[0], a.range[1])).collect();
+    let mut lower = Vec::new();
+    for (k, (m, c)) in l.models.iter().zip(&coefficients).enumerate() {
+        match prove_denominator_positive(m, c, &dom) {
+            Positivity::Proven { lower: lo, .. } => lower.push(lo),
+            Positivity::NotProven { lower: lo, region, .. } => {
+                return Err(FitError::PoleInDomain { what: format!("{name} (field {k})"), lower: lo, region }.into());
+            }
+        }
+    }
+    // Emitted form.
+    let fields: Vec<Field> = l
+        .models
+        .iter()
+        .zip(&coefficients)
+        .map(|(m, c)| {
+            let (num, den) = expr::f32_arrays(m, c);
+            Field { expr: model_expr(m), num, den }
+        })
+        .collect();
+    let d32: Vec<(f32, f32)> = dom.iter().map(|&(a, b)| (a as f32, b as f32)).collect();
+    let args: Vec<String> = spec.file.emit.args.clone().unwrap_or_else(|| l.outer.iter().map(|a| a.name.clone()).collect());
+    let eval_args: Vec<String> = l.basis.args.iter().map(|s| s.to_string()).collect();
+    let eval_domain: Vec<(f32, f32)> = l.basis.arg_domain.iter().map(|&(a, b)| (a as f32, b as f32)).collect();
+    let evaluator = spec.file.emit.evaluator.clone().expect("fields specs name an evaluator");
+    let func = FieldsFunction {
+        module: &name,
+        name: &spec.file.emit.function,
+        args: &args,
+        derived: &l.models[0].derived,
+        domain: &d32,
+        fields: &fields,
+        evaluator: &evaluator,
+        eval_args: &eval_args,
+        eval_domain: &eval_domain,
+        terms: &l.terms,
+        range: (l.basis.range.0 as f32, l.basis.range.1 as f32),
+    };
+    // Verification on the verification grids, in f64 and in the emitted f32 arithmetic.
+    let vouter = tensor(l.outer, &counts(l.outer, true));
+    let vinner = tensor(l.inner, &counts(l.inner, true));
+    let truth = sample(spec, &l, &vouter, &vinner);
+    let (lo, hi) = l.basis.range;
+    let mut pts = Vec::new();
+    let (mut t, mut a64, mut a32) = (Vec::new(), Vec::new(), Vec::new());
+    for (o, row) in vouter.iter().zip(&truth) {
+        let c64: Vec<f64> = l.models.iter().zip(&coefficients).map(|(m, c)| m.eval_full(c, o)).collect();
+        let feats = expr::features_f32(&l.models[0], o, &d32);
+        let c32 = efields::coefficients_f32(&func, &feats);
+        for (u, &y) in vinner.iter().zip(row) {
+            let a = (l.basis.to_args)(o, u);
+            let v64: f64 = l.terms.iter().zip(&c64).map(|(tm, c)| c * tm.eval(&a)).sum::<f64>().clamp(lo, hi);
+            let a_32: Vec<f32> = a.iter().map(|&v| v as f32).collect();
+            let v32 = efields::evaluator_f32(&func, &c32, &a_32);
+            if !v32.is_finite() {
+                return Err(BuildError::NonFinite { spec: name, at: o.iter().chain(u).copied().collect() });
+            }
+            pts.push(o.iter().chain(u).copied().collect::<Vec<f64>>());
+            t.push(y);
+            a64.push(v64);
+            a32.push(v32);
+        }
+    }
+    let verification: Verification = super::verify(spec, &pts, &t, &a64, &a32);
+    let hash = input_hash(spec);
+    let err_line = format!(
+        "max abs {}, rms {} over {} points (f32 code: max abs {}, rms {})",
+        fmt_err(verification.max_abs_error),
+        fmt_err(verification.rms_error),
+        verification.points,
+        fmt_err(verification.max_abs_error_f32),
+        fmt_err(verification.rms_error_f32)
+    );
+    let header = header_lines(&spec_rel_path(spec), &hash, &err_line);
+    let m0 = &l.models[0];
+    let terms_text: Vec<String> = l.basis.terms.iter().map(|s| s.to_string()).collect();
+    let doc = format!(
+        "{}: `{}` returns c_k = s_k + {}·P_k/Q_k over ({}) with P_k = NUM{{k}} · [{}], Q_k = 1 + DEN{{k}} · [{}]; \
+         `{}` evaluates Σ c_k·[{}].",
+        spec.file.description,
+        spec.file.emit.function,
+        m0.factor.as_ref().map_or("1".to_string(), |t| t.label.clone()),
+        args.join(", "),
+        m0.numerator.iter().map(|t| t.label.clone()).collect::<Vec<_>>().join(", "),
+        m0.denominator.iter().map(|t| t.label.clone()).collect::<Vec<_>>().join(", "),
+        evaluator,
+        terms_text.join(", "),
+    );
+    let c64: Vec<(Vec<f64>, Vec<f64>)> = coefficients
+        .iter()
+        .map(|c| {
+            let nn = m0.numerator.len();
+            (c.rows(0, nn).iter().copied().collect(), c.rows(nn, c.len() - nn).iter().copied().collect())
+        })
+        .collect();
+    let json = json!({
+        "generator": GENERATOR,
+        "spec": spec_rel_path(spec),
+        "input_hash": hash,
+        "name": name,
+        "kind": "fields",
+        "quantity": spec.file.quantity,
+        "description": spec.file.description,
+        "function": spec.file.emit.function,
+        "evaluator": evaluator,
+        "axes": super::axes_json(spec),
+        "basis": { "arguments": eval_args, "terms": terms_text, "range": [lo, hi] },
+        "model": {
+            "form": "c_k = offset_k + factor * P_k / Q_k, Q_k = 1 + sum(den_k)",
+            "features": m0.features,
+            "arguments": args,
+            "numerator": m0.numerator.iter().map(|t| t.label.clone()).collect::<Vec<_>>(),
+            "denominator": m0.denominator.iter().map(|t| t.label.clone()).collect::<Vec<_>>(),
+            "derived": m0.derived.iter().map(|d| json!({"name": d.name, "definition": d.describe(&m0.features)})).collect::<Vec<_>>(),
+            "factor": m0.factor.as_ref().map(|t| t.label.clone()),
+        },
+        "fields": l.models.iter().zip(&coefficients).zip(&fields).zip(&lower).map(|(((m, c), fl), lo)| json!({
+            "offset": m.offset,
+            "coefficients": c.iter().copied().collect::<Vec<f64>>(),
+            "numerator_f32": fl.num,
+            "denominator_f32": fl.den,
+            "denominator_lower_bound": lo,
+        })).collect::<Vec<_>>(),
+        "fit": report,
+        "verification": verification,
+    });
+    let artifacts = vec![
+        Artifact { path: format!("wgsl/{name}.wgsl").into(), contents: efields::render_wgsl(&header, &func).into() },
+        Artifact { path: format!("src/{name}.rs").into(), contents: efields::render_rust(&header, &func, &doc, &c64).into() },
+        Artifact { path: format!("json/{name}.json").into(), contents: json_text(&json).into() },
+    ];
+    Ok(Built { name, artifacts, verification, fit: None })
+}
