@@ -113,6 +113,13 @@ fn malformed_specs_exit_2_name_file_line_field_and_write_nothing() {
     // Unknown term in the model.
     let l = line_of(&spec, "numerator");
     bad_spec_case("gloss_length.toml", |t| t.replace("\"gloss^3\"]", "\"roughness^3\"]"), l, "numerator");
+    // A two-stage spec whose offsets do not match its basis (6 terms), or that has no evaluator.
+    let spec = std::fs::read_to_string(root().join("fits/fuzz_ps.toml")).unwrap();
+    let l = line_of(&spec, "offsets");
+    bad_spec_case("fuzz_ps.toml", |t| t.replace("offsets = [0.5, 0.0, 0.0, 0.0, 0.0, 0.0]", "offsets = [0.5, 0.0]"), l, "offsets");
+    bad_spec_case("fuzz_ps.toml", |t| t.replace("offsets = [0.5, 0.0, 0.0, 0.0, 0.0, 0.0]", "offsets = [0.5, 0.0, 0.0, nan, 0.0, 0.0]"), l, "offsets");
+    let l = line_of(&spec, "evaluator");
+    bad_spec_case("fuzz_ps.toml", |t| t.replace("evaluator = \"fuzz_ps\"", "evaluator = \"fuzz_ps_coeffs\""), l, "evaluator");
 }
 
 #[test]

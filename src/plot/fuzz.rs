@@ -83,7 +83,15 @@ impl FuzzResolution {
 /// written (each figure as `.png` and `.svg`). No refit of P̃_s is committed yet, so none is
 /// drawn; [`fuzz_figures_with`] takes one.
 pub fn fuzz_figures(out_dir: &Path, generated: &Path) -> Result<Vec<PathBuf>, PlotError> {
-    fuzz_figures_with(out_dir, generated, &FuzzResolution::FULL, None)
+    // The committed two-stage refit of P̃_s (generated/json/fuzz_ps.json), when there is one.
+    let fields = crate::validate::committed_fields(generated, "fuzz_ps");
+    let refit = fields.as_ref().map(|f| {
+        move |alpha: f64, theta_f: f64| -> [f64; 6] {
+            let c = f(&[alpha, theta_f]);
+            std::array::from_fn(|k| c.get(k).copied().unwrap_or(f64::NAN))
+        }
+    });
+    fuzz_figures_with(out_dir, generated, &FuzzResolution::FULL, refit.as_ref().map(|r| r as &dyn Fn(f64, f64) -> [f64; 6]))
 }
 
 /// [`fuzz_figures`] at resolution `res`, with an optional refit of P̃_s: `ps_refit(α, θf)`
