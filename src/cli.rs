@@ -111,9 +111,13 @@ pub fn build(paths: &Paths, only: &[String], check: bool) -> Result<()> {
     let mode = if check { Mode::Committed } else { Mode::Fit };
     let pb = progress(selected.len(), if check { "check" } else { "build" });
     let mut built: Vec<Built> = Vec::new();
+    let mut seconds: Vec<f64> = Vec::new();
+    let start = std::time::Instant::now();
     for s in &selected {
         pb.set_message(s.file.name.clone());
+        let t = std::time::Instant::now();
         let b = pipeline::build_spec(s, mode, &paths.generated).with_context(|| format!("building {}", s.file.name))?;
+        seconds.push(t.elapsed().as_secs_f64());
         pb.inc(1);
         built.push(b);
     }
@@ -135,14 +139,19 @@ pub fn build(paths: &Paths, only: &[String], check: bool) -> Result<()> {
         anyhow::bail!("{} generated file(s) differ from what the specs and committed coefficients produce; run `shadefit build`", bad.len());
     }
     let written = pipeline::write_all(&paths.generated, &artifacts)?;
-    for b in &built {
+    for (b, t) in built.iter().zip(&seconds) {
         let v = &b.verification;
         println!(
-            "{:<22} max abs {:.3e}  rms {:.3e}  (f32 code: max abs {:.3e})  over {} points",
+            "{:<22} max abs {:.3e}  rms {:.3e}  (f32 code: max abs {:.3e})  over {} points  [{t:.1} s]",
             b.name, v.max_abs_error, v.rms_error, v.max_abs_error_f32, v.points
         );
     }
-    println!("{written} file(s) written, {} unchanged", artifacts.len() - written);
+    println!(
+        "{written} file(s) written, {} unchanged; {:.1} s wall on {} thread(s)",
+        artifacts.len() - written,
+        start.elapsed().as_secs_f64(),
+        rayon::current_num_threads()
+    );
     Ok(())
 }
 

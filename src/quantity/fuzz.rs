@@ -1677,6 +1677,53 @@ mod tests {
     }
 
     #[test]
+    fn convergence_study() {
+        // Max |value(tol) − value(tight)| over fixed points, for tol = 1e-5 … 1e-9 (the
+        // default): the actual error must fall with the tolerance and stay below it. The tight
+        // references are 1e-13 (P_s) and 1e-12 (R), whose own errors are below 1e-12.
+        // `cargo test --release --lib convergence_study -- --nocapture` prints the table.
+        let mut rng = Lcg(29);
+        let ps_points: Vec<[f64; 4]> = (0..60)
+            .map(|i| {
+                let tu = if i % 4 == 0 { (10f64.powf(-5.0 + 4.0 * rng.next())).acos() } else { FRAC_PI_2 * rng.next() };
+                [0.15 + 0.85 * rng.next(), if i % 7 == 0 { 0.0 } else { FRAC_PI_2 * rng.next() }, tu, PI * rng.next()]
+            })
+            .collect();
+        let r_points = [(0.15, 0.1), (0.35, 0.8), (0.6, 1.5), (0.9, 0.3)];
+        let ps_ref: Vec<f64> = ps_points.iter().map(|p| ps(p[0], p[1], p[2], p[3], 1e-13).value).collect();
+        let r_ref: Vec<f64> = r_points.iter().map(|&(a, t)| r(a, t, 1e-12).value).collect();
+        println!("tolerance   P_s max |err|   P_s max estimate   R max |err|   R max estimate");
+        for tol in [1e-5, 1e-6, 1e-7, 1e-8, DEFAULT_TOL] {
+            let (mut pe, mut pest, mut re, mut rest) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+            for (p, t) in ps_points.iter().zip(&ps_ref) {
+                let e = ps(p[0], p[1], p[2], p[3], tol);
+                pe = pe.max((e.value - t).abs());
+                pest = pest.max(e.error);
+            }
+            for (&(a, th), t) in r_points.iter().zip(&r_ref) {
+                let e = r(a, th, tol);
+                re = re.max((e.value - t).abs());
+                rest = rest.max(e.error);
+            }
+            println!("{tol:9.0e}   {pe:13.2e}   {pest:16.2e}   {re:11.2e}   {rest:14.2e}");
+            // Each actual error is below its requested tolerance (plus the reference's 1e-12).
+            assert!(pe <= tol + 1e-12 && re <= tol + 1e-12, "tol {tol:e}: P_s {pe:e}, R {re:e}");
+        }
+        // G and Q: quadrature against the closed forms at the default tolerance.
+        let mut ge = 0.0f64;
+        for i in 0..=20 {
+            for j in 1..=20 {
+                let (d, mu) = (0.5 * i as f64 / 20.0, j as f64 / 20.0);
+                ge = ge.max((g(d, mu, DEFAULT_TOL).value - g_exact(d, mu)).abs());
+            }
+        }
+        let qe = (0..=50).map(|i| 0.5 * i as f64 / 50.0).map(|d| (q(d, DEFAULT_TOL).value - q_exact(d)).abs()).fold(0.0, f64::max);
+        println!("default tolerance: G max |quadrature − closed form| {ge:.2e}, Q max |quadrature − 2E₃| {qe:.2e}");
+        // Closed forms are accurate to ~1e-15 (1 + |ln d|) (see g_matches_closed_form_and_limits).
+        assert!(ge <= DEFAULT_TOL && qe <= DEFAULT_TOL);
+    }
+
+    #[test]
     fn r_default_tolerance_is_honest() {
         for &(al, tf) in &[
             (0.05, 0.8),
