@@ -158,14 +158,15 @@ fn args(spec: &Spec) -> Vec<String> {
 fn build_fit(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> {
     let name = spec.file.name.clone();
     let model = spec.model.as_ref().expect("fit specs carry a model");
-    let objective = spec.file.fit.as_ref().expect("fit specs carry [fit]").objective;
+    let fit_section = spec.file.fit.as_ref().expect("fit specs carry [fit]");
+    let objective = fit_section.objective;
     let counts: Vec<usize> = spec.file.axis.iter().map(|a| a.count).collect();
     let (coefficients, report) = match mode {
         Mode::Fit => {
             let x = grid(spec, &counts);
             let y = sample(spec, &x);
             let data = Data { x, y };
-            let opts = FitOptions { objective, ..FitOptions::default() };
+            let opts = FitOptions { objective, max_rms: fit_section.max_rms, ..FitOptions::default() };
             let f = fit::fit(model, &data, &opts, &name)?;
             (f.coefficients, Some(f.report))
         }
@@ -271,12 +272,22 @@ fn describe_fit(spec: &Spec, model: &fit::RationalModel) -> String {
     let num: Vec<String> = model.numerator.iter().map(|t| format!("({t})")).collect();
     let den: Vec<String> = model.denominator.iter().map(|t| format!("({t})")).collect();
     format!(
-        "{}: `{}` ≈ {} of quantity `{}`, P = NUM · [{}], Q = 1 + DEN · [{}].",
+        "{}: `{}` ≈ {} of quantity `{}`, P = NUM · [{}], Q = {} + DEN · [{}].",
         spec.file.description,
         spec.file.emit.function,
-        if model.clamp.is_some() { "clamp(P/Q)" } else { "P/Q" },
+        {
+            let mut f = "P/Q".to_string();
+            if let Some(t) = &model.factor {
+                f = format!("({t})·{f}");
+            }
+            if model.offset != 0.0 {
+                f = format!("{} + {f}", model.offset);
+            }
+            if model.clamp.is_some() { format!("clamp({f})") } else { f }
+        },
         spec.file.quantity,
         num.join(", "),
+        model.lead.as_ref().map_or("1".to_string(), |t| format!("({t})")),
         den.join(", ")
     )
 }

@@ -113,6 +113,9 @@ fn malformed_specs_exit_2_name_file_line_field_and_write_nothing() {
     // Unknown term in the model.
     let l = line_of(&spec, "numerator");
     bad_spec_case("gloss_length.toml", |t| t.replace("\"gloss^3\"]", "\"roughness^3\"]"), l, "numerator");
+    // An rms cap only means something for minimax.
+    let l = line_of(&spec, "objective") + 1;
+    bad_spec_case("gloss_length.toml", |t| t.replace("objective = \"minimax\"", "objective = \"lsq\"\nmax_rms = 0.01"), l, "max_rms");
     // A two-stage spec whose offsets do not match its basis (6 terms), or that has no evaluator.
     let spec = std::fs::read_to_string(root().join("fits/fuzz_ps.toml")).unwrap();
     let l = line_of(&spec, "offsets");

@@ -60,11 +60,14 @@ pub struct FitOptions {
     pub minimax_iters: usize,
     /// Iterations of the sequential-LP minimax polish (0 disables it).
     pub polish_iters: u64,
+    /// Minimax under an rms cap: the Lawson iterate with the lowest max error among those
+    /// whose rms error is at most this (the least-squares start is the fallback); no polish.
+    pub max_rms: Option<f64>,
 }
 
 impl Default for FitOptions {
     fn default() -> Self {
-        FitOptions { objective: Objective::Lsq, solver: LsqSolver::Lm, minimax_iters: 300, polish_iters: 200 }
+        FitOptions { objective: Objective::Lsq, solver: LsqSolver::Lm, minimax_iters: 300, polish_iters: 200, max_rms: None }
     }
 }
 
@@ -298,6 +301,8 @@ fn minimax(
         p.raw(t).iter().fold(0.0_f64, |m, v| if v.is_nan() { f64::INFINITY } else { m.max(v.abs()) })
     };
     let n = problem.y.len();
+    let rms = |p: &Residuals<'_>, t: &DVector<f64>| (p.raw(t).norm_squared() / n as f64).sqrt();
+    let admissible = |p: &Residuals<'_>, t: &DVector<f64>| opts.max_rms.is_none_or(|cap| rms(p, t) <= cap);
     let mut w = vec![1.0 / n as f64; n];
     let mut best = (max_abs(problem, &theta), theta.clone());
     let mut since_best = 0;
@@ -324,7 +329,7 @@ fn minimax(
         evals += ev;
         theta = t;
         let m = max_abs(problem, &theta);
-        if m < best.0 * (1.0 - 1e-9) {
+        if m < best.0 * (1.0 - 1e-9) && admissible(problem, &theta) {
             best = (m, theta.clone());
             since_best = 0;
         } else {
@@ -336,7 +341,7 @@ fn minimax(
     }
     let mut theta = best.1.clone();
     problem.sqrt_w.iter_mut().for_each(|w| *w = 1.0);
-    if opts.polish_iters > 0 {
+    if opts.polish_iters > 0 && opts.max_rms.is_none() {
         // Sequential-LP polish (an argmin Solver of ours): converges to the equioscillating
         // optimum that Lawson's iteration only approaches linearly.
         let res = Executor::new(problem.clone(), SlpMinimax::default())

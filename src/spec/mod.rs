@@ -277,7 +277,8 @@ impl AxisSpec {
 #[serde(deny_unknown_fields)]
 pub struct FitSection {
     pub objective: Objective,
-    /// kind = "fields", minimax only: the lowest max error among iterates with rms ≤ this.
+    /// Minimax only: the lowest max error among the iterates with rms ≤ this (on the fitting
+    /// samples).
     pub max_rms: Option<f64>,
 }
 
@@ -404,8 +405,13 @@ impl Spec {
         }
         let model = match (file.kind, &file.model) {
             (Kind::Fit, Some(m)) => {
-                if file.fit.is_none() {
+                let Some(fit) = &file.fit else {
                     return Err(at("fit", "kind = \"fit\" needs a [fit] section".into()));
+                };
+                if let Some(cap) = fit.max_rms
+                    && !(cap > 0.0 && cap.is_finite() && fit.objective == Objective::Minimax)
+                {
+                    return Err(at("max_rms", format!("{cap} must be positive and finite, with objective = \"minimax\"")));
                 }
                 let features: Vec<String> = file.axis.iter().map(|a| a.name.clone()).collect();
                 if let Some(f) = &m.features

@@ -167,9 +167,9 @@ pub fn items(generated: &Path) -> Vec<Item> {
     item.add_refit(generated, "fuzz_r", &pts, &truth);
     out.push(item);
 
-    // P̃_s (Listings 1–2 with Eq. 1) on a 9×9 (α, θf) grid × 256 light directions.
-    let alphas = fuzz::linspace(0.15, 1.0, 9);
-    let thetas = fuzz::linspace(0.1, std::f64::consts::FRAC_PI_2, 9);
+    // P̃_s (Listings 1–2 with Eq. 1) on a 17×17 (α, θf) grid × 256 light directions.
+    let alphas = fuzz::linspace(0.15, 1.0, 17);
+    let thetas = fuzz::linspace(0.1, std::f64::consts::FRAC_PI_2, 17);
     let dirs = fuzz::fitting_directions(16, 16);
     let ps = fuzz::ps_grid(&alphas, &thetas, &dirs, 1e-9);
     let mut pts = Vec::new();
@@ -227,7 +227,7 @@ pub fn items(generated: &Path) -> Vec<Item> {
     out.push(Item {
         name: "fuzz_ps (Listings 1–2, Eq. 1 as printed)".into(),
         source: "Ghost of Tsushima supplemental, Eq. 1–2".into(),
-        domain: "α ∈ [0.15, 1] × θf ∈ [0.1, π/2] (9×9) × 256 light directions".into(),
+        domain: "α ∈ [0.15, 1] × θf ∈ [0.1, π/2] (17×17) × 256 light directions".into(),
         points: pts.len(),
         max_abs_error: max,
         rms_error: rms,
