@@ -328,10 +328,10 @@ fn check_points(
             if d > 0.0 {
                 st.max_ratio = st.max_ratio.max(dev / d);
             }
-            if let (Some(r), Some((_, t))) = (st.tight_ratio.as_mut(), tight.get(k)) {
-                if *t > 0.0 {
-                    *r = r.max(dev / t);
-                }
+            if let (Some(r), Some((_, t))) = (st.tight_ratio.as_mut(), tight.get(k))
+                && *t > 0.0
+            {
+                *r = r.max(dev / t);
             }
         }
     }

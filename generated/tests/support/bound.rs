@@ -25,14 +25,14 @@
 //!   for arguments in [−π, π] (no bound outside: the evaluation panics if either side's
 //!   argument may leave that range). The CPU value is Rust's f32 `sin`/`cos` (the platform
 //!   libm), whose own error e_cpu = |cpu − sin x| is measured at each point against the f64
-//!   function (itself within 2^-50 here). With GPU argument x' = x + Δx:
-//!     GPU − CPU = [GPU − sin x'] + [sin x' − sin x] + [sin x − cpu]
-//!               = 2^-11·ε₁ + cos(x)·Δx + r + (e_cpu + 2^-50)·ε₂,   |r| ≤ ½Δx²
-//!   (|sin''| ≤ 1; likewise for cos with −sin(x)·Δx). So Δ passes through linearly with the
-//!   slope, ½·rx² goes to `rem`, and one new ε of 2^-11 + e_cpu + 2^-50 is added. The
-//!   emitted fuzz code takes sin/cos of an exactly clamped argument (Δx = 0), so the bound of
-//!   each is just 2^-11 + e_cpu, about 4.9e-4: this term, amplified by the rational that uses
-//!   the two values, dominates the bound of `fuzz_average_ps` and `fuzz_ps_coeffs`.
+//!   function (itself within 2^-50 here). With GPU argument x' = x + Δx, GPU − CPU =
+//!   [GPU − sin x'] + [sin x' − sin x] + [sin x − cpu] = 2^-11·ε₁ + cos(x)·Δx + r +
+//!   (e_cpu + 2^-50)·ε₂ with |r| ≤ ½Δx² (|sin''| ≤ 1; likewise for cos with −sin(x)·Δx).
+//!   So Δ passes through linearly with the slope, ½·rx² goes to `rem`, and one new ε of
+//!   2^-11 + e_cpu + 2^-50 is added. The emitted fuzz code takes sin/cos of an exactly
+//!   clamped argument (Δx = 0), so the bound of each is just 2^-11 + e_cpu, about 4.9e-4:
+//!   this term, amplified by the rational that uses the two values, dominates the bound of
+//!   `fuzz_average_ps` and `fuzz_ps_coeffs`.
 //! - clamp/min/max: if the two sides cannot straddle a limit, Δ passes through (or is 0 when
 //!   both are clamped); otherwise they are 1-Lipschitz: a new ε of the old bound. select
 //!   needs an exact condition. Integer operations are exact; bitcasts and float→u32

@@ -58,7 +58,7 @@ fn cpu_at(a: &[f32]) -> Vec<f32> {
 pub fn materials() -> Vec<(f32, f32)> {
     let [[a0, a1], [t0, t1]] = FUZZ_PS_DOMAIN;
     let alphas = [a0, 0.3, 0.5, 0.8, a1.next_down(), a1];
-    let thetas = [t0, 0.1, 0.785_398_2, 1.3, t1.next_down(), t1];
+    let thetas = [t0, 0.1, std::f32::consts::FRAC_PI_4, 1.3, t1.next_down(), t1];
     alphas.iter().flat_map(|&a| thetas.iter().map(move |&t| (a, t))).collect()
 }
 
