@@ -32,9 +32,12 @@
 //!              L_b,amb = (c_b/π) P_e(v) [Q̃(d) + c_f R̃(α, θf)(1 − Q̃(d))] E_a
 //!                                                                Q̃ = fuzz_average_penetration, R̃ = fuzz_average_ps
 //! ```
-//! The fuzz spheres have the left one's base under a velvet-like layer: flatter than Lambert
-//! front-on, brighter toward the silhouette (g grows like d/μv), the sheen shaped by the fiber
-//! direction (D_F is largest where the half vector is perpendicular to the fibers).
+//! The fuzz spheres have the left one's base under a velvet-like layer: a pale sheen over a
+//! darker base, shaped by the fiber direction (D_F is largest where the half vector is
+//! perpendicular to the fibers: a vertical band for fibers along the parallels, a horizontal
+//! one for the meridians, where it reaches the lit silhouette as g grows toward grazing
+//! view), and a faint rim on the unlit side from the ambient G̃ term. The poles, where the
+//! combing turns around, show a small whorl.
 //!
 //! # skin_sphere.png: pre-integrated skin diffusion
 //! Left to right: Lambert (max(n·l, 0)), then the punctual LUT D(n·l, κ) for spheres of radius
