@@ -8,7 +8,7 @@ fn specials() -> Vec<f32> {
     let mut v = vec![
         0.0, -0.0, f32::MIN_POSITIVE, -f32::MIN_POSITIVE, 1e-45, -1e-45, f32::INFINITY,
         f32::NEG_INFINITY, f32::NAN, -f32::NAN, f32::MAX, f32::MIN, 1.0, -1.0,
-        1.0 + f32::EPSILON, -f32::EPSILON, 0.15, 0.1499999, 1.5707964, 1.5707965, 3.1415927,
+        1.0 + f32::EPSILON, -f32::EPSILON, 0.15, 0.1499999, 1.5707964, 1.5707965, std::f32::consts::PI,
     ];
     v.extend((0..=64).map(|i| i as f32 / 64.0 * 1.6));
     v

@@ -6,6 +6,9 @@
 mod bound;
 #[path = "support/grid.rs"]
 mod grid;
+#[cfg(feature = "fuzz")]
+#[path = "support/fuzz_ps.rs"]
+mod fuzz_ps;
 
 use shadefit_runtime::{FUNCTIONS, compose, compose_shader, lut, wgsl};
 
@@ -106,14 +109,15 @@ fn wgsl_equals_rust_bit_for_bit() {
 }
 
 /// The bound of tests/support/bound.rs holds for simulated conforming GPUs: FMA contraction of
-/// every `a*b ± c`, divisions off by ±2 ulp, subnormals flushed to zero (each combination over
-/// the whole grid). A rule missing from the bound would show up here without a GPU.
+/// every `a*b ± c`, divisions off by ±2 ulp, subnormals flushed to zero, sin/cos off by up to
+/// 0.999·2^-11 (each combination over the whole grid). A rule missing from the bound would
+/// show up here without a GPU.
 #[test]
 fn bound_covers_simulated_gpus() {
     let gpus = [
-        bound::Gpu { fuse: true, div_ulps: 2, flush_subnormals: true },
-        bound::Gpu { fuse: true, div_ulps: -2, flush_subnormals: false },
-        bound::Gpu { fuse: false, div_ulps: -2, flush_subnormals: true },
+        bound::Gpu { fuse: true, div_ulps: 2, flush_subnormals: true, trig: 0.999 },
+        bound::Gpu { fuse: true, div_ulps: -2, flush_subnormals: false, trig: -0.999 },
+        bound::Gpu { fuse: false, div_ulps: -2, flush_subnormals: true, trig: 0.5 },
     ];
     for f in FUNCTIONS {
         let program = bound::Program::new(&compose(&[f.module]).unwrap());
@@ -134,5 +138,48 @@ fn bound_covers_simulated_gpus() {
             }
             eprintln!("{} on {gpu:?}: {differs} of {} values differ from the CPU, max deviation/bound {worst:.2}", f.name, pts.len() / f.domain.len());
         }
+    }
+}
+
+/// The P̃_s pair (array result and argument, so not in `FUNCTIONS`) through the scalar
+/// wrappers of tests/support/fuzz_ps.rs: interpreted WGSL equals Rust bit for bit, and the
+/// bound covers the simulated GPUs of `bound_covers_simulated_gpus`.
+#[cfg(feature = "fuzz")]
+#[test]
+fn fuzz_ps_pair_equals_rust_and_is_bounded() {
+    let program = bound::Program::new(&(compose(&["fuzz_ps"]).unwrap() + fuzz_ps::WRAPPERS));
+    let gpus = [
+        bound::Gpu::default(),
+        bound::Gpu { fuse: true, div_ulps: 2, flush_subnormals: true, trig: 0.999 },
+        bound::Gpu { fuse: true, div_ulps: -2, flush_subnormals: false, trig: -0.999 },
+    ];
+    for case in fuzz_ps::cases() {
+        let h = program.function(case.name);
+        let (mut worst_abs, mut worst_ratio, mut n) = (0f64, 0f64, 0usize);
+        for (k, p) in case.points.chunks(case.arity).enumerate() {
+            let args: Vec<f32> = p.iter().map(|&b| f32::from_bits(b)).collect();
+            let cpu = (case.cpu)(&args);
+            // The default GPU everywhere; the others on every 7th point (the chained case costs
+            // one interpretation of the coefficients per point).
+            for gpu in if k % 7 == 0 { &gpus[..] } else { &gpus[..1] } {
+                let got = program.simulate_all(h, &args, *gpu);
+                assert_eq!(got.len(), case.outputs, "{}", fuzz_ps::show(case.name, p));
+                for ((v, g, d), c) in got.into_iter().zip(&cpu) {
+                    assert!(v.to_bits() == c.to_bits(), "{}: WGSL (interpreted) {v:e} != Rust {c:e}", fuzz_ps::show(case.name, p));
+                    assert!(c.is_finite() && d.is_finite(), "{}: value {c:e}, bound {d:e}", fuzz_ps::show(case.name, p));
+                    let dev = (g as f64 - v as f64).abs();
+                    assert!(dev <= d, "{} on {gpu:?}: simulated {g:e}, CPU {v:e}, deviation {dev:e} > bound {d:e}", fuzz_ps::show(case.name, p));
+                    worst_abs = worst_abs.max(d);
+                    if d > 0.0 {
+                        worst_ratio = worst_ratio.max(dev / d);
+                    }
+                }
+            }
+            n += 1;
+        }
+        eprintln!(
+            "{}: {n} points x {} values, WGSL == Rust bit for bit; GPU bound up to {worst_abs:.2e}, simulated GPUs at most {worst_ratio:.2} of it",
+            case.name, case.outputs
+        );
     }
 }

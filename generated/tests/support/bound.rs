@@ -21,17 +21,34 @@
 //!   ε of 3 ulp of the quotient.
 //! - Subnormals may be flushed to zero: an argument or result below f32::MIN_POSITIVE in
 //!   magnitude gets a new ε of its own magnitude.
+//! - sin/cos: WGSL (and Vulkan's SPIR-V precision table) allow an absolute error of 2^-11
+//!   for arguments in [−π, π] (no bound outside: the evaluation panics if either side's
+//!   argument may leave that range). The CPU value is Rust's f32 `sin`/`cos` (the platform
+//!   libm), whose own error e_cpu = |cpu − sin x| is measured at each point against the f64
+//!   function (itself within 2^-50 here). With GPU argument x' = x + Δx, GPU − CPU =
+//!   [GPU − sin x'] + [sin x' − sin x] + [sin x − cpu] = 2^-11·ε₁ + cos(x)·Δx + r +
+//!   (e_cpu + 2^-50)·ε₂ with |r| ≤ ½Δx² (|sin''| ≤ 1; likewise for cos with −sin(x)·Δx).
+//!   So Δ passes through linearly with the slope, ½·rx² goes to `rem`, and one new ε of
+//!   2^-11 + e_cpu + 2^-50 is added. The emitted fuzz code takes sin/cos of an exactly
+//!   clamped argument (Δx = 0), so the bound of each is just 2^-11 + e_cpu, about 4.9e-4:
+//!   this term, amplified by the rational that uses the two values, dominates the bound of
+//!   `fuzz_average_ps` and `fuzz_ps_coeffs`.
 //! - clamp/min/max: if the two sides cannot straddle a limit, Δ passes through (or is 0 when
 //!   both are clamped); otherwise they are 1-Lipschitz: a new ε of the old bound. select
 //!   needs an exact condition. Integer operations are exact; bitcasts and float→u32
 //!   conversions must see the same value / integer on both sides (a bitcast of a subnormal,
-//!   possibly flushed to ±0, is let through: the emitted code only tests its bits for NaN),
-//!   otherwise the evaluation panics (an index that could differ between CPU and GPU would
-//!   make the bound meaningless).
+//!   possibly flushed to ±0, is let through: the emitted code only tests its bits for NaN;
+//!   so is the bitcast of an inexact value that is finite on both sides, on which only that
+//!   NaN test is defined), otherwise the evaluation panics (an index that could differ
+//!   between CPU and GPU would make the bound meaningless).
 //!
 //! "ulp" is the spacing of f32 at the larger magnitude either side may reach (|v| + bound).
 //! For the emitted rationals (a dozen operations and one divide on O(1) values) the bound is
 //! a few ulps of the result; for the table lerps about one ulp.
+
+
+// Shared by several test binaries, each using a part of it.
+#![allow(dead_code)]
 
 use naga::{BinaryOperator as B, Expression as E, Handle, Literal, MathFunction as M, ScalarKind, Statement};
 use std::cell::{Cell, RefCell};
@@ -84,6 +101,10 @@ enum V {
     /// their deviation, and for a product its simulated-GPU operands (fusable into an add).
     F { v: f32, g: f32, d: Dev, prod: Option<(f32, f32)> },
     U(u32),
+    /// Bits of an f32 that is finite on both sides but may differ between them (`abs`: with
+    /// the sign masked off, so below 0x7f800000 on both): only a mask and a comparison with
+    /// an infinity/NaN pattern (the emitted NaN test) are defined on it.
+    Finite { bits: u32, abs: bool },
     I(i32),
     B(bool),
     Arr(Rc<Vec<V>>),
@@ -107,6 +128,9 @@ pub struct Gpu {
     /// Ulps added to every quotient (|div_ulps| ≤ 2 stays within the 2.5 ulp allowance).
     pub div_ulps: i32,
     pub flush_subnormals: bool,
+    /// Added to every sin/cos result, as a fraction of the allowance (2^-11 unless set
+    /// otherwise; |trig| < 1: the sum is rounded to f32, so 0.999 stays within it).
+    pub trig: f64,
 }
 
 /// A parsed and validated WGSL module whose functions can be evaluated.
@@ -115,7 +139,11 @@ pub struct Program {
     globals: RefCell<HashMap<Handle<E>, V>>,
     next: Cell<u32>,
     gpu: Cell<Gpu>,
+    trig_allowance: Cell<f64>,
 }
+
+/// WGSL's absolute error allowance for sin and cos on [−π, π].
+pub const WGSL_TRIG_ALLOWANCE: f64 = 1.0 / 2048.0;
 
 /// `x` moved by `n` ulps (toward +inf for n > 0).
 fn step_ulps(x: f32, n: i32) -> f32 {
@@ -132,7 +160,19 @@ impl Program {
         naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all())
             .validate(&module)
             .unwrap_or_else(|e| panic!("{}", e.emit_to_string(wgsl)));
-        Program { module, globals: RefCell::new(HashMap::new()), next: Cell::new(0), gpu: Cell::new(Gpu::default()) }
+        Program {
+            module,
+            globals: RefCell::new(HashMap::new()),
+            next: Cell::new(0),
+            gpu: Cell::new(Gpu::default()),
+            trig_allowance: Cell::new(WGSL_TRIG_ALLOWANCE),
+        }
+    }
+
+    /// Replace the sin/cos allowance of [`WGSL_TRIG_ALLOWANCE`] by a tighter one: not what
+    /// WGSL promises, only to say how close a GPU came (e.g. 2^-22, about 2 ulp at 1).
+    pub fn set_trig_allowance(&self, abs: f64) {
+        self.trig_allowance.set(abs);
     }
 
     pub fn function(&self, name: &str) -> Handle<naga::Function> {
@@ -144,6 +184,13 @@ impl Program {
             .0
     }
 
+    /// Whether `h`, or a function it calls, takes a sin or cos.
+    pub fn uses_trig(&self, h: Handle<naga::Function>) -> bool {
+        let f = &self.module.functions[h];
+        f.expressions.iter().any(|(_, e)| matches!(e, E::Math { fun: M::Sin | M::Cos, .. }))
+            || f.expressions.iter().any(|(_, e)| matches!(e, E::CallResult(g) if self.uses_trig(*g)))
+    }
+
     /// Evaluate `h` at `args`: the f32 value (CPU semantics) and the bound on |GPU − CPU|.
     pub fn eval(&self, h: Handle<naga::Function>, args: &[f32]) -> (f32, f64) {
         let (v, _, d) = self.simulate(h, args, Gpu::default());
@@ -152,12 +199,30 @@ impl Program {
 
     /// [`Program::eval`], plus the value on a simulated conforming GPU.
     pub fn simulate(&self, h: Handle<naga::Function>, args: &[f32], gpu: Gpu) -> (f32, f32, f64) {
+        match self.simulate_all(h, args, gpu).as_slice() {
+            [one] => *one,
+            other => panic!("function returned {} values", other.len()),
+        }
+    }
+
+    /// [`Program::eval`] of a function returning an f32 or an array of f32: each element's
+    /// value and bound (the bounds are per element; their deviations may be correlated).
+    pub fn eval_all(&self, h: Handle<naga::Function>, args: &[f32]) -> Vec<(f32, f64)> {
+        self.simulate_all(h, args, Gpu::default()).into_iter().map(|(v, _, d)| (v, d)).collect()
+    }
+
+    /// [`Program::simulate`] of a function returning an f32 or an array of f32.
+    pub fn simulate_all(&self, h: Handle<naga::Function>, args: &[f32], gpu: Gpu) -> Vec<(f32, f32, f64)> {
         self.next.set(0);
         self.gpu.set(gpu);
         let a: Vec<V> = args.iter().map(|&x| self.f(x, x, Dev::default(), None)).collect();
-        match self.call(h, a) {
-            V::F { v, g, d, .. } => (v, g, d.radius()),
+        let scalar = |v: &V| match v {
+            V::F { v, g, d, .. } => (*v, *g, d.radius()),
             other => panic!("function returned {other:?}"),
+        };
+        match self.call(h, a) {
+            V::Arr(items) => items.iter().map(scalar).collect(),
+            v => vec![scalar(&v)],
         }
     }
 
@@ -295,6 +360,13 @@ impl Program {
                     other => panic!("unsupported f32 operator {other:?}"),
                 }
             }
+            (V::Finite { bits, .. }, V::U(0x7fff_ffff)) if op == B::And => V::Finite { bits: bits & 0x7fff_ffff, abs: true },
+            (V::Finite { abs: true, .. }, V::U(c)) if c >= 0x7f80_0000 => match op {
+                // |bits| ≤ 0x7f7fffff < c on both sides.
+                B::Less | B::LessEqual | B::NotEqual => V::B(true),
+                B::Greater | B::GreaterEqual | B::Equal => V::B(false),
+                other => panic!("unsupported operator {other:?} on the bits of an inexact value"),
+            },
             (V::U(x), V::U(y)) => match op {
                 B::Add => V::U(x.wrapping_add(y)),
                 B::Subtract => V::U(x.wrapping_sub(y)),
@@ -346,6 +418,29 @@ impl Program {
         self.f(r, g, d, None)
     }
 
+    /// sin (or cos) of x: see the module docs for the bound.
+    fn trig(&self, sin: bool, x: f32, gx: f32, dx: Dev) -> V {
+        let rx = dx.radius();
+        let pi = std::f64::consts::PI;
+        assert!(
+            x.is_finite() && (x as f64).abs() + rx <= pi && (gx as f64).abs() <= pi,
+            "{}({x:e} ± {rx:e}) outside [-π, π], where WGSL bounds its error",
+            if sin { "sin" } else { "cos" }
+        );
+        let (x64, gx64) = (x as f64, gx as f64);
+        let (r, exact, slope, g64) = if sin {
+            (x.sin(), x64.sin(), x64.cos(), gx64.sin())
+        } else {
+            (x.cos(), x64.cos(), -x64.sin(), gx64.cos())
+        };
+        let mut d = Dev::lin(slope, &dx, 0.0, &Dev::default());
+        d.rem += 0.5 * rx * rx;
+        let cpu_err = (r as f64 - exact).abs();
+        let d = self.fresh(d, self.trig_allowance.get() + cpu_err + 2f64.powi(-50));
+        let g = (g64 + self.gpu.get().trig * self.trig_allowance.get()) as f32;
+        self.f(r, g, d, None)
+    }
+
     fn math(&self, fun: M, a: V, b: Option<V>, c: Option<V>) -> V {
         let inf = Dev::default();
         match (fun, a, b, c) {
@@ -361,6 +456,7 @@ impl Program {
             (M::Max, V::F { v, g, d, .. }, Some(V::F { v: w, g: gw, d: dw, .. }), None) => {
                 self.clamp(v, g, d, w, gw, &dw, f32::INFINITY, f32::INFINITY, &inf)
             }
+            (M::Sin | M::Cos, V::F { v, g, d, .. }, None, None) => self.trig(fun == M::Sin, v, g, d),
             (M::Min, V::U(x), Some(V::U(y)), None) => V::U(x.min(y)),
             (M::Max, V::U(x), Some(V::U(y)), None) => V::U(x.max(y)),
             (M::Clamp, V::U(x), Some(V::U(lo)), Some(V::U(hi))) => V::U(x.max(lo).min(hi)),
@@ -476,16 +572,22 @@ impl Frame<'_, '_> {
                 let v = self.expr(*expr);
                 match (v, kind, convert) {
                     (V::F { v, g, d, .. }, ScalarKind::Uint, None) => {
-                        // Exact unless the value is subnormal and may have been flushed to ±0;
-                        // the emitted code only tests the bits for NaN, which neither is.
                         let r = d.radius();
-                        assert!(
-                            r == 0.0 || (v.abs() < f32::MIN_POSITIVE && r <= f32::MIN_POSITIVE as f64),
-                            "bitcast of an inexact value"
-                        );
                         let nan = |x: f32| (x.to_bits() & 0x7fff_ffff) > 0x7f80_0000;
                         assert_eq!(nan(g), nan(v), "simulated GPU bitcast differs in NaN-ness");
-                        V::U(v.to_bits())
+                        if r == 0.0 || (v.abs() < f32::MIN_POSITIVE && r <= f32::MIN_POSITIVE as f64) {
+                            // Exact unless the value is subnormal and may have been flushed to
+                            // ±0; the emitted code only tests the bits for NaN, which neither is.
+                            V::U(v.to_bits())
+                        } else {
+                            // Inexact but finite on both sides (|v| + r below f32::MAX): the
+                            // bits differ, their NaN test does not.
+                            assert!(
+                                v.is_finite() && (v.abs() as f64 + r) < f32::MAX as f64 && g.is_finite(),
+                                "bitcast of an inexact value that may not be finite ({v:e} ± {r:e})"
+                            );
+                            V::Finite { bits: v.to_bits(), abs: false }
+                        }
                     }
                     (V::U(u), ScalarKind::Float, None) => p.exact(f32::from_bits(u)),
                     (V::F { v, g, d, .. }, ScalarKind::Uint, Some(4)) => {
