@@ -33,12 +33,32 @@ fn max_abs(r: &DVector<f64>) -> f64 {
     r.iter().fold(0.0_f64, |m, v| if v.is_nan() { f64::INFINITY } else { m.max(v.abs()) })
 }
 
-/// Solve the linearised LP; returns (δ, predicted max).
-fn lp_step(r: &DVector<f64>, j: &DMatrix<f64>, bounds: &[f64]) -> Option<(DVector<f64>, f64)> {
+/// Samples in the LP: all of them up to [`FULL_LP`]; above, the `max(8·params, FULL_LP / 2)`
+/// largest |r_i|. The minimax optimum is decided by its extremal samples, and every candidate
+/// step is still judged on all samples (a sample left out that would become the largest makes
+/// the step fail the ratio test and shrink), so this changes the cost, not the answer: the
+/// simplex work grows faster than linearly in the rows.
+const FULL_LP: usize = 512;
+
+fn working_set(r: &DVector<f64>, n_params: usize) -> Vec<usize> {
+    let mut idx: Vec<usize> = (0..r.len()).collect();
+    if r.len() <= FULL_LP {
+        return idx;
+    }
+    let k = (8 * n_params).max(FULL_LP / 2).min(r.len());
+    // Largest |r| first; ties by index, so the set is deterministic.
+    idx.sort_by(|&a, &b| r[b].abs().total_cmp(&r[a].abs()).then(a.cmp(&b)));
+    idx.truncate(k);
+    idx.sort_unstable();
+    idx
+}
+
+/// Solve the linearised LP on the samples `rows`; returns (δ, predicted max).
+fn lp_step(r: &DVector<f64>, j: &DMatrix<f64>, bounds: &[f64], rows: &[usize]) -> Option<(DVector<f64>, f64)> {
     let mut lp = Lp::new(OptimizationDirection::Minimize);
     let deltas: Vec<_> = bounds.iter().map(|&b| lp.add_var(0.0, (-b, b))).collect();
     let t = lp.add_var(1.0, (0.0, f64::INFINITY));
-    for i in 0..r.len() {
+    for &i in rows {
         let row: Vec<(microlp::Variable, f64)> =
             deltas.iter().enumerate().map(|(k, &d)| (d, j[(i, k)])).filter(|(_, v)| *v != 0.0).collect();
         let mut upper = row.clone();
@@ -76,9 +96,10 @@ where
         let j = problem.jacobian(&theta)?;
         let norm = theta.iter().fold(0.0_f64, |a, v| a.max(v.abs())).max(1e-12);
         let scale: Vec<f64> = theta.iter().map(|v| v.abs().max(1e-3 * norm)).collect();
+        let rows = working_set(&r, theta.len());
         for _ in 0..40 {
             let bounds: Vec<f64> = scale.iter().map(|s| self.rho * s).collect();
-            let Some((delta, predicted)) = lp_step(&r, &j, &bounds) else {
+            let Some((delta, predicted)) = lp_step(&r, &j, &bounds, &rows) else {
                 self.rho *= 0.25;
                 continue;
             };
