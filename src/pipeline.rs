@@ -78,17 +78,22 @@ pub fn input_hash(spec: &Spec) -> String {
     format!("sha256:{}", d.iter().map(|b| format!("{b:02x}")).collect::<String>())
 }
 
-/// Tensor grid over axes with the given counts, first axis fastest.
+/// Tensor grid over the spec's axes with the given counts, first axis fastest.
 pub fn grid(spec: &Spec, counts: &[usize]) -> Vec<Vec<f64>> {
-    let axes: Vec<Vec<f64>> = spec.file.axis.iter().zip(counts).map(|(a, &n)| a.points(n)).collect();
+    tensor(&spec.file.axis, counts)
+}
+
+/// Tensor grid over some axes with the given counts, first axis fastest.
+fn tensor(axes: &[crate::spec::AxisSpec], counts: &[usize]) -> Vec<Vec<f64>> {
+    let pts: Vec<Vec<f64>> = axes.iter().zip(counts).map(|(a, &n)| a.points(n)).collect();
     let total: usize = counts.iter().product();
     (0..total)
         .map(|mut k| {
-            axes.iter()
-                .map(|pts| {
-                    let i = k % pts.len();
-                    k /= pts.len();
-                    pts[i]
+            pts.iter()
+                .map(|p| {
+                    let i = k % p.len();
+                    k /= p.len();
+                    p[i]
                 })
                 .collect()
         })

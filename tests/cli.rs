@@ -1,24 +1,10 @@
 //! The CLI contract, end to end through the binary: JSON keys, exit codes, bad input, NIST.
 
+mod common;
+
+use common::*;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn shadefit(args: &[&str], dir: Option<&Path>) -> Output {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_shadefit"));
-    c.args(args);
-    if let Some(d) = dir {
-        c.current_dir(d);
-    }
-    c.output().expect("the binary runs")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
+use std::process::Command;
 
 #[test]
 fn eval_json_contract() {
@@ -61,25 +47,6 @@ fn eval_bad_parameters_exit_2() {
     }
     let o = shadefit(&["eval", "gloss-length", "gloss=nan"], None);
     assert!(stderr(&o).contains("'gloss'"), "names the field: {}", stderr(&o));
-}
-
-/// A scratch project: a copy of fits/ plus an empty generated/ folder.
-fn scratch() -> tempfile::TempDir {
-    let d = tempfile::tempdir().unwrap();
-    std::fs::create_dir(d.path().join("fits")).unwrap();
-    for e in std::fs::read_dir(root().join("fits")).unwrap() {
-        let p = e.unwrap().path();
-        if p.extension().is_some_and(|x| x == "toml") {
-            std::fs::copy(&p, d.path().join("fits").join(p.file_name().unwrap())).unwrap();
-        }
-    }
-    d
-}
-
-fn assert_nothing_written(d: &Path) {
-    let g = d.join("generated");
-    let n = std::fs::read_dir(&g).map(|r| r.count()).unwrap_or(0);
-    assert_eq!(n, 0, "a failed build must write nothing");
 }
 
 fn bad_spec_case(file: &str, edit: impl Fn(&str) -> String, line: usize, field: &str) {
@@ -141,35 +108,6 @@ fn build_check_passes_on_committed_tree_and_catches_a_changed_spec() {
     assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
     assert!(stderr(&o).contains("gloss_table"), "{}", stderr(&o));
     assert_eq!(before, snapshot(&d.path().join("generated")));
-}
-
-fn copy_dir(from: &Path, to: &Path) {
-    std::fs::create_dir_all(to).unwrap();
-    for e in std::fs::read_dir(from).unwrap() {
-        let p = e.unwrap().path();
-        if p.is_dir() {
-            copy_dir(&p, &to.join(p.file_name().unwrap()));
-        } else {
-            std::fs::copy(&p, to.join(p.file_name().unwrap())).unwrap();
-        }
-    }
-}
-
-fn snapshot(dir: &Path) -> Vec<(PathBuf, Vec<u8>)> {
-    let mut out = Vec::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(d) = stack.pop() {
-        for e in std::fs::read_dir(&d).unwrap() {
-            let p = e.unwrap().path();
-            if p.is_dir() {
-                stack.push(p);
-            } else {
-                out.push((p.strip_prefix(dir).unwrap().to_path_buf(), std::fs::read(&p).unwrap()));
-            }
-        }
-    }
-    out.sort();
-    out
 }
 
 #[test]

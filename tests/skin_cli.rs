@@ -2,25 +2,11 @@
 //! bad profiles (exit 2, file/line/field named, nothing written), CSV profiles in specs and the
 //! staleness they cause, determinism across thread counts, and the committed LUTs' limits.
 
-use std::path::{Path, PathBuf};
+mod common;
+
+use common::*;
+use std::path::Path;
 use std::process::{Command, Output};
-
-fn shadefit(args: &[&str], dir: Option<&Path>) -> Output {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_shadefit"));
-    c.args(args);
-    if let Some(d) = dir {
-        c.current_dir(d);
-    }
-    c.output().expect("the binary runs")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
 
 fn json(o: &Output) -> serde_json::Value {
     assert!(o.status.success(), "{}", stderr(o));
@@ -29,24 +15,6 @@ fn json(o: &Output) -> serde_json::Value {
 
 fn rgb(v: &serde_json::Value) -> Vec<f64> {
     v["value"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect()
-}
-
-/// A scratch project: a copy of fits/*.toml and no generated/ folder.
-fn scratch() -> tempfile::TempDir {
-    let d = tempfile::tempdir().unwrap();
-    std::fs::create_dir(d.path().join("fits")).unwrap();
-    for e in std::fs::read_dir(root().join("fits")).unwrap() {
-        let p = e.unwrap().path();
-        if p.extension().is_some_and(|x| x == "toml") {
-            std::fs::copy(&p, d.path().join("fits").join(p.file_name().unwrap())).unwrap();
-        }
-    }
-    d
-}
-
-fn assert_nothing_written(d: &Path) {
-    let n = std::fs::read_dir(d.join("generated")).map(|r| r.count()).unwrap_or(0);
-    assert_eq!(n, 0, "a failed build must write nothing");
 }
 
 const SIX_GAUSSIANS: &str = "[profile]\ngaussians = [\n\
@@ -164,23 +132,6 @@ fn build_rejects_bad_profiles_and_writes_nothing() {
     bad_build(|t| t.replace("curvature_max = 1.0", "curvature_max = 0.0"), &[], "skin_punctual_lut.toml", line("curvature_max"), "curvature_max");
     bad_build(|t| t.replace("resolution = [65, 64]", "resolution = [65]"), &[], "skin_punctual_lut.toml", line("resolution"), "resolution");
     bad_build(|t| t.replace("kernel = \"linear\"", "kernel = \"gaussian\""), &[], "skin_punctual_lut.toml", line("kernel"), "kernel");
-}
-
-fn snapshot(dir: &Path) -> Vec<(PathBuf, Vec<u8>)> {
-    let mut out = Vec::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(d) = stack.pop() {
-        for e in std::fs::read_dir(&d).unwrap() {
-            let p = e.unwrap().path();
-            if p.is_dir() {
-                stack.push(p);
-            } else {
-                out.push((p.strip_prefix(dir).unwrap().to_path_buf(), std::fs::read(&p).unwrap()));
-            }
-        }
-    }
-    out.sort();
-    out
 }
 
 #[test]

@@ -122,6 +122,34 @@ fn inputs(f: &FieldsFunction<'_>, clamp_fn: &str, lit: &dyn Fn(f32) -> String, c
         .collect()
 }
 
+/// One line per field, `        EXPR,`, coefficients named `{UPPER}_NUM{k}{suffix}[j]`.
+fn field_lines(f: &FieldsFunction<'_>, suffix: &str, lit: &dyn Fn(f32) -> String) -> String {
+    let upper = f.module.to_uppercase();
+    f.fields
+        .iter()
+        .enumerate()
+        .map(|(k, fl)| {
+            let e = render(
+                &fl.expr,
+                &|i| format!("x{i}"),
+                &|a, j| format!("{upper}_{}{k}{suffix}[{j}]", if a == 0 { "NUM" } else { "DEN" }),
+                lit,
+            );
+            format!("        {e},\n")
+        })
+        .collect()
+}
+
+/// The evaluator's argument lines `    let a{i} = CLAMP(arg, lo, hi);`.
+fn evaluator_inputs(f: &FieldsFunction<'_>, clamp_fn: &str, lit: &dyn Fn(f32) -> String) -> String {
+    f.eval_args
+        .iter()
+        .zip(f.eval_domain)
+        .enumerate()
+        .map(|(i, (a, (lo, hi)))| format!("    let a{i} = {clamp_fn}({a}, {}, {});\n", lit(*lo), lit(*hi)))
+        .collect()
+}
+
 pub fn render_wgsl(header: &[String], f: &FieldsFunction<'_>) -> String {
     let upper = f.module.to_uppercase();
     let m = f.module;
@@ -144,20 +172,7 @@ pub fn render_wgsl(header: &[String], f: &FieldsFunction<'_>) -> String {
         }
     }
     let params: Vec<String> = f.args.iter().map(|a| format!("{a}: f32")).collect();
-    let body: Vec<String> = f
-        .fields
-        .iter()
-        .enumerate()
-        .map(|(k, fl)| {
-            let e = render(
-                &fl.expr,
-                &|i| format!("x{i}"),
-                &|a, j| format!("{upper}_{}{k}[{j}]", if a == 0 { "NUM" } else { "DEN" }),
-                &wlit,
-            );
-            format!("        {e},\n")
-        })
-        .collect();
+    let body = field_lines(f, "", &wlit);
     s.push_str(&format!(
         "\n// The {nk} coefficients at ({args}); evaluate once per material and pass them to {ev}.\n\
          fn {name}({params}) -> array<f32, {nk}> {{\n{inputs}    return array<f32, {nk}>(\n{body}    );\n}}\n",
@@ -166,16 +181,10 @@ pub fn render_wgsl(header: &[String], f: &FieldsFunction<'_>) -> String {
         name = f.name,
         params = params.join(", "),
         inputs = inputs(f, &format!("{m}_input"), &wlit, &|fun, v| format!("{fun}({v})")),
-        body = body.concat(),
+        body = body,
     ));
     let eparams: Vec<String> = f.eval_args.iter().map(|a| format!("{a}: f32")).collect();
-    let eins: String = f
-        .eval_args
-        .iter()
-        .zip(f.eval_domain)
-        .enumerate()
-        .map(|(i, (a, (lo, hi)))| format!("    let a{i} = {m}_input({a}, {}, {});\n", wlit(*lo), wlit(*hi)))
-        .collect();
+    let eins = evaluator_inputs(f, &format!("{m}_input"), &wlit);
     let sum = basis_sum(f.terms, &|k| format!("c[{k}]"), &|i| format!("a{i}"));
     s.push_str(&format!(
         "\n// Σ c_k b_k({eargs}), clamped to [{lo}, {hi}].\nfn {ev}(c: array<f32, {nk}>, {eparams}) -> f32 {{\n{eins}    \
@@ -218,20 +227,7 @@ pub fn render_rust(header: &[String], f: &FieldsFunction<'_>, doc: &str, c64: &[
         }
     }
     let params: Vec<String> = f.args.iter().map(|a| format!("{a}: f32")).collect();
-    let body: Vec<String> = f
-        .fields
-        .iter()
-        .enumerate()
-        .map(|(k, fl)| {
-            let e = render(
-                &fl.expr,
-                &|i| format!("x{i}"),
-                &|a, j| format!("{upper}_{}{k}[{j}]", if a == 0 { "NUM" } else { "DEN" }),
-                &rlit,
-            );
-            format!("        {e},\n")
-        })
-        .collect();
+    let body = field_lines(f, "", &rlit);
     s.push_str(&format!(
         "\n/// CPU version of the WGSL function of the same name: the {nk} coefficients at ({args}).\n\
          pub fn {name}({params}) -> [f32; {nk}] {{\n{inputs}    [\n{body}    ]\n}}\n",
@@ -239,7 +235,7 @@ pub fn render_rust(header: &[String], f: &FieldsFunction<'_>, doc: &str, c64: &[
         name = f.name,
         params = params.join(", "),
         inputs = inputs(f, "input", &rlit, &|fun, v| format!("{v}.{fun}()")),
-        body = body.concat(),
+        body = body,
     ));
     // The f64 version: same expressions, full-precision coefficients, no f32 rounding.
     for (k, (num, den)) in c64.iter().enumerate() {
@@ -263,36 +259,17 @@ pub fn render_rust(header: &[String], f: &FieldsFunction<'_>, doc: &str, c64: &[
             )
         }))
         .collect();
-    let body64: Vec<String> = f
-        .fields
-        .iter()
-        .enumerate()
-        .map(|(k, fl)| {
-            let e = render(
-                &fl.expr,
-                &|i| format!("x{i}"),
-                &|a, j| format!("{upper}_{}{k}_F64[{j}]", if a == 0 { "NUM" } else { "DEN" }),
-                &|v| rlit64(v as f64),
-            );
-            format!("        {e},\n")
-        })
-        .collect();
+    let body64 = field_lines(f, "_F64", &|v| rlit64(v as f64));
     s.push_str(&format!(
         "\n/// The coefficients in f64 from the unrounded fit, for evaluation at build time (e.g. to\n\
          /// bake them into a material's uniforms); rounds to f32 at most once, at the caller.\n\
          pub fn {name}_f64({params}) -> [f64; {nk}] {{\n{inputs64}    [\n{body}    ]\n}}\n",
         name = f.name,
         params = params64.join(", "),
-        body = body64.concat(),
+        body = body64,
     ));
     let eparams: Vec<String> = f.eval_args.iter().map(|a| format!("{a}: f32")).collect();
-    let eins: String = f
-        .eval_args
-        .iter()
-        .zip(f.eval_domain)
-        .enumerate()
-        .map(|(i, (a, (lo, hi)))| format!("    let a{i} = input({a}, {}, {});\n", rlit(*lo), rlit(*hi)))
-        .collect();
+    let eins = evaluator_inputs(f, "input", &rlit);
     let sum = basis_sum(f.terms, &|k| format!("c[{k}]"), &|i| format!("a{i}"));
     s.push_str(&format!(
         "\n/// CPU version of the WGSL function of the same name: Σ c_k b_k({eargs}), clamped to [{lo}, {hi}].\n\

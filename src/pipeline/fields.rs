@@ -3,7 +3,7 @@
 //! positive on the outer domain, verify on the verification grids in f64 and in the emitted
 //! f32 arithmetic, emit WGSL, Rust and JSON.
 
-use super::{committed_json, fmt_err, input_hash, json_text, spec_rel_path, BuildError, Built, Mode, Verification};
+use super::{committed_json, fmt_err, input_hash, json_text, spec_rel_path, tensor, BuildError, Built, Mode, Verification};
 use crate::emit::expr::{self, model_expr};
 use crate::emit::fields::{self as efields, Field, FieldsFunction};
 use crate::emit::{header_lines, Artifact, GENERATOR};
@@ -16,23 +16,6 @@ use crate::spec::{AxisSpec, Spec};
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 use serde_json::{json, Value};
-
-/// Tensor grid over some axes with the given counts, first axis fastest.
-fn tensor(axes: &[AxisSpec], counts: &[usize]) -> Vec<Vec<f64>> {
-    let pts: Vec<Vec<f64>> = axes.iter().zip(counts).map(|(a, &n)| a.points(n)).collect();
-    let total: usize = counts.iter().product();
-    (0..total)
-        .map(|mut k| {
-            pts.iter()
-                .map(|p| {
-                    let i = k % p.len();
-                    k /= p.len();
-                    p[i]
-                })
-                .collect()
-        })
-        .collect()
-}
 
 struct Layout<'a> {
     basis: &'static InnerBasis,
