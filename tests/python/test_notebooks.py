@@ -10,7 +10,9 @@ Committed notebooks carry no outputs (they are generated from generated/ and the
 run); the executed copies go to out/notebooks/ with the time each took (out/notebooks.json).
 
 NOTEBOOK_TIMEOUT bounds a whole notebook (each cell gets what is left of it): the slowest,
-fuzz.ipynb, runs `shadefit samples` for P_s and R (~15 s of integration on two cores).
+fuzz.ipynb, takes ~15 s on two cores (`shadefit samples fuzz_ps`, 627 264 integrals, and 54
+`eval fuzz-r`), validate.ipynb ~10 s (`shadefit validate`); the limit leaves room for a busy
+machine.
 """
 
 from __future__ import annotations
