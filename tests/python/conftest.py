@@ -9,7 +9,10 @@ generated/json files against independent scipy/nlopt computations:
                         out/fit_comparison.json);
 * test_nist.py       -- `shadefit fit` on NIST StRD MGH09 and Kirby2 (certified RSS), beside scipy;
 * test_generated.py  -- the generated JSON files (fits and tables) re-evaluated in numpy on their
-                        verification grids: their error claims confirmed.
+                        verification grids: their error claims confirmed; the two-stage fit
+                        (fuzz_ps.json) against `shadefit eval` at a subset of its grid;
+* test_skin.py       -- `shadefit eval` of the skin quantities against scipy, the skin LUT files;
+* test_notebooks.py  -- every notebook in notebooks/ executed headless without a cell error.
 
 Artefacts go to tests/python/out/ (gitignored; $SHADEFIT_PYTEST_OUT overrides).
 """

@@ -11,6 +11,8 @@ numerator coefficient, so c = M theta + b over the free parameters theta (the re
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 
 
@@ -30,6 +32,66 @@ def term_values(term: str, features: list[str], x: np.ndarray) -> np.ndarray:
             v = v * x[:, features.index(name)] ** (int(power) if power else 1)
         total += v
     return total
+
+
+# Derived features, as generated/json writes their definitions: "OFFSET + SCALE*NAME", "cos(NAME)",
+# "sin(NAME)" (numbers in round-trip decimal).
+_AFFINE = re.compile(r"^(\S+) \+ (\S+)\*(\w+)$")
+_TRIG = re.compile(r"^(sin|cos)\((\w+)\)$")
+
+
+def derived_value(definition: str, cols: dict) -> np.ndarray:
+    m = _AFFINE.match(definition.strip())
+    if m:
+        return float(m[1]) + float(m[2]) * cols[m[3]]
+    m = _TRIG.match(definition.strip())
+    if m:
+        return (np.sin if m[1] == "sin" else np.cos)(cols[m[2]])
+    raise ValueError(f"derived feature definition {definition!r} not understood")
+
+
+def model_inputs(m: dict) -> list[str]:
+    """The features of a generated/json model that are inputs (not derived), in order."""
+    derived = {d["name"] for d in m.get("derived") or []}
+    return [f for f in m["features"] if f not in derived]
+
+
+def feature_matrix(m: dict, x) -> np.ndarray:
+    """Values of every feature of a generated/json model (`features`, `derived`) at points x
+    (shape (n, inputs)), columns in `features` order."""
+    x = np.atleast_2d(np.asarray(x, dtype=float))
+    inputs = model_inputs(m)
+    assert x.shape[1] == len(inputs), (x.shape, inputs)
+    cols = {name: x[:, i] for i, name in enumerate(inputs)}
+    for d in m.get("derived") or []:
+        cols[d["name"]] = derived_value(d["definition"], cols)
+    return np.stack([cols[f] for f in m["features"]], axis=1)
+
+
+def model_pq(m: dict, c, x) -> tuple[np.ndarray, np.ndarray]:
+    """P and Q of a generated/json model (`form`: offset + factor * P / Q,
+    Q = denominator_lead + sum(den)) with coefficients c = [p..., q...] at input points x."""
+    c = np.asarray(c, dtype=float)
+    f = feature_matrix(m, x)
+    feats = m["features"]
+    nn = len(m["numerator"])
+    p = sum(cj * term_values(t, feats, f) for t, cj in zip(m["numerator"], c[:nn]))
+    q = term_values(m.get("denominator_lead") or "1", feats, f)
+    for t, cj in zip(m["denominator"], c[nn:]):
+        q = q + cj * term_values(t, feats, f)
+    return p + np.zeros(f.shape[0]), q
+
+
+def model_value(m: dict, c, x, offset: float | None = None) -> np.ndarray:
+    """offset + factor * P / Q, clamped if the model has a clamp (f64). `offset` overrides the
+    model's (a field of a kind "fields" file carries its own)."""
+    p, q = model_pq(m, c, x)
+    f = feature_matrix(m, x)
+    factor = term_values(m["factor"], m["features"], f) if m.get("factor") else 1.0
+    v = (m.get("offset", 0.0) if offset is None else offset) + factor * p / q
+    if m.get("clamp") is not None:
+        v = np.clip(v, *m["clamp"])
+    return v
 
 
 class Rational:

@@ -19,21 +19,28 @@ Tolerances:
   gamma_K = K u / (1 - K u), u = 2^-24, K the longest chain of roundings.
 * f32 tables: the lookup is replayed operation for operation in numpy float32 (IEEE single, no
   FMA, like the emitted Rust), so only F64_TOL (the truth) applies.
+
+Two-stage fits (kind "fields", generated/json/fuzz_ps.json) are checked at the end of this file
+against `shadefit eval` at a seeded subset of their verification grid.
 """
 
 from __future__ import annotations
+
+import tomllib
 
 import numpy as np
 import pytest
 
 import sf_cli
 import sf_reference as ref
-from sf_rational import Rational
+from sf_rational import Rational, model_inputs, model_pq, model_value, term_values
 
 F64_TOL = 1e-9
-# Fits and tables; skin LUTs (kind "skin-lut", RGB textures) are checked in test_skin.py.
-NAMES = sorted(p.stem for p in (sf_cli.ROOT / "generated" / "json").glob("*.json")
-               if sf_cli.generated(p.stem)["kind"] != "skin-lut")
+KINDS = {p.stem: sf_cli.generated(p.stem)["kind"] for p in (sf_cli.ROOT / "generated" / "json").glob("*.json")}
+# Fits and tables; skin LUTs (kind "skin-lut", RGB textures) are checked in test_skin.py, two-stage
+# fits (kind "fields") at the end of this file.
+NAMES = sorted(n for n, k in KINDS.items() if k in ("fit", "table"))
+FIELDS = sorted(n for n, k in KINDS.items() if k == "fields")
 
 
 @pytest.fixture(scope="module")
@@ -64,7 +71,8 @@ REFERENCED = ("gloss-length", "gloss-from-length", "gloss-combine")
 def load(name):
     g = sf_cli.generated(name)
     if g["quantity"] not in REFERENCED:
-        pytest.skip(f"no independent reference for quantity {g['quantity']!r} in this suite")
+        pytest.skip(f"no independent reference for quantity {g['quantity']!r} in this suite "
+                    "(its claim is checked against eval in test_fit_error_claim_bounds_eval)")
     return g
 
 
@@ -282,17 +290,171 @@ def test_table_values_are_the_integral(name, inverse):
     assert err.max() <= F64_TOL, (x[int(err.argmax())], values[int(err.argmax())], want[int(err.argmax())])
 
 
-@pytest.mark.parametrize("name", [n for n in NAMES if sf_cli.generated(n)["kind"] == "fit"])
+def dense_grid(axes, n):
+    mesh = np.meshgrid(*[np.linspace(*a["range"], n) for a in axes], indexing="ij")
+    return np.stack([v.ravel() for v in mesh], axis=1)
+
+
+@pytest.mark.parametrize("name", [n for n in NAMES if KINDS[n] == "fit"])
 def test_denominator_lower_bound_holds(name):
     """`denominator_lower_bound` is a proven lower bound of Q on the domain: it must be positive
     and not above Q's minimum on a dense grid (which is >= the true minimum)."""
     g = sf_cli.generated(name)
     m = g["model"]
-    if m.get("derived") or m.get("denominator_lead", "1") != "1":
-        pytest.skip("lead/derived features: not covered by this suite's model")
-    model = Rational(m["features"], m["numerator"], m["denominator"], m["clamp"])
-    n = 20001 if len(g["axes"]) == 1 else 513
-    mesh = np.meshgrid(*[np.linspace(*a["range"], n) for a in g["axes"]], indexing="ij")
-    x = np.stack([v.ravel() for v in mesh], axis=1)
-    qmin = model.bind(x).q_min(np.array(m["coefficients"]))
+    assert model_inputs(m) == [a["name"] for a in g["axes"]]
+    x = dense_grid(g["axes"], 20001 if len(g["axes"]) == 1 else 513)
+    # Q = denominator_lead + sum(den), derived features included (sf_rational.model_pq).
+    qmin = float(np.min(model_pq(m, m["coefficients"], x)[1]))
     assert 0.0 < m["denominator_lower_bound"] <= qmin * (1 + 1e-12), (m["denominator_lower_bound"], qmin)
+
+
+# ---------------------------------------------------------------------------------------------
+# Fits of quantities with no scipy reference here (fuzz G, Q, R): their claims against
+# `shadefit eval` (the integral), at a seeded subset of the verification grid and the claimed
+# worst point, in f64 through the generated model form (sf_rational.model_value: derived
+# features, denominator lead, offset, factor). Not independent of shadefit's integrator, but it
+# ties the file's coefficients and error claim to the integral `eval` serves.
+
+FIT_EVAL_POINTS = 12   # per file, + the worst point (fuzz-r: ~40 ms a point)
+
+
+@pytest.mark.parametrize("name", [n for n in NAMES if KINDS[n] == "fit"
+                                  and sf_cli.generated(n)["quantity"] not in REFERENCED])
+def test_fit_error_claim_bounds_eval(name):
+    """As test_fields_error_claim_bounds_eval, for a kind "fit" file: the subset's errors are at
+    most the claimed maximum (they are points of its grid), the worst point's is the maximum.
+    Tolerance: the spec's integrator tolerance (the verification's truth), eval's error
+    estimate, and 1e-12 for the f64 model sum's rounding."""
+    g = sf_cli.generated(name)
+    m, ver = g["model"], g["verification"]
+    c = np.array(m["coefficients"], dtype=float)
+    nn = len(m["numerator"])
+    # The f32 arrays are the f64 coefficients rounded to f32.
+    assert m["numerator_f32"] == [float(np.float32(v)) for v in c[:nn]]
+    assert m["denominator_f32"] == [float(np.float32(v)) for v in c[nn:]]
+    x_all = grid(g["axes"], "verify")
+    assert ver["points"] == x_all.shape[0]
+    worst = np.array(ver["worst_point"], dtype=float)
+    assert np.any(np.all(np.abs(x_all - worst) <= 1e-15, axis=1)), worst
+    rng = np.random.default_rng(20250612)
+    x = np.vstack([x_all[rng.choice(x_all.shape[0], FIT_EVAL_POINTS, replace=False)], worst])
+    approx = model_value(m, c, x)
+    names = [a["name"] for a in g["axes"]]
+    tol_spec = spec_tolerance(g)
+    errs = []
+    for p, a in zip(x, approx):
+        out = sf_cli.eval_point(g["quantity"], **{k: float(v) for k, v in zip(names, p)})
+        errs.append((abs(a - out["value"]), out["error_estimate"], p))
+    for e, est, p in errs:
+        assert e <= ver["max_abs_error"] + tol_spec + est + 1e-12, (p.tolist(), e, ver["max_abs_error"])
+    e, est, _ = errs[-1]
+    assert abs(e - ver["max_abs_error"]) <= tol_spec + est + 1e-12, (worst.tolist(), e, ver["max_abs_error"])
+
+
+# ---------------------------------------------------------------------------------------------
+# Two-stage fits (kind "fields"): coefficient fields c_k(outer) = offset_k + factor * P_k / Q_k
+# over the outer axes (fuzz_ps: alpha, theta_f), each the generated/json model form with its own
+# offset and coefficients, combined by the inner basis (fuzz_ps: P~_s = c0 + c1 n.u + c2 t.u +
+# c3 (n.u)^2 + c4 (n.u)(t.u) + c5 (t.u)^2) and clamped to the basis range.
+#
+# Reference: `shadefit eval QUANTITY` (the integral, one process per point; eval takes one point,
+# so the subset is small). Light direction (theta_u, phi_u) -> arguments, from the spec's
+# conventions (normal +z, fiber t = (sin theta_f, 0, cos theta_f), phi_u from the fiber azimuth):
+#   n.u = cos theta_u,   t.u = sin theta_u cos phi_u sin theta_f + cos theta_u cos theta_f.
+
+FIELD_OUTER_POINTS = 8   # seeded subset of the outer verification grid (fuzz_ps: 15 x 15)
+FIELD_INNER_POINTS = 6   # light directions per outer point, of the inner grid (fuzz_ps: 25 x 25)
+# 8 x 6 + the claimed worst point = 49 `eval` processes (a few ms each).
+
+
+def fields_args(quantity, outer, inner):
+    if quantity != "fuzz-ps":
+        raise AssertionError(f"no light-direction convention for quantity {quantity!r} in this suite")
+    theta_f, theta_u, phi_u = outer[:, 1], inner[:, 0], inner[:, 1]
+    n_u = np.cos(theta_u)
+    t_u = np.sin(theta_u) * np.cos(phi_u) * np.sin(theta_f) + np.cos(theta_u) * np.cos(theta_f)
+    return np.stack([n_u, t_u], axis=1)
+
+
+def fields_value(g, x):
+    """The two-stage form in f64 at points x = (outer..., inner...) (rows)."""
+    m, basis = g["model"], g["basis"]
+    n_outer = len(model_inputs(m))
+    outer, inner = x[:, :n_outer], x[:, n_outer:]
+    args = fields_args(g["quantity"], outer, inner)
+    total = np.zeros(x.shape[0])
+    assert len(g["fields"]) == len(basis["terms"])
+    for f, term in zip(g["fields"], basis["terms"]):
+        ck = model_value(m, f["coefficients"], outer, offset=f["offset"])
+        total += ck * term_values(term, basis["arguments"], args)
+    return np.clip(total, *basis["range"])
+
+
+def spec_tolerance(g):
+    """The integrator's absolute tolerance per sample of the spec the file came from."""
+    spec = tomllib.loads((sf_cli.ROOT / g["spec"]).read_text())
+    return float(spec.get("tolerance", 1e-12))   # the spec schema's default (README)
+
+
+@pytest.mark.parametrize("name", FIELDS)
+def test_fields_error_claim_bounds_eval(name):
+    """At a seeded subset of the verification grid (plus the claimed worst point), P~ in numpy f64
+    against `shadefit eval`. The subset's points are points of the grid the claim
+    `verification.max_abs_error` was measured on, so that maximum bounds their error; at the
+    claimed worst point the error must be the maximum itself.
+
+    Tolerance: the verification's samples were integrated to the spec's `tolerance` (1e-9 for
+    fuzz_ps), eval's to its reported `error_estimate` (1e-12); the model sum in f64 differs from
+    shadefit's by rounding (~1e-15, within 1e-12)."""
+    g = sf_cli.generated(name)
+    ver = g["verification"]
+    axes = g["axes"]
+    n_outer = len(model_inputs(g["model"]))
+    outer_grid = grid(axes[:n_outer], "verify")
+    inner_grid = grid(axes[n_outer:], "verify")
+    assert ver["points"] == outer_grid.shape[0] * inner_grid.shape[0]
+    rng = np.random.default_rng(20250611)
+    io = rng.choice(outer_grid.shape[0], FIELD_OUTER_POINTS, replace=False)
+    pts = [np.concatenate([outer_grid[i], inner_grid[j]])
+           for i in io for j in rng.choice(inner_grid.shape[0], FIELD_INNER_POINTS, replace=False)]
+    worst = np.array(ver["worst_point"], dtype=float)
+    # The claimed worst point is a point of the verification grid.
+    assert np.any(np.all(np.abs(outer_grid - worst[:n_outer]) <= 1e-15, axis=1)), worst
+    assert np.any(np.all(np.abs(inner_grid - worst[n_outer:]) <= 1e-15, axis=1)), worst
+    x = np.array(pts + [worst])
+    approx = fields_value(g, x)
+    names = [a["name"] for a in axes]
+    tol_spec = spec_tolerance(g)
+    errs = []
+    for p, a in zip(x, approx):
+        out = sf_cli.eval_point(g["quantity"], **{k: float(v) for k, v in zip(names, p)})
+        errs.append((abs(a - out["value"]), out["error_estimate"], p))
+    for e, est, p in errs:
+        assert e <= ver["max_abs_error"] + tol_spec + est + 1e-12, (p.tolist(), e, ver["max_abs_error"])
+    e, est, _ = errs[-1]
+    assert abs(e - ver["max_abs_error"]) <= tol_spec + est + 1e-12, (worst.tolist(), e, ver["max_abs_error"])
+
+
+@pytest.mark.parametrize("name", FIELDS)
+def test_fields_f32_arrays_are_rounded_coefficients(name):
+    g = sf_cli.generated(name)
+    nn = len(g["model"]["numerator"])
+    for k, f in enumerate(g["fields"]):
+        c = np.array(f["coefficients"], dtype=float)
+        assert len(c) == nn + len(g["model"]["denominator"]), k
+        # The f32 arrays are the f64 coefficients rounded to nearest f32 (exact comparison).
+        assert f["numerator_f32"] == [float(np.float32(v)) for v in c[:nn]], k
+        assert f["denominator_f32"] == [float(np.float32(v)) for v in c[nn:]], k
+
+
+@pytest.mark.parametrize("name", FIELDS)
+def test_fields_denominator_lower_bounds_hold(name):
+    """Each field's `denominator_lower_bound` is a proven lower bound of its Q on the outer domain:
+    positive and not above Q's minimum on a dense grid (which is >= the true minimum)."""
+    g = sf_cli.generated(name)
+    m = g["model"]
+    n_outer = len(model_inputs(m))
+    x = dense_grid(g["axes"][:n_outer], 513)
+    for k, f in enumerate(g["fields"]):
+        qmin = float(np.min(model_pq(m, f["coefficients"], x)[1]))
+        assert 0.0 < f["denominator_lower_bound"] <= qmin * (1 + 1e-12), (k, f["denominator_lower_bound"], qmin)
