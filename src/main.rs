@@ -25,7 +25,7 @@ enum Command {
     /// Tables and fits known from the specs, with whether generated/ is up to date.
     List,
     /// Evaluate an integral (not a fit) at one point: QUANTITY name=value ...
-    #[command(after_help = "Quantities:\n  gloss-length       gloss=G | alpha=A   GGX average normal length\n  gloss-from-length  length=L            gloss with that average normal length\n  gloss-combine      x=G1 y=G2           combined gloss (RNM)\n  skin-punctual      curvature=K n_dot_l=C   skin diffusion for a punctual light (RGB)\n  skin-sh            curvature=K band=L      SH band factor of skin scattering (RGB)")]
+    #[command(after_help = "Quantities:\n  gloss-length       gloss=G | alpha=A   GGX average normal length\n  gloss-from-length  length=L            gloss with that average normal length\n  gloss-combine      x=G1 y=G2           combined gloss (RNM)\n  skin-punctual      curvature=K n_dot_l=C   skin diffusion for a punctual light (RGB)\n  skin-sh            curvature=K band=L      SH band factor of skin scattering (RGB)\n  fuzz-ps            alpha=A theta_f=F theta_u=T phi_u=P   fraction the fuzz layer scatters toward the base, P_s\n  fuzz-g             mu_v=M d=D          hemispherical average G of the fuzz layer\n  fuzz-q             d=D                 average penetration Q = 2 E3(d)\n  fuzz-r             alpha=A theta_f=F   cosine-weighted average of P_s, R\n(angles in radians; `shadefit list` and README give the domains)")]
     Eval {
         quantity: String,
         /// Parameters as name=value.

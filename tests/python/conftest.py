@@ -12,6 +12,7 @@ generated/json files against independent scipy/nlopt computations:
                         verification grids: their error claims confirmed; the two-stage fit
                         (fuzz_ps.json) against `shadefit eval` at a subset of its grid;
 * test_skin.py       -- `shadefit eval` of the skin quantities against scipy, the skin LUT files;
+* test_fuzz.py       -- `shadefit eval` of the fuzz quantities (P_s, G, Q, R) against scipy/numpy;
 * test_notebooks.py  -- every notebook in notebooks/ executed headless without a cell error.
 
 Artefacts go to tests/python/out/ (gitignored; $SHADEFIT_PYTEST_OUT overrides).
