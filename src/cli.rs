@@ -4,6 +4,7 @@
 use crate::fit::{self, Data, FitOptions, Objective, RationalModel};
 use crate::pipeline::{self, Built, Mode};
 use crate::quantity;
+use crate::scene::{self, Scene};
 use crate::spec::{self, data::read_csv, ModelSpec, Spec};
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -112,6 +113,7 @@ pub fn build(paths: &Paths, only: &[String], check: bool) -> Result<()> {
     let pb = progress(selected.len(), if check { "check" } else { "build" });
     let mut built: Vec<Built> = Vec::new();
     let mut seconds: Vec<f64> = Vec::new();
+    let mut scene_names: Vec<String> = Vec::new();
     let start = std::time::Instant::now();
     for s in &selected {
         pb.set_message(s.file.name.clone());
@@ -122,8 +124,28 @@ pub fn build(paths: &Paths, only: &[String], check: bool) -> Result<()> {
         built.push(b);
     }
     pb.finish_and_clear();
+    let scenes = Scene::load_dir(&paths.fits.join("scenes")).map_err(input_err)?;
     let mut artifacts: Vec<_> = built.iter().flat_map(|b| b.artifacts.clone()).collect();
-    artifacts.push(pipeline::runtime_index(&specs));
+    if only.is_empty() {
+        // Every scene module, with the node files of this build recorded for its cache.
+        for sc in &scenes {
+            let t = std::time::Instant::now();
+            let nodes: Vec<(String, String, Vec<crate::emit::Artifact>)> = scene::plan(sc)
+                .nodes
+                .iter()
+                .filter_map(|n| {
+                    let b = built.iter().find(|b| &b.name == n)?;
+                    let spec = specs.iter().find(|s| &s.file.name == n)?;
+                    Some((n.clone(), pipeline::input_hash(spec), b.artifacts.clone()))
+                })
+                .collect();
+            let sb = scene::build_scene(sc, &specs, &paths.generated, &nodes).with_context(|| format!("building scene {}", sc.file.name))?;
+            artifacts.extend(sb.artifacts);
+            seconds.push(t.elapsed().as_secs_f64());
+            scene_names.push(sc.module());
+        }
+    }
+    artifacts.push(scene::runtime_index(&specs, &scenes, &paths.generated)?);
     if check {
         let mut bad = pipeline::stale(&paths.generated, &artifacts);
         if only.is_empty() {
@@ -146,12 +168,44 @@ pub fn build(paths: &Paths, only: &[String], check: bool) -> Result<()> {
             b.name, v.max_abs_error, v.rms_error, v.max_abs_error_f32, v.points
         );
     }
+    for (n, t) in scene_names.iter().zip(&seconds[built.len()..]) {
+        println!("{n:<22} scene module  [{t:.1} s]");
+    }
     println!(
         "{written} file(s) written, {} unchanged; {:.1} s wall on {} thread(s)",
         artifacts.len() - written,
         start.elapsed().as_secs_f64(),
         rayon::current_num_threads()
     );
+    Ok(())
+}
+
+/// `shadefit build --scene FILE [--force]`: only the nodes the scene reaches, each only when its
+/// inputs or files changed since the scene's last build, then the scene module.
+pub fn build_scene(paths: &Paths, file: &Path, force: bool) -> Result<()> {
+    let start = std::time::Instant::now();
+    let sc = Scene::load(file).map_err(input_err)?;
+    let specs = load_specs(paths, &[])?;
+    let mut scenes = Scene::load_dir(&paths.fits.join("scenes")).map_err(input_err)?;
+    if !scenes.iter().any(|s| s.file.name == sc.file.name) {
+        scenes.push(sc.clone());
+    }
+    let r = scene::build(&sc, &specs, &scenes, &paths.generated, force).with_context(|| format!("building scene {}", sc.file.name))?;
+    println!("scene {}: {} up to date, {} built", sc.file.name, r.up_to_date.len(), r.built.len());
+    println!("  built: {}", if r.built.is_empty() { "-".to_string() } else { r.built.join(", ") });
+    println!("  up to date: {}", if r.up_to_date.is_empty() { "-".to_string() } else { r.up_to_date.join(", ") });
+    println!("  not reached: {}", r.skipped.join(", "));
+    for rec in &r.records {
+        let what = rec["what"].as_str().unwrap_or("?");
+        let ours = rec.get("max_abs_error").or(rec.get("error_estimate")).and_then(|v| v.as_f64());
+        let general = rec.get("general_fit_max_abs_error").or(rec.get("general_fit_abs_error")).and_then(|v| v.as_f64());
+        println!(
+            "  {what}: error {} (general fit at the same parameters: {})",
+            ours.map_or("-".into(), |v| format!("{v:.3e}")),
+            general.map_or("-".into(), |v| format!("{v:.3e}"))
+        );
+    }
+    println!("{} file(s) written; {:.2} s wall", r.written, start.elapsed().as_secs_f64());
     Ok(())
 }
 

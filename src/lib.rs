@@ -9,5 +9,6 @@ pub mod cli;
 pub mod emit;
 pub mod pipeline;
 pub mod plot;
+pub mod scene;
 pub mod spec;
 pub mod validate;

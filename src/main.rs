@@ -49,6 +49,13 @@ enum Command {
         /// committed coefficients produce.
         #[arg(long)]
         check: bool,
+        /// Build only what this scene manifest (fits/scenes/NAME.toml) needs, skipping nodes
+        /// whose inputs and files are unchanged since its last build.
+        #[arg(long, conflicts_with_all = ["only", "check"])]
+        scene: Option<PathBuf>,
+        /// With --scene: rebuild every reached node.
+        #[arg(long, requires = "scene")]
+        force: bool,
     },
     /// Fit a model to your own CSV data, from no start values.
     Fit {
@@ -98,7 +105,8 @@ fn main() -> ExitCode {
         Command::Eval { quantity, params, json, profile, kernel } => {
             cli::eval_skin(&quantity, &params, json, profile.as_deref(), kernel.as_deref())
         }
-        Command::Build { only, check } => cli::build(&paths, &only, check),
+        Command::Build { scene: Some(file), force, .. } => cli::build_scene(&paths, &file, force),
+        Command::Build { only, check, .. } => cli::build(&paths, &only, check),
         Command::Fit { data, x, y, model, objective, json } => cli::fit_data(&data, &x, &y, &model, objective, json),
         Command::Samples { name, json } => cli::samples(&paths, &name, json),
         Command::Plot { out } => cli::plot(&paths, &out),

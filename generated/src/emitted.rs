@@ -34,6 +34,18 @@ pub mod skin_punctual_lut;
 #[cfg(feature = "skin")]
 #[path = "skin_sh_lut.rs"]
 pub mod skin_sh_lut;
+#[cfg(feature = "scenes")]
+#[path = "scene_cobblestone_gloss.rs"]
+pub mod scene_cobblestone_gloss;
+#[cfg(feature = "scenes")]
+#[path = "scene_deferred_moss.rs"]
+pub mod scene_deferred_moss;
+#[cfg(feature = "scenes")]
+#[path = "scene_skin_character.rs"]
+pub mod scene_skin_character;
+#[cfg(feature = "scenes")]
+#[path = "scene_velvet_horse.rs"]
+pub mod scene_velvet_horse;
 
 /// WGSL libraries by module name (each starts with `#define_import_path shadefit::NAME`).
 pub mod wgsl {
@@ -59,6 +71,14 @@ pub mod wgsl {
     pub const SKIN_PUNCTUAL_LUT: &str = include_str!("../wgsl/skin_punctual_lut.wgsl");
     #[cfg(feature = "skin")]
     pub const SKIN_SH_LUT: &str = include_str!("../wgsl/skin_sh_lut.wgsl");
+    #[cfg(feature = "scenes")]
+    pub const SCENE_COBBLESTONE_GLOSS: &str = include_str!("../wgsl/scene_cobblestone_gloss.wgsl");
+    #[cfg(feature = "scenes")]
+    pub const SCENE_DEFERRED_MOSS: &str = include_str!("../wgsl/scene_deferred_moss.wgsl");
+    #[cfg(feature = "scenes")]
+    pub const SCENE_SKIN_CHARACTER: &str = include_str!("../wgsl/scene_skin_character.wgsl");
+    #[cfg(feature = "scenes")]
+    pub const SCENE_VELVET_HORSE: &str = include_str!("../wgsl/scene_velvet_horse.wgsl");
 
     /// The WGSL library of a module, if its feature is enabled.
     pub fn module(name: &str) -> Option<&'static str> {
@@ -85,6 +105,14 @@ pub mod wgsl {
             "skin_punctual_lut" => Some(SKIN_PUNCTUAL_LUT),
             #[cfg(feature = "skin")]
             "skin_sh_lut" => Some(SKIN_SH_LUT),
+            #[cfg(feature = "scenes")]
+            "scene_cobblestone_gloss" => Some(SCENE_COBBLESTONE_GLOSS),
+            #[cfg(feature = "scenes")]
+            "scene_deferred_moss" => Some(SCENE_DEFERRED_MOSS),
+            #[cfg(feature = "scenes")]
+            "scene_skin_character" => Some(SCENE_SKIN_CHARACTER),
+            #[cfg(feature = "scenes")]
+            "scene_velvet_horse" => Some(SCENE_VELVET_HORSE),
             _ => None,
         }
     }
@@ -113,6 +141,14 @@ pub mod wgsl {
         "skin_punctual_lut",
         #[cfg(feature = "skin")]
         "skin_sh_lut",
+        #[cfg(feature = "scenes")]
+        "scene_cobblestone_gloss",
+        #[cfg(feature = "scenes")]
+        "scene_deferred_moss",
+        #[cfg(feature = "scenes")]
+        "scene_skin_character",
+        #[cfg(feature = "scenes")]
+        "scene_velvet_horse",
     ];
 }
 
@@ -134,4 +170,14 @@ pub const FUNCTIONS: &[EmittedFunction] = &[
     EmittedFunction { module: "gloss_length", name: "gloss_to_normal_length", domain: &[[0e0, 1e0]], cpu: Cpu::One(gloss_length::gloss_to_normal_length) },
     #[cfg(feature = "gloss")]
     EmittedFunction { module: "gloss_table", name: "gloss_to_normal_length_lut", domain: &[[0e0, 1e0]], cpu: Cpu::One(gloss_table::gloss_to_normal_length_lut) },
+    #[cfg(feature = "scenes")]
+    EmittedFunction { module: "scene_cobblestone_gloss", name: "cobblestone_gloss_to_normal_length", domain: &[[3e-1, 9e-1]], cpu: Cpu::One(scene_cobblestone_gloss::cobblestone_gloss_to_normal_length) },
+    #[cfg(feature = "scenes")]
+    EmittedFunction { module: "scene_deferred_moss", name: "moss_fuzz_ps", domain: &[[-1e0, 1e0], [-1e0, 1e0]], cpu: Cpu::Two(scene_deferred_moss::moss_fuzz_ps) },
+    #[cfg(feature = "scenes")]
+    EmittedFunction { module: "scene_deferred_moss", name: "moss_fuzz_g", domain: &[[1e-3, 1e0]], cpu: Cpu::One(scene_deferred_moss::moss_fuzz_g) },
+    #[cfg(feature = "scenes")]
+    EmittedFunction { module: "scene_velvet_horse", name: "velvet_fuzz_ps", domain: &[[-1e0, 1e0], [-1e0, 1e0]], cpu: Cpu::Two(scene_velvet_horse::velvet_fuzz_ps) },
+    #[cfg(feature = "scenes")]
+    EmittedFunction { module: "scene_velvet_horse", name: "velvet_fuzz_g", domain: &[[1e-3, 1e0]], cpu: Cpu::One(scene_velvet_horse::velvet_fuzz_g) },
 ];
