@@ -487,7 +487,12 @@ pub fn build_scene(
         .iter()
         .map(|e| format!("{} {:.3e}", e.name, e.record["max_abs_error"].as_f64().unwrap_or(f64::NAN)))
         .collect();
-    let err_line = if errs.is_empty() { "constants from the integrals only".to_string() } else { format!("max abs {}", errs.join(", ")) };
+    let worst = emitted.iter().filter_map(|e| e.record["max_abs_error"].as_f64()).fold(0.0, f64::max);
+    let err_line = if errs.is_empty() {
+        "no functions; constants from the integrals only".to_string()
+    } else {
+        format!("max abs {worst:.3e} over the scene's functions ({})", errs.join(", "))
+    };
     let header = header_lines(&rel, &hash, &err_line);
     let mut w = String::new();
     for h in &header {
