@@ -104,6 +104,24 @@ proptest! {
 }
 
 #[test]
+fn gloss_outside_its_domain() {
+    // NaN stays NaN (it used to bisect to ≈ 3e-20).
+    assert!(shadefit::quantity::gloss::gloss_from_length(f64::NAN).is_nan());
+    // α slightly above 1 (k < 0): the series' terms alternate, and L stays continuous through
+    // α = 1 (L = 2/3 exactly there): the first-order change is dL/dα·Δα with |dL/dα| < 1.
+    for da in [1e-12, 1e-9, 1e-6] {
+        let l = shadefit::quantity::gloss::normal_length(1.0 + da);
+        assert!((l - 2.0 / 3.0).abs() <= da, "L(1 + {da:e}) = {l}");
+    }
+    // Well above 1 the series must keep summing its alternating terms (it used to stop at the
+    // first negative one: 1e-2 off at α = 1.2); the quadrature is accurate to ~1e-14.
+    for a in [1.05, 1.2, 1.4] {
+        let (l, quad) = (shadefit::quantity::gloss::normal_length(a), normal_length_quadrature(a, 1e-14).value);
+        assert!((l - quad).abs() < 1e-12, "L({a}) = {l}, quadrature {quad}");
+    }
+}
+
+#[test]
 fn gloss_series_switch_is_continuous() {
     // The closed form switches from the power series to the logarithmic form at k = 1 − α² = ½.
     let a0 = 0.5f64.sqrt();

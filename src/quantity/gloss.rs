@@ -61,6 +61,11 @@ pub fn one_minus_length(alpha: f64) -> f64 {
 /// Average normal length L(α) = E[n·h] of GGX with roughness α ∈ (0, 1].
 pub fn normal_length(alpha: f64) -> f64 {
     let k = (1.0 - alpha) * (1.0 + alpha);
+    if k < -0.5 {
+        // α > √1.5 (outside the gloss domain): atanh(√k)/√k = atan(√−k)/√−k, no cancellation.
+        let s = (-k).sqrt();
+        return (1.0 - alpha * alpha * s.atan() / s) / k;
+    }
     if k < 0.5 { length_series(k) } else { 1.0 - one_minus_length(alpha) }
 }
 
@@ -73,7 +78,8 @@ fn length_series(k: f64) -> f64 {
         let nf = n as f64;
         let term = 2.0 * kn / ((2.0 * nf + 1.0) * (2.0 * nf + 3.0));
         sum += term;
-        if term < 1e-18 * sum {
+        // |term|: for α > 1 (k < 0, outside the gloss domain) the terms alternate in sign.
+        if term.abs() < 1e-18 * sum.abs() {
             break;
         }
         kn *= k;
@@ -105,6 +111,9 @@ pub fn length_range() -> (f64, f64) {
 
 /// Gloss whose average normal length is `length`, clamped to g ∈ [0, 1] outside the table.
 pub fn gloss_from_length(length: f64) -> f64 {
+    if length.is_nan() {
+        return f64::NAN;
+    }
     let (lo, hi) = length_range();
     if length <= lo {
         return 0.0;
