@@ -547,6 +547,7 @@ pub fn build_scene(
     let rust_a = Artifact { path: format!("src/{module}.rs").into(), contents: r.into() };
     let json = json!({
         "generator": GENERATOR,
+        "kind": "scene",
         "scene": rel,
         "input_hash": hash,
         "name": scene.file.name,
