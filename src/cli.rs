@@ -130,13 +130,13 @@ pub fn build(paths: &Paths, only: &[String], check: bool) -> Result<()> {
         // Every scene module, with the node files of this build recorded for its cache.
         for sc in &scenes {
             let t = std::time::Instant::now();
-            let nodes: Vec<(String, String, Vec<crate::emit::Artifact>)> = scene::plan(sc)
+            let nodes: Vec<scene::NodeRecord> = scene::plan(sc)
                 .nodes
                 .iter()
                 .filter_map(|n| {
                     let b = built.iter().find(|b| &b.name == n)?;
                     let spec = specs.iter().find(|s| &s.file.name == n)?;
-                    Some((n.clone(), pipeline::input_hash(spec), b.artifacts.clone()))
+                    Some(scene::node_record(n, pipeline::input_hash(spec), &b.artifacts))
                 })
                 .collect();
             let sb = scene::build_scene(sc, &specs, &paths.generated, &nodes).with_context(|| format!("building scene {}", sc.file.name))?;
@@ -145,7 +145,7 @@ pub fn build(paths: &Paths, only: &[String], check: bool) -> Result<()> {
             scene_names.push(sc.module());
         }
     }
-    artifacts.push(scene::runtime_index(&specs, &scenes, &paths.generated)?);
+    artifacts.push(scene::runtime_index(&specs, &scenes));
     if check {
         let mut bad = pipeline::stale(&paths.generated, &artifacts);
         if only.is_empty() {

@@ -64,6 +64,20 @@ pub struct Verification {
     pub max_abs_error_in_parameter: Option<f64>,
 }
 
+impl Verification {
+    /// The `measured error:` text of a generated file's header.
+    pub fn header_line(&self) -> String {
+        format!(
+            "max abs {}, rms {} over {} points (f32 code: max abs {}, rms {})",
+            fmt_err(self.max_abs_error),
+            fmt_err(self.rms_error),
+            self.points,
+            fmt_err(self.max_abs_error_f32),
+            fmt_err(self.rms_error_f32)
+        )
+    }
+}
+
 /// Result of building one spec.
 #[derive(Debug, Clone)]
 pub struct Built {
@@ -73,13 +87,17 @@ pub struct Built {
     pub fit: Option<FitReport>,
 }
 
+/// Lowercase hex of a digest.
+pub fn hex(bytes: &[u8]) -> String {
+    bytes.iter().map(|b| format!("{b:02x}")).collect()
+}
+
 pub fn input_hash(spec: &Spec) -> String {
     let mut h = Sha256::new();
     h.update(GENERATOR.as_bytes());
     h.update(b"\n");
     h.update(spec.text.as_bytes());
-    let d = h.finalize();
-    format!("sha256:{}", d.iter().map(|b| format!("{b:02x}")).collect::<String>())
+    format!("sha256:{}", hex(&h.finalize()))
 }
 
 /// Tensor grid over the spec's axes with the given counts, first axis fastest.
@@ -88,7 +106,7 @@ pub fn grid(spec: &Spec, counts: &[usize]) -> Vec<Vec<f64>> {
 }
 
 /// Tensor grid over some axes with the given counts, first axis fastest.
-fn tensor(axes: &[crate::spec::AxisSpec], counts: &[usize]) -> Vec<Vec<f64>> {
+pub(crate) fn tensor(axes: &[crate::spec::AxisSpec], counts: &[usize]) -> Vec<Vec<f64>> {
     let pts: Vec<Vec<f64>> = axes.iter().zip(counts).map(|(a, &n)| a.points(n)).collect();
     let total: usize = counts.iter().product();
     (0..total)
@@ -219,14 +237,7 @@ fn build_fit(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> 
     }
     let verification = verify(spec, &vx, &truth, &approx64, &approx32);
     let hash = input_hash(spec);
-    let err_line = format!(
-        "max abs {}, rms {} over {} points (f32 code: max abs {}, rms {})",
-        fmt_err(verification.max_abs_error),
-        fmt_err(verification.rms_error),
-        verification.points,
-        fmt_err(verification.max_abs_error_f32),
-        fmt_err(verification.rms_error_f32)
-    );
+    let err_line = verification.header_line();
     let header = header_lines(&spec_rel_path(spec), &hash, &err_line);
     let a = args(spec);
     let func = wgsl::Function {

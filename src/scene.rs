@@ -37,7 +37,7 @@ use crate::fit::model::{ModelParts, Term};
 use crate::fit::{self, Data, FitOptions, Objective, RationalModel};
 use crate::pipeline::{self, input_hash, BuildError, Mode};
 use crate::quantity::{fuzz, gloss};
-use crate::spec::{line_of, parse_toml, Spec, SpecError};
+use crate::spec::{is_identifier, line_of, parse_toml, Spec, SpecError};
 use nalgebra::{DMatrix, DVector};
 use serde::Deserialize;
 use serde_json::{json, Value};
@@ -85,11 +85,6 @@ const FEATURES: &[(&str, &[(&str, f64, f64)])] = &[
     ("gloss_mips", &[("gloss", 0.0, 1.0)]),
     ("gloss_combine", &[]),
 ];
-
-fn is_identifier(s: &str) -> bool {
-    let mut c = s.chars();
-    matches!(c.next(), Some(x) if x.is_ascii_lowercase()) && c.all(|x| x.is_ascii_lowercase() || x.is_ascii_digit() || x == '_')
-}
 
 impl Scene {
     pub fn load(path: &Path) -> Result<Scene, SpecError> {
@@ -247,11 +242,11 @@ pub fn scene_hash(scene: &Scene, specs: &[Spec], plan: &Plan) -> Result<String, 
     for n in names {
         h.update(format!("\n{n} {}", input_hash(find(specs, n)?)).as_bytes());
     }
-    Ok(format!("sha256:{}", h.finalize().iter().map(|b| format!("{b:02x}")).collect::<String>()))
+    Ok(format!("sha256:{}", pipeline::hex(&h.finalize())))
 }
 
 fn sha(bytes: &[u8]) -> String {
-    Sha256::digest(bytes).iter().map(|b| format!("{b:02x}")).collect()
+    pipeline::hex(&Sha256::digest(bytes))
 }
 
 /// One emitted scalar function of a scene, with its measured error and the general fit's at
@@ -291,30 +286,33 @@ fn model(inputs: &[&str], num: &[&str], den: &[&str], fixed: Vec<(usize, f64)>, 
     .expect("scene models are well formed")
 }
 
-/// P_s at fixed (α, θf): the six coefficients of Eq. 1 by minimax over the spec's light
-/// directions (Lawson's iteration on the 6-term linear system), and R as a constant.
+/// P_s at fixed (α, θf): the coefficients of the quantity's inner basis (Eq. 1) by minimax over
+/// the spec's light directions (Lawson's iteration on the linear system), and R as a constant.
 fn fuzz_ps(specs: &[Spec], generated: &Path, material: &str, alpha: f64, theta_f: f64) -> Result<(Emitted, Constant), BuildError> {
     let spec = find(specs, "fuzz_ps")?;
-    let inner = &spec.file.axis[2..];
-    let dirs = |verify: bool| -> Vec<(f64, f64)> {
-        let n = |a: &crate::spec::AxisSpec| if verify { a.verify_count() } else { a.count };
-        let tu = inner[0].points(n(&inner[0]));
-        let pu = inner[1].points(n(&inner[1]));
-        pu.iter().flat_map(|&p| tu.iter().map(move |&t| (t, p))).collect()
+    let ib = spec.quantity.basis.expect("fuzz-ps has an inner basis");
+    let args: Vec<String> = ib.args.iter().map(|a| a.to_string()).collect();
+    let terms: Vec<Term> = ib.terms.iter().map(|t| Term::parse(t, &args).expect("basis terms are valid")).collect();
+    let outer = [alpha, theta_f];
+    let inner_axes = &spec.file.axis[spec.file.axis.len() - ib.inner..];
+    let dirs = |verify: bool| -> Vec<Vec<f64>> {
+        let counts: Vec<usize> = inner_axes.iter().map(|a| if verify { a.verify_count() } else { a.count }).collect();
+        pipeline::tensor(inner_axes, &counts)
     };
-    let basis = |(tu, pu): (f64, f64)| {
-        let (nu, td) = (tu.cos(), tu.sin() * pu.cos() * theta_f.sin() + tu.cos() * theta_f.cos());
-        [1.0, nu, td, nu * nu, nu * td, td * td]
+    let basis = |u: &[f64]| -> Vec<f64> {
+        let a = (ib.to_args)(&outer, u);
+        terms.iter().map(|t| t.eval(&a)).collect()
     };
+    let sample = |d: &[Vec<f64>]| -> Vec<f64> { (ib.sample)(&outer, d, spec.file.tolerance).iter().map(|e| e.value).collect() };
+    let (lo, hi) = ib.range;
     let fit_dirs = dirs(false);
-    let y: Vec<f64> = fuzz::ps_directions(alpha, theta_f, &fit_dirs, spec.file.tolerance).iter().map(|e| e.value).collect();
-    let b = DMatrix::from_fn(fit_dirs.len(), 6, |i, k| basis(fit_dirs[i])[k]);
-    let yv = DVector::from_vec(y);
+    let b = DMatrix::from_fn(fit_dirs.len(), terms.len(), |i, k| basis(&fit_dirs[i])[k]);
+    let yv = DVector::from_vec(sample(&fit_dirs));
     let mut w = vec![1.0; fit_dirs.len()];
     let mut best: Option<(f64, DVector<f64>)> = None;
     for _ in 0..200 {
         let sw: Vec<f64> = w.iter().map(|v: &f64| v.sqrt()).collect();
-        let bw = DMatrix::from_fn(b.nrows(), 6, |i, k| b[(i, k)] * sw[i]);
+        let bw = DMatrix::from_fn(b.nrows(), b.ncols(), |i, k| b[(i, k)] * sw[i]);
         let yw = DVector::from_fn(b.nrows(), |i, _| yv[i] * sw[i]);
         let Ok(c) = bw.svd(true, true).solve(&yw, 1e-14) else { break };
         let r = &b * &c - &yv;
@@ -333,18 +331,18 @@ fn fuzz_ps(specs: &[Spec], generated: &Path, material: &str, alpha: f64, theta_f
     let (_, c) = best.ok_or_else(|| BuildError::Scene(format!("{material}: the P_s system at α = {alpha}, θf = {theta_f} is singular")))?;
     // Errors on the verification directions, next to the general fit at the same (α, θf).
     let vd = dirs(true);
-    let truth: Vec<f64> = fuzz::ps_directions(alpha, theta_f, &vd, spec.file.tolerance).iter().map(|e| e.value).collect();
-    let ours: Vec<f64> = vd.iter().map(|&d| basis(d).iter().zip(c.iter()).map(|(b, c)| b * c).sum::<f64>().clamp(0.0, 1.0)).collect();
-    let general = crate::validate::committed_fields(generated, "fuzz_ps").map(|f| {
-        let g = f(&[alpha, theta_f]);
-        let approx: Vec<f64> = vd.iter().map(|&d| basis(d).iter().zip(&g).map(|(b, c)| b * c).sum::<f64>().clamp(0.0, 1.0)).collect();
-        max_err(&truth, &approx)
-    });
-    let m = model(&["n_dot_u", "t_dot_u"], &["1", "n_dot_u", "t_dot_u", "n_dot_u^2", "n_dot_u*t_dot_u", "t_dot_u^2"], &[], vec![], Some((0.0, 1.0)));
+    let truth = sample(&vd);
+    let eval_at = |coef: &[f64]| -> Vec<f64> {
+        vd.iter().map(|u| basis(u).iter().zip(coef).map(|(b, c)| b * c).sum::<f64>().clamp(lo, hi)).collect()
+    };
+    let ours = eval_at(c.as_slice());
+    let general = crate::validate::committed_fields(generated, "fuzz_ps").map(|f| max_err(&truth, &eval_at(&f(&outer))));
+    let arg_refs: Vec<&str> = ib.args.to_vec();
+    let m = model(&arg_refs, ib.terms, &[], vec![], Some((lo, hi)));
     let ps = Emitted {
         name: format!("{material}_fuzz_ps"),
-        args: vec!["n_dot_u".into(), "t_dot_u".into()],
-        domain: vec![(-1.0, 1.0), (-1.0, 1.0)],
+        args,
+        domain: ib.arg_domain.to_vec(),
         record: json!({"what": "P_s coefficients at fixed (alpha, theta_f)", "alpha": alpha, "theta_f": theta_f,
             "coefficients": c.iter().copied().collect::<Vec<f64>>(), "points": vd.len(),
             "max_abs_error": max_err(&truth, &ours), "general_fit_max_abs_error": general}),
@@ -352,10 +350,8 @@ fn fuzz_ps(specs: &[Spec], generated: &Path, material: &str, alpha: f64, theta_f
         coefficients: c,
     };
     let r = fuzz::r(alpha, theta_f, 1e-10);
-    let rspec = find(specs, "fuzz_r")?;
     let general_r = crate::validate::committed_refit(generated, "fuzz_r")
         .map(|(s, cf)| (s.model.as_ref().map_or(f64::NAN, |m| m.eval_clamped(&cf, &[alpha, theta_f])) - r.value).abs());
-    let _ = rspec;
     let rc = Constant {
         name: format!("{}_AVERAGE_PS", material.to_uppercase()),
         value: r.value,
@@ -394,7 +390,6 @@ fn fuzz_g(specs: &[Spec], generated: &Path, material: &str, d: f64) -> Result<(E
     let q = fuzz::q_exact(d);
     let general_q = crate::validate::committed_refit(generated, "fuzz_q")
         .map(|(s, c)| (s.model.as_ref().map_or(f64::NAN, |m| m.eval_clamped(&c, &[d])) - q).abs());
-    let _ = find(specs, "fuzz_q")?;
     let qc = Constant {
         name: format!("{}_AVERAGE_PENETRATION", material.to_uppercase()),
         value: q,
@@ -454,13 +449,20 @@ pub struct SceneBuild {
     pub records: Vec<Value>,
 }
 
-/// Build the scene module. `nodes` are (name, input hash, artifacts) of the reached spec nodes,
-/// whose file hashes the scene JSON records for the cache.
+/// A reached spec node as the scene's cache records it: name, input hash, file → SHA-256.
+pub type NodeRecord = (String, String, BTreeMap<String, String>);
+
+/// The cache record of a node from the artifacts it was built into.
+pub fn node_record(name: &str, input_hash: String, artifacts: &[Artifact]) -> NodeRecord {
+    (name.to_string(), input_hash, artifacts.iter().map(|a| (a.path.display().to_string(), sha(&a.contents))).collect())
+}
+
+/// Build the scene module; `nodes` are the reached spec nodes, recorded in the scene JSON.
 pub fn build_scene(
     scene: &Scene,
     specs: &[Spec],
     generated: &Path,
-    nodes: &[(String, String, Vec<Artifact>)],
+    nodes: &[NodeRecord],
 ) -> Result<SceneBuild, BuildError> {
     let p = plan(scene);
     let hash = scene_hash(scene, specs, &p)?;
@@ -533,13 +535,8 @@ pub fn build_scene(
         functions.push((e.name.clone(), e.domain.clone()));
     }
     let records: Vec<Value> = emitted.iter().map(|e| e.record.clone()).chain(constants.iter().map(|c| c.record.clone())).collect();
-    let node_records: Vec<Value> = nodes
-        .iter()
-        .map(|(n, h, arts)| {
-            let files: BTreeMap<String, String> = arts.iter().map(|a| (a.path.display().to_string(), sha(&a.contents))).collect();
-            json!({"name": n, "input_hash": h, "files": files})
-        })
-        .collect();
+    let node_records: Vec<Value> =
+        nodes.iter().map(|(n, h, files)| json!({"name": n, "input_hash": h, "files": files})).collect();
     let reached: Vec<&str> = p.nodes.iter().map(String::as_str).collect();
     let all: Vec<&str> = specs.iter().map(|s| s.file.name.as_str()).collect();
     let skipped: Vec<&str> = all.iter().copied().filter(|n| !reached.contains(n)).collect();
@@ -613,18 +610,18 @@ pub fn build(
         let h = input_hash(spec);
         if !force && let Some(rec) = recorded(name).filter(|r| recorded_fresh(generated, r, &h)) {
             up_to_date.push(name.clone());
-            // Same files as recorded: their hashes carry over.
-            let arts: Vec<Artifact> = rec["files"]
+            // Unchanged files: their recorded hashes carry over.
+            let files: BTreeMap<String, String> = rec["files"]
                 .as_object()
-                .map(|f| f.keys().map(|p| Artifact { path: p.into(), contents: std::fs::read(generated.join(p)).unwrap_or_default() }).collect())
+                .map(|f| f.iter().map(|(p, v)| (p.clone(), v.as_str().unwrap_or("").to_string())).collect())
                 .unwrap_or_default();
-            nodes.push((name.clone(), h, arts));
+            nodes.push((name.clone(), h, files));
             continue;
         }
         let b = pipeline::build_spec(spec, Mode::Fit, generated)?;
         built.push(name.clone());
-        artifacts.extend(b.artifacts.clone());
-        nodes.push((name.clone(), h, b.artifacts));
+        nodes.push(node_record(name, h, &b.artifacts));
+        artifacts.extend(b.artifacts);
     }
     let hash = scene_hash(scene, specs, &p)?;
     let scene_fresh = !force
@@ -641,7 +638,7 @@ pub fn build(
         built.push(scene.module());
     }
     if !built.is_empty() {
-        artifacts.push(runtime_index(specs, scenes, generated)?);
+        artifacts.push(runtime_index(specs, scenes));
     }
     let written = emit::write_all(generated, &artifacts)?;
     let skipped = specs.iter().map(|s| s.file.name.clone()).filter(|n| !p.nodes.contains(n)).collect();
@@ -650,9 +647,9 @@ pub fn build(
 
 /// The runtime index with every scene's functions (read from the scenes' committed JSON-free
 /// plan: the function names follow from the manifests).
-pub fn runtime_index(specs: &[Spec], scenes: &[Scene], _generated: &Path) -> Result<Artifact, BuildError> {
+pub fn runtime_index(specs: &[Spec], scenes: &[Scene]) -> Artifact {
     let list: Vec<(String, Vec<(String, Vec<(f64, f64)>)>)> = scenes.iter().map(|s| (s.module(), scene_functions(s, specs))).collect();
-    Ok(pipeline::runtime_index_with_scenes(specs, &list))
+    pipeline::runtime_index_with_scenes(specs, &list)
 }
 
 /// The scalar functions a scene emits (name, domain), from its plan alone.
@@ -661,7 +658,10 @@ pub fn scene_functions(scene: &Scene, specs: &[Spec]) -> Vec<(String, Vec<(f64, 
         .special
         .iter()
         .map(|s| match s {
-            Special::FuzzPs { material, .. } => (format!("{material}_fuzz_ps"), vec![(-1.0, 1.0), (-1.0, 1.0)]),
+            Special::FuzzPs { material, .. } => {
+                let d = crate::quantity::lookup("fuzz-ps").ok().and_then(|q| q.basis).map_or(vec![], |b| b.arg_domain.to_vec());
+                (format!("{material}_fuzz_ps"), d)
+            }
             Special::FuzzG { material, .. } => {
                 let r = specs.iter().find(|s| s.file.name == "fuzz_g").map_or([0.001, 1.0], |s| s.file.axis[0].range);
                 (format!("{material}_fuzz_g"), vec![(r[0], r[1])])

@@ -374,7 +374,6 @@ pub fn fit_fields(
     opts: &FieldOptions,
     what: &str,
 ) -> Result<FieldsFit, FitError> {
-    let nk = models.len();
     if data.is_empty() || data.len() != x.len() {
         return Err(FitError::NoData { what: what.into() });
     }
@@ -510,7 +509,6 @@ pub fn fit_fields(
     if !max.is_finite() {
         return Err(FitError::Diverged { what: what.into(), iters: evals, residual: max });
     }
-    let _ = nk;
     Ok(FieldsFit {
         coefficients: fields.full(&fields.theta),
         stage1,
@@ -521,11 +519,6 @@ pub fn fit_fields(
         lm_evaluations: evals,
         outer_iterations: outer,
     })
-}
-
-/// Whether every field's denominator is proven positive on the box `domain`.
-pub fn fields_positive(models: &[RationalModel], coefficients: &[DVector<f64>], domain: &[(f64, f64)]) -> Vec<Positivity> {
-    models.iter().zip(coefficients).map(|(m, c)| prove_denominator_positive(m, c, domain)).collect()
 }
 
 #[cfg(test)]

@@ -3,7 +3,7 @@
 //! positive on the outer domain, verify on the verification grids in f64 and in the emitted
 //! f32 arithmetic, emit WGSL, Rust and JSON.
 
-use super::{committed_json, fmt_err, input_hash, json_text, spec_rel_path, tensor, BuildError, Built, Mode, Verification};
+use super::{committed_json, input_hash, json_text, spec_rel_path, tensor, BuildError, Built, Mode, Verification};
 use crate::emit::expr::{self, model_expr};
 use crate::emit::fields::{self as efields, Field, FieldsFunction};
 use crate::emit::{header_lines, Artifact, GENERATOR};
@@ -186,14 +186,7 @@ pub fn build(spec: &Spec, mode: Mode, root: &std::path::Path) -> Result<Built, B
     }
     let verification: Verification = super::verify(spec, &pts, &t, &a64, &a32);
     let hash = input_hash(spec);
-    let err_line = format!(
-        "max abs {}, rms {} over {} points (f32 code: max abs {}, rms {})",
-        fmt_err(verification.max_abs_error),
-        fmt_err(verification.rms_error),
-        verification.points,
-        fmt_err(verification.max_abs_error_f32),
-        fmt_err(verification.rms_error_f32)
-    );
+    let err_line = verification.header_line();
     let header = header_lines(&spec_rel_path(spec), &hash, &err_line);
     let m0 = &l.models[0];
     let terms_text: Vec<String> = l.basis.terms.iter().map(|s| s.to_string()).collect();

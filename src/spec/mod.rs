@@ -333,7 +333,8 @@ pub struct Spec {
     pub model: Option<RationalModel>,
 }
 
-fn is_identifier(s: &str) -> bool {
+/// A lowercase identifier: a-z or _, then a-z, 0-9 or _.
+pub(crate) fn is_identifier(s: &str) -> bool {
     let mut chars = s.chars();
     matches!(chars.next(), Some(c) if c.is_ascii_lowercase() || c == '_')
         && chars.all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_')
