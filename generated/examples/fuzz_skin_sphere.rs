@@ -272,18 +272,7 @@ fn render(g: &gpu::Gpu, label: &str, shader: &str, params: &Params, lut: Option<
         usage: wgpu::BufferUsages::UNIFORM,
     });
     let size = width as u64 * height as u64 * 16;
-    let output = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("radiance"),
-        size,
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-        mapped_at_creation: false,
-    });
-    let readback = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("readback"),
-        size,
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
+    let (output, readback) = gpu::output_and_readback(device, size);
     let stage = wgpu::ShaderStages::COMPUTE;
     let mut layout_entries = vec![
         wgpu::BindGroupLayoutEntry {
@@ -329,21 +318,8 @@ fn render(g: &gpu::Gpu, label: &str, shader: &str, params: &Params, lut: Option<
         entries.push(wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(view) });
         entries.push(wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(sampler) });
     }
-    let bgl = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries: &layout_entries });
+    let (bgl, pipeline) = gpu::compute_pipeline(device, label, &module, "main", &layout_entries);
     let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(label), layout: &bgl, entries: &entries });
-    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some(label),
-        bind_group_layouts: &[Some(&bgl)],
-        immediate_size: 0,
-    });
-    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-        label: Some(label),
-        layout: Some(&layout),
-        module: &module,
-        entry_point: Some("main"),
-        compilation_options: Default::default(),
-        cache: None,
-    });
     let mut encoder = device.create_command_encoder(&Default::default());
     {
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(label), timestamp_writes: None });

@@ -60,16 +60,7 @@ fn run(g: &gpu::Gpu, label: &str, r: Run) -> Vec<f32> {
         label: Some(label),
         source: wgpu::ShaderSource::Wgsl(r.shader.into()),
     });
-    let storage = |binding, read_only| wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    };
+    let storage = gpu::storage_entry;
     let mut entries = vec![storage(0, true), storage(1, false)];
     if r.texture.is_some() {
         entries.push(wgpu::BindGroupLayoutEntry {
@@ -92,38 +83,14 @@ fn run(g: &gpu::Gpu, label: &str, r: Run) -> Vec<f32> {
     if r.table.is_some() {
         entries.push(storage(3, true));
     }
-    let bgl = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries: &entries });
-    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some(label),
-        bind_group_layouts: &[Some(&bgl)],
-        immediate_size: 0,
-    });
-    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-        label: Some(label),
-        layout: Some(&layout),
-        module: &module,
-        entry_point: Some("main"),
-        compilation_options: Default::default(),
-        cache: None,
-    });
+    let (bgl, pipeline) = gpu::compute_pipeline(device, label, &module, "main", &entries);
     let input = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some("inputs"),
         contents: bytemuck::cast_slice(&inputs),
         usage: wgpu::BufferUsages::STORAGE,
     });
     let size = (padded * r.outputs * 4) as u64;
-    let output = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("outputs"),
-        size,
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-        mapped_at_creation: false,
-    });
-    let readback = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("readback"),
-        size,
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
+    let (output, readback) = gpu::output_and_readback(device, size);
     let mut bind = vec![
         wgpu::BindGroupEntry { binding: 0, resource: input.as_entire_binding() },
         wgpu::BindGroupEntry { binding: 1, resource: output.as_entire_binding() },
