@@ -53,6 +53,20 @@ pub enum PlotError {
     Data { path: PathBuf, message: String },
 }
 
+/// The house style of a chart's axes: dark axis lines, tick labels and descriptions in the
+/// embedded font, and the two descriptions.
+fn axes_style<'m, 'a, 'b, X: Ranged, Y: Ranged, DB: DrawingBackend>(
+    mesh: &'m mut plotters::chart::MeshStyle<'a, 'b, X, Y, DB>,
+    x_desc: &str,
+    y_desc: &str,
+) -> &'m mut plotters::chart::MeshStyle<'a, 'b, X, Y, DB> {
+    mesh.axis_style(RGBColor(60, 60, 60))
+        .label_style((FAMILY, LABEL_SIZE))
+        .axis_desc_style((FAMILY, DESC_SIZE))
+        .x_desc(x_desc)
+        .y_desc(y_desc)
+}
+
 /// How one series of a line plot is drawn.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SeriesStyle {
@@ -382,16 +396,12 @@ impl Figure for LineFigure<'_> {
             .map_err(de)?;
         let xf = |v: &f64| x_ticks.label(*v);
         let yf = |v: &f64| y_ticks.label(*v);
-        chart
-            .configure_mesh()
-            .bold_line_style(RGBColor(222, 222, 222))
-            .light_line_style(RGBColor(242, 242, 242))
-            .axis_style(RGBColor(60, 60, 60))
-            .label_style((FAMILY, LABEL_SIZE))
-            .axis_desc_style((FAMILY, DESC_SIZE))
-            .x_desc(self.x_label)
-            .y_desc(self.y_label)
-            .x_label_formatter(&xf)
+        axes_style(
+            chart.configure_mesh().bold_line_style(RGBColor(222, 222, 222)).light_line_style(RGBColor(242, 242, 242)),
+            self.x_label,
+            self.y_label,
+        )
+        .x_label_formatter(&xf)
             .y_label_formatter(&yf)
             .draw()
             .map_err(de)?;
@@ -710,14 +720,7 @@ impl Figure for HeatmapFigure<'_> {
                     )
                 }))
                 .map_err(de)?;
-            chart
-                .configure_mesh()
-                .disable_mesh()
-                .axis_style(RGBColor(60, 60, 60))
-                .label_style((FAMILY, LABEL_SIZE))
-                .axis_desc_style((FAMILY, DESC_SIZE))
-                .x_desc(self.x_label)
-                .y_desc(self.y_label)
+            axes_style(chart.configure_mesh().disable_mesh(), self.x_label, self.y_label)
                 .x_label_formatter(&xf)
                 .y_label_formatter(&yf)
                 .draw()

@@ -9,8 +9,8 @@
 //!
 //! The RGB image shows linear values sRGB-encoded for viewing (no tonemapping: D ≤ 1).
 
-use super::{Axis, DrawResult, FAMILY, Figure, LABEL_SIZE, Panel, PlotError, Series, SeriesStyle, TITLE_SIZE};
-use super::{DESC_SIZE, de, label_width, ticks, write_figure};
+use super::{Axis, DrawResult, FAMILY, Figure, Panel, PlotError, Series, SeriesStyle, TITLE_SIZE};
+use super::{de, label_width, ticks, write_figure};
 use crate::emit::texture::srgb8;
 use crate::integrate::Tolerance;
 use crate::quantity::skin::{DEFAULT_TOLERANCE, Gaussian, Kernel, Profile, punctual_grid_estimates};
@@ -328,14 +328,7 @@ impl Figure for RgbImage<'_> {
             .map_err(de)?;
         let xf = |v: &f64| xt.label(*v);
         let yf = |v: &f64| yt.label(*v);
-        chart
-            .configure_mesh()
-            .disable_mesh()
-            .axis_style(RGBColor(60, 60, 60))
-            .label_style((FAMILY, LABEL_SIZE))
-            .axis_desc_style((FAMILY, DESC_SIZE))
-            .x_desc(self.x_label)
-            .y_desc(self.y_label)
+        super::axes_style(chart.configure_mesh().disable_mesh(), self.x_label, self.y_label)
             .x_label_formatter(&xf)
             .y_label_formatter(&yf)
             .draw()
