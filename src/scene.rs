@@ -624,10 +624,8 @@ pub fn build(
         artifacts.extend(b.artifacts);
     }
     let hash = scene_hash(scene, specs, &p)?;
-    let scene_fresh = !force
-        && previous["input_hash"].as_str() == Some(hash.as_str())
-        && built.is_empty()
-        && recorded_fresh(generated, &json!({"input_hash": hash, "files": previous["files"]}), &hash);
+    // The scene JSON records the scene node itself like any other node (input hash, files).
+    let scene_fresh = !force && built.is_empty() && recorded_fresh(generated, &previous, &hash);
     let mut records = previous["specialised"].as_array().cloned().unwrap_or_default();
     if scene_fresh {
         up_to_date.push(scene.module());
