@@ -10,6 +10,7 @@ use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
 use std::collections::BTreeMap;
+use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 
 /// Bad input: exit code 2.
@@ -111,19 +112,27 @@ pub fn build(paths: &Paths, only: &[String], check: bool) -> Result<()> {
         specs.iter().filter(|s| only.is_empty() || only.contains(&s.file.name)).collect();
     let mode = if check { Mode::Committed } else { Mode::Fit };
     let pb = progress(selected.len(), if check { "check" } else { "build" });
-    let mut built: Vec<Built> = Vec::new();
-    let mut seconds: Vec<f64> = Vec::new();
     let mut scene_names: Vec<String> = Vec::new();
     let start = std::time::Instant::now();
-    for s in &selected {
-        pb.set_message(s.file.name.clone());
-        let t = std::time::Instant::now();
-        let b = pipeline::build_spec(s, mode, &paths.generated).with_context(|| format!("building {}", s.file.name))?;
-        seconds.push(t.elapsed().as_secs_f64());
-        pb.inc(1);
-        built.push(b);
-    }
+    // Specs are independent: build them concurrently (each also parallelises its own sampling on
+    // the same rayon pool), collected in spec order, so the outputs do not depend on scheduling.
+    let results: Vec<Result<(Built, f64)>> = selected
+        .par_iter()
+        .map(|s| {
+            let t = std::time::Instant::now();
+            let b = pipeline::build_spec(s, mode, &paths.generated).with_context(|| format!("building {}", s.file.name))?;
+            pb.inc(1);
+            Ok((b, t.elapsed().as_secs_f64()))
+        })
+        .collect();
     pb.finish_and_clear();
+    let mut built: Vec<Built> = Vec::new();
+    let mut seconds: Vec<f64> = Vec::new();
+    for r in results {
+        let (b, t) = r?;
+        built.push(b);
+        seconds.push(t);
+    }
     let scenes = Scene::load_dir(&paths.fits.join("scenes")).map_err(input_err)?;
     let mut artifacts: Vec<_> = built.iter().flat_map(|b| b.artifacts.clone()).collect();
     if only.is_empty() {
