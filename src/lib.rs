@@ -5,6 +5,7 @@
 pub mod fit;
 pub mod integrate;
 pub mod quantity;
+pub mod bench;
 pub mod cli;
 pub mod emit;
 pub mod pipeline;
