@@ -445,3 +445,48 @@ pub fn plot(paths: &Paths, out: &Path) -> Result<()> {
     println!("{} file(s) written", files.len());
     Ok(())
 }
+
+/// Arguments of `shadefit bench`.
+pub struct BenchArgs {
+    pub quick: bool,
+    pub json: bool,
+    pub only: Vec<String>,
+    pub python: Option<PathBuf>,
+    pub no_python: bool,
+}
+
+pub fn bench(paths: &Paths, a: &BenchArgs) -> Result<()> {
+    use crate::bench::{self, Mode, Sections, tables};
+    const KNOWN: [&str; 4] = ["integrators", "fits", "tables", "forms"];
+    if let Some(bad) = a.only.iter().find(|s| !KNOWN.contains(&s.as_str())) {
+        return Err(input_err(format!(
+            "--only: unknown section '{bad}' (known: {})",
+            KNOWN.join(", ")
+        )));
+    }
+    let on = |s: &str| a.only.is_empty() || a.only.iter().any(|o| o == s);
+    let sections = Sections {
+        integrators: on("integrators"),
+        fits: on("fits"),
+        tables: on("tables"),
+        forms: on("forms"),
+    };
+    let specs = load_specs(paths, &[])?;
+    let root = paths.fits.parent().unwrap_or(Path::new("")).to_path_buf();
+    let python = match (&a.python, a.no_python) {
+        (_, true) => None,
+        (Some(p), false) => Some(tables::Python {
+            interpreter: p.clone(),
+            script: root.join("benches/numpy_tables.py"),
+            required: true,
+        }),
+        (None, false) => Some(tables::default_python(&root)),
+    };
+    let report = bench::run(Mode::new(a.quick), sections, &specs, python.as_ref())?;
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        print!("{}", bench::render(&report));
+    }
+    Ok(())
+}

@@ -94,6 +94,24 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Run time against error: integrators, fit solvers, tables against numpy/scipy, shader forms.
+    Bench {
+        /// The CI mode: fewer points and settings (under a minute).
+        #[arg(long)]
+        quick: bool,
+        #[arg(long)]
+        json: bool,
+        /// Sections to run, comma-separated: integrators, fits, tables, forms (default: all).
+        #[arg(long, value_delimiter = ',')]
+        only: Vec<String>,
+        /// Interpreter for the numpy/scipy side (default: tests/python/.venv, else python3);
+        /// when given, a failure of that side fails the run.
+        #[arg(long, conflicts_with = "no_python")]
+        python: Option<PathBuf>,
+        /// Skip the numpy/scipy side.
+        #[arg(long)]
+        no_python: bool,
+    },
 }
 
 fn main() -> ExitCode {
@@ -111,6 +129,9 @@ fn main() -> ExitCode {
         Command::Samples { name, json } => cli::samples(&paths, &name, json),
         Command::Plot { out } => cli::plot(&paths, &out),
         Command::Validate { json } => cli::validate(&paths, json),
+        Command::Bench { quick, json, only, python, no_python } => {
+            cli::bench(&paths, &cli::BenchArgs { quick, json, only, python, no_python })
+        }
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -13,5 +13,312 @@
 //! Quick mode (`--quick`, what the test command runs) uses fewer points and settings; both
 //! modes print one table per section, or one JSON document with `--json`.
 
+pub mod fits;
 pub mod forms;
+pub mod integrals;
 pub mod ops;
+pub mod tables;
+
+use crate::spec::Spec;
+use anyhow::Result;
+use serde::Serialize;
+use std::fmt::Write as _;
+use std::time::Instant;
+
+/// Quick (CI) or full run.
+#[derive(Debug, Clone, Copy)]
+pub struct Mode {
+    pub quick: bool,
+    /// Repeat a timed workload until it has run this long (short workloads are noise otherwise).
+    pub min_seconds: f64,
+}
+
+impl Mode {
+    pub fn new(quick: bool) -> Mode {
+        Mode {
+            quick,
+            min_seconds: if quick { 0.02 } else { 0.2 },
+        }
+    }
+}
+
+/// Seconds per call of `f` (repeated until `min_seconds` have passed) and its last result.
+pub(crate) fn time_it<T>(min_seconds: f64, mut f: impl FnMut() -> T) -> (f64, T) {
+    let start = Instant::now();
+    let mut runs = 0u32;
+    loop {
+        let r = f();
+        runs += 1;
+        let elapsed = start.elapsed().as_secs_f64();
+        if elapsed >= min_seconds || runs >= 1_000_000 {
+            return (elapsed / runs as f64, r);
+        }
+    }
+}
+
+/// splitmix64: the fixed-seed generator of the Monte Carlo baselines and the sample subsets.
+pub(crate) struct SplitMix(pub u64);
+
+impl SplitMix {
+    pub fn next_f64(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^= z >> 31;
+        (z >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+    }
+}
+
+/// Which sections to run.
+#[derive(Debug, Clone, Copy)]
+pub struct Sections {
+    pub integrators: bool,
+    pub fits: bool,
+    pub tables: bool,
+    pub forms: bool,
+}
+
+/// The whole benchmark run.
+#[derive(Debug, Clone, Serialize)]
+pub struct Report {
+    pub mode: &'static str,
+    pub threads: usize,
+    pub seconds: f64,
+    pub integrators: Vec<integrals::IntegratorRow>,
+    pub fits: Vec<fits::FitRow>,
+    pub tables: Vec<tables::TableRow>,
+    pub forms: Vec<forms::FormRow>,
+}
+
+/// Run the selected sections.
+pub fn run(
+    mode: Mode,
+    sections: Sections,
+    specs: &[Spec],
+    python: Option<&tables::Python>,
+) -> Result<Report> {
+    let start = Instant::now();
+    let integrators = if sections.integrators {
+        integrals::all(&mode)
+    } else {
+        Vec::new()
+    };
+    let fits = if sections.fits {
+        fits::all(&mode, specs)
+    } else {
+        Vec::new()
+    };
+    let tables = if sections.tables {
+        tables::all(&mode, specs, python)?
+    } else {
+        Vec::new()
+    };
+    let forms = if sections.forms {
+        forms::shader_forms(mode.quick)?
+    } else {
+        Vec::new()
+    };
+    Ok(Report {
+        mode: if mode.quick { "quick" } else { "full" },
+        threads: rayon::current_num_threads(),
+        seconds: start.elapsed().as_secs_f64(),
+        integrators,
+        fits,
+        tables,
+        forms,
+    })
+}
+
+fn sci(v: f64) -> String {
+    if v == 0.0 {
+        "0".into()
+    } else {
+        format!("{v:.2e}")
+    }
+}
+
+fn opt_sci(v: Option<f64>) -> String {
+    v.map_or("-".into(), sci)
+}
+
+fn seconds(s: f64) -> String {
+    match s {
+        s if s >= 1.0 => format!("{s:.2} s"),
+        s if s >= 1e-3 => format!("{:.2} ms", s * 1e3),
+        s if s >= 1e-6 => format!("{:.2} µs", s * 1e6),
+        s => format!("{:.1} ns", s * 1e9),
+    }
+}
+
+/// The human-readable report: one table per section.
+pub fn render(r: &Report) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "shadefit bench ({} mode, {} thread(s) for the parallel parts, {:.1} s)",
+        r.mode, r.threads, r.seconds
+    );
+    if !r.integrators.is_empty() {
+        let _ = writeln!(
+            s,
+            "\n## Integrators (one thread; time and evaluations per point; error against the named reference)\n"
+        );
+        let mut last = "";
+        for row in &r.integrators {
+            if row.quantity != last {
+                let _ = writeln!(
+                    s,
+                    "{} ({} points; reference: {})",
+                    row.quantity, row.points, row.reference
+                );
+                let _ = writeln!(
+                    s,
+                    "  {:<72} {:>12} {:>12} {:>12} {:>10} {:>10}",
+                    "method", "setting", "time/point", "evals/point", "max err", "max est"
+                );
+                last = row.quantity;
+            }
+            let _ = writeln!(
+                s,
+                "  {:<72} {:>12} {:>12} {:>12.0} {:>10} {:>10}",
+                row.method,
+                row.setting,
+                seconds(row.seconds_per_point),
+                row.evals_per_point,
+                sci(row.max_error),
+                opt_sci(row.max_estimate)
+            );
+        }
+    }
+    if !r.fits.is_empty() {
+        let _ = writeln!(
+            s,
+            "\n## Fits (solver × objective; errors on the fitting samples)\n"
+        );
+        let _ = writeln!(
+            s,
+            "  {:<13} {:>7} {:>5} {:<36} {:<8} {:>10} {:>6} {:>7} {:>10} {:>10} {:>9}",
+            "spec",
+            "samples",
+            "free",
+            "solver",
+            "objective",
+            "time",
+            "iters",
+            "evals",
+            "max err",
+            "rms err",
+            "cond"
+        );
+        for f in &r.fits {
+            let obj = serde_json::to_value(f.objective)
+                .ok()
+                .and_then(|v| v.as_str().map(String::from))
+                .unwrap_or_default();
+            let _ = writeln!(
+                s,
+                "  {:<13} {:>7} {:>5} {:<36} {:<8} {:>10} {:>6} {:>7} {:>10} {:>10} {:>9}{}",
+                f.spec,
+                f.samples,
+                f.free_coefficients,
+                f.solver,
+                obj,
+                seconds(f.seconds),
+                f.iterations.map_or("-".into(), |v| v.to_string()),
+                f.evaluations.map_or("-".into(), |v| v.to_string()),
+                opt_sci(f.max_error),
+                opt_sci(f.rms_error),
+                opt_sci(f.condition_number),
+                f.failure
+                    .as_ref()
+                    .map_or(String::new(), |e| format!("  FAILED: {e}"))
+            );
+        }
+    }
+    if !r.tables.is_empty() {
+        let _ = writeln!(
+            s,
+            "\n## Tables against numpy/scipy (one thread each; seconds per point on a seeded subset of the grid; ratio at max error ≤ {:.0e})\n",
+            tables::TARGET_ERROR
+        );
+        for t in &r.tables {
+            let _ = writeln!(
+                s,
+                "{} ({}; {} points, {} sampled; build tolerance {:.0e})",
+                t.name, t.quantity, t.table_points, t.sample_points, t.build_tolerance
+            );
+            let _ = writeln!(
+                s,
+                "  {:<44} {:<22} {:>12} {:>10} {:>12}",
+                "method", "setting", "time/point", "max err", "table time"
+            );
+            for c in t.shadefit.iter().chain(&t.numpy) {
+                let _ = writeln!(
+                    s,
+                    "  {:<44} {:<22} {:>12} {:>10} {:>12}{}",
+                    c.method,
+                    c.setting,
+                    seconds(c.seconds_per_point),
+                    opt_sci(c.max_error),
+                    seconds(c.seconds_per_point * t.table_points as f64),
+                    if c.note.is_empty() {
+                        String::new()
+                    } else {
+                        format!("  ({})", c.note)
+                    }
+                );
+            }
+            let label = |k: usize| if k == 0 { "" } else { "without closed forms: " };
+            let ratios: Vec<&Option<tables::Ratio>> = if t.ratio_integrators.is_some() {
+                vec![&t.ratio, &t.ratio_integrators]
+            } else {
+                vec![&t.ratio]
+            };
+            for (k, r) in ratios.into_iter().enumerate() {
+                match r {
+                    Some(q) => {
+                        let _ = writeln!(
+                            s,
+                            "  => {}shadefit {} ({} err, {}/pt) vs {} {} ({} err, {}/pt): {}× faster{}",
+                            label(k),
+                            q.shadefit.setting,
+                            opt_sci(q.shadefit.max_error),
+                            seconds(q.shadefit.seconds_per_point),
+                            q.numpy.method,
+                            q.numpy.setting,
+                            opt_sci(q.numpy.max_error),
+                            seconds(q.numpy.seconds_per_point),
+                            if q.speedup < 10.0 { format!("{:.1}", q.speedup) } else { format!("{:.0}", q.speedup) },
+                            if q.at_target {
+                                String::new()
+                            } else {
+                                format!(" (numpy did not reach {:.0e})", tables::TARGET_ERROR)
+                            }
+                        );
+                    }
+                    None => {
+                        let _ = writeln!(
+                            s,
+                            "  => {}no ratio{}",
+                            label(k),
+                            if t.note.is_empty() {
+                                String::new()
+                            } else {
+                                format!(": {}", t.note)
+                            }
+                        );
+                    }
+                }
+            }
+        }
+    }
+    if !r.forms.is_empty() {
+        let _ = writeln!(
+            s,
+            "\n## Shader forms (op counts from naga's IR; max error of the f32 code)\n"
+        );
+        s.push_str(&forms::render(&r.forms));
+    }
+    s
+}

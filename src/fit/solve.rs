@@ -259,18 +259,24 @@ fn least_squares(
             Ok((theta, report.number_of_evaluations, report.number_of_evaluations))
         }
         LsqSolver::GaussNewton => {
-            use argmin::solver::gaussnewton::GaussNewtonLS;
-            use argmin::solver::linesearch::MoreThuenteLineSearch;
-            let ls = MoreThuenteLineSearch::new();
-            let gn = GaussNewtonLS::new(ls);
+            use argmin::solver::gaussnewton::GaussNewton;
+            // Plain Gauss–Newton, not argmin's GaussNewtonLS: that runs its line search with no
+            // iteration cap, and from a start whose normal equations are singular (a NaN step)
+            // neither More–Thuente nor backtracking ever returns (seen on fits/fuzz_g.toml's
+            // multi-start). A full step per iteration, capped at 200 iterations, always ends;
+            // a diverged result is caught below.
+            let gn = GaussNewton::new();
             let res = Executor::new(problem.clone(), gn)
                 .configure(|s| s.param(problem.theta.clone()).max_iters(200))
                 .run()
                 .map_err(|e| FitError::Solver { what: what.into(), msg: e.to_string() })?;
             let st = res.state();
             let theta = st.get_best_param().cloned().unwrap_or_else(|| problem.theta.clone());
-            problem.theta.copy_from(&theta);
             let iters = st.get_iter() as usize;
+            if !theta.iter().all(|v| v.is_finite()) {
+                return Err(FitError::Diverged { what: what.into(), iters, residual: st.get_best_cost() });
+            }
+            problem.theta.copy_from(&theta);
             Ok((theta, iters, iters))
         }
     }

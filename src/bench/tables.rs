@@ -1,0 +1,458 @@
+//! Default tables: shadefit against a straightforward numpy/scipy implementation of the same
+//! integrals (`benches/numpy_tables.py`) at equal max error.
+//!
+//! For each spec in fits/ (the samples every fit and table is built from), a seeded subset of
+//! its grid is evaluated to a tolerance 1–3 orders below the tightest setting (the reference).
+//! shadefit's integrator runs over the subset at a ladder of tolerances (one thread, like the
+//! numpy side); the numpy/scipy script runs its own methods over the same points with their own
+//! ladders (vectorised Gauss–Legendre, per-point `quad`/`dblquad`, Monte Carlo) and reports
+//! seconds per point and max error. The speed ratio at equal error compares the fastest numpy
+//! row within [`TARGET_ERROR`] with the fastest shadefit row within the same bound; when no numpy
+//! row reaches it, the most accurate numpy row is compared with the fastest shadefit row at
+//! least as accurate, and the row says so. Where scipy has the closed form (E_n for G and Q,
+//! artanh for the gloss length) a second ratio leaves it out: shadefit against the numerical
+//! integration a user writes without it. Table times are seconds per point × table size.
+
+use super::{Mode, SplitMix, time_it};
+use crate::pipeline;
+use crate::spec::Spec;
+use anyhow::{Context, Result};
+use serde::Serialize;
+use serde_json::{Value, json};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// Max error at which the ratio is taken: below every table's use (f32 rounding is 6e-8
+/// relative) and reachable by the straightforward methods within the time budget.
+pub const TARGET_ERROR: f64 = 1e-8;
+
+/// Errors below this are not resolved by the references (their own tolerance is 1e-12 to
+/// 1e-14 absolute, and f64 rounding of the sums is ~1e-15): "equal error" saturates here.
+const ERROR_FLOOR: f64 = 1e-12;
+
+/// One point of a time-vs-error curve.
+#[derive(Debug, Clone, Serialize)]
+pub struct CurvePoint {
+    pub method: String,
+    pub setting: String,
+    pub points: usize,
+    pub seconds_per_point: f64,
+    pub max_error: Option<f64>,
+    pub note: String,
+}
+
+/// The comparison at equal error.
+#[derive(Debug, Clone, Serialize)]
+pub struct Ratio {
+    pub numpy: CurvePoint,
+    pub shadefit: CurvePoint,
+    /// numpy seconds per point / shadefit seconds per point.
+    pub speedup: f64,
+    /// Whether the numpy row reached [`TARGET_ERROR`].
+    pub at_target: bool,
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct TableRow {
+    pub name: String,
+    pub quantity: String,
+    pub table_points: usize,
+    pub sample_points: usize,
+    /// Tolerance the spec builds the table with.
+    pub build_tolerance: f64,
+    pub shadefit: Vec<CurvePoint>,
+    pub numpy: Vec<CurvePoint>,
+    pub ratio: Option<Ratio>,
+    /// The same against numpy/scipy's numerical integrations only (no closed-form rows).
+    pub ratio_integrators: Option<Ratio>,
+    pub note: String,
+}
+
+/// How a spec's values map to the numpy script's points and channels.
+#[derive(Clone, Copy, PartialEq)]
+enum Shape {
+    Scalar,
+    /// (curvature, n·l) → RGB; the script takes (n_dot_l, kappa).
+    SkinPunctual,
+    /// (curvature, band ∈ {1, 2}) → RGB; the script takes (kappa) → k₁ RGB, k₂ RGB.
+    SkinSh,
+}
+
+/// The specs compared, with how many grid points each samples (quick, full).
+const TABLES: &[(&str, usize, usize)] = &[
+    ("gloss_table", 32, 128),
+    ("gloss_inverse_table", 32, 128),
+    ("gloss_combine_lut", 32, 128),
+    ("skin_punctual_lut", 24, 96),
+    ("skin_sh_lut", 8, 32),
+    ("fuzz_q", 32, 128),
+    ("fuzz_g", 32, 128),
+    ("fuzz_ps", 24, 128),
+    ("fuzz_r", 3, 8),
+];
+
+struct Table<'a> {
+    spec: &'a Spec,
+    shape: Shape,
+    /// Points of the numpy view (see [`Shape`]).
+    points: Vec<Vec<f64>>,
+    /// Spec-grid points behind each numpy point (two for SkinSh: bands 1 and 2).
+    grid_points: Vec<Vec<Vec<f64>>>,
+    table_points: usize,
+}
+
+impl Table<'_> {
+    /// Values of every numpy point (all channels, flattened point-major) at tolerance `tol`.
+    fn eval(&self, tol: f64) -> Vec<f64> {
+        let q = self.spec.quantity;
+        self.grid_points
+            .iter()
+            .flat_map(|gs| {
+                gs.iter().flat_map(move |g| match q.eval_channels {
+                    Some(multi) => multi(g, tol)
+                        .into_iter()
+                        .map(|e| e.value)
+                        .collect::<Vec<_>>(),
+                    None => vec![(q.eval)(g, tol).value],
+                })
+            })
+            .collect()
+    }
+
+    fn channels(&self) -> usize {
+        match self.shape {
+            Shape::Scalar => 1,
+            Shape::SkinPunctual => 3,
+            Shape::SkinSh => 6,
+        }
+    }
+
+    fn params(&self) -> Vec<String> {
+        match self.shape {
+            // The script names gloss `g`; every other axis keeps the spec's name.
+            Shape::Scalar => self
+                .spec
+                .file
+                .axis
+                .iter()
+                .map(|a| {
+                    if a.name == "gloss" {
+                        "g".into()
+                    } else {
+                        a.name.clone()
+                    }
+                })
+                .collect(),
+            Shape::SkinPunctual => vec!["n_dot_l".into(), "kappa".into()],
+            Shape::SkinSh => vec!["kappa".into()],
+        }
+    }
+}
+
+fn table<'a>(spec: &'a Spec, n: usize, seed: u64) -> Table<'a> {
+    let counts: Vec<usize> = spec.file.axis.iter().map(|a| a.count).collect();
+    let grid = pipeline::grid(spec, &counts);
+    let shape = match spec.file.quantity.as_str() {
+        "skin-punctual" => Shape::SkinPunctual,
+        "skin-sh" => Shape::SkinSh,
+        _ => Shape::Scalar,
+    };
+    // SH rows are (curvature, band) with band fastest... the grid is first-axis fastest: group
+    // both bands of one curvature.
+    let units: Vec<Vec<Vec<f64>>> = match shape {
+        Shape::SkinSh => {
+            let nk = counts[0];
+            (0..nk)
+                .map(|k| vec![grid[k].clone(), grid[k + nk].clone()])
+                .collect()
+        }
+        _ => grid.into_iter().map(|g| vec![g]).collect(),
+    };
+    let table_points = units.len();
+    // The two grid corners, then seeded picks without repetition, in grid order.
+    let mut picks = vec![0, table_points - 1];
+    let mut rng = SplitMix(seed);
+    while picks.len() < n.min(table_points) {
+        let i = ((rng.next_f64() * table_points as f64) as usize).min(table_points - 1);
+        if !picks.contains(&i) {
+            picks.push(i);
+        }
+    }
+    picks.sort_unstable();
+    let grid_points: Vec<Vec<Vec<f64>>> = picks.iter().map(|&i| units[i].clone()).collect();
+    let points = grid_points
+        .iter()
+        .map(|gs| match shape {
+            Shape::Scalar => gs[0].clone(),
+            Shape::SkinPunctual => vec![gs[0][1], gs[0][0]],
+            Shape::SkinSh => vec![gs[0][0]],
+        })
+        .collect();
+    Table {
+        spec,
+        shape,
+        points,
+        grid_points,
+        table_points,
+    }
+}
+
+/// shadefit's ladder of tolerances per quantity (closed forms: one setting).
+fn ladder(mode: &Mode, quantity: &str) -> Option<Vec<f64>> {
+    let q = mode.quick;
+    match quantity {
+        "gloss-length" | "gloss-from-length" | "gloss-combine" | "fuzz-q" => None,
+        // The skin quantities integrate to min(tol, 1e-10) (quantity::skin_tolerance): the
+        // tabulated tolerance is the only setting.
+        "skin-punctual" | "skin-sh" => Some(vec![1e-10]),
+        "fuzz-r" => Some(if q {
+            vec![1e-5, 1e-7, 1e-9]
+        } else {
+            vec![1e-5, 1e-7, 1e-9, 1e-10]
+        }),
+        "fuzz-ps" => Some(if q {
+            vec![1e-3, 1e-5, 1e-7, 1e-9]
+        } else {
+            vec![1e-3, 1e-5, 1e-7, 1e-9, 1e-11]
+        }),
+        _ => Some(if q {
+            vec![1e-4, 1e-6, 1e-8, 1e-10]
+        } else {
+            vec![1e-4, 1e-6, 1e-8, 1e-10, 1e-12]
+        }),
+    }
+}
+
+/// Reference tolerance: below the tightest ladder setting (R is capped at 1e-13 inside).
+fn reference_tolerance(quantity: &str) -> f64 {
+    match quantity {
+        "fuzz-r" => 1e-12,
+        "fuzz-ps" => 1e-13,
+        _ => 1e-14,
+    }
+}
+
+fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
+}
+
+/// The numpy/scipy script and the interpreter to run it with.
+pub struct Python {
+    pub interpreter: PathBuf,
+    pub script: PathBuf,
+    /// Whether a failure of the script fails the run (else each table notes it).
+    pub required: bool,
+}
+
+pub fn all(mode: &Mode, specs: &[Spec], python: Option<&Python>) -> Result<Vec<TableRow>> {
+    let mut tables = Vec::new();
+    for (k, (name, quick_n, full_n)) in TABLES.iter().enumerate() {
+        let Some(spec) = specs.iter().find(|s| s.file.name == *name) else {
+            continue;
+        };
+        tables.push(table(
+            spec,
+            if mode.quick { *quick_n } else { *full_n },
+            0x5EED + k as u64,
+        ));
+    }
+    let mut rows = Vec::new();
+    let mut inputs = Vec::new();
+    for t in &tables {
+        let quantity = t.spec.file.quantity.clone();
+        let truth = t.eval(reference_tolerance(&quantity));
+        let mut curve = Vec::new();
+        let settings: Vec<(String, f64)> = match ladder(mode, &quantity) {
+            Some(tols) => tols
+                .into_iter()
+                .map(|tol| (format!("tol {tol:.0e}"), tol))
+                .collect(),
+            None => vec![("closed form".to_string(), t.spec.file.tolerance)],
+        };
+        for (setting, tol) in settings {
+            let (seconds, values) = time_it(mode.min_seconds, || t.eval(tol));
+            curve.push(CurvePoint {
+                method: "shadefit".into(),
+                setting,
+                points: t.points.len(),
+                seconds_per_point: seconds / t.points.len() as f64,
+                max_error: Some(max_abs_diff(&values, &truth)),
+                note: String::new(),
+            });
+        }
+        let c = t.channels();
+        inputs.push(json!({
+            "name": t.spec.file.name,
+            "quantity": quantity,
+            "params": t.params(),
+            "channels": c,
+            "points": t.points,
+            "reference": truth.chunks(c).collect::<Vec<_>>(),
+            "table_points": t.table_points,
+        }));
+        rows.push(TableRow {
+            name: t.spec.file.name.clone(),
+            quantity,
+            table_points: t.table_points,
+            sample_points: t.points.len(),
+            build_tolerance: t.spec.file.tolerance,
+            shadefit: curve,
+            numpy: Vec::new(),
+            ratio: None,
+            ratio_integrators: None,
+            note: String::new(),
+        });
+    }
+    if let Some(py) = python {
+        let input = json!({"quick": mode.quick, "target_error": TARGET_ERROR, "tables": inputs});
+        let out = match run_python(py, &input) {
+            Ok(v) => v,
+            Err(e) if !py.required => {
+                for row in &mut rows {
+                    row.note = format!("numpy/scipy comparison failed: {e:#}");
+                }
+                return Ok(rows);
+            }
+            Err(e) => return Err(e),
+        };
+        for row in &mut rows {
+            let Some(t) = out["tables"]
+                .as_array()
+                .and_then(|ts| ts.iter().find(|t| t["name"] == row.name.as_str()))
+            else {
+                row.note = "the numpy script returned nothing for this table".into();
+                continue;
+            };
+            row.numpy = t["rows"]
+                .as_array()
+                .map(|rs| rs.iter().map(curve_point).collect())
+                .unwrap_or_default();
+            if let Some(n) = t["note"].as_str() {
+                row.note = n.to_string();
+            }
+            row.ratio = ratio(&row.numpy, &row.shadefit);
+            let integrations: Vec<CurvePoint> = row
+                .numpy
+                .iter()
+                .filter(|c| !c.method.starts_with("closed form"))
+                .cloned()
+                .collect();
+            if integrations.len() < row.numpy.len() {
+                row.ratio_integrators = ratio(&integrations, &row.shadefit);
+            }
+        }
+    } else {
+        for row in &mut rows {
+            row.note = "numpy/scipy comparison not run (no Python)".into();
+        }
+    }
+    Ok(rows)
+}
+
+fn curve_point(v: &Value) -> CurvePoint {
+    CurvePoint {
+        method: v["method"].as_str().unwrap_or("?").to_string(),
+        setting: v["setting"].as_str().unwrap_or("").to_string(),
+        points: v["points"].as_u64().unwrap_or(0) as usize,
+        seconds_per_point: v["seconds_per_point"].as_f64().unwrap_or(f64::NAN),
+        max_error: v["max_error"].as_f64(),
+        note: v["note"].as_str().unwrap_or("").to_string(),
+    }
+}
+
+/// The comparison at equal error (see the module doc).
+pub(crate) fn ratio(numpy: &[CurvePoint], shadefit: &[CurvePoint]) -> Option<Ratio> {
+    let ok = |c: &&CurvePoint| c.max_error.is_some_and(f64::is_finite) && c.seconds_per_point > 0.0;
+    let fastest_within = |rows: &[CurvePoint], bound: f64| -> Option<CurvePoint> {
+        rows.iter()
+            .filter(ok)
+            .filter(|c| c.max_error.unwrap() <= bound.max(ERROR_FLOOR))
+            .min_by(|a, b| a.seconds_per_point.total_cmp(&b.seconds_per_point))
+            .cloned()
+    };
+    let (np, at_target) = match fastest_within(numpy, TARGET_ERROR) {
+        Some(n) => (n, true),
+        None => (
+            numpy
+                .iter()
+                .filter(ok)
+                .min_by(|a, b| a.max_error.unwrap().total_cmp(&b.max_error.unwrap()))?
+                .clone(),
+            false,
+        ),
+    };
+    let bound = if at_target {
+        TARGET_ERROR
+    } else {
+        np.max_error.unwrap()
+    };
+    let sf = fastest_within(shadefit, bound)?;
+    Some(Ratio {
+        speedup: np.seconds_per_point / sf.seconds_per_point,
+        numpy: np,
+        shadefit: sf,
+        at_target,
+    })
+}
+
+/// Run the script on `input`; its JSON answer.
+fn run_python(py: &Python, input: &Value) -> Result<Value> {
+    let dir = tempfile_dir()?;
+    let inp = dir.join("in.json");
+    let out = dir.join("out.json");
+    std::fs::write(&inp, serde_json::to_vec(input)?)?;
+    let status = Command::new(&py.interpreter)
+        .arg(&py.script)
+        .arg(&inp)
+        .arg(&out)
+        // One thread, like shadefit's side of the comparison.
+        .env("OMP_NUM_THREADS", "1")
+        .env("OPENBLAS_NUM_THREADS", "1")
+        .env("MKL_NUM_THREADS", "1")
+        .status()
+        .with_context(|| {
+            format!(
+                "running {} {}",
+                py.interpreter.display(),
+                py.script.display()
+            )
+        })?;
+    anyhow::ensure!(
+        status.success(),
+        "{} exited with {status}",
+        py.script.display()
+    );
+    let text =
+        std::fs::read_to_string(&out).with_context(|| format!("reading {}", out.display()))?;
+    let v = serde_json::from_str(&text).with_context(|| format!("parsing {}", out.display()))?;
+    let _ = std::fs::remove_dir_all(&dir);
+    Ok(v)
+}
+
+fn tempfile_dir() -> Result<PathBuf> {
+    let base = std::env::temp_dir();
+    for k in 0..1000u32 {
+        let d = base.join(format!("shadefit-bench-{}-{k}", std::process::id()));
+        if std::fs::create_dir(&d).is_ok() {
+            return Ok(d);
+        }
+    }
+    anyhow::bail!("cannot create a temporary folder in {}", base.display())
+}
+
+/// The default interpreter: the test suite's venv when present, else `python3`.
+pub fn default_python(root: &Path) -> Python {
+    let venv = root.join("tests/python/.venv/bin/python");
+    Python {
+        interpreter: if venv.exists() {
+            venv
+        } else {
+            PathBuf::from("python3")
+        },
+        script: root.join("benches/numpy_tables.py"),
+        required: false,
+    }
+}
