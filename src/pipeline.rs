@@ -1,9 +1,13 @@
 //! The build: for every spec, sample the integral, fit (or tabulate), verify, emit.
 //!
-//! - `Mode::Fit` integrates and fits from scratch (what `shadefit build` does);
+//! - `Mode::Fit` integrates and fits from scratch (what `shadefit build` does); a fit's f64
+//!   coefficients are then rounded to f32 and re-optimised in f32 on the fitting samples
+//!   (`fit::f32round`), and the emitted code uses those f32 coefficients;
 //! - `Mode::Committed` takes the coefficients or table values from the committed JSON in
 //!   generated/json and re-verifies and re-emits them (what `shadefit build --check` compares
-//!   byte for byte; it fails if a spec changed since its JSON was written).
+//!   byte for byte; it fails if a spec changed since its JSON was written). A fit's f32
+//!   coefficients are read back too, and must lie within `f32round::MAX_ULPS` of the rounded f64
+//!   ones; what the re-optimisation measured on the fitting samples is carried over.
 //!
 //! Samples are computed in parallel with rayon and collected in grid order, so outputs are
 //! byte-identical at any thread count.
@@ -11,11 +15,11 @@
 use crate::emit::expr;
 use crate::emit::{self, header_lines, rust, wgsl, Artifact, GENERATOR};
 use crate::fit::positivity::{prove_denominator_positive, Positivity};
-use crate::fit::{self, Data, FitOptions, FitReport};
+use crate::fit::{self, f32round, Data, FitOptions, FitReport};
 use crate::spec::{Kind, Spec};
 use nalgebra::DVector;
 use rayon::prelude::*;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 use sha2::{Digest, Sha256};
 use std::path::Path;
@@ -47,6 +51,8 @@ pub enum BuildError {
     Spec(#[from] crate::spec::SpecError),
     #[error("{spec}: {msg}")]
     Skin { spec: String, msg: String },
+    #[error("{spec}: the f32 coefficients in generated/json/{spec}.json do not belong to its f64 coefficients: {why}; run `shadefit build`")]
+    F32Coefficients { spec: String, why: String },
 }
 
 /// Errors of an emitted function against the integral on the verification grid.
@@ -188,14 +194,31 @@ fn build_fit(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> 
     let fit_section = spec.file.fit.as_ref().expect("fit specs carry [fit]");
     let objective = fit_section.objective;
     let counts: Vec<usize> = spec.file.axis.iter().map(|a| a.count).collect();
-    let (coefficients, report) = match mode {
+    let dom = domain(spec);
+    let (coefficients, report, (num, den), on_grid) = match mode {
         Mode::Fit => {
             let x = grid(spec, &counts);
             let y = sample(spec, &x);
             let data = Data { x, y };
             let opts = FitOptions { objective, max_rms: fit_section.max_rms, ..FitOptions::default() };
             let f = fit::fit(model, &data, &opts, &name)?;
-            (f.coefficients, Some(f.report))
+            let r = f32round::round_and_reoptimise(
+                model,
+                &f.coefficients,
+                &data,
+                &dom,
+                &f32round::RoundOptions::new(objective, fit_section.max_rms),
+                &name,
+            )?;
+            let on_grid = RoundingOnGrid {
+                fitting_samples: data.len(),
+                f64: r.f64,
+                rounded_f32: r.rounded,
+                reoptimised_f32: r.reoptimised,
+                sweeps: r.sweeps,
+                evaluations: r.evaluations,
+            };
+            (f.coefficients, Some(f.report), (r.num, r.den), on_grid)
         }
         Mode::Committed => {
             let v = committed_json(root, spec)?;
@@ -203,18 +226,42 @@ fn build_fit(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> 
             if c.len() != model.n_full() {
                 return Err(BuildError::NoCommitted { spec: name, why: "coefficient count differs from the spec".into() });
             }
-            (DVector::from_vec(c), None)
+            let c = DVector::from_vec(c);
+            let f32s = committed_f32(model, &c, &v["model"], &name)?;
+            let on_grid: RoundingOnGrid = serde_json::from_value(v["f32_rounding"].clone()).map_err(|e| {
+                BuildError::NoCommitted { spec: name.clone(), why: format!("'f32_rounding' unreadable ({e})") }
+            })?;
+            (c, None, f32s, on_grid)
         }
     };
-    let dom = domain(spec);
     let lower = match prove_denominator_positive(model, &coefficients, &dom) {
         Positivity::Proven { lower, .. } => lower,
         Positivity::NotProven { lower, region, .. } => {
             return Err(fit::FitError::PoleInDomain { what: name, lower, region }.into());
         }
     };
+    let lower32 = match prove_denominator_positive(model, &f32round::widen(&num, &den), &dom) {
+        Positivity::Proven { lower, .. } => lower,
+        Positivity::NotProven { lower, region, .. } => {
+            return Err(fit::FitError::PoleInDomain { what: format!("{name} (f32 coefficients)"), lower, region }.into());
+        }
+    };
+    let (num0, den0) = f32round::rounded(model, &coefficients);
+    let moves: Vec<i64> =
+        num0.iter().chain(&den0).zip(num.iter().chain(&den)).map(|(&a, &b)| f32round::ulps_between(a, b)).collect();
+    let mut f32_rounding = serde_json::to_value(&on_grid).expect("the rounding report serialises");
+    let extra = json!({
+        "objective": objective,
+        "max_ulps_allowed": f32round::MAX_ULPS,
+        "moves_ulps": moves,
+        "coefficients_moved": moves.iter().filter(|m| **m != 0).count(),
+        "max_move_ulps": moves.iter().map(|m| m.unsigned_abs()).max().unwrap_or(0),
+        "denominator_lower_bound": lower32,
+    });
+    if let (Some(o), Value::Object(x)) = (f32_rounding.as_object_mut(), extra) {
+        o.extend(x);
+    }
     let e = expr::model_expr(model);
-    let (num, den) = expr::f32_arrays(model, &coefficients);
     let clamp32 = model.clamp.map(|(a, b)| (a as f32, b as f32));
     let vcounts: Vec<usize> = spec.file.axis.iter().map(|a| a.verify_count()).collect();
     let vx = grid(spec, &vcounts);
@@ -279,6 +326,7 @@ fn build_fit(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> 
             "objective": objective,
         },
         "verification": verification,
+        "f32_rounding": f32_rounding,
     });
     let artifacts = vec![
         Artifact { path: format!("wgsl/{name}.wgsl").into(), contents: wgsl::render_module(&header, &func).into() },
@@ -286,6 +334,61 @@ fn build_fit(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> 
         Artifact { path: format!("json/{name}.json").into(), contents: json_text(&json).into() },
     ];
     Ok(Built { name, artifacts, verification, fit: report })
+}
+
+/// What rounding to f32 did on the fitting samples (part of `f32_rounding` in the JSON): measured
+/// by `build`, carried over from the committed JSON by `build --check` (which does not sample the
+/// fitting grid); the rest of `f32_rounding` follows from the coefficients and is recomputed.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct RoundingOnGrid {
+    fitting_samples: usize,
+    /// The f64 fit, the coefficients rounded to nearest f32, and the re-optimised f32 ones
+    /// (f32 arithmetic, emitted order).
+    f64: f32round::Errors,
+    rounded_f32: f32round::Errors,
+    reoptimised_f32: f32round::Errors,
+    sweeps: usize,
+    evaluations: usize,
+}
+
+/// The committed f32 arrays: f32 values, as many as the model's terms, fixed coefficients as
+/// rounded, every one within [`f32round::MAX_ULPS`] of the rounded f64 coefficient.
+fn committed_f32(model: &fit::RationalModel, c: &DVector<f64>, m: &Value, spec: &str) -> Result<(Vec<f32>, Vec<f32>), BuildError> {
+    let bad = |why: String| BuildError::F32Coefficients { spec: spec.into(), why };
+    let (num0, den0) = f32round::rounded(model, c);
+    let labels = model.coefficient_labels();
+    let read = |key: &str, want: usize, first: usize| -> Result<Vec<f32>, BuildError> {
+        let v = f64_array(m, spec, key)?;
+        if v.len() != want {
+            return Err(bad(format!("'{key}' has {} values, the model {want}", v.len())));
+        }
+        v.iter()
+            .enumerate()
+            .map(|(j, &x)| {
+                if (x as f32) as f64 == x {
+                    Ok(x as f32)
+                } else {
+                    Err(bad(format!("{} = {x:e} in '{key}' is not an f32", labels[first + j])))
+                }
+            })
+            .collect()
+    };
+    let num = read("numerator_f32", num0.len(), 0)?;
+    let den = read("denominator_f32", den0.len(), num0.len())?;
+    for (i, (&a, &b)) in num0.iter().chain(&den0).zip(num.iter().chain(&den)).enumerate() {
+        let d = f32round::ulps_between(a, b);
+        if d.unsigned_abs() > f32round::MAX_ULPS as u64 {
+            return Err(bad(format!(
+                "{} = {b:e} is {d} ulps from the rounded coefficient {a:e} (at most {} allowed)",
+                labels[i],
+                f32round::MAX_ULPS
+            )));
+        }
+        if d != 0 && model.fixed.iter().any(|f| f.0 == i) {
+            return Err(bad(format!("{} is fixed but {b:e} differs from its rounded value {a:e}", labels[i])));
+        }
+    }
+    Ok((num, den))
 }
 
 fn describe_fit(spec: &Spec, model: &fit::RationalModel) -> String {

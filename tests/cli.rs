@@ -111,6 +111,30 @@ fn build_check_passes_on_committed_tree_and_catches_a_changed_spec() {
 }
 
 #[test]
+fn build_check_rejects_f32_coefficients_that_are_not_the_fit_s() {
+    // `build --check` reads a fit's f32 arrays from the committed JSON; they must be f32 values
+    // within the move cap (64 ulps) of the rounded f64 coefficients. A value 1000 ulps away, or
+    // one that is not an f32, stops it with exit 1, naming the spec and the coefficient.
+    let cases: [(&str, fn(f32) -> f64, &str); 2] = [
+        ("ulps", |v| f32::from_bits(v.to_bits() + 1000) as f64, "1000 ulps"),
+        ("not an f32", |v| v as f64 + 1e-12, "not an f32"),
+    ];
+    for (what, edit, want) in cases {
+        let d = scratch();
+        copy_dir(&root().join("generated"), &d.path().join("generated"));
+        let p = d.path().join("generated/json/gloss_length.json");
+        let mut v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&p).unwrap()).unwrap();
+        let old = v["model"]["numerator_f32"][1].as_f64().unwrap() as f32;
+        v["model"]["numerator_f32"][1] = serde_json::json!(edit(old));
+        std::fs::write(&p, serde_json::to_string_pretty(&v).unwrap()).unwrap();
+        let o = shadefit(&["build", "--check", "--only", "gloss_length"], Some(d.path()));
+        assert_eq!(o.status.code(), Some(1), "{what}: {}", stderr(&o));
+        let e = stderr(&o);
+        assert!(e.contains("gloss_length") && e.contains("num[gloss]") && e.contains(want), "{what}: {e}");
+    }
+}
+
+#[test]
 fn build_is_byte_identical_at_any_thread_count() {
     let run = |threads: &str| {
         let d = scratch();

@@ -15,11 +15,11 @@ fn input(v: f32, lo: f32, hi: f32) -> f32 {
 
 /// Numerator coefficients, one per numerator term.
 pub const FUZZ_G_NUM: [f32; 3] = [
-    1e0_f32, -1.151825e0_f32, 7.885459e-1_f32,
+    1e0_f32, -1.1518276e0_f32, 7.885459e-1_f32,
 ];
 /// Denominator coefficients (the constant term 1 is implicit).
 pub const FUZZ_G_DEN: [f32; 2] = [
-    6.2828356e-1_f32, 1.0087495e-1_f32,
+    6.282831e-1_f32, 1.00874774e-1_f32,
 ];
 
 /// CPU version of the WGSL function of the same name.

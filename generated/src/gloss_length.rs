@@ -19,7 +19,7 @@ pub const GLOSS_LENGTH_NUM: [f32; 4] = [
 ];
 /// Denominator coefficients (the constant term 1 is implicit).
 pub const GLOSS_LENGTH_DEN: [f32; 2] = [
-    -1.0721555e0_f32, 8.92649e0_f32,
+    -1.0721556e0_f32, 8.926489e0_f32,
 ];
 
 /// CPU version of the WGSL function of the same name.

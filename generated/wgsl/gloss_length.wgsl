@@ -15,7 +15,7 @@ const GLOSS_LENGTH_NUM: array<f32, 4> = array<f32, 4>(
     6.666667e-1f, 1.0266422e-1f, 7.5295796e0f, 5.5504626e-1f,
 );
 const GLOSS_LENGTH_DEN: array<f32, 2> = array<f32, 2>(
-    -1.0721555e0f, 8.92649e0f,
+    -1.0721556e0f, 8.926489e0f,
 );
 
 fn gloss_to_normal_length(gloss: f32) -> f32 {

@@ -1,6 +1,8 @@
 //! Fitting: model forms (`model`), the problem on data (`problem`), solvers (`solve`),
-//! reports (`report`) and the denominator positivity proof (`positivity`).
+//! reports (`report`), the denominator positivity proof (`positivity`) and the f32 coefficients
+//! of emitted code (`f32round`).
 
+pub mod f32round;
 pub mod fields;
 pub mod minimax;
 pub mod model;

@@ -2,6 +2,17 @@
 //! inner grid, fit the coefficient fields jointly (`fit::fields`), prove every denominator
 //! positive on the outer domain, verify on the verification grids in f64 and in the emitted
 //! f32 arithmetic, emit WGSL, Rust and JSON.
+//!
+//! **f32 coefficients.** The emitted arrays are the f64 coefficients rounded to nearest f32; they
+//! are not re-optimised in f32 as `kind = "fit"` coefficients are (`fit::f32round`). The JSON's
+//! `f32_rounding` reports, on the fitting samples, the errors of the f64 fields and of the f32
+//! code (`reoptimised: false`); committed mode carries it over. Why not: one evaluation of the
+//! f64 and f32 errors on the fitting samples (fuzz_ps: 627 264) takes ~0.3 s on two cores, and a
+//! coordinate sweep over 6 × 27 coefficients with 14 candidate moves each needs ~2 300 f32
+//! evaluations: minutes a sweep (estimated ~15 s even if only the moved field and then the basis
+//! sums were re-evaluated), against a budget of a few seconds. Nor is there much to gain: rounding
+//! changes the committed fit's max error on those samples by ~5e-6 of its 0.115 (downward, as
+//! it happens): the error is the form's, not the coefficients'.
 
 use super::{committed_json, input_hash, json_text, spec_rel_path, tensor, BuildError, Built, Mode, Verification};
 use crate::emit::expr::{self, model_expr};
@@ -10,7 +21,8 @@ use crate::emit::{header_lines, Artifact, GENERATOR};
 use crate::fit::fields::{fit_fields, FieldOptions, PointData};
 use crate::fit::model::Term;
 use crate::fit::positivity::{prove_denominator_positive, Positivity};
-use crate::fit::{FitError, RationalModel};
+use crate::fit::f32round::Errors;
+use crate::fit::{FitError, Objective, RationalModel};
 use crate::quantity::InnerBasis;
 use crate::spec::{AxisSpec, Spec};
 use nalgebra::{DMatrix, DVector};
@@ -60,6 +72,50 @@ fn design(l: &Layout<'_>, o: &[f64], inner: &[Vec<f64>]) -> DMatrix<f64> {
     b
 }
 
+/// The fitting samples: outer and inner grids, and the samples at each outer point.
+struct FittingGrid {
+    outer: Vec<Vec<f64>>,
+    inner: Vec<Vec<f64>>,
+    data: Vec<PointData>,
+}
+
+/// Errors on the fitting samples of the f64 fields and of the emitted f32 code (the f64
+/// coefficients rounded to nearest f32), by the fit's objective. Outer points in parallel,
+/// residuals collected in grid order and summed sequentially.
+fn fitting_errors(
+    l: &Layout<'_>,
+    coefficients: &[DVector<f64>],
+    func: &FieldsFunction<'_>,
+    g: &FittingGrid,
+    objective: Objective,
+) -> (Errors, Errors) {
+    let (lo, hi) = l.basis.range;
+    let rows: Vec<(Vec<f64>, Vec<f64>)> = g
+        .outer
+        .par_iter()
+        .zip(&g.data)
+        .map(|(o, d)| {
+            let c64: Vec<f64> = l.models.iter().zip(coefficients).map(|(m, c)| m.eval_full(c, o)).collect();
+            let feats = expr::features_f32(&l.models[0], o, func.domain);
+            let c32 = efields::coefficients_f32(func, &feats);
+            let mut r64 = Vec::with_capacity(g.inner.len());
+            let mut r32 = Vec::with_capacity(g.inner.len());
+            for (u, &y) in g.inner.iter().zip(d.y.iter()) {
+                let a = (l.basis.to_args)(o, u);
+                let v64: f64 = l.terms.iter().zip(&c64).map(|(tm, c)| c * tm.eval(&a)).sum::<f64>().clamp(lo, hi);
+                let a_32: Vec<f32> = a.iter().map(|&v| v as f32).collect();
+                r64.push(v64 - y);
+                r32.push(efields::evaluator_f32(func, &c32, &a_32) as f64 - y);
+            }
+            (r64, r32)
+        })
+        .collect();
+    (
+        Errors::of(rows.iter().flat_map(|r| r.0.iter().copied()), objective),
+        Errors::of(rows.iter().flat_map(|r| r.1.iter().copied()), objective),
+    )
+}
+
 pub fn build(spec: &Spec, mode: Mode, root: &std::path::Path) -> Result<Built, BuildError> {
     let name = spec.file.name.clone();
     let l = layout(spec);
@@ -67,7 +123,9 @@ pub fn build(spec: &Spec, mode: Mode, root: &std::path::Path) -> Result<Built, B
     let counts = |axes: &[AxisSpec], verify: bool| -> Vec<usize> {
         axes.iter().map(|a| if verify { a.verify_count() } else { a.count }).collect()
     };
-    let (coefficients, report): (Vec<DVector<f64>>, Option<Value>) = match mode {
+    // Fit mode keeps the fitting samples for the f32 rounding report; committed mode carries that
+    // report over from the committed JSON (it does not sample the fitting grid).
+    let (coefficients, report, fitting): (Vec<DVector<f64>>, Option<Value>, Result<FittingGrid, Value>) = match mode {
         Mode::Fit => {
             let outer = tensor(l.outer, &counts(l.outer, false));
             let inner = tensor(l.inner, &counts(l.inner, false));
@@ -102,7 +160,7 @@ pub fn build(spec: &Spec, mode: Mode, root: &std::path::Path) -> Result<Built, B
                 "lm_evaluations": f.lm_evaluations,
                 "outer_iterations": f.outer_iterations,
             });
-            (f.coefficients, Some(report))
+            (f.coefficients, Some(report), Ok(FittingGrid { outer, inner, data }))
         }
         Mode::Committed => {
             let v = committed_json(root, spec)?;
@@ -118,7 +176,7 @@ pub fn build(spec: &Spec, mode: Mode, root: &std::path::Path) -> Result<Built, B
                 }
                 c.push(DVector::from_vec(v));
             }
-            (c, v.get("fit").cloned())
+            (c, v.get("fit").cloned(), Err(v["f32_rounding"].clone()))
         }
     };
     let dom: Vec<(f64, f64)> = l.outer.iter().map(|a| (a.range[0], a.range[1])).collect();
@@ -158,6 +216,19 @@ pub fn build(spec: &Spec, mode: Mode, root: &std::path::Path) -> Result<Built, B
         eval_domain: &eval_domain,
         terms: &l.terms,
         range: (l.basis.range.0 as f32, l.basis.range.1 as f32),
+    };
+    let f32_rounding = match fitting {
+        Ok(g) => {
+            let (e64, e32) = fitting_errors(&l, &coefficients, &func, &g, fit_section.objective);
+            json!({
+                "fitting_samples": g.outer.len() * g.inner.len(),
+                "objective": fit_section.objective,
+                "f64": e64,
+                "rounded_f32": e32,
+                "reoptimised": false,
+            })
+        }
+        Err(committed) => committed,
     };
     // Verification on the verification grids, in f64 and in the emitted f32 arithmetic.
     let vouter = tensor(l.outer, &counts(l.outer, true));
@@ -239,6 +310,7 @@ pub fn build(spec: &Spec, mode: Mode, root: &std::path::Path) -> Result<Built, B
         })).collect::<Vec<_>>(),
         "fit": report,
         "verification": verification,
+        "f32_rounding": f32_rounding,
     });
     let artifacts = vec![
         Artifact { path: format!("wgsl/{name}.wgsl").into(), contents: efields::render_wgsl(&header, &func).into() },

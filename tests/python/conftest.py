@@ -9,8 +9,10 @@ generated/json files against independent scipy/nlopt computations:
                         out/fit_comparison.json);
 * test_nist.py       -- `shadefit fit` on NIST StRD MGH09 and Kirby2 (certified RSS), beside scipy;
 * test_generated.py  -- the generated JSON files (fits and tables) re-evaluated in numpy on their
-                        verification grids: their error claims confirmed; the two-stage fit
-                        (fuzz_ps.json) against `shadefit eval` at a subset of its grid;
+                        verification grids: their error claims confirmed; the f32 coefficients'
+                        `f32_rounding` claims on the fitting grid (emitted f32 code replayed in
+                        numpy float32, sf_f32.py); the two-stage fit (fuzz_ps.json) against
+                        `shadefit eval` at a subset of its grid;
 * test_skin.py       -- `shadefit eval` of the skin quantities against scipy, the skin LUT files;
 * test_fuzz.py       -- `shadefit eval` of the fuzz quantities (P_s, G, Q, R) against scipy/numpy;
 * test_notebooks.py  -- every notebook in notebooks/ executed headless without a cell error.

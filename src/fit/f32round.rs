@@ -1,0 +1,419 @@
+//! f32 coefficients for emitted code: the f64 fit rounded to f32, then re-optimised in f32.
+//!
+//! Shaders evaluate the fitted form in f32 with f32 coefficients. Rounding each f64 coefficient
+//! to the nearest f32 moves it by up to half an ulp; where the form has large coefficients that
+//! cancel, those moves add up to more than the fit's own error, and the nearest f32 vector is no
+//! longer the best one. [`round_and_reoptimise`] starts from the rounded vector and searches its
+//! f32 neighbours:
+//!
+//! - **Objective**: the spec's, of the f32-*evaluated* function (exactly the emitted arithmetic:
+//!   [`expr::eval_f32`] of [`expr::model_expr`] on [`expr::features_f32`], the clamp applied in
+//!   f32), residuals against the fitting samples in f64: minimax max |r|, lsq rms, l4 Σ r⁴. On
+//!   the fitting grid, not the verification grid, so the verification stays a measurement.
+//! - **Moves**: coordinate sweeps. For each coefficient that is not fixed, in order, the
+//!   candidates ±1, ±2, ±4, …, ±`max_ulps` ulps from its current value, each within `max_ulps`
+//!   of the rounded value; the best strictly improving admissible one is taken (ties go to the
+//!   earlier candidate). Sweeps repeat until one moves nothing or `max_sweeps` is reached.
+//! - **Constraints**: with `max_rms`, an accepted vector's rms is at most max(cap, the rounded
+//!   vector's rms); each pin f(at) = value holds in f32 within max(the rounded vector's error
+//!   there, one ulp of the value in f32); the denominator stays provably positive: a move of a
+//!   denominator coefficient is accepted only if [`prove_denominator_positive`] succeeds on the
+//!   f32 values widened to f64. That proof is of the f64 evaluation of the f32 coefficients; the
+//!   f32 evaluation of Q differs from it by its own rounding, a few ulps of Σ|q_j D_j|.
+//! - **Deterministic**: sequential, in a fixed order, sums in sample order: the result does not
+//!   depend on the thread count.
+//!
+//! Two-stage fits (`kind = "fields"`) are not re-optimised; see `pipeline::fields`.
+
+use super::model::RationalModel;
+use super::positivity::{prove_denominator_positive, Positivity};
+use super::problem::Data;
+use super::solve::{FitError, Objective};
+use crate::emit::expr::{self, Expr};
+use nalgebra::DVector;
+use serde::{Deserialize, Serialize};
+
+/// Search limits of the re-optimisation.
+#[derive(Debug, Clone, Copy)]
+pub struct RoundOptions {
+    pub objective: Objective,
+    /// Minimax under an rms cap (see the module doc).
+    pub max_rms: Option<f64>,
+    /// Largest move of one coefficient from its rounded value, in ulps.
+    pub max_ulps: u32,
+    /// Most coordinate sweeps.
+    pub max_sweeps: usize,
+}
+
+/// Move cap of the committed fits: a coefficient may move at most this many ulps from its
+/// rounded value (`build --check` rejects committed f32 arrays farther away).
+pub const MAX_ULPS: u32 = 64;
+
+impl RoundOptions {
+    pub fn new(objective: Objective, max_rms: Option<f64>) -> Self {
+        RoundOptions { objective, max_rms, max_ulps: MAX_ULPS, max_sweeps: 100 }
+    }
+}
+
+/// Errors of one coefficient vector on the fitting samples.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Errors {
+    /// The spec's objective: max |r| (minimax), rms (lsq) or Σ r⁴ (l4).
+    pub objective: f64,
+    pub max_abs_error: f64,
+    pub rms_error: f64,
+}
+
+impl Errors {
+    /// Errors of residuals (non-finite ones count as infinite).
+    pub fn of(residuals: impl Iterator<Item = f64>, objective: Objective) -> Errors {
+        let (mut n, mut max, mut s2, mut s4) = (0usize, 0.0f64, 0.0f64, 0.0f64);
+        for r in residuals {
+            let a = if r.is_finite() { r.abs() } else { f64::INFINITY };
+            n += 1;
+            max = max.max(a);
+            s2 += a * a;
+            s4 += (a * a) * (a * a);
+        }
+        let rms = (s2 / n.max(1) as f64).sqrt();
+        let objective = match objective {
+            Objective::Minimax => max,
+            Objective::Lsq => rms,
+            Objective::L4 => s4,
+        };
+        Errors { objective, max_abs_error: max, rms_error: rms }
+    }
+}
+
+/// The f32 coefficients and what rounding and re-optimisation did on the fitting samples.
+#[derive(Debug, Clone)]
+pub struct Rounding {
+    pub num: Vec<f32>,
+    pub den: Vec<f32>,
+    pub f64: Errors,
+    pub rounded: Errors,
+    pub reoptimised: Errors,
+    pub sweeps: usize,
+    /// Objective evaluations (each over all samples, or stopped early once it cannot improve).
+    pub evaluations: usize,
+}
+
+/// Position of an f32 on the line of all finite f32s (±0 both at 0): consecutive floats differ
+/// by one, so the difference of two positions is their distance in ulps.
+fn ordinal(x: f32) -> i64 {
+    let b = x.to_bits();
+    if b & 0x8000_0000 != 0 { -((b & 0x7fff_ffff) as i64) } else { b as i64 }
+}
+
+fn from_ordinal(k: i64) -> f32 {
+    if k < 0 { f32::from_bits((-k) as u32 | 0x8000_0000) } else { f32::from_bits(k as u32) }
+}
+
+/// Signed distance from `a` to `b` in f32 ulps (number of f32s stepped over, ±0 counted once).
+pub fn ulps_between(a: f32, b: f32) -> i64 {
+    ordinal(b) - ordinal(a)
+}
+
+/// The f32 `k` ulps above (k < 0: below) `x`, if it is finite.
+pub fn step_ulps(x: f32, k: i64) -> Option<f32> {
+    let o = ordinal(x) + k;
+    if o.unsigned_abs() > 0x7f7f_ffff {
+        return None;
+    }
+    Some(from_ordinal(o))
+}
+
+/// The f64 coefficients rounded to nearest f32: (numerator, denominator).
+pub fn rounded(model: &RationalModel, c: &DVector<f64>) -> (Vec<f32>, Vec<f32>) {
+    expr::f32_arrays(model, c)
+}
+
+/// The f32 coefficients widened to one f64 vector [num; den].
+pub fn widen(num: &[f32], den: &[f32]) -> DVector<f64> {
+    DVector::from_iterator(num.len() + den.len(), num.iter().chain(den).map(|&v| v as f64))
+}
+
+/// The emitted f32 function on fixed samples.
+struct F32Function<'a> {
+    expr: Expr,
+    features: Vec<Vec<f32>>,
+    y: &'a [f64],
+    clamp: Option<(f32, f32)>,
+}
+
+impl F32Function<'_> {
+    fn value(&self, num: &[f32], den: &[f32], i: usize) -> f32 {
+        let v = expr::eval_f32(&self.expr, &self.features[i], num, den);
+        match self.clamp {
+            Some((lo, hi)) => v.clamp(lo, hi),
+            None => v,
+        }
+    }
+
+    fn residual(&self, num: &[f32], den: &[f32], i: usize) -> f64 {
+        self.value(num, den, i) as f64 - self.y[i]
+    }
+
+    fn errors(&self, num: &[f32], den: &[f32], objective: Objective) -> Errors {
+        Errors::of((0..self.y.len()).map(|i| self.residual(num, den, i)), objective)
+    }
+
+    /// The objective in comparable form (max |r|, Σ r², Σ r⁴), or None as soon as it reaches
+    /// `bound` (every partial value is a lower bound of the total).
+    fn score(&self, num: &[f32], den: &[f32], objective: Objective, bound: f64) -> Option<f64> {
+        let mut acc = 0.0f64;
+        for i in 0..self.y.len() {
+            let r = self.residual(num, den, i);
+            if !r.is_finite() {
+                return None;
+            }
+            let a = r.abs();
+            acc = match objective {
+                Objective::Minimax => acc.max(a),
+                Objective::Lsq => acc + a * a,
+                Objective::L4 => acc + (a * a) * (a * a),
+            };
+            if acc >= bound {
+                return None;
+            }
+        }
+        Some(acc)
+    }
+
+    fn rms(&self, num: &[f32], den: &[f32]) -> f64 {
+        let s: f64 = (0..self.y.len()).map(|i| self.residual(num, den, i).powi(2)).sum();
+        (s / self.y.len().max(1) as f64).sqrt()
+    }
+}
+
+/// Round `c` to f32 and re-optimise the f32 vector (see the module doc). `domain` is the box the
+/// emitted code clamps its inputs to (and the positivity proof covers); `data` the fitting
+/// samples. Fails only if the rounded vector's denominator is not provably positive.
+pub fn round_and_reoptimise(
+    model: &RationalModel,
+    c: &DVector<f64>,
+    data: &Data,
+    domain: &[(f64, f64)],
+    opts: &RoundOptions,
+    what: &str,
+) -> Result<Rounding, FitError> {
+    let objective = opts.objective;
+    let d32: Vec<(f32, f32)> = domain.iter().map(|&(a, b)| (a as f32, b as f32)).collect();
+    let f = F32Function {
+        expr: expr::model_expr(model),
+        features: data.x.iter().map(|x| expr::features_f32(model, x, &d32)).collect(),
+        y: &data.y,
+        clamp: model.clamp.map(|(a, b)| (a as f32, b as f32)),
+    };
+    let f64_errors = Errors::of(data.x.iter().zip(&data.y).map(|(x, y)| model.eval_clamped(c, x) - y), objective);
+    let (num0, den0) = rounded(model, c);
+    if let Positivity::NotProven { lower, region, .. } = prove_denominator_positive(model, &widen(&num0, &den0), domain) {
+        return Err(FitError::PoleInDomain { what: format!("{what} (f32 coefficients)"), lower, region });
+    }
+    let rounded_errors = f.errors(&num0, &den0, objective);
+
+    // Pins: f32 value at each pin point (before the clamp) and its allowed error.
+    let expr_ = &f.expr;
+    let pins: Vec<(Vec<f32>, f64, f64)> = model
+        .pins
+        .iter()
+        .map(|p| {
+            let xs = expr::features_f32(model, &p.at, &d32);
+            let e0 = (expr::eval_f32(expr_, &xs, &num0, &den0) as f64 - p.value).abs();
+            let v32 = p.value as f32;
+            let ulp = step_ulps(v32.abs(), 1).map_or(f64::INFINITY, |u| (u - v32.abs()) as f64);
+            (xs, p.value, e0.max(ulp))
+        })
+        .collect();
+    let pins_hold = |num: &[f32], den: &[f32]| {
+        pins.iter().all(|(xs, v, tol)| (expr::eval_f32(expr_, xs, num, den) as f64 - v).abs() <= *tol)
+    };
+    let rms_cap = opts.max_rms.map(|cap| cap.max(rounded_errors.rms_error));
+
+    let nn = num0.len();
+    let movable: Vec<usize> = (0..model.n_full()).filter(|i| !model.fixed.iter().any(|f| f.0 == *i)).collect();
+    let start: Vec<f32> = num0.iter().chain(&den0).copied().collect();
+    let mut cur = start.clone();
+    let split = |v: &[f32]| (v[..nn].to_vec(), v[nn..].to_vec());
+    let mut evaluations = 1usize;
+    let mut best = f.score(&num0, &den0, objective, f64::INFINITY).unwrap_or(f64::INFINITY);
+    let steps: Vec<i64> = std::iter::successors(Some(1i64), |s| Some(s * 2))
+        .take_while(|&s| s <= opts.max_ulps as i64)
+        .flat_map(|s| [s, -s])
+        .collect();
+    let mut sweeps = 0;
+    while sweeps < opts.max_sweeps {
+        sweeps += 1;
+        let mut moved = false;
+        for &j in &movable {
+            let mut choice: Option<(f32, f64)> = None;
+            for &k in &steps {
+                let Some(v) = step_ulps(cur[j], k) else { continue };
+                if ulps_between(start[j], v).unsigned_abs() > opts.max_ulps as u64 {
+                    continue;
+                }
+                let mut cand = cur.clone();
+                cand[j] = v;
+                let (num, den) = split(&cand);
+                let bound = choice.map_or(best, |c| c.1);
+                evaluations += 1;
+                let Some(s) = f.score(&num, &den, objective, bound) else { continue };
+                let admissible = rms_cap.is_none_or(|cap| f.rms(&num, &den) <= cap)
+                    && pins_hold(&num, &den)
+                    && (j < nn
+                        || matches!(
+                            prove_denominator_positive(model, &widen(&num, &den), domain),
+                            Positivity::Proven { .. }
+                        ));
+                if admissible {
+                    choice = Some((v, s));
+                }
+            }
+            if let Some((v, s)) = choice {
+                cur[j] = v;
+                best = s;
+                moved = true;
+            }
+        }
+        if !moved {
+            break;
+        }
+    }
+    let (num, den) = split(&cur);
+    let reoptimised = f.errors(&num, &den, objective);
+    Ok(Rounding { num, den, f64: f64_errors, rounded: rounded_errors, reoptimised, sweeps, evaluations })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fit::model::{ModelParts, Pin, Term};
+    use crate::fit::{fit, FitOptions};
+
+    #[test]
+    fn ulp_steps_cross_zero_and_count_floats() {
+        assert_eq!(step_ulps(1.0, 1), Some(1.0 + f32::EPSILON));
+        assert_eq!(step_ulps(1.0, -1), Some(1.0 - f32::EPSILON / 2.0));
+        assert_eq!(ulps_between(1.0, 1.0 + 4.0 * f32::EPSILON), 4);
+        // ±0 are one position: the smallest subnormals are one step either side.
+        let tiny = f32::from_bits(1);
+        assert_eq!(step_ulps(0.0, 1), Some(tiny));
+        assert_eq!(step_ulps(-0.0, -1), Some(-tiny));
+        assert_eq!(ulps_between(-tiny, tiny), 2);
+        assert_eq!(step_ulps(f32::MAX, 1), None);
+        assert_eq!(step_ulps(f32::MIN, -1), None);
+    }
+
+    fn samples(lo: f64, hi: f64, n: usize, f: impl Fn(f64) -> f64) -> Data {
+        let x: Vec<Vec<f64>> = (0..n).map(|i| vec![lo + (hi - lo) * i as f64 / (n - 1) as f64]).collect();
+        let y = x.iter().map(|p| f(p[0])).collect();
+        Data { x, y }
+    }
+
+    /// A quartic fitted to ln x on [8, 9]: on a narrow interval far from 0 the monomial terms
+    /// cancel (Σ|c_j x^j| ≈ 9.6 at x = 9 for values ≈ 2.2), so rounding the coefficients to f32
+    /// costs far more than the fit's own error.
+    fn cancelling(objective: Objective) -> (RationalModel, DVector<f64>, Data) {
+        let model = RationalModel::rational_1d("x", 4, 0);
+        let data = samples(8.0, 9.0, 201, f64::ln);
+        let f = fit(&model, &data, &FitOptions { objective, ..FitOptions::default() }, "quartic").unwrap();
+        (model, f.coefficients, data)
+    }
+
+    #[test]
+    fn reoptimised_objective_is_at_most_the_rounded_one() {
+        // The search accepts only strict decreases of the objective it reports (the same sums in
+        // the same order), so no tolerance: ≤ exactly, for every objective and a rational form.
+        let rational = RationalModel::rational_1d("x", 3, 2);
+        let data = samples(0.0, 1.0, 129, |x| (1.0 + 3.0 * x).sqrt() / (1.0 + x * x));
+        for objective in [Objective::Lsq, Objective::Minimax, Objective::L4] {
+            let opts = FitOptions { objective, ..FitOptions::default() };
+            let f = fit(&rational, &data, &opts, "rational").unwrap();
+            let ro = RoundOptions::new(objective, None);
+            let r = round_and_reoptimise(&rational, &f.coefficients, &data, &[(0.0, 1.0)], &ro, "rational").unwrap();
+            assert!(r.reoptimised.objective <= r.rounded.objective, "{objective:?}: {r:?}");
+            let (m, c, d) = cancelling(objective);
+            let r = round_and_reoptimise(&m, &c, &d, &[(8.0, 9.0)], &ro, "quartic").unwrap();
+            assert!(r.reoptimised.objective <= r.rounded.objective, "{objective:?}: {r:?}");
+        }
+    }
+
+    #[test]
+    fn reoptimisation_repairs_rounding_of_cancelling_coefficients() {
+        let (m, c, d) = cancelling(Objective::Minimax);
+        let r = round_and_reoptimise(&m, &c, &d, &[(8.0, 9.0)], &RoundOptions::new(Objective::Minimax, None), "quartic")
+            .unwrap();
+        // The case is one where rounding dominates: the f64 fit is good to ~1e-8, while rounding
+        // each coefficient by up to 2^-24 relative moves the value by up to Σ|c_j x^j|·2^-24 ≈
+        // 5.7e-7 at x = 9; require 10× the fit error.
+        assert!(r.rounded.max_abs_error > 10.0 * r.f64.max_abs_error, "{r:?}");
+        // What rounding adds is a quartic δ(x) = Σ δc_j x^j that moves of the coefficients can
+        // cancel; what they cannot is the f32 evaluation's own rounding, about an ulp of the
+        // value (2^-22 ≈ 2.4e-7 for values in [2, 4)). The search must get the max error at least
+        // 20% below the rounded one (from ~4.4e-7 toward that floor).
+        assert!(r.reoptimised.max_abs_error < 0.8 * r.rounded.max_abs_error, "{r:?}");
+    }
+
+    #[test]
+    fn moves_stay_within_the_cap_and_only_free_coefficients_move() {
+        let (m, c, d) = cancelling(Objective::Lsq);
+        for cap in [2u32, 8, MAX_ULPS] {
+            let opts = RoundOptions { max_ulps: cap, ..RoundOptions::new(Objective::Lsq, None) };
+            let r = round_and_reoptimise(&m, &c, &d, &[(8.0, 9.0)], &opts, "quartic").unwrap();
+            let (n0, d0) = rounded(&m, &c);
+            let moves: Vec<i64> =
+                n0.iter().chain(&d0).zip(r.num.iter().chain(&r.den)).map(|(&a, &b)| ulps_between(a, b)).collect();
+            assert!(moves.iter().all(|k| k.unsigned_abs() <= cap as u64), "cap {cap}: {moves:?}");
+            assert!(moves.iter().any(|k| *k != 0), "cap {cap}: nothing moved");
+        }
+        // A fixed coefficient keeps its rounded value.
+        let feats = vec!["x".to_string()];
+        let terms = |ts: &[&str]| ts.iter().map(|t| Term::parse(t, &feats).unwrap()).collect::<Vec<_>>();
+        let fixed = RationalModel::new(ModelParts {
+            inputs: feats.clone(),
+            numerator: terms(&["1", "x", "x^2", "x^3", "x^4"]),
+            fixed: vec![(0, -0.6)],
+            ..ModelParts::default()
+        })
+        .unwrap();
+        let f = fit(&fixed, &d, &FitOptions::default(), "fixed").unwrap();
+        let r = round_and_reoptimise(&fixed, &f.coefficients, &d, &[(8.0, 9.0)], &RoundOptions::new(Objective::Lsq, None), "fixed")
+            .unwrap();
+        assert_eq!(r.num[0], -0.6f32);
+        assert!(r.num[1..].iter().zip(&rounded(&fixed, &f.coefficients).0[1..]).any(|(a, b)| a != b));
+    }
+
+    #[test]
+    fn pins_and_positivity_survive_the_search() {
+        // A rational with both ends pinned (as gloss_length is), fitted minimax.
+        let feats = vec!["x".to_string()];
+        let terms = |ts: &[&str]| ts.iter().map(|t| Term::parse(t, &feats).unwrap()).collect::<Vec<_>>();
+        let target = |x: f64| 0.3 + x.powf(1.5) / (0.4 + x);
+        let m = RationalModel::new(ModelParts {
+            inputs: feats.clone(),
+            numerator: terms(&["1", "x", "x^2", "x^3"]),
+            denominator: terms(&["x", "x^2"]),
+            pins: vec![Pin { at: vec![0.0], value: target(0.0), eliminate: 0 }, Pin { at: vec![1.0], value: target(1.0), eliminate: 3 }],
+            ..ModelParts::default()
+        })
+        .unwrap();
+        let d = samples(0.0, 1.0, 257, target);
+        let f = fit(&m, &d, &FitOptions { objective: Objective::Minimax, ..FitOptions::default() }, "pinned").unwrap();
+        let r = round_and_reoptimise(&m, &f.coefficients, &d, &[(0.0, 1.0)], &RoundOptions::new(Objective::Minimax, None), "pinned")
+            .unwrap();
+        let e = expr::model_expr(&m);
+        for p in &m.pins {
+            let x = [p.at[0] as f32];
+            let got = expr::eval_f32(&e, &x, &r.num, &r.den) as f64;
+            let (n0, d0) = rounded(&m, &f.coefficients);
+            let start = expr::eval_f32(&e, &x, &n0, &d0) as f64;
+            // The pin's tolerance: the rounded vector's error there, or one ulp of the value
+            // (2^-23 for values in [1, 2), 2^-25 in [0.25, 0.5)).
+            let ulp = (step_ulps(p.value as f32, 1).unwrap() - p.value as f32) as f64;
+            assert!((got - p.value).abs() <= (start - p.value).abs().max(ulp), "pin at {:?}: {got} vs {}", p.at, p.value);
+        }
+        // Not vacuous: the search moved something (measured: one numerator coefficient).
+        assert_ne!((r.num.clone(), r.den.clone()), rounded(&m, &f.coefficients));
+        assert!(matches!(prove_denominator_positive(&m, &widen(&r.num, &r.den), &[(0.0, 1.0)]), Positivity::Proven { .. }));
+    }
+}
