@@ -182,43 +182,114 @@ fn args(spec: &Spec) -> Vec<String> {
     spec.file.emit.args.clone().unwrap_or_else(|| spec.file.axis.iter().map(|a| a.name.clone()).collect())
 }
 
-fn build_fit(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> {
-    let name = spec.file.name.clone();
+/// The integral on a verification grid: the points and the values there.
+#[derive(Debug, Clone)]
+pub struct Reference {
+    pub points: Vec<Vec<f64>>,
+    pub values: Vec<f64>,
+}
+
+impl Reference {
+    /// The spec's verification grid (`verify` points per axis) and the integral on it.
+    pub fn of_spec(spec: &Spec) -> Reference {
+        let counts: Vec<usize> = spec.file.axis.iter().map(|a| a.verify_count()).collect();
+        let points = grid(spec, &counts);
+        let values = sample(spec, &points);
+        Reference { points, values }
+    }
+}
+
+/// Whether a build requires every denominator proven positive on the domain (what the
+/// pipeline's own fits must be) or only measures constants it did not fit (the published ones,
+/// in `bench`): then a denominator not proven positive is built anyway, with the interval
+/// bound the proof reached as its lower bound.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Denominators {
+    Proven,
+    Unchecked,
+}
+
+/// The lower bound of a denominator on `domain`; an error when it must be proven positive and
+/// is not.
+pub(crate) fn denominator_bound(
+    what: impl FnOnce() -> String,
+    model: &fit::RationalModel,
+    c: &DVector<f64>,
+    domain: &[(f64, f64)],
+    check: Denominators,
+) -> Result<f64, BuildError> {
+    match (prove_denominator_positive(model, c, domain), check) {
+        (Positivity::Proven { lower, .. }, _) | (Positivity::NotProven { lower, .. }, Denominators::Unchecked) => Ok(lower),
+        (Positivity::NotProven { lower, region, .. }, Denominators::Proven) => {
+            Err(fit::FitError::PoleInDomain { what: what(), lower, region }.into())
+        }
+    }
+}
+
+/// Fit the spec's model to samples with the spec's objective.
+pub fn fit_samples(spec: &Spec, data: &Data) -> Result<fit::Fit, BuildError> {
     let model = spec.model.as_ref().expect("fit specs carry a model");
     let fit_section = spec.file.fit.as_ref().expect("fit specs carry [fit]");
-    let objective = fit_section.objective;
-    let counts: Vec<usize> = spec.file.axis.iter().map(|a| a.count).collect();
+    let opts = FitOptions { objective: fit_section.objective, max_rms: fit_section.max_rms, ..FitOptions::default() };
+    Ok(fit::fit(model, data, &opts, &spec.file.name)?)
+}
+
+/// The committed coefficients of a fit spec (generated/json/NAME.json under `root`), checked
+/// against the spec's hash and model.
+pub fn committed_coefficients(spec: &Spec, root: &Path) -> Result<DVector<f64>, BuildError> {
+    let name = &spec.file.name;
+    let model = spec.model.as_ref().expect("fit specs carry a model");
+    let v = committed_json(root, spec)?;
+    let c = f64_array(&v["model"], name, "coefficients")?;
+    if c.len() != model.n_full() {
+        return Err(BuildError::NoCommitted { spec: name.clone(), why: "coefficient count differs from the spec".into() });
+    }
+    Ok(DVector::from_vec(c))
+}
+
+/// The committed values of a table spec, checked against the spec's hash and grid.
+pub fn committed_values(spec: &Spec, root: &Path) -> Result<Vec<f64>, BuildError> {
+    let name = &spec.file.name;
+    let v = committed_json(root, spec)?;
+    let vals = f64_array(&v, name, "values")?;
+    if vals.len() != table_points(spec).len() {
+        return Err(BuildError::NoCommitted { spec: name.clone(), why: "table size differs from the spec".into() });
+    }
+    Ok(vals)
+}
+
+fn build_fit(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> {
     let (coefficients, report) = match mode {
         Mode::Fit => {
+            let counts: Vec<usize> = spec.file.axis.iter().map(|a| a.count).collect();
             let x = grid(spec, &counts);
             let y = sample(spec, &x);
-            let data = Data { x, y };
-            let opts = FitOptions { objective, max_rms: fit_section.max_rms, ..FitOptions::default() };
-            let f = fit::fit(model, &data, &opts, &name)?;
+            let f = fit_samples(spec, &Data { x, y })?;
             (f.coefficients, Some(f.report))
         }
-        Mode::Committed => {
-            let v = committed_json(root, spec)?;
-            let c = f64_array(&v["model"], &name, "coefficients")?;
-            if c.len() != model.n_full() {
-                return Err(BuildError::NoCommitted { spec: name, why: "coefficient count differs from the spec".into() });
-            }
-            (DVector::from_vec(c), None)
-        }
+        Mode::Committed => (committed_coefficients(spec, root)?, None),
     };
+    fit_from_coefficients(spec, coefficients, report, &Reference::of_spec(spec), Denominators::Proven)
+}
+
+/// Verify a fit with the given coefficients against `reference` (in f64 and in the emitted
+/// f32 arithmetic) and render its files (see [`Denominators`] for the positivity check).
+pub fn fit_from_coefficients(
+    spec: &Spec,
+    coefficients: DVector<f64>,
+    report: Option<FitReport>,
+    reference: &Reference,
+    check: Denominators,
+) -> Result<Built, BuildError> {
+    let name = spec.file.name.clone();
+    let model = spec.model.as_ref().expect("fit specs carry a model");
+    let objective = spec.file.fit.as_ref().expect("fit specs carry [fit]").objective;
     let dom = domain(spec);
-    let lower = match prove_denominator_positive(model, &coefficients, &dom) {
-        Positivity::Proven { lower, .. } => lower,
-        Positivity::NotProven { lower, region, .. } => {
-            return Err(fit::FitError::PoleInDomain { what: name, lower, region }.into());
-        }
-    };
+    let lower = denominator_bound(|| name.clone(), model, &coefficients, &dom, check)?;
     let e = expr::model_expr(model);
     let (num, den) = expr::f32_arrays(model, &coefficients);
     let clamp32 = model.clamp.map(|(a, b)| (a as f32, b as f32));
-    let vcounts: Vec<usize> = spec.file.axis.iter().map(|a| a.verify_count()).collect();
-    let vx = grid(spec, &vcounts);
-    let truth = sample(spec, &vx);
+    let (vx, truth) = (&reference.points, &reference.values);
     let d32 = domain_f32(spec);
     let approx64: Vec<f64> = vx.iter().map(|x| model.eval_clamped(&coefficients, x)).collect();
     let approx32: Vec<f32> = vx
@@ -235,7 +306,7 @@ fn build_fit(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> 
     if let Some(i) = approx32.iter().position(|v| !v.is_finite()) {
         return Err(BuildError::NonFinite { spec: name, at: vx[i].clone() });
     }
-    let verification = verify(spec, &vx, &truth, &approx64, &approx32);
+    let verification = verify(spec, vx, truth, &approx64, &approx32);
     let hash = input_hash(spec);
     let err_line = verification.header_line();
     let header = header_lines(&spec_rel_path(spec), &hash, &err_line);
@@ -356,26 +427,30 @@ fn verify(spec: &Spec, vx: &[Vec<f64>], truth: &[f64], a64: &[f64], a32: &[f32])
     }
 }
 
+/// The grid points of a table spec (`count` per axis, first axis fastest).
+pub fn table_points(spec: &Spec) -> Vec<Vec<f64>> {
+    let counts: Vec<usize> = spec.file.axis.iter().map(|a| a.count).collect();
+    grid(spec, &counts)
+}
+
 fn build_table(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> {
+    let values: Vec<f64> = match mode {
+        Mode::Fit => sample(spec, &table_points(spec)),
+        Mode::Committed => committed_values(spec, root)?,
+    };
+    table_from_values(spec, values, &Reference::of_spec(spec))
+}
+
+/// Verify a table with the given values (at [`table_points`]) against `reference`, through
+/// the emitted f32 interpolation, and render its files.
+pub fn table_from_values(spec: &Spec, values: Vec<f64>, reference: &Reference) -> Result<Built, BuildError> {
     let name = spec.file.name.clone();
     let counts: Vec<usize> = spec.file.axis.iter().map(|a| a.count).collect();
-    let points = grid(spec, &counts);
-    let values: Vec<f64> = match mode {
-        Mode::Fit => sample(spec, &points),
-        Mode::Committed => {
-            let v = committed_json(root, spec)?;
-            let vals = f64_array(&v, &name, "values")?;
-            if vals.len() != points.len() {
-                return Err(BuildError::NoCommitted { spec: name, why: "table size differs from the spec".into() });
-            }
-            vals
-        }
-    };
+    let points = table_points(spec);
+    assert_eq!(values.len(), points.len(), "{name}: one value per table point");
     let v32: Vec<f32> = values.iter().map(|&v| v as f32).collect();
     let d32 = domain_f32(spec);
-    let vcounts: Vec<usize> = spec.file.axis.iter().map(|a| a.verify_count()).collect();
-    let vx = grid(spec, &vcounts);
-    let truth = sample(spec, &vx);
+    let (vx, truth) = (&reference.points, &reference.values);
     let approx32: Vec<f32> = vx
         .iter()
         .map(|x| {
@@ -384,7 +459,7 @@ fn build_table(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError
         })
         .collect();
     let approx64: Vec<f64> = approx32.iter().map(|&v| v as f64).collect();
-    let verification = verify(spec, &vx, &truth, &approx64, &approx32);
+    let verification = verify(spec, vx, truth, &approx64, &approx32);
     let hash = input_hash(spec);
     let err_line = format!(
         "linear interpolation of the f32 table: max abs {}, rms {} over {} points",
