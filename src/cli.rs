@@ -482,7 +482,7 @@ pub fn bench(paths: &Paths, a: &BenchArgs) -> Result<()> {
         }),
         (None, false) => Some(tables::default_python(&root)),
     };
-    let report = bench::run(Mode::new(a.quick), sections, &specs, python.as_ref())?;
+    let report = bench::run(Mode::new(a.quick), sections, &specs, paths, python.as_ref())?;
     if a.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
     } else {

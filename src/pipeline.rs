@@ -35,6 +35,8 @@ pub enum Mode {
 
 #[derive(Debug, thiserror::Error)]
 pub enum BuildError {
+    #[error("{spec}: the f32 coefficients in generated/json/{spec}.json do not belong to its f64 coefficients: {why}; run `shadefit build`")]
+    F32Coefficients { spec: String, why: String },
     #[error(transparent)]
     Fit(#[from] fit::FitError),
     #[error("{spec}: generated/json/{spec}.json is missing or unreadable ({why}); run `shadefit build`")]
@@ -51,8 +53,6 @@ pub enum BuildError {
     Spec(#[from] crate::spec::SpecError),
     #[error("{spec}: {msg}")]
     Skin { spec: String, msg: String },
-    #[error("{spec}: the f32 coefficients in generated/json/{spec}.json do not belong to its f64 coefficients: {why}; run `shadefit build`")]
-    F32Coefficients { spec: String, why: String },
 }
 
 /// Errors of an emitted function against the integral on the verification grid.
@@ -188,26 +188,99 @@ fn args(spec: &Spec) -> Vec<String> {
     spec.file.emit.args.clone().unwrap_or_else(|| spec.file.axis.iter().map(|a| a.name.clone()).collect())
 }
 
+/// The integral on a verification grid: the points and the values there.
+#[derive(Debug, Clone)]
+pub struct Reference {
+    pub points: Vec<Vec<f64>>,
+    pub values: Vec<f64>,
+}
+
+impl Reference {
+    /// The spec's verification grid (`verify` points per axis) and the integral on it.
+    pub fn of_spec(spec: &Spec) -> Reference {
+        let counts: Vec<usize> = spec.file.axis.iter().map(|a| a.verify_count()).collect();
+        let points = grid(spec, &counts);
+        let values = sample(spec, &points);
+        Reference { points, values }
+    }
+}
+
+/// Whether a build requires every denominator proven positive on the domain (what the
+/// pipeline's own fits must be) or only measures constants it did not fit (the published ones,
+/// in `bench`): then a denominator not proven positive is built anyway, with the interval
+/// bound the proof reached as its lower bound.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Denominators {
+    Proven,
+    Unchecked,
+}
+
+/// The lower bound of a denominator on `domain`; an error when it must be proven positive and
+/// is not.
+pub(crate) fn denominator_bound(
+    what: impl FnOnce() -> String,
+    model: &fit::RationalModel,
+    c: &DVector<f64>,
+    domain: &[(f64, f64)],
+    check: Denominators,
+) -> Result<f64, BuildError> {
+    match (prove_denominator_positive(model, c, domain), check) {
+        (Positivity::Proven { lower, .. }, _) | (Positivity::NotProven { lower, .. }, Denominators::Unchecked) => Ok(lower),
+        (Positivity::NotProven { lower, region, .. }, Denominators::Proven) => {
+            Err(fit::FitError::PoleInDomain { what: what(), lower, region }.into())
+        }
+    }
+}
+
+/// Fit the spec's model to samples with the spec's objective.
+pub fn fit_samples(spec: &Spec, data: &Data) -> Result<fit::Fit, BuildError> {
+    let model = spec.model.as_ref().expect("fit specs carry a model");
+    let fit_section = spec.file.fit.as_ref().expect("fit specs carry [fit]");
+    let opts = FitOptions { objective: fit_section.objective, max_rms: fit_section.max_rms, ..FitOptions::default() };
+    Ok(fit::fit(model, data, &opts, &spec.file.name)?)
+}
+
+/// The committed coefficients of a fit spec (generated/json/NAME.json under `root`), checked
+/// against the spec's hash and model.
+pub fn committed_coefficients(spec: &Spec, root: &Path) -> Result<DVector<f64>, BuildError> {
+    let name = &spec.file.name;
+    let model = spec.model.as_ref().expect("fit specs carry a model");
+    let v = committed_json(root, spec)?;
+    let c = f64_array(&v["model"], name, "coefficients")?;
+    if c.len() != model.n_full() {
+        return Err(BuildError::NoCommitted { spec: name.clone(), why: "coefficient count differs from the spec".into() });
+    }
+    Ok(DVector::from_vec(c))
+}
+
+/// The committed values of a table spec, checked against the spec's hash and grid.
+pub fn committed_values(spec: &Spec, root: &Path) -> Result<Vec<f64>, BuildError> {
+    let name = &spec.file.name;
+    let v = committed_json(root, spec)?;
+    let vals = f64_array(&v, name, "values")?;
+    if vals.len() != table_points(spec).len() {
+        return Err(BuildError::NoCommitted { spec: name.clone(), why: "table size differs from the spec".into() });
+    }
+    Ok(vals)
+}
+
 fn build_fit(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> {
     let name = spec.file.name.clone();
     let model = spec.model.as_ref().expect("fit specs carry a model");
     let fit_section = spec.file.fit.as_ref().expect("fit specs carry [fit]");
-    let objective = fit_section.objective;
-    let counts: Vec<usize> = spec.file.axis.iter().map(|a| a.count).collect();
-    let dom = domain(spec);
-    let (coefficients, report, (num, den), on_grid) = match mode {
+    let (coefficients, report, f32s) = match mode {
         Mode::Fit => {
+            let counts: Vec<usize> = spec.file.axis.iter().map(|a| a.count).collect();
             let x = grid(spec, &counts);
             let y = sample(spec, &x);
             let data = Data { x, y };
-            let opts = FitOptions { objective, max_rms: fit_section.max_rms, ..FitOptions::default() };
-            let f = fit::fit(model, &data, &opts, &name)?;
+            let f = fit_samples(spec, &data)?;
             let r = f32round::round_and_reoptimise(
                 model,
                 &f.coefficients,
                 &data,
-                &dom,
-                &f32round::RoundOptions::new(objective, fit_section.max_rms),
+                &domain(spec),
+                &f32round::RoundOptions::new(fit_section.objective, fit_section.max_rms),
                 &name,
             )?;
             let on_grid = RoundingOnGrid {
@@ -218,54 +291,65 @@ fn build_fit(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> 
                 sweeps: r.sweeps,
                 evaluations: r.evaluations,
             };
-            (f.coefficients, Some(f.report), (r.num, r.den), on_grid)
+            (f.coefficients, Some(f.report), F32Coefficients { num: r.num, den: r.den, on_grid })
         }
         Mode::Committed => {
-            let v = committed_json(root, spec)?;
-            let c = f64_array(&v["model"], &name, "coefficients")?;
-            if c.len() != model.n_full() {
-                return Err(BuildError::NoCommitted { spec: name, why: "coefficient count differs from the spec".into() });
-            }
-            let c = DVector::from_vec(c);
-            let f32s = committed_f32(model, &c, &v["model"], &name)?;
-            let on_grid: RoundingOnGrid = serde_json::from_value(v["f32_rounding"].clone()).map_err(|e| {
-                BuildError::NoCommitted { spec: name.clone(), why: format!("'f32_rounding' unreadable ({e})") }
-            })?;
-            (c, None, f32s, on_grid)
+            let (c, f32s) = committed_fit(spec, root)?;
+            (c, None, f32s)
         }
     };
-    let lower = match prove_denominator_positive(model, &coefficients, &dom) {
-        Positivity::Proven { lower, .. } => lower,
-        Positivity::NotProven { lower, region, .. } => {
-            return Err(fit::FitError::PoleInDomain { what: name, lower, region }.into());
-        }
+    fit_from_coefficients(spec, coefficients, report, Some(f32s), &Reference::of_spec(spec), Denominators::Proven)
+}
+
+/// The committed f64 and f32 coefficients of a fit spec, checked against the spec's hash and
+/// model and against each other, with the committed report of the f32 re-optimisation.
+pub fn committed_fit(spec: &Spec, root: &Path) -> Result<(DVector<f64>, F32Coefficients), BuildError> {
+    let name = &spec.file.name;
+    let model = spec.model.as_ref().expect("fit specs carry a model");
+    let c = committed_coefficients(spec, root)?;
+    let v = committed_json(root, spec)?;
+    let (num, den) = committed_f32(model, &c, &v["model"], name)?;
+    let on_grid: RoundingOnGrid = serde_json::from_value(v["f32_rounding"].clone())
+        .map_err(|e| BuildError::NoCommitted { spec: name.clone(), why: format!("'f32_rounding' unreadable ({e})") })?;
+    Ok((c, F32Coefficients { num, den, on_grid }))
+}
+
+/// The f32 coefficients a fit is emitted with, re-optimised on its fitting samples, and what
+/// that measured there.
+pub struct F32Coefficients {
+    num: Vec<f32>,
+    den: Vec<f32>,
+    on_grid: RoundingOnGrid,
+}
+
+/// Verify a fit with the given coefficients against `reference` (in f64 and in the emitted
+/// f32 arithmetic) and render its files (see [`Denominators`] for the positivity check). The
+/// f32 coefficients are `f32s` (re-optimised, with their report in the JSON) or, without them,
+/// the f64 ones rounded to nearest.
+pub fn fit_from_coefficients(
+    spec: &Spec,
+    coefficients: DVector<f64>,
+    report: Option<FitReport>,
+    f32s: Option<F32Coefficients>,
+    reference: &Reference,
+    check: Denominators,
+) -> Result<Built, BuildError> {
+    let name = spec.file.name.clone();
+    let model = spec.model.as_ref().expect("fit specs carry a model");
+    let objective = spec.file.fit.as_ref().expect("fit specs carry [fit]").objective;
+    let dom = domain(spec);
+    let lower = denominator_bound(|| name.clone(), model, &coefficients, &dom, check)?;
+    let (num, den) = match &f32s {
+        Some(f) => (f.num.clone(), f.den.clone()),
+        None => expr::f32_arrays(model, &coefficients),
     };
-    let lower32 = match prove_denominator_positive(model, &f32round::widen(&num, &den), &dom) {
-        Positivity::Proven { lower, .. } => lower,
-        Positivity::NotProven { lower, region, .. } => {
-            return Err(fit::FitError::PoleInDomain { what: format!("{name} (f32 coefficients)"), lower, region }.into());
-        }
+    let f32_rounding = match f32s {
+        Some(f) => Some(rounding_report(spec, model, &coefficients, &f, check)?),
+        None => None,
     };
-    let (num0, den0) = f32round::rounded(model, &coefficients);
-    let moves: Vec<i64> =
-        num0.iter().chain(&den0).zip(num.iter().chain(&den)).map(|(&a, &b)| f32round::ulps_between(a, b)).collect();
-    let mut f32_rounding = serde_json::to_value(&on_grid).expect("the rounding report serialises");
-    let extra = json!({
-        "objective": objective,
-        "max_ulps_allowed": f32round::MAX_ULPS,
-        "moves_ulps": moves,
-        "coefficients_moved": moves.iter().filter(|m| **m != 0).count(),
-        "max_move_ulps": moves.iter().map(|m| m.unsigned_abs()).max().unwrap_or(0),
-        "denominator_lower_bound": lower32,
-    });
-    if let (Some(o), Value::Object(x)) = (f32_rounding.as_object_mut(), extra) {
-        o.extend(x);
-    }
     let e = expr::model_expr(model);
     let clamp32 = model.clamp.map(|(a, b)| (a as f32, b as f32));
-    let vcounts: Vec<usize> = spec.file.axis.iter().map(|a| a.verify_count()).collect();
-    let vx = grid(spec, &vcounts);
-    let truth = sample(spec, &vx);
+    let (vx, truth) = (&reference.points, &reference.values);
     let d32 = domain_f32(spec);
     let approx64: Vec<f64> = vx.iter().map(|x| model.eval_clamped(&coefficients, x)).collect();
     let approx32: Vec<f32> = vx
@@ -282,7 +366,7 @@ fn build_fit(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> 
     if let Some(i) = approx32.iter().position(|v| !v.is_finite()) {
         return Err(BuildError::NonFinite { spec: name, at: vx[i].clone() });
     }
-    let verification = verify(spec, &vx, &truth, &approx64, &approx32);
+    let verification = verify(spec, vx, truth, &approx64, &approx32);
     let hash = input_hash(spec);
     let err_line = verification.header_line();
     let header = header_lines(&spec_rel_path(spec), &hash, &err_line);
@@ -297,7 +381,7 @@ fn build_fit(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> 
     };
     let doc = describe_fit(spec, model);
     let labels = model.coefficient_labels();
-    let json = json!({
+    let mut json = json!({
         "generator": GENERATOR,
         "spec": spec_rel_path(spec),
         "input_hash": hash,
@@ -326,14 +410,46 @@ fn build_fit(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> 
             "objective": objective,
         },
         "verification": verification,
-        "f32_rounding": f32_rounding,
     });
+    if let (Some(o), Some(r)) = (json.as_object_mut(), f32_rounding) {
+        o.insert("f32_rounding".into(), r);
+    }
     let artifacts = vec![
         Artifact { path: format!("wgsl/{name}.wgsl").into(), contents: wgsl::render_module(&header, &func).into() },
         Artifact { path: format!("src/{name}.rs").into(), contents: rust::render_module(&header, &func, &doc).into() },
         Artifact { path: format!("json/{name}.json").into(), contents: json_text(&json).into() },
     ];
     Ok(Built { name, artifacts, verification, fit: report })
+}
+
+/// The `f32_rounding` object of a fit's JSON: the measurements on the fitting samples, the
+/// moves from the rounded coefficients and the denominator bound of the f32 coefficients.
+fn rounding_report(
+    spec: &Spec,
+    model: &fit::RationalModel,
+    coefficients: &DVector<f64>,
+    f: &F32Coefficients,
+    check: Denominators,
+) -> Result<Value, BuildError> {
+    let name = &spec.file.name;
+    let lower32 =
+        denominator_bound(|| format!("{name} (f32 coefficients)"), model, &f32round::widen(&f.num, &f.den), &domain(spec), check)?;
+    let (num0, den0) = f32round::rounded(model, coefficients);
+    let moves: Vec<i64> =
+        num0.iter().chain(&den0).zip(f.num.iter().chain(&f.den)).map(|(&a, &b)| f32round::ulps_between(a, b)).collect();
+    let mut r = serde_json::to_value(&f.on_grid).expect("the rounding report serialises");
+    let extra = json!({
+        "objective": spec.file.fit.as_ref().expect("fit specs carry [fit]").objective,
+        "max_ulps_allowed": f32round::MAX_ULPS,
+        "moves_ulps": moves,
+        "coefficients_moved": moves.iter().filter(|m| **m != 0).count(),
+        "max_move_ulps": moves.iter().map(|m| m.unsigned_abs()).max().unwrap_or(0),
+        "denominator_lower_bound": lower32,
+    });
+    if let (Some(o), Value::Object(x)) = (r.as_object_mut(), extra) {
+        o.extend(x);
+    }
+    Ok(r)
 }
 
 /// What rounding to f32 did on the fitting samples (part of `f32_rounding` in the JSON): measured
@@ -459,26 +575,30 @@ fn verify(spec: &Spec, vx: &[Vec<f64>], truth: &[f64], a64: &[f64], a32: &[f32])
     }
 }
 
+/// The grid points of a table spec (`count` per axis, first axis fastest).
+pub fn table_points(spec: &Spec) -> Vec<Vec<f64>> {
+    let counts: Vec<usize> = spec.file.axis.iter().map(|a| a.count).collect();
+    grid(spec, &counts)
+}
+
 fn build_table(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> {
+    let values: Vec<f64> = match mode {
+        Mode::Fit => sample(spec, &table_points(spec)),
+        Mode::Committed => committed_values(spec, root)?,
+    };
+    table_from_values(spec, values, &Reference::of_spec(spec))
+}
+
+/// Verify a table with the given values (at [`table_points`]) against `reference`, through
+/// the emitted f32 interpolation, and render its files.
+pub fn table_from_values(spec: &Spec, values: Vec<f64>, reference: &Reference) -> Result<Built, BuildError> {
     let name = spec.file.name.clone();
     let counts: Vec<usize> = spec.file.axis.iter().map(|a| a.count).collect();
-    let points = grid(spec, &counts);
-    let values: Vec<f64> = match mode {
-        Mode::Fit => sample(spec, &points),
-        Mode::Committed => {
-            let v = committed_json(root, spec)?;
-            let vals = f64_array(&v, &name, "values")?;
-            if vals.len() != points.len() {
-                return Err(BuildError::NoCommitted { spec: name, why: "table size differs from the spec".into() });
-            }
-            vals
-        }
-    };
+    let points = table_points(spec);
+    assert_eq!(values.len(), points.len(), "{name}: one value per table point");
     let v32: Vec<f32> = values.iter().map(|&v| v as f32).collect();
     let d32 = domain_f32(spec);
-    let vcounts: Vec<usize> = spec.file.axis.iter().map(|a| a.verify_count()).collect();
-    let vx = grid(spec, &vcounts);
-    let truth = sample(spec, &vx);
+    let (vx, truth) = (&reference.points, &reference.values);
     let approx32: Vec<f32> = vx
         .iter()
         .map(|x| {
@@ -487,7 +607,7 @@ fn build_table(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError
         })
         .collect();
     let approx64: Vec<f64> = approx32.iter().map(|&v| v as f64).collect();
-    let verification = verify(spec, &vx, &truth, &approx64, &approx32);
+    let verification = verify(spec, vx, truth, &approx64, &approx32);
     let hash = input_hash(spec);
     let err_line = format!(
         "linear interpolation of the f32 table: max abs {}, rms {} over {} points",

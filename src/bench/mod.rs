@@ -96,6 +96,7 @@ pub fn run(
     mode: Mode,
     sections: Sections,
     specs: &[Spec],
+    paths: &crate::cli::Paths,
     python: Option<&tables::Python>,
 ) -> Result<Report> {
     let start = Instant::now();
@@ -115,7 +116,7 @@ pub fn run(
         Vec::new()
     };
     let forms = if sections.forms {
-        forms::shader_forms(mode.quick)?
+        forms::shader_forms_at(&paths.fits, &paths.generated, mode.quick)?
     } else {
         Vec::new()
     };

@@ -14,15 +14,14 @@
 //! changes the committed fit's max error on those samples by ~5e-6 of its 0.115 (downward, as
 //! it happens): the error is the form's, not the coefficients'.
 
-use super::{committed_json, input_hash, json_text, spec_rel_path, tensor, BuildError, Built, Mode, Verification};
+use super::{committed_json, input_hash, json_text, spec_rel_path, tensor, BuildError, Built, Denominators, Mode, Verification};
 use crate::emit::expr::{self, model_expr};
 use crate::emit::fields::{self as efields, Field, FieldsFunction};
 use crate::emit::{header_lines, Artifact, GENERATOR};
 use crate::fit::fields::{fit_fields, FieldOptions, PointData};
 use crate::fit::model::Term;
-use crate::fit::positivity::{prove_denominator_positive, Positivity};
 use crate::fit::f32round::Errors;
-use crate::fit::{FitError, Objective, RationalModel};
+use crate::fit::{Objective, RationalModel};
 use crate::quantity::InnerBasis;
 use crate::spec::{AxisSpec, Spec};
 use nalgebra::{DMatrix, DVector};
@@ -72,8 +71,36 @@ fn design(l: &Layout<'_>, o: &[f64], inner: &[Vec<f64>]) -> DMatrix<f64> {
     b
 }
 
+/// The quantity on a verification grid: outer points × inner points, one row of values per
+/// outer point.
+#[derive(Debug, Clone)]
+pub struct FieldsReference {
+    pub outer: Vec<Vec<f64>>,
+    pub inner: Vec<Vec<f64>>,
+    pub rows: Vec<Vec<f64>>,
+}
+
+impl FieldsReference {
+    /// The quantity at every outer point × every inner point (rows in parallel, in order).
+    pub fn sample(spec: &Spec, outer: Vec<Vec<f64>>, inner: Vec<Vec<f64>>) -> FieldsReference {
+        let rows = sample(spec, &layout(spec), &outer, &inner);
+        FieldsReference { outer, inner, rows }
+    }
+
+    /// The spec's verification grids (`verify` points per axis).
+    pub fn of_spec(spec: &Spec) -> FieldsReference {
+        let l = layout(spec);
+        let (outer, inner) = (tensor(l.outer, &verify_counts(l.outer)), tensor(l.inner, &verify_counts(l.inner)));
+        FieldsReference::sample(spec, outer, inner)
+    }
+}
+
+fn verify_counts(axes: &[AxisSpec]) -> Vec<usize> {
+    axes.iter().map(|a| a.verify_count()).collect()
+}
+
 /// The fitting samples: outer and inner grids, and the samples at each outer point.
-struct FittingGrid {
+pub struct FittingGrid {
     outer: Vec<Vec<f64>>,
     inner: Vec<Vec<f64>>,
     data: Vec<PointData>,
@@ -116,84 +143,121 @@ fn fitting_errors(
     )
 }
 
-pub fn build(spec: &Spec, mode: Mode, root: &std::path::Path) -> Result<Built, BuildError> {
-    let name = spec.file.name.clone();
+/// The two-stage fit of a fields spec on its sampling grids: the coefficients of every field
+/// and the fit's report (JSON, as the generated file records it).
+pub fn fit(spec: &Spec) -> Result<(Vec<DVector<f64>>, Value), BuildError> {
+    fit_on_grid(spec).map(|(c, r, _)| (c, r))
+}
+
+/// [`fit`], also returning the fitting samples.
+fn fit_on_grid(spec: &Spec) -> Result<(Vec<DVector<f64>>, Value, FittingGrid), BuildError> {
+    let name = &spec.file.name;
     let l = layout(spec);
     let fit_section = spec.file.fit.as_ref().expect("fields specs carry [fit]");
-    let counts = |axes: &[AxisSpec], verify: bool| -> Vec<usize> {
-        axes.iter().map(|a| if verify { a.verify_count() } else { a.count }).collect()
-    };
+    let counts = |axes: &[AxisSpec]| -> Vec<usize> { axes.iter().map(|a| a.count).collect() };
+    let outer = tensor(l.outer, &counts(l.outer));
+    let inner = tensor(l.inner, &counts(l.inner));
+    let y = sample(spec, &l, &outer, &inner);
+    let data: Vec<PointData> = outer
+        .iter()
+        .zip(y)
+        .map(|(o, y)| PointData { design: design(&l, o, &inner), y: DVector::from_vec(y) })
+        .collect();
+    let opts = FieldOptions { objective: fit_section.objective, max_rms: fit_section.max_rms, ..FieldOptions::default() };
+    let f = fit_fields(&l.models, &outer, &data, &opts, name)?;
+    let mut conds: Vec<f64> = f.stage1.iter().map(|s| s.condition).collect();
+    conds.sort_by(f64::total_cmp);
+    // Above 1e8 the stage-1 optimum is not determined by data accurate to 1e-9 (θf ≈ 0).
+    let finite: Vec<f64> = conds.iter().copied().filter(|c| *c <= 1e8).collect();
+    let report = json!({
+        "grid_points": outer.len(),
+        "inner_samples": inner.len(),
+        "objective": fit_section.objective,
+        "max_rms": fit_section.max_rms,
+        "max_abs_error": f.max_abs_error,
+        "rms_error": f.rms_error,
+        "stage1_max_abs_error": f.stage1_max_abs_error,
+        "stage1_rms_error": f.stage1_rms_error,
+        "stage1_condition": {
+            "min": finite.first(),
+            "median": finite.get(finite.len() / 2),
+            "max_up_to_1e8": finite.last(),
+            "points_above_1e8": conds.len() - finite.len(),
+            "max": conds.last(),
+        },
+        "lm_evaluations": f.lm_evaluations,
+        "outer_iterations": f.outer_iterations,
+    });
+    Ok((f.coefficients, report, FittingGrid { outer, inner, data }))
+}
+
+/// The committed coefficients of every field (generated/json/NAME.json under `root`, checked
+/// against the spec's hash and model) and the committed fit report.
+pub fn committed(spec: &Spec, root: &std::path::Path) -> Result<(Vec<DVector<f64>>, Option<Value>), BuildError> {
+    let name = spec.file.name.clone();
+    let l = layout(spec);
+    let v = committed_json(root, spec)?;
+    let fields = v["fields"].as_array().ok_or_else(|| BuildError::NoCommitted { spec: name.clone(), why: "no 'fields' array".into() })?;
+    if fields.len() != l.models.len() {
+        return Err(BuildError::NoCommitted { spec: name, why: "field count differs from the spec".into() });
+    }
+    let mut c = Vec::new();
+    for (fv, m) in fields.iter().zip(&l.models) {
+        let v = super::f64_array(fv, &name, "coefficients")?;
+        if v.len() != m.n_full() {
+            return Err(BuildError::NoCommitted { spec: name, why: "coefficient count differs from the spec".into() });
+        }
+        c.push(DVector::from_vec(v));
+    }
+    Ok((c, v.get("fit").cloned()))
+}
+
+pub fn build(spec: &Spec, mode: Mode, root: &std::path::Path) -> Result<Built, BuildError> {
     // Fit mode keeps the fitting samples for the f32 rounding report; committed mode carries that
     // report over from the committed JSON (it does not sample the fitting grid).
-    let (coefficients, report, fitting): (Vec<DVector<f64>>, Option<Value>, Result<FittingGrid, Value>) = match mode {
+    let (coefficients, report, rounding) = match mode {
         Mode::Fit => {
-            let outer = tensor(l.outer, &counts(l.outer, false));
-            let inner = tensor(l.inner, &counts(l.inner, false));
-            let y = sample(spec, &l, &outer, &inner);
-            let data: Vec<PointData> = outer
-                .iter()
-                .zip(y)
-                .map(|(o, y)| PointData { design: design(&l, o, &inner), y: DVector::from_vec(y) })
-                .collect();
-            let opts = FieldOptions { objective: fit_section.objective, max_rms: fit_section.max_rms, ..FieldOptions::default() };
-            let f = fit_fields(&l.models, &outer, &data, &opts, &name)?;
-            let mut conds: Vec<f64> = f.stage1.iter().map(|s| s.condition).collect();
-            conds.sort_by(f64::total_cmp);
-            // Above 1e8 the stage-1 optimum is not determined by data accurate to 1e-9 (θf ≈ 0).
-            let finite: Vec<f64> = conds.iter().copied().filter(|c| *c <= 1e8).collect();
-            let report = json!({
-                "grid_points": outer.len(),
-                "inner_samples": inner.len(),
-                "objective": fit_section.objective,
-                "max_rms": fit_section.max_rms,
-                "max_abs_error": f.max_abs_error,
-                "rms_error": f.rms_error,
-                "stage1_max_abs_error": f.stage1_max_abs_error,
-                "stage1_rms_error": f.stage1_rms_error,
-                "stage1_condition": {
-                    "min": finite.first(),
-                    "median": finite.get(finite.len() / 2),
-                    "max_up_to_1e8": finite.last(),
-                    "points_above_1e8": conds.len() - finite.len(),
-                    "max": conds.last(),
-                },
-                "lm_evaluations": f.lm_evaluations,
-                "outer_iterations": f.outer_iterations,
-            });
-            (f.coefficients, Some(report), Ok(FittingGrid { outer, inner, data }))
+            let (c, r, g) = fit_on_grid(spec)?;
+            (c, Some(r), Rounding::Measure(g))
         }
         Mode::Committed => {
+            let (c, r) = committed(spec, root)?;
             let v = committed_json(root, spec)?;
-            let fields = v["fields"].as_array().ok_or_else(|| BuildError::NoCommitted { spec: name.clone(), why: "no 'fields' array".into() })?;
-            if fields.len() != l.models.len() {
-                return Err(BuildError::NoCommitted { spec: name, why: "field count differs from the spec".into() });
-            }
-            let mut c = Vec::new();
-            for (fv, m) in fields.iter().zip(&l.models) {
-                let v = super::f64_array(fv, &name, "coefficients")?;
-                if v.len() != m.n_full() {
-                    return Err(BuildError::NoCommitted { spec: name, why: "coefficient count differs from the spec".into() });
-                }
-                c.push(DVector::from_vec(v));
-            }
-            (c, v.get("fit").cloned(), Err(v["f32_rounding"].clone()))
+            (c, r, Rounding::Committed(v["f32_rounding"].clone()))
         }
     };
+    fields_from_coefficients(spec, &coefficients, report, Some(rounding), &FieldsReference::of_spec(spec), Denominators::Proven)
+}
+
+/// The `f32_rounding` report of a fields build: measured on the fitting samples, or committed.
+pub enum Rounding {
+    Measure(FittingGrid),
+    Committed(Value),
+}
+
+/// Verify fields with the given coefficients against `reference` (in f64 and in the emitted
+/// f32 arithmetic) and render their files (see [`Denominators`] for the positivity check of
+/// every field on the outer domain).
+pub fn fields_from_coefficients(
+    spec: &Spec,
+    coefficients: &[DVector<f64>],
+    report: Option<Value>,
+    rounding: Option<Rounding>,
+    reference: &FieldsReference,
+    check: Denominators,
+) -> Result<Built, BuildError> {
+    let name = spec.file.name.clone();
+    let l = layout(spec);
     let dom: Vec<(f64, f64)> = l.outer.iter().map(|a| (a.range[0], a.range[1])).collect();
     let mut lower = Vec::new();
-    for (k, (m, c)) in l.models.iter().zip(&coefficients).enumerate() {
-        match prove_denominator_positive(m, c, &dom) {
-            Positivity::Proven { lower: lo, .. } => lower.push(lo),
-            Positivity::NotProven { lower: lo, region, .. } => {
-                return Err(FitError::PoleInDomain { what: format!("{name} (field {k})"), lower: lo, region }.into());
-            }
-        }
+    for (k, (m, c)) in l.models.iter().zip(coefficients).enumerate() {
+        lower.push(super::denominator_bound(|| format!("{name} (field {k})"), m, c, &dom, check)?);
     }
     // Emitted form.
     let fields: Vec<Field> = l
         .models
         .iter()
-        .zip(&coefficients)
+        .zip(coefficients)
         .map(|(m, c)| {
             let (num, den) = expr::f32_arrays(m, c);
             Field { expr: model_expr(m), num, den }
@@ -217,28 +281,27 @@ pub fn build(spec: &Spec, mode: Mode, root: &std::path::Path) -> Result<Built, B
         terms: &l.terms,
         range: (l.basis.range.0 as f32, l.basis.range.1 as f32),
     };
-    let f32_rounding = match fitting {
-        Ok(g) => {
-            let (e64, e32) = fitting_errors(&l, &coefficients, &func, &g, fit_section.objective);
+    let f32_rounding = rounding.map(|r| match r {
+        Rounding::Measure(g) => {
+            let objective = spec.file.fit.as_ref().expect("fields specs carry [fit]").objective;
+            let (e64, e32) = fitting_errors(&l, coefficients, &func, &g, objective);
             json!({
                 "fitting_samples": g.outer.len() * g.inner.len(),
-                "objective": fit_section.objective,
+                "objective": objective,
                 "f64": e64,
                 "rounded_f32": e32,
                 "reoptimised": false,
             })
         }
-        Err(committed) => committed,
-    };
-    // Verification on the verification grids, in f64 and in the emitted f32 arithmetic.
-    let vouter = tensor(l.outer, &counts(l.outer, true));
-    let vinner = tensor(l.inner, &counts(l.inner, true));
-    let truth = sample(spec, &l, &vouter, &vinner);
+        Rounding::Committed(v) => v,
+    });
+    // Verification on the reference grids, in f64 and in the emitted f32 arithmetic.
+    let (vouter, vinner, truth) = (&reference.outer, &reference.inner, &reference.rows);
     let (lo, hi) = l.basis.range;
     let mut pts = Vec::new();
     let (mut t, mut a64, mut a32) = (Vec::new(), Vec::new(), Vec::new());
-    for (o, row) in vouter.iter().zip(&truth) {
-        let c64: Vec<f64> = l.models.iter().zip(&coefficients).map(|(m, c)| m.eval_full(c, o)).collect();
+    for (o, row) in vouter.iter().zip(truth) {
+        let c64: Vec<f64> = l.models.iter().zip(coefficients).map(|(m, c)| m.eval_full(c, o)).collect();
         let feats = expr::features_f32(&l.models[0], o, &d32);
         let c32 = efields::coefficients_f32(&func, &feats);
         for (u, &y) in vinner.iter().zip(row) {
@@ -280,7 +343,7 @@ pub fn build(spec: &Spec, mode: Mode, root: &std::path::Path) -> Result<Built, B
             (c.rows(0, nn).iter().copied().collect(), c.rows(nn, c.len() - nn).iter().copied().collect())
         })
         .collect();
-    let json = json!({
+    let mut json = json!({
         "generator": GENERATOR,
         "spec": spec_rel_path(spec),
         "input_hash": hash,
@@ -301,7 +364,7 @@ pub fn build(spec: &Spec, mode: Mode, root: &std::path::Path) -> Result<Built, B
             "derived": m0.derived.iter().map(|d| json!({"name": d.name, "definition": d.describe(&m0.features)})).collect::<Vec<_>>(),
             "factor": m0.factor.as_ref().map(|t| t.label.clone()),
         },
-        "fields": l.models.iter().zip(&coefficients).zip(&fields).zip(&lower).map(|(((m, c), fl), lo)| json!({
+        "fields": l.models.iter().zip(coefficients).zip(&fields).zip(&lower).map(|(((m, c), fl), lo)| json!({
             "offset": m.offset,
             "coefficients": c.iter().copied().collect::<Vec<f64>>(),
             "numerator_f32": fl.num,
@@ -310,8 +373,10 @@ pub fn build(spec: &Spec, mode: Mode, root: &std::path::Path) -> Result<Built, B
         })).collect::<Vec<_>>(),
         "fit": report,
         "verification": verification,
-        "f32_rounding": f32_rounding,
     });
+    if let (Some(o), Some(r)) = (json.as_object_mut(), f32_rounding) {
+        o.insert("f32_rounding".into(), r);
+    }
     let artifacts = vec![
         Artifact { path: format!("wgsl/{name}.wgsl").into(), contents: efields::render_wgsl(&header, &func).into() },
         Artifact { path: format!("src/{name}.rs").into(), contents: efields::render_rust(&header, &func, &doc, &c64).into() },

@@ -111,13 +111,14 @@ fn bilinear(values: &[[f64; 3]], (w, h): (usize, usize), x: f64, y: f64) -> [f64
     })
 }
 
-/// Measured errors on the grid with every midpoint added (see the module docs).
+/// Measured errors on the grid with every midpoint added (see the module docs), one
+/// verification per emitted lookup in `codes` (the integral is computed once).
 fn verify(
     spec: &Spec,
     lut: &SkinLut,
     values: &[[f64; 3]],
-    code: &SkinLutCode<'_>,
-) -> Result<Verification, BuildError> {
+    codes: &[&SkinLutCode<'_>],
+) -> Result<Vec<Verification>, BuildError> {
     let n = lut.curvature_count;
     let m = 2 * n - 1;
     // Mapped coordinate t = k/(m − 1) of the fine grid: even k are the texels.
@@ -125,7 +126,7 @@ fn verify(
         (0..m).map(|k| skin::mapped_curvature(k as f64 / (m - 1) as f64, lut.curvature_max, lut.curvature_mapping)).collect();
     let mut points: Vec<Vec<f64>> = Vec::new();
     let mut approx64: Vec<[f64; 3]> = Vec::new();
-    let mut approx32: Vec<[f32; 3]> = Vec::new();
+    let mut approx32: Vec<Vec<[f32; 3]>> = vec![Vec::new(); codes.len()];
     let truth: Vec<[f64; 3]> = match lut.kind {
         SkinLutKind::Punctual { n_dot_l, .. } => {
             let mu = 2 * n_dot_l - 1;
@@ -134,7 +135,9 @@ fn verify(
                 for (a, &nl) in nls.iter().enumerate() {
                     points.push(vec![kappa, nl]);
                     approx64.push(bilinear(values, (n_dot_l, n), a as f64 / 2.0, b as f64 / 2.0));
-                    approx32.push(code.punctual_f32(nl as f32, kappa as f32));
+                    for (a32, code) in approx32.iter_mut().zip(codes) {
+                        a32.push(code.punctual_f32(nl as f32, kappa as f32));
+                    }
                 }
             }
             integrate(spec, lut, &nls, &kappas)?.iter().map(|e| e.map(|x| x.value)).collect()
@@ -146,14 +149,16 @@ fn verify(
                     points.push(vec![kappa, band as f64]);
                     let row = &values[(band as usize - 1) * n..band as usize * n];
                     approx64.push(bilinear(row, (n, 1), a as f64 / 2.0, 0.0));
-                    approx32.push(code.sh_f32(kappa as f32, band));
+                    for (a32, code) in approx32.iter_mut().zip(codes) {
+                        a32.push(code.sh_f32(kappa as f32, band));
+                    }
                 }
             }
             t.iter().map(|e| e.map(|x| x.value)).collect()
         }
     };
     let mut worst = (0usize, 0.0f64);
-    let (mut ss, mut ss32, mut max32) = (0.0, 0.0, 0.0f64);
+    let mut ss = 0.0;
     for (k, want) in truth.iter().enumerate() {
         for c in 0..3 {
             let e = (approx64[k][c] - want[c]).abs();
@@ -161,24 +166,34 @@ fn verify(
                 worst = (k, e);
             }
             ss += e * e;
-            let e32 = (approx32[k][c] as f64 - want[c]).abs();
-            if !e32.is_finite() {
-                return Err(BuildError::NonFinite { spec: spec.file.name.clone(), at: points[k].clone() });
-            }
-            ss32 += e32 * e32;
-            max32 = max32.max(e32);
         }
     }
     let count = (3 * truth.len()) as f64;
-    Ok(Verification {
-        points: truth.len(),
-        max_abs_error: worst.1,
-        rms_error: (ss / count).sqrt(),
-        worst_point: points[worst.0].clone(),
-        max_abs_error_f32: max32,
-        rms_error_f32: (ss32 / count).sqrt(),
-        max_abs_error_in_parameter: None,
-    })
+    approx32
+        .iter()
+        .map(|a32| {
+            let (mut ss32, mut max32) = (0.0, 0.0f64);
+            for (k, want) in truth.iter().enumerate() {
+                for c in 0..3 {
+                    let e32 = (a32[k][c] as f64 - want[c]).abs();
+                    if !e32.is_finite() {
+                        return Err(BuildError::NonFinite { spec: spec.file.name.clone(), at: points[k].clone() });
+                    }
+                    ss32 += e32 * e32;
+                    max32 = max32.max(e32);
+                }
+            }
+            Ok(Verification {
+                points: truth.len(),
+                max_abs_error: worst.1,
+                rms_error: (ss / count).sqrt(),
+                worst_point: points[worst.0].clone(),
+                max_abs_error_f32: max32,
+                rms_error_f32: (ss32 / count).sqrt(),
+                max_abs_error_in_parameter: None,
+            })
+        })
+        .collect()
 }
 
 fn committed(root: &Path, spec: &Spec, hash: &str) -> Result<Value, BuildError> {
@@ -269,6 +284,18 @@ fn compact_json(v: &Value) -> String {
 
 /// Build one skin LUT spec (see the module docs).
 pub fn build(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> {
+    Ok(build_verified(spec, mode, root, false)?.0)
+}
+
+/// Tabulate and build a skin LUT spec (as [`build`] in `Mode::Fit`), and verify on the same
+/// grid the lookup over the texels as the texture stores them (the spec's texture format,
+/// interpolated in f32): what a linear sampler returns, up to its filter-weight precision.
+pub fn build_with_texture_error(spec: &Spec) -> Result<(Built, Verification), BuildError> {
+    let (built, texture) = build_verified(spec, Mode::Fit, Path::new(""), true)?;
+    Ok((built, texture.expect("verified with the stored texels")))
+}
+
+fn build_verified(spec: &Spec, mode: Mode, root: &Path, texture: bool) -> Result<(Built, Option<Verification>), BuildError> {
     let lut = SkinLut::from_spec(spec)?;
     let name = spec.file.name.clone();
     let hash = input_hash(spec, &lut);
@@ -289,14 +316,20 @@ pub fn build(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> 
         }
         Mode::Committed => (Vec::new(), None),
     };
-    let (values, verification, quadrature) = match fresh {
+    let (values, verification, quadrature, texture) = match fresh {
         Some(q) => {
             let values32: Vec<[f32; 3]> = values.iter().map(|v| v.map(|x| x as f32)).collect();
-            let code = code(&lut, &name, layout, &values32);
-            let ver = verify(spec, &lut, &values, &code)?;
-            (values, ver, q)
+            let stored: Vec<[f32; 3]> = values32.iter().map(|v| v.map(|x| lut.format.stored(x))).collect();
+            let (emitted, sampled) = (code(&lut, &name, layout, &values32), code(&lut, &name, layout, &stored));
+            let codes: &[&SkinLutCode] = if texture { &[&emitted, &sampled] } else { &[&emitted] };
+            let mut ver = verify(spec, &lut, &values, codes)?.into_iter();
+            let emitted_ver = ver.next().expect("one verification per lookup");
+            (values, emitted_ver, q, ver.next())
         }
-        None => committed_parts(&committed(root, spec, &hash)?, &name, w * h)?,
+        None => {
+            let (values, ver, q) = committed_parts(&committed(root, spec, &hash)?, &name, w * h)?;
+            (values, ver, q, None)
+        }
     };
     if let Some(k) = values.iter().position(|v| v.iter().any(|x| !x.is_finite())) {
         return Err(BuildError::NonFinite { spec: name, at: vec![k as f64] });
@@ -383,7 +416,7 @@ pub fn build(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> 
         Artifact { path: format!("data/{name}.ktx2").into(), contents: ktx2 },
         Artifact { path: format!("data/{name}.png").into(), contents: png },
     ];
-    Ok(Built { name, artifacts, verification, fit: None })
+    Ok((Built { name, artifacts, verification, fit: None }, texture))
 }
 
 fn code<'a>(lut: &'a SkinLut, name: &'a str, layout: Layout, values: &'a [[f32; 3]]) -> SkinLutCode<'a> {
