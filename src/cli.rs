@@ -135,6 +135,9 @@ pub fn build(paths: &Paths, only: &[String], check: bool) -> Result<()> {
     }
     let scenes = Scene::load_dir(&paths.fits.join("scenes")).map_err(input_err)?;
     let mut artifacts: Vec<_> = built.iter().flat_map(|b| b.artifacts.clone()).collect();
+    // The scene modules read their specs' coefficients from generated/json: write this build's
+    // first, so a scene never specialises the previous build's fit.
+    let mut written = if check { 0 } else { pipeline::write_all(&paths.generated, &artifacts)? };
     if only.is_empty() {
         // Every scene module, with the node files of this build recorded for its cache.
         for sc in &scenes {
@@ -169,7 +172,8 @@ pub fn build(paths: &Paths, only: &[String], check: bool) -> Result<()> {
         }
         anyhow::bail!("{} generated file(s) differ from what the specs and committed coefficients produce; run `shadefit build`", bad.len());
     }
-    let written = pipeline::write_all(&paths.generated, &artifacts)?;
+    // Spec files were written above (unchanged ones are skipped, so this writes the rest).
+    written += pipeline::write_all(&paths.generated, &artifacts)?;
     for (b, t) in built.iter().zip(&seconds) {
         let v = &b.verification;
         println!(

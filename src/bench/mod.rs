@@ -281,7 +281,7 @@ pub fn render(r: &Report) -> String {
                     Some(q) => {
                         let _ = writeln!(
                             s,
-                            "  => {}shadefit {} ({} err, {}/pt) vs {} {} ({} err, {}/pt): {}× faster{}",
+                            "  => {}shadefit {} ({} err, {}/pt) vs {} {} ({} err, {}/pt): {}× speed-up{}",
                             label(k),
                             q.shadefit.setting,
                             opt_sci(q.shadefit.max_error),
