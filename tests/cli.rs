@@ -258,3 +258,42 @@ fn refit_reproduces_committed_coefficients() {
         }
     }
 }
+
+#[test]
+fn bench_integrators_honour_their_tolerances_and_converge() {
+    let out = shadefit(&["bench", "--quick", "--only", "integrators", "--json", "--no-python"], None);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let rows = v["integrators"].as_array().unwrap();
+    let mut production = 0;
+    for r in rows {
+        let method = r["method"].as_str().unwrap();
+        let err = r["max_error"].as_f64().unwrap();
+        assert!(err.is_finite(), "{method}: error {err}");
+        // The production integrators take an absolute tolerance: their measured error must be
+        // within it, and their error estimate (an upper estimate by design) above the error.
+        if let Some(tol) = r["setting"].as_str().unwrap().strip_prefix("tol ").map(|t| t.parse::<f64>().unwrap()) {
+            if method.ends_with("(shadefit)") {
+                production += 1;
+                assert!(err <= tol, "{} {method} at tol {tol:e}: error {err:e}", r["quantity"]);
+                let est = r["max_estimate"].as_f64().unwrap();
+                assert!(est >= err, "{} {method} at tol {tol:e}: estimate {est:e} below error {err:e}", r["quantity"]);
+            }
+        }
+    }
+    assert!(production >= 15, "every quantity's integrator at several tolerances (got {production} rows)");
+    // The product rule for P_s converges (slowly: the specular cone is a cusp) as n grows.
+    let gl: Vec<f64> = rows
+        .iter()
+        .filter(|r| r["quantity"] == "fuzz P_s" && r["method"].as_str().unwrap().starts_with("Gauss–Legendre"))
+        .map(|r| r["max_error"].as_f64().unwrap())
+        .collect();
+    assert!(gl.len() >= 3 && gl.windows(2).all(|w| w[1] < w[0]), "P_s product-rule errors must fall with n: {gl:?}");
+}
+
+#[test]
+fn bench_rejects_an_unknown_section() {
+    let out = shadefit(&["bench", "--only", "integrators,speed"], None);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("unknown section 'speed'"));
+}

@@ -456,3 +456,34 @@ pub fn default_python(root: &Path) -> Python {
         required: false,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn point(method: &str, seconds: f64, err: Option<f64>) -> CurvePoint {
+        CurvePoint { method: method.into(), setting: String::new(), points: 1, seconds_per_point: seconds, max_error: err, note: String::new() }
+    }
+
+    #[test]
+    fn ratio_at_the_target_takes_the_fastest_row_within_it_on_each_side() {
+        let numpy = [point("gl", 1.0, Some(1e-6)), point("quad", 8.0, Some(1e-9)), point("gl", 4.0, Some(5e-9)), point("bad", 0.1, None)];
+        let shadefit = [point("sf", 0.001, Some(1e-5)), point("sf", 0.02, Some(2e-9)), point("sf", 0.05, Some(1e-12))];
+        let r = ratio(&numpy, &shadefit).expect("both sides reach 1e-8");
+        assert!(r.at_target);
+        assert_eq!(r.numpy.seconds_per_point, 4.0, "the fastest numpy row within 1e-8");
+        assert_eq!(r.shadefit.seconds_per_point, 0.02, "the fastest shadefit row within 1e-8");
+        assert_eq!(r.speedup, 200.0);
+    }
+
+    #[test]
+    fn ratio_off_target_matches_the_best_numpy_error() {
+        let numpy = [point("mc", 1.0, Some(1e-2)), point("mc", 10.0, Some(3e-3))];
+        let shadefit = [point("sf", 0.001, Some(5e-3)), point("sf", 0.002, Some(1e-3))];
+        let r = ratio(&numpy, &shadefit).expect("shadefit matches 3e-3");
+        assert!(!r.at_target);
+        assert_eq!((r.numpy.seconds_per_point, r.shadefit.seconds_per_point), (10.0, 0.002));
+        // No shadefit row as accurate as numpy's best: no ratio rather than an unequal one.
+        assert!(ratio(&numpy, &[point("sf", 0.001, Some(5e-2))]).is_none());
+    }
+}
