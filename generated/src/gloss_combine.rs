@@ -15,11 +15,11 @@ fn input(v: f32, lo: f32, hi: f32) -> f32 {
 
 /// Numerator coefficients, one per numerator term.
 pub const GLOSS_COMBINE_NUM: [f32; 4] = [
-    -5.8788437e-1_f32, 1.004575e0_f32, -5.8837246e-2_f32, 1.58590555e1_f32,
+    -5.878865e-1_f32, 1.0045825e0_f32, -5.8837064e-2_f32, 1.58590555e1_f32,
 ];
 /// Denominator coefficients (the constant term 1 is implicit).
 pub const GLOSS_COMBINE_DEN: [f32; 3] = [
-    9.89125e0_f32, 1.1930928e1_f32, -2.6328876e1_f32,
+    9.891235e0_f32, 1.19309e1_f32, -2.6328876e1_f32,
 ];
 
 /// CPU version of the WGSL function of the same name.

@@ -12,10 +12,10 @@ fn gloss_combine_input(v: f32, lo: f32, hi: f32) -> f32 {
 }
 
 const GLOSS_COMBINE_NUM: array<f32, 4> = array<f32, 4>(
-    -5.8788437e-1f, 1.004575e0f, -5.8837246e-2f, 1.58590555e1f,
+    -5.878865e-1f, 1.0045825e0f, -5.8837064e-2f, 1.58590555e1f,
 );
 const GLOSS_COMBINE_DEN: array<f32, 3> = array<f32, 3>(
-    9.89125e0f, 1.1930928e1f, -2.6328876e1f,
+    9.891235e0f, 1.19309e1f, -2.6328876e1f,
 );
 
 fn combine_gloss(x: f32, y: f32) -> f32 {

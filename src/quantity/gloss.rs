@@ -121,19 +121,42 @@ pub fn gloss_from_length(length: f64) -> f64 {
     if length >= hi {
         return 1.0;
     }
-    // Bisection on 1 − L, which decreases strictly with g: 64 halvings of [0, 1] reach the
-    // f64 spacing of g, so the result is the nearest representable root up to one ulp.
-    let target = 1.0 - length;
+    // Illinois (modified regula falsi) on h(g) = ln(1 − L(g)) − ln(1 − length). h decreases
+    // strictly and is close to linear in g (1 − L ≈ α²(ln(2/α) − 1) with α² = 2/(1 + 2^(18g))),
+    // so secant steps converge in a few evaluations; halving the stale end's value (Illinois)
+    // keeps both ends moving, and a step that would not land inside the bracket bisects. It stops
+    // when the bracket is down to adjacent f64 values or two spacings: the root to about one ulp,
+    // like 64 bisection steps, in ~10 closed-form evaluations.
+    let target = (1.0 - length).ln();
+    let h = |g: f64| one_minus_length(alpha_from_gloss(g)).ln() - target;
     let (mut a, mut b) = (0.0_f64, 1.0_f64);
-    for _ in 0..64 {
+    let (mut ha, mut hb) = (h(a), h(b));
+    let mut last = 0i8;
+    for _ in 0..200 {
         let m = 0.5 * (a + b);
-        if m <= a || m >= b {
+        if m <= a || m >= b || b - a <= 2.0 * f64::EPSILON * b {
             break;
         }
-        if one_minus_length(alpha_from_gloss(m)) > target {
-            a = m;
+        let mut x = b - hb * (b - a) / (hb - ha);
+        if !(x > a && x < b) {
+            x = m;
+        }
+        let hx = h(x);
+        if hx == 0.0 {
+            return x;
+        }
+        if hx > 0.0 {
+            (a, ha) = (x, hx);
+            if last == 1 {
+                hb *= 0.5;
+            }
+            last = 1;
         } else {
-            b = m;
+            (b, hb) = (x, hx);
+            if last == -1 {
+                ha *= 0.5;
+            }
+            last = -1;
         }
     }
     0.5 * (a + b)
