@@ -29,7 +29,7 @@ pub struct IntegratorRow {
     pub max_error: f64,
     /// Largest error estimate the method reported (adaptive methods only).
     pub max_estimate: Option<f64>,
-    pub reference: &'static str,
+    pub reference: String,
 }
 
 /// Outcome of one method at one setting on all points: values, estimates, evaluations.
@@ -64,7 +64,7 @@ fn row(
     quantity: &'static str,
     method: &str,
     setting: String,
-    reference: (&'static str, &[f64]),
+    reference: (&str, &[f64]),
     run: impl Fn() -> Run,
 ) -> IntegratorRow {
     let (seconds, r) = time_it(mode.min_seconds, run);
@@ -84,8 +84,27 @@ fn row(
         evals_per_point: r.evals as f64 / n as f64,
         max_error,
         max_estimate: r.estimates.map(|e| e.iter().copied().fold(0.0, f64::max)),
-        reference: reference.0,
+        reference: reference.0.to_string(),
     }
+}
+
+/// The production integrator `eval` at each tolerance of `ladder`, against itself at `ref_tol`:
+/// the reference values (for the other methods) and the rows.
+fn self_ladder(
+    mode: &Mode,
+    quantity: &'static str,
+    method: &str,
+    ref_tol: f64,
+    ladder: Vec<f64>,
+    eval: impl Fn(f64) -> Vec<Estimate>,
+) -> (Vec<f64>, Vec<IntegratorRow>) {
+    let truth: Vec<f64> = eval(ref_tol).iter().map(|e| e.value).collect();
+    let label = format!("adaptive at tol {ref_tol:.0e}");
+    let rows = ladder
+        .into_iter()
+        .map(|tol| row(mode, quantity, method, format!("tol {tol:.0e}"), (&label, &truth), || Run::from_estimates(eval(tol))))
+        .collect();
+    (truth, rows)
 }
 
 /// Every integrator's table.
@@ -194,19 +213,15 @@ fn fuzz_ps(mode: &Mode) -> Vec<IntegratorRow> {
             .map(|p| fuzz::ps(p[0], p[1], p[2], p[3], tol))
             .collect()
     };
-    let truth: Vec<f64> = eval(REF_TOL).iter().map(|e| e.value).collect();
+    let (truth, mut rows) = self_ladder(
+        mode,
+        "fuzz P_s",
+        "adaptive G10/K21 on the reduced 1-D integral (shadefit)",
+        REF_TOL,
+        tols(mode, &[1e-4, 1e-7, 1e-9], &[1e-3, 1e-5, 1e-7, 1e-9, 1e-11]),
+        eval,
+    );
     let reference = ("adaptive at tol 1e-13", truth.as_slice());
-    let mut rows = Vec::new();
-    for tol in tols(mode, &[1e-4, 1e-7, 1e-9], &[1e-3, 1e-5, 1e-7, 1e-9, 1e-11]) {
-        rows.push(row(
-            mode,
-            "fuzz P_s",
-            "adaptive G10/K21 on the reduced 1-D integral (shadefit)",
-            format!("tol {tol:.0e}"),
-            reference,
-            || Run::from_estimates(eval(tol)),
-        ));
-    }
     for n in if mode.quick {
         vec![16, 64, 256]
     } else {
@@ -273,19 +288,15 @@ fn fuzz_r(mode: &Mode) -> Vec<IntegratorRow> {
     };
     let eval =
         |tol: f64| -> Vec<Estimate> { pts.iter().map(|p| fuzz::r(p[0], p[1], tol)).collect() };
-    let truth: Vec<f64> = eval(REF_TOL).iter().map(|e| e.value).collect();
+    let (truth, mut rows) = self_ladder(
+        mode,
+        "fuzz R",
+        "nested adaptive: A by GL32/GL24, η by G7/K15, w by G10/K21 (shadefit)",
+        REF_TOL,
+        tols(mode, &[1e-5, 1e-7, 1e-9], &[1e-4, 1e-5, 1e-7, 1e-9, 1e-10]),
+        eval,
+    );
     let reference = ("adaptive at tol 1e-12", truth.as_slice());
-    let mut rows = Vec::new();
-    for tol in tols(mode, &[1e-5, 1e-7, 1e-9], &[1e-4, 1e-5, 1e-7, 1e-9, 1e-10]) {
-        rows.push(row(
-            mode,
-            "fuzz R",
-            "nested adaptive: A by GL32/GL24, η by G7/K15, w by G10/K21 (shadefit)",
-            format!("tol {tol:.0e}"),
-            reference,
-            || Run::from_estimates(eval(tol)),
-        ));
-    }
     // The straightforward nesting: a product rule over the light directions of adaptive P_s.
     for n in if mode.quick {
         vec![4, 8, 16]
@@ -531,23 +542,15 @@ fn skin_punctual(mode: &Mode) -> Vec<IntegratorRow> {
     };
     // One value per point and channel, point-major.
     let flat = |e: Vec<[Estimate; 3]>| -> Vec<Estimate> { e.into_iter().flatten().collect() };
-    let truth: Vec<f64> = flat(eval(1e-14)).iter().map(|e| e.value).collect();
-    let reference = ("adaptive at tol 1e-14", truth.as_slice());
-    let mut rows = Vec::new();
-    for tol in tols(
+    let (truth, mut rows) = self_ladder(
         mode,
-        &[1e-6, 1e-8, 1e-10],
-        &[1e-4, 1e-6, 1e-8, 1e-10, 1e-12],
-    ) {
-        rows.push(row(
-            mode,
-            "skin punctual (RGB)",
-            "adaptive G10/K21 split at the kinks (shadefit)",
-            format!("tol {tol:.0e}"),
-            reference,
-            || Run::from_estimates(flat(eval(tol))),
-        ));
-    }
+        "skin punctual (RGB)",
+        "adaptive G10/K21 split at the kinks (shadefit)",
+        1e-14,
+        tols(mode, &[1e-6, 1e-8, 1e-10], &[1e-4, 1e-6, 1e-8, 1e-10, 1e-12]),
+        |tol| flat(eval(tol)),
+    );
+    let reference = ("adaptive at tol 1e-14", truth.as_slice());
     // The straightforward ring integral: Gauss–Legendre over x ∈ [−π, π], unsplit.
     for n in if mode.quick {
         vec![64, 1024]
@@ -613,23 +616,13 @@ fn skin_sh(mode: &Mode) -> Vec<IntegratorRow> {
             })
             .collect()
     };
-    let truth: Vec<f64> = eval(1e-14).iter().map(|e| e.value).collect();
-    let reference = ("adaptive at tol 1e-14", truth.as_slice());
-    tols(
+    self_ladder(
         mode,
-        &[1e-6, 1e-8, 1e-10],
-        &[1e-4, 1e-6, 1e-8, 1e-10, 1e-12],
+        "skin SH bands (RGB)",
+        "adaptive G10/K21 over the chord (shadefit)",
+        1e-14,
+        tols(mode, &[1e-6, 1e-8, 1e-10], &[1e-4, 1e-6, 1e-8, 1e-10, 1e-12]),
+        eval,
     )
-    .into_iter()
-    .map(|tol| {
-        row(
-            mode,
-            "skin SH bands (RGB)",
-            "adaptive G10/K21 over the chord (shadefit)",
-            format!("tol {tol:.0e}"),
-            reference,
-            || Run::from_estimates(eval(tol)),
-        )
-    })
-    .collect()
+    .1
 }
