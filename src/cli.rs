@@ -137,6 +137,7 @@ pub fn build(paths: &Paths, only: &[String], check: bool) -> Result<()> {
     let mut artifacts: Vec<_> = built.iter().flat_map(|b| b.artifacts.clone()).collect();
     // The scene modules read their specs' coefficients from generated/json: write this build's
     // first, so a scene never specialises the previous build's fit.
+    let spec_files = artifacts.len();
     let mut written = if check { 0 } else { pipeline::write_all(&paths.generated, &artifacts)? };
     if only.is_empty() {
         // Every scene module, with the node files of this build recorded for its cache.
@@ -172,8 +173,8 @@ pub fn build(paths: &Paths, only: &[String], check: bool) -> Result<()> {
         }
         anyhow::bail!("{} generated file(s) differ from what the specs and committed coefficients produce; run `shadefit build`", bad.len());
     }
-    // Spec files were written above (unchanged ones are skipped, so this writes the rest).
-    written += pipeline::write_all(&paths.generated, &artifacts)?;
+    // The spec files were written above; now the scene modules and the runtime index.
+    written += pipeline::write_all(&paths.generated, &artifacts[spec_files..])?;
     for (b, t) in built.iter().zip(&seconds) {
         let v = &b.verification;
         println!(

@@ -240,19 +240,6 @@ pub fn fit_samples(spec: &Spec, data: &Data) -> Result<fit::Fit, BuildError> {
     Ok(fit::fit(model, data, &opts, &spec.file.name)?)
 }
 
-/// The committed coefficients of a fit spec (generated/json/NAME.json under `root`), checked
-/// against the spec's hash and model.
-pub fn committed_coefficients(spec: &Spec, root: &Path) -> Result<DVector<f64>, BuildError> {
-    let name = &spec.file.name;
-    let model = spec.model.as_ref().expect("fit specs carry a model");
-    let v = committed_json(root, spec)?;
-    let c = f64_array(&v["model"], name, "coefficients")?;
-    if c.len() != model.n_full() {
-        return Err(BuildError::NoCommitted { spec: name.clone(), why: "coefficient count differs from the spec".into() });
-    }
-    Ok(DVector::from_vec(c))
-}
-
 /// The committed values of a table spec, checked against the spec's hash and grid.
 pub fn committed_values(spec: &Spec, root: &Path) -> Result<Vec<f64>, BuildError> {
     let name = &spec.file.name;
@@ -301,13 +288,18 @@ fn build_fit(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> 
     fit_from_coefficients(spec, coefficients, report, Some(f32s), &Reference::of_spec(spec), Denominators::Proven)
 }
 
-/// The committed f64 and f32 coefficients of a fit spec, checked against the spec's hash and
-/// model and against each other, with the committed report of the f32 re-optimisation.
+/// The committed f64 and f32 coefficients of a fit spec (generated/json/NAME.json under `root`),
+/// checked against the spec's hash and model and against each other, with the committed report
+/// of the f32 re-optimisation.
 pub fn committed_fit(spec: &Spec, root: &Path) -> Result<(DVector<f64>, F32Coefficients), BuildError> {
     let name = &spec.file.name;
     let model = spec.model.as_ref().expect("fit specs carry a model");
-    let c = committed_coefficients(spec, root)?;
     let v = committed_json(root, spec)?;
+    let c = f64_array(&v["model"], name, "coefficients")?;
+    if c.len() != model.n_full() {
+        return Err(BuildError::NoCommitted { spec: name.clone(), why: "coefficient count differs from the spec".into() });
+    }
+    let c = DVector::from_vec(c);
     let (num, den) = committed_f32(model, &c, &v["model"], name)?;
     let on_grid: RoundingOnGrid = serde_json::from_value(v["f32_rounding"].clone())
         .map_err(|e| BuildError::NoCommitted { spec: name.clone(), why: format!("'f32_rounding' unreadable ({e})") })?;

@@ -4,7 +4,6 @@ mod common;
 
 use common::*;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 #[test]
 fn eval_json_contract() {
@@ -138,16 +137,7 @@ fn build_check_rejects_f32_coefficients_that_are_not_the_fit_s() {
 fn build_is_byte_identical_at_any_thread_count() {
     // The whole build (every spec, built concurrently, and every scene): ~45 s on one thread.
     let run = |threads: &str| {
-        let d = scratch();
-        copy_dir(&root().join("fits/scenes"), &d.path().join("fits/scenes"));
-        let o = Command::new(env!("CARGO_BIN_EXE_shadefit"))
-            .args(["build"])
-            .current_dir(d.path())
-            .env("RAYON_NUM_THREADS", threads)
-            .output()
-            .unwrap();
-        assert!(o.status.success(), "{}", stderr(&o));
-        snapshot(&d.path().join("generated"))
+        build_snapshot(&["build"], threads, |d| copy_dir(&root().join("fits/scenes"), &d.join("fits/scenes")))
     };
     let one = run("1");
     assert!(one.iter().any(|(p, _)| p.to_string_lossy().contains("scene_")), "the scenes are built too");

@@ -6,7 +6,7 @@ mod common;
 
 use common::*;
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Output;
 
 fn json(o: &Output) -> serde_json::Value {
     assert!(o.status.success(), "{}", stderr(o));
@@ -136,17 +136,7 @@ fn build_rejects_bad_profiles_and_writes_nothing() {
 
 #[test]
 fn skin_luts_are_byte_identical_at_any_thread_count_and_match_the_committed_ones() {
-    let run = |threads: &str| {
-        let d = scratch();
-        let o = Command::new(env!("CARGO_BIN_EXE_shadefit"))
-            .args(["build", "--only", "skin_punctual_lut,skin_sh_lut"])
-            .current_dir(d.path())
-            .env("RAYON_NUM_THREADS", threads)
-            .output()
-            .unwrap();
-        assert!(o.status.success(), "{}", stderr(&o));
-        snapshot(&d.path().join("generated"))
-    };
+    let run = |threads: &str| build_snapshot(&["build", "--only", "skin_punctual_lut,skin_sh_lut"], threads, |_| {});
     let one = run("1");
     let names: Vec<String> = one.iter().map(|(p, _)| p.display().to_string()).collect();
     for f in ["data/skin_punctual_lut.ktx2", "data/skin_punctual_lut.png", "json/skin_sh_lut.json", "src/skin_sh_lut.rs", "wgsl/skin_punctual_lut.wgsl"] {

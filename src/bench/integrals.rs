@@ -120,12 +120,9 @@ pub fn all(mode: &Mode) -> Vec<IntegratorRow> {
     rows
 }
 
-fn tols(mode: &Mode, quick: &[f64], full: &[f64]) -> Vec<f64> {
-    if mode.quick {
-        quick.to_vec()
-    } else {
-        full.to_vec()
-    }
+/// The quick or the full list of settings.
+fn pick<T: Copy>(mode: &Mode, quick: &[T], full: &[T]) -> Vec<T> {
+    if mode.quick { quick.to_vec() } else { full.to_vec() }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -169,7 +166,6 @@ fn unit(theta: f64, phi: f64) -> [f64; 3] {
 /// P_s by an n_μ × 2n_μ Gauss–Legendre product rule over the lower hemisphere in (μ = cos θ, φ).
 fn ps_gauss_legendre(
     p: &[f64; 4],
-    n: usize,
     rule: &(Vec<f64>, Vec<f64>),
     rule_phi: &(Vec<f64>, Vec<f64>),
 ) -> f64 {
@@ -185,7 +181,6 @@ fn ps_gauss_legendre(
             sum += wm * wp * fuzz::sggx_phase(p[0], t, u, v);
         }
     }
-    debug_assert_eq!(rule.0.len(), n);
     // Jacobians: dμ = ½ dx, dφ = π dx.
     sum * 0.5 * PI
 }
@@ -218,15 +213,11 @@ fn fuzz_ps(mode: &Mode) -> Vec<IntegratorRow> {
         "fuzz P_s",
         "adaptive G10/K21 on the reduced 1-D integral (shadefit)",
         REF_TOL,
-        tols(mode, &[1e-4, 1e-7, 1e-9], &[1e-3, 1e-5, 1e-7, 1e-9, 1e-11]),
+        pick(mode, &[1e-4, 1e-7, 1e-9], &[1e-3, 1e-5, 1e-7, 1e-9, 1e-11]),
         eval,
     );
     let reference = ("adaptive at tol 1e-13", truth.as_slice());
-    for n in if mode.quick {
-        vec![16, 64, 256]
-    } else {
-        vec![16, 64, 256, 1024]
-    } {
+    for n in pick(mode, &[16, 64, 256], &[16, 64, 256, 1024]) {
         let rule = gauss_legendre(n);
         let rule_phi = gauss_legendre(2 * n);
         rows.push(row(
@@ -238,18 +229,14 @@ fn fuzz_ps(mode: &Mode) -> Vec<IntegratorRow> {
             || {
                 Run::fixed(
                     pts.iter()
-                        .map(|p| ps_gauss_legendre(p, n, &rule, &rule_phi))
+                        .map(|p| ps_gauss_legendre(p, &rule, &rule_phi))
                         .collect(),
                     (2 * n * n) as u64,
                 )
             },
         ));
     }
-    for n in if mode.quick {
-        vec![1_000, 10_000]
-    } else {
-        vec![1_000, 10_000, 100_000, 1_000_000]
-    } {
+    for n in pick(mode, &[1_000, 10_000], &[1_000, 10_000, 100_000, 1_000_000]) {
         rows.push(row(
             mode,
             "fuzz P_s",
@@ -293,16 +280,12 @@ fn fuzz_r(mode: &Mode) -> Vec<IntegratorRow> {
         "fuzz R",
         "nested adaptive: A by GL32/GL24, η by G7/K15, w by G10/K21 (shadefit)",
         REF_TOL,
-        tols(mode, &[1e-5, 1e-7, 1e-9], &[1e-4, 1e-5, 1e-7, 1e-9, 1e-10]),
+        pick(mode, &[1e-5, 1e-7, 1e-9], &[1e-4, 1e-5, 1e-7, 1e-9, 1e-10]),
         eval,
     );
     let reference = ("adaptive at tol 1e-12", truth.as_slice());
     // The straightforward nesting: a product rule over the light directions of adaptive P_s.
-    for n in if mode.quick {
-        vec![4, 8, 16]
-    } else {
-        vec![4, 8, 16, 32]
-    } {
+    for n in pick(mode, &[4, 8, 16], &[4, 8, 16, 32]) {
         let (x, w) = gauss_legendre(n);
         let (xp, wp) = gauss_legendre(2 * n);
         rows.push(row(
@@ -359,7 +342,7 @@ fn fuzz_g(mode: &Mode) -> Vec<IntegratorRow> {
         .collect();
     let mut rows = Vec::new();
     let closed = ("closed form in E₁, E₂", exact.as_slice());
-    for tol in tols(mode, &[1e-6, 1e-9, 1e-12], &[1e-4, 1e-6, 1e-9, 1e-12]) {
+    for tol in pick(mode, &[1e-6, 1e-9, 1e-12], &[1e-4, 1e-6, 1e-9, 1e-12]) {
         rows.push(row(
             mode,
             "fuzz G",
@@ -418,7 +401,7 @@ fn fuzz_q(mode: &Mode) -> Vec<IntegratorRow> {
     let quad_ref: Vec<f64> = pts.iter().map(|&d| fuzz::q(d, 1e-14).value).collect();
     let mut rows = Vec::new();
     let closed = ("closed form 2E₃(d)", exact.as_slice());
-    for tol in tols(mode, &[1e-6, 1e-9, 1e-12], &[1e-4, 1e-6, 1e-9, 1e-12]) {
+    for tol in pick(mode, &[1e-6, 1e-9, 1e-12], &[1e-4, 1e-6, 1e-9, 1e-12]) {
         rows.push(row(
             mode,
             "fuzz Q",
@@ -459,7 +442,7 @@ fn gloss_length(mode: &Mode) -> Vec<IntegratorRow> {
         || Run::fixed(gs.iter().map(|&g| gloss::length_from_gloss(g)).collect(), 0),
     ));
     let reference = ("closed form", closed.as_slice());
-    for tol in tols(mode, &[1e-6, 1e-9, 1e-12], &[1e-4, 1e-6, 1e-9, 1e-12]) {
+    for tol in pick(mode, &[1e-6, 1e-9, 1e-12], &[1e-4, 1e-6, 1e-9, 1e-12]) {
         rows.push(row(
             mode,
             "gloss length",
@@ -475,11 +458,7 @@ fn gloss_length(mode: &Mode) -> Vec<IntegratorRow> {
             },
         ));
     }
-    for n in if mode.quick {
-        vec![16, 256]
-    } else {
-        vec![16, 64, 256, 1024]
-    } {
+    for n in pick(mode, &[16, 256], &[16, 64, 256, 1024]) {
         let rule = gauss_legendre(n);
         rows.push(row(
             mode,
@@ -547,16 +526,12 @@ fn skin_punctual(mode: &Mode) -> Vec<IntegratorRow> {
         "skin punctual (RGB)",
         "adaptive G10/K21 split at the kinks (shadefit)",
         1e-14,
-        tols(mode, &[1e-6, 1e-8, 1e-10], &[1e-4, 1e-6, 1e-8, 1e-10, 1e-12]),
+        pick(mode, &[1e-6, 1e-8, 1e-10], &[1e-4, 1e-6, 1e-8, 1e-10, 1e-12]),
         |tol| flat(eval(tol)),
     );
     let reference = ("adaptive at tol 1e-14", truth.as_slice());
     // The straightforward ring integral: Gauss–Legendre over x ∈ [−π, π], unsplit.
-    for n in if mode.quick {
-        vec![64, 1024]
-    } else {
-        vec![64, 256, 1024, 4096]
-    } {
+    for n in pick(mode, &[64, 1024], &[64, 256, 1024, 4096]) {
         let (x, w) = gauss_legendre(n);
         rows.push(row(
             mode,
@@ -621,7 +596,7 @@ fn skin_sh(mode: &Mode) -> Vec<IntegratorRow> {
         "skin SH bands (RGB)",
         "adaptive G10/K21 over the chord (shadefit)",
         1e-14,
-        tols(mode, &[1e-6, 1e-8, 1e-10], &[1e-4, 1e-6, 1e-8, 1e-10, 1e-12]),
+        pick(mode, &[1e-6, 1e-8, 1e-10], &[1e-4, 1e-6, 1e-8, 1e-10, 1e-12]),
         eval,
     )
     .1

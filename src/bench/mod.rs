@@ -270,47 +270,9 @@ pub fn render(r: &Report) -> String {
                     }
                 );
             }
-            let label = |k: usize| if k == 0 { "" } else { "without closed forms: " };
-            let ratios: Vec<&Option<tables::Ratio>> = if t.ratio_integrators.is_some() {
-                vec![&t.ratio, &t.ratio_integrators]
-            } else {
-                vec![&t.ratio]
-            };
-            for (k, r) in ratios.into_iter().enumerate() {
-                match r {
-                    Some(q) => {
-                        let _ = writeln!(
-                            s,
-                            "  => {}shadefit {} ({} err, {}/pt) vs {} {} ({} err, {}/pt): {}× speed-up{}",
-                            label(k),
-                            q.shadefit.setting,
-                            opt_sci(q.shadefit.max_error),
-                            seconds(q.shadefit.seconds_per_point),
-                            q.numpy.method,
-                            q.numpy.setting,
-                            opt_sci(q.numpy.max_error),
-                            seconds(q.numpy.seconds_per_point),
-                            if q.speedup < 10.0 { format!("{:.1}", q.speedup) } else { format!("{:.0}", q.speedup) },
-                            if q.at_target {
-                                String::new()
-                            } else {
-                                format!(" (numpy did not reach {:.0e})", tables::TARGET_ERROR)
-                            }
-                        );
-                    }
-                    None => {
-                        let _ = writeln!(
-                            s,
-                            "  => {}no ratio{}",
-                            label(k),
-                            if t.note.is_empty() {
-                                String::new()
-                            } else {
-                                format!(": {}", t.note)
-                            }
-                        );
-                    }
-                }
+            s.push_str(&ratio_line("", &t.ratio, &t.note));
+            if t.ratio_integrators.is_some() {
+                s.push_str(&ratio_line("without closed forms: ", &t.ratio_integrators, &t.note));
             }
         }
     }
@@ -322,4 +284,23 @@ pub fn render(r: &Report) -> String {
         s.push_str(&forms::render(&r.forms));
     }
     s
+}
+
+/// The "=> …" line of a table's comparison at equal error (or why there is none).
+fn ratio_line(label: &str, ratio: &Option<tables::Ratio>, note: &str) -> String {
+    let Some(q) = ratio else {
+        return format!("  => {label}no ratio{}\n", if note.is_empty() { String::new() } else { format!(": {note}") });
+    };
+    format!(
+        "  => {label}shadefit {} ({} err, {}/pt) vs {} {} ({} err, {}/pt): {}× speed-up{}\n",
+        q.shadefit.setting,
+        opt_sci(q.shadefit.max_error),
+        seconds(q.shadefit.seconds_per_point),
+        q.numpy.method,
+        q.numpy.setting,
+        opt_sci(q.numpy.max_error),
+        seconds(q.numpy.seconds_per_point),
+        if q.speedup < 10.0 { format!("{:.1}", q.speedup) } else { format!("{:.0}", q.speedup) },
+        if q.at_target { String::new() } else { format!(" (numpy did not reach {:.0e})", tables::TARGET_ERROR) }
+    )
 }

@@ -400,9 +400,9 @@ pub(crate) fn ratio(numpy: &[CurvePoint], shadefit: &[CurvePoint]) -> Option<Rat
 
 /// Run the script on `input`; its JSON answer.
 fn run_python(py: &Python, input: &Value) -> Result<Value> {
-    let dir = tempfile_dir()?;
-    let inp = dir.join("in.json");
-    let out = dir.join("out.json");
+    let dir = tempfile::tempdir().context("creating a temporary folder")?;
+    let inp = dir.path().join("in.json");
+    let out = dir.path().join("out.json");
     std::fs::write(&inp, serde_json::to_vec(input)?)?;
     let status = Command::new(&py.interpreter)
         .arg(&py.script)
@@ -413,34 +413,10 @@ fn run_python(py: &Python, input: &Value) -> Result<Value> {
         .env("OPENBLAS_NUM_THREADS", "1")
         .env("MKL_NUM_THREADS", "1")
         .status()
-        .with_context(|| {
-            format!(
-                "running {} {}",
-                py.interpreter.display(),
-                py.script.display()
-            )
-        })?;
-    anyhow::ensure!(
-        status.success(),
-        "{} exited with {status}",
-        py.script.display()
-    );
-    let text =
-        std::fs::read_to_string(&out).with_context(|| format!("reading {}", out.display()))?;
-    let v = serde_json::from_str(&text).with_context(|| format!("parsing {}", out.display()))?;
-    let _ = std::fs::remove_dir_all(&dir);
-    Ok(v)
-}
-
-fn tempfile_dir() -> Result<PathBuf> {
-    let base = std::env::temp_dir();
-    for k in 0..1000u32 {
-        let d = base.join(format!("shadefit-bench-{}-{k}", std::process::id()));
-        if std::fs::create_dir(&d).is_ok() {
-            return Ok(d);
-        }
-    }
-    anyhow::bail!("cannot create a temporary folder in {}", base.display())
+        .with_context(|| format!("running {} {}", py.interpreter.display(), py.script.display()))?;
+    anyhow::ensure!(status.success(), "{} exited with {status}", py.script.display());
+    let text = std::fs::read_to_string(&out).with_context(|| format!("reading {}", out.display()))?;
+    serde_json::from_str(&text).with_context(|| format!("parsing {}", out.display()))
 }
 
 /// The default interpreter: the test suite's venv when present, else `python3`.

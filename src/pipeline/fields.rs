@@ -192,8 +192,8 @@ fn fit_on_grid(spec: &Spec) -> Result<(Vec<DVector<f64>>, Value, FittingGrid), B
 }
 
 /// The committed coefficients of every field (generated/json/NAME.json under `root`, checked
-/// against the spec's hash and model) and the committed fit report.
-pub fn committed(spec: &Spec, root: &std::path::Path) -> Result<(Vec<DVector<f64>>, Option<Value>), BuildError> {
+/// against the spec's hash and model) and the committed JSON they were read from.
+pub fn committed(spec: &Spec, root: &std::path::Path) -> Result<(Vec<DVector<f64>>, Value), BuildError> {
     let name = spec.file.name.clone();
     let l = layout(spec);
     let v = committed_json(root, spec)?;
@@ -209,7 +209,7 @@ pub fn committed(spec: &Spec, root: &std::path::Path) -> Result<(Vec<DVector<f64
         }
         c.push(DVector::from_vec(v));
     }
-    Ok((c, v.get("fit").cloned()))
+    Ok((c, v))
 }
 
 pub fn build(spec: &Spec, mode: Mode, root: &std::path::Path) -> Result<Built, BuildError> {
@@ -221,9 +221,8 @@ pub fn build(spec: &Spec, mode: Mode, root: &std::path::Path) -> Result<Built, B
             (c, Some(r), Rounding::Measure(g))
         }
         Mode::Committed => {
-            let (c, r) = committed(spec, root)?;
-            let v = committed_json(root, spec)?;
-            (c, r, Rounding::Committed(v["f32_rounding"].clone()))
+            let (c, v) = committed(spec, root)?;
+            (c, v.get("fit").cloned(), Rounding::Committed(v["f32_rounding"].clone()))
         }
     };
     fields_from_coefficients(spec, &coefficients, report, Some(rounding), &FieldsReference::of_spec(spec), Denominators::Proven)

@@ -13,6 +13,21 @@ pub fn shadefit(args: &[&str], dir: Option<&Path>) -> Output {
     c.output().expect("the binary runs")
 }
 
+/// `shadefit ARGS` in a scratch copy of fits/ (plus `setup`) with RAYON_NUM_THREADS = `threads`:
+/// what it wrote under generated/.
+pub fn build_snapshot(args: &[&str], threads: &str, setup: impl Fn(&Path)) -> Vec<(PathBuf, Vec<u8>)> {
+    let d = scratch();
+    setup(d.path());
+    let o = Command::new(env!("CARGO_BIN_EXE_shadefit"))
+        .args(args)
+        .current_dir(d.path())
+        .env("RAYON_NUM_THREADS", threads)
+        .output()
+        .expect("the binary runs");
+    assert!(o.status.success(), "{}", stderr(&o));
+    snapshot(&d.path().join("generated"))
+}
+
 pub fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
