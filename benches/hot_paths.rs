@@ -6,7 +6,9 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use shadefit::fit::{self, Data, FitOptions, Objective, RationalModel};
-use shadefit::quantity::{fuzz, gloss, skin};
+use shadefit::family::fuzz::integrals as fuzz;
+use shadefit::family::gloss::integrals as gloss;
+use shadefit::family::skin::integrals as skin;
 use std::hint::black_box;
 
 fn integrands(c: &mut Criterion) {

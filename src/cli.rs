@@ -2,15 +2,14 @@
 //! user's input come back as [`InputError`] (exit code 2); everything else is a job failure.
 
 use crate::fit::{self, Data, FitOptions, Objective, RationalModel};
-use crate::pipeline::{self, Built, Mode};
-use crate::quantity;
-use crate::scene::{self, Scene};
+use crate::build;
+use crate::family;
+use crate::pipeline;
 use crate::spec::{self, data::read_csv, ModelSpec, Spec};
-use anyhow::{Context, Result};
+use anyhow::Result;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
 use std::collections::BTreeMap;
-use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 
 /// Bad input: exit code 2.
@@ -22,11 +21,7 @@ fn input_err(e: impl std::fmt::Display) -> anyhow::Error {
     InputError(e.to_string()).into()
 }
 
-/// Project paths: specs in `fits/`, outputs in `generated/`.
-pub struct Paths {
-    pub fits: PathBuf,
-    pub generated: PathBuf,
-}
+pub use crate::build::Paths;
 
 /// `name=value` arguments as a map (each name once, each value a number).
 fn parse_params(params: &[String]) -> Result<BTreeMap<String, f64>> {
@@ -47,7 +42,7 @@ fn parse_params(params: &[String]) -> Result<BTreeMap<String, f64>> {
 }
 
 pub fn eval(name: &str, params: &[String], as_json: bool) -> Result<()> {
-    let q = quantity::lookup(name).map_err(input_err)?;
+    let q = family::catalog().lookup(name).map_err(input_err)?;
     let named = parse_params(params)?;
     let canonical = q.resolve(&named).map_err(input_err)?;
     if let Some(multi) = q.eval_channels {
@@ -85,17 +80,12 @@ pub fn eval(name: &str, params: &[String], as_json: bool) -> Result<()> {
 }
 
 fn load_specs(paths: &Paths, only: &[String]) -> Result<Vec<Spec>> {
-    let specs = spec::load_dir(&paths.fits).map_err(input_err)?;
-    for name in only {
-        if !specs.iter().any(|s| &s.file.name == name) {
-            return Err(input_err(format!(
-                "no spec named '{name}' in {} (known: {})",
-                paths.fits.display(),
-                specs.iter().map(|s| s.file.name.as_str()).collect::<Vec<_>>().join(", ")
-            )));
-        }
-    }
-    Ok(specs)
+    build::load_specs(paths, only).map_err(build_err)
+}
+
+/// A build error for the CLI edge: the user's input exits 2, a failed job 1.
+fn build_err(e: build::Error) -> anyhow::Error {
+    if e.is_input() { input_err(e) } else { anyhow::Error::new(e) }
 }
 
 fn progress(len: usize, what: &str) -> ProgressBar {
@@ -107,87 +97,36 @@ fn progress(len: usize, what: &str) -> ProgressBar {
 }
 
 pub fn build(paths: &Paths, only: &[String], check: bool) -> Result<()> {
-    let specs = load_specs(paths, only)?;
-    let selected: Vec<&Spec> =
-        specs.iter().filter(|s| only.is_empty() || only.contains(&s.file.name)).collect();
-    let mode = if check { Mode::Committed } else { Mode::Fit };
-    let pb = progress(selected.len(), if check { "check" } else { "build" });
-    let mut scene_names: Vec<String> = Vec::new();
     let start = std::time::Instant::now();
-    // Specs are independent: build them concurrently (each also parallelises its own sampling on
-    // the same rayon pool), collected in spec order, so the outputs do not depend on scheduling.
-    let results: Vec<Result<(Built, f64)>> = selected
-        .par_iter()
-        .map(|s| {
-            let t = std::time::Instant::now();
-            let b = pipeline::build_spec(s, mode, &paths.generated).with_context(|| format!("building {}", s.file.name))?;
-            pb.inc(1);
-            Ok((b, t.elapsed().as_secs_f64()))
-        })
-        .collect();
+    let n = if only.is_empty() { load_specs(paths, only)?.len() } else { only.len() };
+    let pb = progress(n, if check { "check" } else { "build" });
+    let summary = build::run(paths, only, check, &|| pb.inc(1));
     pb.finish_and_clear();
-    let mut built: Vec<Built> = Vec::new();
-    let mut seconds: Vec<f64> = Vec::new();
-    for r in results {
-        let (b, t) = r?;
-        built.push(b);
-        seconds.push(t);
-    }
-    let scenes = Scene::load_dir(&paths.fits.join("scenes")).map_err(input_err)?;
-    let mut artifacts: Vec<_> = built.iter().flat_map(|b| b.artifacts.clone()).collect();
-    // The scene modules read their specs' coefficients from generated/json: write this build's
-    // first, so a scene never specialises the previous build's fit.
-    let spec_files = artifacts.len();
-    let mut written = if check { 0 } else { pipeline::write_all(&paths.generated, &artifacts)? };
-    if only.is_empty() {
-        // Every scene module, with the node files of this build recorded for its cache.
-        for sc in &scenes {
-            let t = std::time::Instant::now();
-            let nodes: Vec<scene::NodeRecord> = scene::plan(sc)
-                .nodes
-                .iter()
-                .filter_map(|n| {
-                    let b = built.iter().find(|b| &b.name == n)?;
-                    let spec = specs.iter().find(|s| &s.file.name == n)?;
-                    Some(scene::node_record(n, pipeline::input_hash(spec), &b.artifacts))
-                })
-                .collect();
-            let sb = scene::build_scene(sc, &specs, &paths.generated, &nodes).with_context(|| format!("building scene {}", sc.file.name))?;
-            artifacts.extend(sb.artifacts);
-            seconds.push(t.elapsed().as_secs_f64());
-            scene_names.push(sc.module());
-        }
-    }
-    artifacts.push(scene::runtime_index(&specs, &scenes));
+    let summary = summary.map_err(build_err)?;
     if check {
-        let mut bad = pipeline::stale(&paths.generated, &artifacts);
-        if only.is_empty() {
-            bad.extend(pipeline::orphans(&paths.generated, &artifacts).into_iter().map(|p| format!("{p} (no spec produces it)")));
-        }
-        if bad.is_empty() {
-            println!("generated/ is up to date ({} files from {} specs)", artifacts.len(), selected.len());
+        if summary.stale.is_empty() {
+            println!("generated/ is up to date ({} files from {} specs)", summary.files, summary.specs);
             return Ok(());
         }
-        for p in &bad {
+        for p in &summary.stale {
             println!("stale: {p}");
         }
-        anyhow::bail!("{} generated file(s) differ from what the specs and committed coefficients produce; run `shadefit build`", bad.len());
+        return Err(build::Error::Stale { count: summary.stale.len() }.into());
     }
-    // The spec files were written above; now the scene modules and the runtime index.
-    written += pipeline::write_all(&paths.generated, &artifacts[spec_files..])?;
-    for (b, t) in built.iter().zip(&seconds) {
+    for (b, t) in &summary.built {
         let v = &b.verification;
         println!(
             "{:<22} max abs {:.3e}  rms {:.3e}  (f32 code: max abs {:.3e})  over {} points  [{t:.1} s]",
             b.name, v.max_abs_error, v.rms_error, v.max_abs_error_f32, v.points
         );
     }
-    for (n, t) in scene_names.iter().zip(&seconds[built.len()..]) {
+    for (n, t) in &summary.scenes {
         println!("{n:<22} scene module  [{t:.1} s]");
     }
     println!(
-        "{written} file(s) written, {} unchanged; {:.1} s wall on {} thread(s)",
-        artifacts.len() - written,
+        "{} file(s) written, {} unchanged; {:.1} s wall on {} thread(s)",
+        summary.written,
+        summary.files - summary.written,
         start.elapsed().as_secs_f64(),
         rayon::current_num_threads()
     );
@@ -198,14 +137,9 @@ pub fn build(paths: &Paths, only: &[String], check: bool) -> Result<()> {
 /// inputs or files changed since the scene's last build, then the scene module.
 pub fn build_scene(paths: &Paths, file: &Path, force: bool) -> Result<()> {
     let start = std::time::Instant::now();
-    let sc = Scene::load(file).map_err(input_err)?;
-    let specs = load_specs(paths, &[])?;
-    let mut scenes = Scene::load_dir(&paths.fits.join("scenes")).map_err(input_err)?;
-    if !scenes.iter().any(|s| s.file.name == sc.file.name) {
-        scenes.push(sc.clone());
-    }
-    let r = scene::build(&sc, &specs, &scenes, &paths.generated, force).with_context(|| format!("building scene {}", sc.file.name))?;
-    println!("scene {}: {} up to date, {} built", sc.file.name, r.up_to_date.len(), r.built.len());
+    let r = build::run_scene(paths, file, force).map_err(build_err)?;
+    let name = file.file_stem().map_or(String::new(), |s| s.to_string_lossy().into_owned());
+    println!("scene {name}: {} up to date, {} built", r.up_to_date.len(), r.built.len());
     println!("  built: {}", if r.built.is_empty() { "-".to_string() } else { r.built.join(", ") });
     println!("  up to date: {}", if r.up_to_date.is_empty() { "-".to_string() } else { r.up_to_date.join(", ") });
     println!("  not reached: {}", r.skipped.join(", "));
@@ -223,50 +157,31 @@ pub fn build_scene(paths: &Paths, file: &Path, force: bool) -> Result<()> {
     Ok(())
 }
 
-/// A skin quantity with a diffusion profile of your own (`--profile`: a TOML file with a
-/// `[profile]` section, or a CSV radial profile) and/or the ring kernel (`--kernel`).
-pub fn eval_skin(name: &str, params: &[String], as_json: bool, profile: Option<&Path>, kernel: Option<&str>) -> Result<()> {
-    use crate::quantity::skin::{self, Kernel};
-    let q = quantity::lookup(name).map_err(input_err)?;
-    if !matches!(q.name, "skin-punctual" | "skin-sh") {
-        return Err(input_err(format!("--profile and --kernel apply to skin-punctual and skin-sh, not '{}'", q.name)));
-    }
-    let kernel = match (q.name, kernel) {
-        (_, None) | ("skin-punctual", Some("linear")) => Kernel::Linear,
-        ("skin-punctual", Some("radial")) => Kernel::Radial,
-        ("skin-punctual", Some(other)) => return Err(input_err(format!("--kernel '{other}': expected linear or radial"))),
-        (_, Some(_)) => return Err(input_err("--kernel applies to skin-punctual (skin-sh integrates the radial profile over the sphere)")),
+/// `eval` with `--profile`/`--kernel`, for the quantities whose family takes them.
+pub fn eval_with_options(name: &str, params: &[String], as_json: bool, profile: Option<&Path>, kernel: Option<&str>) -> Result<()> {
+    let q = family::catalog().lookup(name).map_err(input_err)?;
+    let takes: Vec<&str> = family::families().iter().filter_map(|f| f.eval_options).flat_map(|(names, _)| names.iter().copied()).collect();
+    let Some((_, with)) = family::of_quantity(q.name).and_then(|f| f.eval_options).filter(|(names, _)| names.contains(&q.name)) else {
+        return Err(input_err(format!("--profile and --kernel apply to {}, not '{}'", takes.join(" and "), q.name)));
     };
     let named = parse_params(params)?;
     let p = q.resolve(&named).map_err(input_err)?;
-    let loaded = match profile {
-        Some(path) => spec::profile::load_profile_file(path).map_err(input_err)?,
-        None => spec::profile::LoadedProfile::deon_luebke(),
-    };
-    let tol = crate::integrate::Tolerance { abs: 1e-12, ..skin::DEFAULT_TOLERANCE };
-    let est = match q.name {
-        "skin-punctual" => skin::punctual(&loaded.profile, kernel, p[0], p[1], tol),
-        _ => skin::sh_band(&loaded.profile, p[0], p[1] as u32, tol),
-    };
-    let where_ = profile.map_or("the default profile".to_string(), |p| p.display().to_string());
-    let est = est.map_err(|e| input_err(format!("{where_}: {e}")))?;
-    let values: Vec<f64> = est.iter().map(|e| e.value).collect();
-    let error = est.iter().map(|e| e.error).fold(0.0, f64::max);
-    let kernel_name = if kernel == Kernel::Linear { "linear" } else { "radial" };
+    let e = with(q, &p, &family::EvalOptions { profile, kernel }).map_err(input_err)?;
     if as_json {
-        let out = json!({
+        let mut out = json!({
             "quantity": q.name,
             "params": named,
-            "value": values,
+            "value": e.values,
             "channels": q.channels,
-            "error_estimate": error,
-            "profile": loaded.provenance(),
-            "kernel": if q.name == "skin-punctual" { kernel_name } else { "radial (sphere)" },
+            "error_estimate": e.error,
         });
+        if let Some(map) = out.as_object_mut() {
+            map.extend(e.extra);
+        }
         println!("{out}");
     } else {
-        let parts: Vec<String> = q.channels.iter().zip(&values).map(|(c, v)| format!("{c} {v:.17e}")).collect();
-        println!("{} = {}  (error estimate {error:.1e}; profile: {where_})", q.name, parts.join(", "));
+        let parts: Vec<String> = q.channels.iter().zip(&e.values).map(|(c, v)| format!("{c} {v:.17e}")).collect();
+        println!("{} = {}  (error estimate {:.1e}; {})", q.name, parts.join(", "), e.error, e.note);
     }
     Ok(())
 }
@@ -275,10 +190,9 @@ pub fn eval_skin(name: &str, params: &[String], as_json: bool, profile: Option<&
 pub fn samples(paths: &Paths, name: &str, as_json: bool) -> Result<()> {
     let specs = load_specs(paths, &[name.to_string()])?;
     let s = specs.iter().find(|s| s.file.name == name).expect("load_specs checked the name");
-    if s.file.kind == spec::Kind::SkinLut {
-        return Err(input_err(format!(
-            "{name} is a skin LUT: its samples are its texels, \"values\" in generated/json/{name}.json (RGB, with the axes)"
-        )));
+    if let spec::Kind::Custom(kind) = s.file.kind {
+        let note = family::catalog().kind(kind).map_or("{name}: kind = \"{kind}\" has no samples", |k| k.samples_note);
+        return Err(input_err(note.replace("{name}", name).replace("{kind}", kind)));
     }
     let counts: Vec<usize> = s.file.axis.iter().map(|a| a.count).collect();
     let x = pipeline::grid(s, &counts);
@@ -315,13 +229,13 @@ pub fn samples(paths: &Paths, name: &str, as_json: bool) -> Result<()> {
 }
 
 pub fn list(paths: &Paths) -> Result<()> {
-    let specs = spec::load_dir(&paths.fits).map_err(input_err)?;
+    let specs = build::status(paths).map_err(build_err)?;
     println!("{:<22} {:<8} {:<18} {:<28} status", "name", "kind", "quantity", "function");
-    for s in &specs {
-        let status = match pipeline::build_spec(s, Mode::Committed, &paths.generated) {
-            Ok(b) if pipeline::stale(&paths.generated, &b.artifacts).is_empty() => "up to date".to_string(),
-            Ok(_) => "stale".to_string(),
-            Err(e) => format!("stale ({})", short(&e.to_string())),
+    for (s, st) in &specs {
+        let status = match st {
+            Ok(true) => "up to date".to_string(),
+            Ok(false) => "stale".to_string(),
+            Err(e) => format!("stale ({})", short(e)),
         };
         println!(
             "{:<22} {:<8} {:<18} {:<28} {status}",
@@ -417,7 +331,8 @@ fn load_model(arg: &str, x_cols: &[String]) -> Result<RationalModel> {
 }
 
 pub fn validate(paths: &Paths, as_json: bool) -> Result<()> {
-    let items = crate::validate::all(&paths.generated);
+    let validators: Vec<fn(&Path) -> Vec<crate::validate::Item>> = family::families().iter().map(|f| f.validate).collect();
+    let items = crate::validate::all(&paths.generated, &validators);
     if as_json {
         println!("{}", serde_json::to_string_pretty(&json!({ "items": items }))?);
         return Ok(());
@@ -441,9 +356,10 @@ pub fn validate(paths: &Paths, as_json: bool) -> Result<()> {
 
 /// Figures (PNG and SVG) of every family with committed outputs.
 pub fn plot(paths: &Paths, out: &Path) -> Result<()> {
-    let mut files = crate::plot::gloss_figures(out, &paths.generated)?;
-    files.extend(crate::plot::fuzz_figures(out, &paths.generated)?);
-    files.extend(crate::plot::skin_figures(out, &paths.generated)?);
+    let mut files = Vec::new();
+    for f in family::families() {
+        files.extend((f.figures)(out, &paths.generated)?);
+    }
     for f in &files {
         println!("{}", f.display());
     }

@@ -4,8 +4,10 @@
 
 pub mod fit;
 pub mod integrate;
+pub mod family;
 pub mod quantity;
 pub mod bench;
+pub mod build;
 pub mod cli;
 pub mod emit;
 pub mod pipeline;

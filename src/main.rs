@@ -25,18 +25,18 @@ enum Command {
     /// Tables and fits known from the specs, with whether generated/ is up to date.
     List,
     /// Evaluate an integral (not a fit) at one point: QUANTITY name=value ...
-    #[command(after_help = "Quantities:\n  gloss-length       gloss=G | alpha=A   GGX average normal length\n  gloss-from-length  length=L            gloss with that average normal length\n  gloss-combine      x=G1 y=G2           combined gloss (RNM)\n  skin-punctual      curvature=K n_dot_l=C   skin diffusion for a punctual light (RGB)\n  skin-sh            curvature=K band=L      SH band factor of skin scattering (RGB)\n  fuzz-ps            alpha=A theta_f=F theta_u=T phi_u=P   fraction the fuzz layer scatters toward the base, P_s\n  fuzz-g             mu_v=M d=D          hemispherical average G of the fuzz layer\n  fuzz-q             d=D                 average penetration Q = 2 E3(d)\n  fuzz-r             alpha=A theta_f=F   cosine-weighted average of P_s, R\n(angles in radians; `shadefit list` and README give the domains)")]
+    #[command(after_help = shadefit::family::eval_help())]
     Eval {
         quantity: String,
         /// Parameters as name=value.
         params: Vec<String>,
         #[arg(long)]
         json: bool,
-        /// Skin quantities: the diffusion profile, a TOML file with a [profile] section or a
-        /// CSV radial profile (radius_mm,red,green,blue); default d'Eon–Luebke.
+        /// Quantities whose family takes it: a profile file (e.g. a diffusion profile, a TOML
+        /// file with a [profile] section or a CSV radial profile radius_mm,red,green,blue).
         #[arg(long)]
         profile: Option<PathBuf>,
-        /// skin-punctual: the ring kernel, linear (default) or radial.
+        /// Quantities whose family takes it: the integration kernel (e.g. linear or radial).
         #[arg(long)]
         kernel: Option<String>,
     },
@@ -121,7 +121,7 @@ fn main() -> ExitCode {
         Command::List => cli::list(&paths),
         Command::Eval { quantity, params, json, profile: None, kernel: None } => cli::eval(&quantity, &params, json),
         Command::Eval { quantity, params, json, profile, kernel } => {
-            cli::eval_skin(&quantity, &params, json, profile.as_deref(), kernel.as_deref())
+            cli::eval_with_options(&quantity, &params, json, profile.as_deref(), kernel.as_deref())
         }
         Command::Build { scene: Some(file), force, .. } => cli::build_scene(&paths, &file, force),
         Command::Build { only, check, .. } => cli::build(&paths, &only, check),

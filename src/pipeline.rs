@@ -25,7 +25,6 @@ use sha2::{Digest, Sha256};
 use std::path::Path;
 
 pub mod fields;
-pub mod skin;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Mode {
@@ -51,8 +50,11 @@ pub enum BuildError {
     NonFinite { spec: String, at: Vec<f64> },
     #[error(transparent)]
     Spec(#[from] crate::spec::SpecError),
+    /// A spec input a family's builder rejects (e.g. a diffusion profile it cannot integrate).
     #[error("{spec}: {msg}")]
-    Skin { spec: String, msg: String },
+    Input { spec: String, msg: String },
+    #[error("{spec}: no builder for kind = \"{kind}\"")]
+    UnknownKind { spec: String, kind: String },
 }
 
 /// Errors of an emitted function against the integral on the verification grid.
@@ -135,7 +137,7 @@ pub fn sample(spec: &Spec, points: &[Vec<f64>]) -> Vec<f64> {
     points.par_iter().map(|p| (q.eval)(p, tol).value).collect()
 }
 
-fn spec_rel_path(spec: &Spec) -> String {
+pub fn spec_rel_path(spec: &Spec) -> String {
     format!("fits/{}", spec.path.file_name().and_then(|s| s.to_str()).unwrap_or("?"))
 }
 
@@ -161,17 +163,24 @@ fn f64_array(v: &Value, spec: &str, key: &str) -> Result<Vec<f64>, BuildError> {
         .ok_or_else(|| BuildError::NoCommitted { spec: spec.into(), why: format!("no numeric array '{key}'") })
 }
 
-fn fmt_err(v: f64) -> String {
+pub fn fmt_err(v: f64) -> String {
     format!("{v:.3e}")
 }
 
-/// Build one spec in the given mode; `root` is the generated/ folder.
-pub fn build_spec(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> {
+/// The builder of a family spec kind.
+pub type CustomBuild = fn(&Spec, Mode, &Path) -> Result<Built, BuildError>;
+
+/// Build one spec in the given mode; `root` is the generated/ folder; `custom` finds the builder
+/// of a family spec kind by name.
+pub fn build_spec(spec: &Spec, mode: Mode, root: &Path, custom: &dyn Fn(&str) -> Option<CustomBuild>) -> Result<Built, BuildError> {
     match spec.file.kind {
         Kind::Fit => build_fit(spec, mode, root),
         Kind::Table => build_table(spec, mode, root),
-        Kind::SkinLut => skin::build(spec, mode, root),
         Kind::Fields => fields::build(spec, mode, root),
+        Kind::Custom(kind) => match custom(kind) {
+            Some(build) => build(spec, mode, root),
+            None => Err(BuildError::UnknownKind { spec: spec.file.name.clone(), kind: kind.into() }),
+        },
     }
 }
 
@@ -533,7 +542,7 @@ fn axes_json(spec: &Spec) -> Value {
     )
 }
 
-fn json_text(v: &Value) -> String {
+pub fn json_text(v: &Value) -> String {
     let mut s = serde_json::to_string_pretty(v).expect("JSON values serialise");
     s.push('\n');
     s
@@ -719,9 +728,9 @@ pub fn runtime_index_with_scenes(specs: &[Spec], scenes: &[SceneIndex]) -> Artif
     }
     s.push_str("    ];\n}\n");
     s.push_str("\n/// Every emitted function with its domain and CPU version (for GPU verification).\npub const FUNCTIONS: &[EmittedFunction] = &[\n");
-    // Skin LUT lookups return RGB (see emit::skin) and coefficient fields return arrays (see
-    // emit::fields): not scalar functions of this list.
-    for spec in specs.iter().filter(|s| !matches!(s.file.kind, Kind::SkinLut | Kind::Fields)) {
+    // Family spec kinds (e.g. RGB LUT lookups) and coefficient fields (see emit::fields) return
+    // arrays: not scalar functions of this list.
+    for spec in specs.iter().filter(|s| !matches!(s.file.kind, Kind::Custom(_) | Kind::Fields)) {
         let arity = spec.file.axis.len();
         let domain: Vec<String> = spec
             .file

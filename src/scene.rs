@@ -36,7 +36,8 @@ use crate::emit::{self, expr, header_lines, rust, wgsl, Artifact, GENERATOR};
 use crate::fit::model::{ModelParts, Term};
 use crate::fit::{self, Data, FitOptions, Objective, RationalModel};
 use crate::pipeline::{self, input_hash, BuildError, Mode};
-use crate::quantity::{fuzz, gloss};
+use crate::family::fuzz::integrals as fuzz;
+use crate::family::gloss::integrals as gloss;
 use crate::spec::{is_identifier, line_of, parse_toml, Spec, SpecError};
 use nalgebra::{DMatrix, DVector};
 use serde::Deserialize;
@@ -336,7 +337,7 @@ fn fuzz_ps(specs: &[Spec], generated: &Path, material: &str, alpha: f64, theta_f
         vd.iter().map(|u| basis(u).iter().zip(coef).map(|(b, c)| b * c).sum::<f64>().clamp(lo, hi)).collect()
     };
     let ours = eval_at(c.as_slice());
-    let general = crate::validate::committed_fields(generated, "fuzz_ps").map(|f| max_err(&truth, &eval_at(&f(&outer))));
+    let general = crate::validate::committed_fields(generated, "fuzz_ps", crate::family::catalog()).map(|f| max_err(&truth, &eval_at(&f(&outer))));
     let arg_refs: Vec<&str> = ib.args.to_vec();
     let m = model(&arg_refs, ib.terms, &[], vec![], Some((lo, hi)));
     let ps = Emitted {
@@ -350,7 +351,7 @@ fn fuzz_ps(specs: &[Spec], generated: &Path, material: &str, alpha: f64, theta_f
         coefficients: c,
     };
     let r = fuzz::r(alpha, theta_f, 1e-10);
-    let general_r = crate::validate::committed_refit(generated, "fuzz_r")
+    let general_r = crate::validate::committed_refit(generated, "fuzz_r", crate::family::catalog())
         .map(|(s, cf)| (s.model.as_ref().map_or(f64::NAN, |m| m.eval_clamped(&cf, &[alpha, theta_f])) - r.value).abs());
     let rc = Constant {
         name: format!("{}_AVERAGE_PS", material.to_uppercase()),
@@ -374,7 +375,7 @@ fn fuzz_g(specs: &[Spec], generated: &Path, material: &str, d: f64) -> Result<(E
     let vx: Vec<f64> = ax.points(ax.verify_count() * 4 + 1);
     let truth: Vec<f64> = vx.iter().map(|&mu| fuzz::g_exact(d, mu)).collect();
     let ours: Vec<f64> = vx.iter().map(|&mu| m.eval_clamped(&f.coefficients, &[mu])).collect();
-    let general = crate::validate::committed_refit(generated, "fuzz_g").map(|(s, c)| {
+    let general = crate::validate::committed_refit(generated, "fuzz_g", crate::family::catalog()).map(|(s, c)| {
         let gm = s.model.expect("fit specs carry a model");
         max_err(&truth, &vx.iter().map(|&mu| gm.eval_clamped(&c, &[mu, d])).collect::<Vec<_>>())
     });
@@ -388,7 +389,7 @@ fn fuzz_g(specs: &[Spec], generated: &Path, material: &str, d: f64) -> Result<(E
         coefficients: f.coefficients,
     };
     let q = fuzz::q_exact(d);
-    let general_q = crate::validate::committed_refit(generated, "fuzz_q")
+    let general_q = crate::validate::committed_refit(generated, "fuzz_q", crate::family::catalog())
         .map(|(s, c)| (s.model.as_ref().map_or(f64::NAN, |m| m.eval_clamped(&c, &[d])) - q).abs());
     let qc = Constant {
         name: format!("{}_AVERAGE_PENETRATION", material.to_uppercase()),
@@ -426,7 +427,7 @@ fn gloss_length(specs: &[Spec], generated: &Path, material: &str, lo: f64, hi: f
     let vx: Vec<f64> = (0..nv).map(|i| lo + (hi - lo) * i as f64 / (nv - 1) as f64).collect();
     let truth: Vec<f64> = vx.iter().map(|&g| gloss::length_from_gloss(g)).collect();
     let ours: Vec<f64> = vx.iter().map(|&g| m.eval_clamped(&f.coefficients, &[g])).collect();
-    let general_err = crate::validate::committed_refit(generated, "gloss_length").map(|(s, c)| {
+    let general_err = crate::validate::committed_refit(generated, "gloss_length", crate::family::catalog()).map(|(s, c)| {
         let gm = s.model.expect("fit specs carry a model");
         max_err(&truth, &vx.iter().map(|&g| gm.eval_clamped(&c, &[g])).collect::<Vec<_>>())
     });
@@ -594,6 +595,7 @@ pub fn build(
     scenes: &[Scene],
     generated: &Path,
     force: bool,
+    custom: &dyn Fn(&str) -> Option<pipeline::CustomBuild>,
 ) -> Result<SceneReport, BuildError> {
     let p = plan(scene);
     let json_path = generated.join("json").join(format!("{}.json", scene.module()));
@@ -618,7 +620,7 @@ pub fn build(
             nodes.push((name.clone(), h, files));
             continue;
         }
-        let b = pipeline::build_spec(spec, Mode::Fit, generated)?;
+        let b = pipeline::build_spec(spec, Mode::Fit, generated, custom)?;
         built.push(name.clone());
         nodes.push(node_record(name, h, &b.artifacts));
         artifacts.extend(b.artifacts);
@@ -657,7 +659,7 @@ pub fn scene_functions(scene: &Scene, specs: &[Spec]) -> Vec<(String, Vec<(f64, 
         .iter()
         .map(|s| match s {
             Special::FuzzPs { material, .. } => {
-                let d = crate::quantity::lookup("fuzz-ps").ok().and_then(|q| q.basis).map_or(vec![], |b| b.arg_domain.to_vec());
+                let d = crate::family::catalog().lookup("fuzz-ps").ok().and_then(|q| q.basis).map_or(vec![], |b| b.arg_domain.to_vec());
                 (format!("{material}_fuzz_ps"), d)
             }
             Special::FuzzG { material, .. } => {
@@ -667,4 +669,10 @@ pub fn scene_functions(scene: &Scene, specs: &[Spec]) -> Vec<(String, Vec<(f64, 
             Special::GlossLength { material, lo, hi } => (format!("{material}_gloss_to_normal_length"), vec![(*lo, *hi)]),
         })
         .collect()
+}
+
+/// A scene feature a family offers (see `crate::family::Family::scene_features`).
+#[derive(Debug)]
+pub struct Feature {
+    pub name: &'static str,
 }

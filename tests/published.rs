@@ -1,8 +1,8 @@
 //! The committed refits against the published COD: WWII constants, measured against the
 //! integrals (the closed form, itself checked against quadrature in the library's tests).
 
-use shadefit::quantity::gloss::{combine, gloss_from_length, length_from_gloss};
-use shadefit::validate::gloss::{published_combine, published_fit_coefficients, rational_1d, PUBLISHED_ENDS};
+use shadefit::family::gloss::integrals::{combine, gloss_from_length, length_from_gloss};
+use shadefit::family::gloss::published::{published_combine, published_fit_coefficients, rational_1d, PUBLISHED_ENDS};
 use std::path::PathBuf;
 
 fn committed(name: &str) -> Vec<f64> {

@@ -1,6 +1,6 @@
 //! Property-based stress tests of the integrators' numerical stability (proptest, fixed seed).
 //!
-//! Every integrator of `shadefit::quantity` over its documented domain and beyond its edges:
+//! Every integrator of the families (`shadefit::family::*::integrals`) over its documented domain and beyond its edges:
 //! results finite (or the documented NaN / panic for invalid input), inside the bounds theory
 //! gives, monotone where theory says so, continuous across the seams where the code switches
 //! formulas or splits its domain, and finite at extreme parameters (with a printed table of how
@@ -12,12 +12,12 @@
 use proptest::prelude::*;
 use proptest::test_runner::{RngAlgorithm, RngSeed};
 use shadefit::integrate::Tolerance;
-use shadefit::quantity::fuzz::{self, expn, g, g_exact, ps, q, q_exact, r};
-use shadefit::quantity::gloss::{
+use shadefit::family::fuzz::integrals::{self as fuzz, expn, g, g_exact, ps, q, q_exact, r};
+use shadefit::family::gloss::integrals::{
     alpha_from_gloss, combine, gloss_from_length, length_from_gloss, length_range, normal_length,
     normal_length_quadrature, one_minus_length,
 };
-use shadefit::quantity::skin::{Kernel, default_skin_profile, punctual, sh_band};
+use shadefit::family::skin::integrals::{Kernel, default_skin_profile, punctual, sh_band};
 use std::f64::consts::{FRAC_PI_2, PI};
 use std::time::Instant;
 
@@ -106,17 +106,17 @@ proptest! {
 #[test]
 fn gloss_outside_its_domain() {
     // NaN stays NaN (it used to bisect to ≈ 3e-20).
-    assert!(shadefit::quantity::gloss::gloss_from_length(f64::NAN).is_nan());
+    assert!(shadefit::family::gloss::integrals::gloss_from_length(f64::NAN).is_nan());
     // α slightly above 1 (k < 0): the series' terms alternate, and L stays continuous through
     // α = 1 (L = 2/3 exactly there): the first-order change is dL/dα·Δα with |dL/dα| < 1.
     for da in [1e-12, 1e-9, 1e-6] {
-        let l = shadefit::quantity::gloss::normal_length(1.0 + da);
+        let l = shadefit::family::gloss::integrals::normal_length(1.0 + da);
         assert!((l - 2.0 / 3.0).abs() <= da, "L(1 + {da:e}) = {l}");
     }
     // Well above 1 the series must keep summing its alternating terms (it used to stop at the
     // first negative one: 1e-2 off at α = 1.2); the quadrature is accurate to ~1e-14.
     for a in [1.05, 1.2, 1.4] {
-        let (l, quad) = (shadefit::quantity::gloss::normal_length(a), normal_length_quadrature(a, 1e-14).value);
+        let (l, quad) = (shadefit::family::gloss::integrals::normal_length(a), normal_length_quadrature(a, 1e-14).value);
         assert!((l - quad).abs() < 1e-12, "L({a}) = {l}, quadrature {quad}");
     }
 }

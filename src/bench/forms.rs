@@ -29,7 +29,8 @@ use crate::fit::positivity::{prove_denominator_positive, Positivity};
 use crate::fit::{Data, RationalModel, Term};
 use crate::pipeline::fields::{self as pfields, FieldsReference};
 use crate::pipeline::{self, Built, Denominators, Reference, Verification};
-use crate::quantity::{fuzz, QuantityDef};
+use crate::family::fuzz::integrals as fuzz;
+use crate::quantity::QuantityDef;
 use crate::spec::Spec;
 use crate::validate;
 use anyhow::{Context, Result};
@@ -108,7 +109,7 @@ impl Ctx<'_> {
     }
 
     fn spec(&self, name: &str) -> Result<Spec> {
-        Ok(Spec::load(&self.fits.join(format!("{name}.toml")))?)
+        Ok(Spec::load(&self.fits.join(format!("{name}.toml")), crate::family::catalog())?)
     }
 
     /// The committed spec `base` as TOML with `edit` applied and named `name`: a spec in
@@ -118,7 +119,7 @@ impl Ctx<'_> {
         t.insert("name".into(), name.into());
         edit(&mut t);
         let text = toml::to_string(&t).with_context(|| format!("variant {name}"))?;
-        Ok(Spec::parse(&self.fits.join(format!("{name}.toml")), text)?)
+        Ok(Spec::parse(&self.fits.join(format!("{name}.toml")), text, crate::family::catalog())?)
     }
 }
 
@@ -321,7 +322,7 @@ fn gloss_length(ctx: &Ctx) -> Result<Vec<FormRow>> {
     // The committed verification grid (16 points per step of the 256-entry table); quick: 4.
     let reference = integral.reference(pipeline::grid(&refit, &[ctx.pick(4081, 1021)]));
     let published_spec = ctx.variant(&refit, "gloss_length_published", |_| {})?;
-    let published = validate::gloss::published_fit_coefficients(validate::gloss::PUBLISHED_ENDS.1);
+    let published = crate::family::gloss::published::published_fit_coefficients(crate::family::gloss::published::PUBLISHED_ENDS.1);
     let cheaper = ctx.variant(&refit, "gloss_length_2_1", |t| {
         set(t, "model.numerator", strings(&["1", "gloss", "gloss^2"]));
         set(t, "model.denominator", strings(&["gloss"]));
@@ -355,7 +356,7 @@ fn gloss_combine(ctx: &Ctx) -> Result<Vec<FormRow>> {
     let n = ctx.pick(253, 127);
     let reference = integral.reference(pipeline::grid(&refit, &[n, n]));
     let published_spec = ctx.variant(&refit, "gloss_combine_published", |_| {})?;
-    let (p, q) = (validate::gloss::PUBLISHED_COMBINE_P, validate::gloss::PUBLISHED_COMBINE_Q);
+    let (p, q) = (crate::family::gloss::published::PUBLISHED_COMBINE_P, crate::family::gloss::published::PUBLISHED_COMBINE_Q);
     let published: Vec<f64> = p.iter().chain(&q[1..]).copied().collect();
     let cheaper = ctx.variant(&refit, "gloss_combine_3_2", |t| {
         set(t, "model.numerator", strings(&["1", "x + y", "x*y"]));
@@ -383,7 +384,7 @@ fn fuzz_q(ctx: &Ctx) -> Result<Vec<FormRow>> {
 
 fn fuzz_q_forms(ctx: &Ctx, refit: &Spec, integral: &mut Integral, reference: &Reference) -> Result<Vec<FormRow>> {
     let published_spec = ctx.variant(refit, "fuzz_q_published", |_| {})?;
-    let [c0, c1] = validate::fuzz::Q_COEFFS;
+    let [c0, c1] = crate::family::fuzz::published::Q_COEFFS;
     let linear = ctx.variant(refit, "fuzz_q_linear", |t| set(t, "model.numerator", strings(&["1", "d"])))?;
     let rational = ctx.variant(refit, "fuzz_q_2_1", |t| set(t, "model.denominator", strings(&["d"])))?;
     let table = table_spec(ctx, refit, "fuzz_q_table_33", 33)?;
@@ -407,7 +408,7 @@ fn fuzz_g(ctx: &Ctx) -> Result<Vec<FormRow>> {
     let n = ctx.pick(257, 129);
     let reference = integral.reference(pipeline::grid(&refit, &[n, n]));
     let published_spec = ctx.variant(&refit, "fuzz_g_published", |_| {})?;
-    let c = validate::fuzz::G_COEFFS;
+    let c = crate::family::fuzz::published::G_COEFFS;
     let richer = ctx.variant(&refit, "fuzz_g_4_3", |t| {
         set(t, "model.numerator", strings(&["d", "d*mu_v", "d*mu_v^2", "d*mu_v^3"]));
         set(t, "model.denominator", strings(&["mu_v", "mu_v^2", "mu_v^3"]));
@@ -442,7 +443,7 @@ fn fuzz_r(ctx: &Ctx) -> Result<Vec<FormRow>> {
     let fine = table_spec(ctx, &refit, &format!("fuzz_r_table_{half}"), half)?;
     let coarse = table_spec(ctx, &refit, &format!("fuzz_r_table_{quarter}"), quarter)?;
     Ok(vec![
-        fit_row(&published_spec, DVector::from_row_slice(&validate::fuzz::R_COEFFS), &reference, PUBLISHED, "Listing 5")?,
+        fit_row(&published_spec, DVector::from_row_slice(&crate::family::fuzz::published::R_COEFFS), &reference, PUBLISHED, "Listing 5")?,
         refit_row(&refit, ctx.generated, &reference, "fits/fuzz_r.toml, committed")?,
         fit_row(&cheaper, integral.fit(&cheaper, &[half, half])?, &reference, "rational, fewer terms", &format!("minimax on {half}×{half}"))?,
         table_row(&fine, table_values(&mut integral, &fine), &reference, &format!("table {half}²"), "")?,
@@ -511,7 +512,7 @@ fn fuzz_ps(ctx: &Ctx) -> Result<Vec<FormRow>> {
     // Listing 2 does.
     let published_spec = ctx.variant(&refit, "fuzz_ps_published", |t| set(t, "axis.1.range", toml::Value::Array(vec![0.1.into(), FRAC_PI_2.into()])))?;
     let published: Vec<DVector<f64>> =
-        [0, 1, 2, 4, 3, 5].iter().map(|&k| DVector::from_row_slice(&validate::fuzz::PS_COEFFS[k])).collect();
+        [0, 1, 2, 4, 3, 5].iter().map(|&k| DVector::from_row_slice(&crate::family::fuzz::published::PS_COEFFS[k])).collect();
     let (committed, _) = pfields::committed(&refit, ctx.generated)?;
     // A cheaper form: the fields of degree 2 in (β, γ, δ), fitted as fits/fuzz_ps.toml is on
     // a coarser grid.
@@ -617,7 +618,7 @@ fn skin_punctual(ctx: &Ctx) -> Result<Vec<FormRow>> {
                 set(t, "resolution", toml::Value::Array(vec![(w as i64).into(), (h as i64).into()]))
             })?
         };
-        let (built, texture) = pipeline::skin::build_with_texture_error(&spec)?;
+        let (built, texture) = crate::family::skin::build::build_with_texture_error(&spec)?;
         let source = ops::Source::parse(wgsl_of(&built)?)?;
         let f = &spec.file.emit.function;
         let committed_note = if (w, h) == (65, 64) { ", committed size" } else { "" };
@@ -819,7 +820,7 @@ mod tests {
         // (and Q = 2·E₃ in closed form): the emitted f32 code adds the rounding of
         // 1 + d·(c0 + d·c1), a few ulps of 1 (< 1e-6).
         let truth: Vec<f64> = reference.points.iter().map(|p| fuzz::q_exact(p[0])).collect();
-        let f64_form: Vec<f64> = reference.points.iter().map(|p| validate::fuzz::published_q(p[0])).collect();
+        let f64_form: Vec<f64> = reference.points.iter().map(|p| crate::family::fuzz::published::published_q(p[0])).collect();
         let (max, _, _) = validate::measure(&reference.points, &truth, &f64_form);
         assert!((get("published").max_error - max).abs() < 1e-6, "{} vs {max}", get("published").max_error);
         // The linear form, counted by hand from its emitted source: the input clamp (mask,

@@ -11,7 +11,9 @@
 
 use super::{Mode, SplitMix, time_it};
 use crate::integrate::{Estimate, Tolerance, adaptive, gauss_legendre};
-use crate::quantity::{fuzz, gloss, skin};
+use crate::family::fuzz::integrals as fuzz;
+use crate::family::gloss::integrals as gloss;
+use crate::family::skin::integrals as skin;
 use serde::Serialize;
 use std::f64::consts::{FRAC_PI_2, PI};
 

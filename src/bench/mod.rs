@@ -304,3 +304,11 @@ fn ratio_line(label: &str, ratio: &Option<tables::Ratio>, note: &str) -> String 
         if q.at_target { String::new() } else { format!(" (numpy did not reach {:.0e})", tables::TARGET_ERROR) }
     )
 }
+
+/// A family's benchmark rows (see `crate::family::Family::bench`).
+#[derive(Clone, Copy)]
+pub struct FamilyBench {}
+
+impl FamilyBench {
+    pub const NONE: FamilyBench = FamilyBench {};
+}

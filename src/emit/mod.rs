@@ -6,7 +6,6 @@
 pub mod expr;
 pub mod fields;
 pub mod rust;
-pub mod skin;
 pub mod texture;
 pub mod wgsl;
 

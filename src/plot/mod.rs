@@ -9,17 +9,10 @@
 //! bytes depend only on the inputs: ticks, colours and legend placement are computed here
 //! without clocks, hashing or randomness, which the tests check by rendering twice.
 //!
-//! Figure families built on these primitives: [`gloss_figures`], [`fuzz_figures`], [`skin_figures`].
+//! Each family draws its own figures on these primitives (`family::*::plot`).
 
 mod colormap;
-mod fuzz;
-mod gloss;
-mod skin;
-mod ticks;
-
-pub use fuzz::{FuzzResolution, fuzz_figures, fuzz_figures_with};
-pub use gloss::gloss_figures;
-pub use skin::skin_figures;
+pub mod ticks;
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -55,14 +48,14 @@ pub enum PlotError {
 
 /// The house style of a chart's axes: dark axis lines, tick labels and descriptions in the
 /// embedded font, and the two descriptions.
-fn axes_style<'m, 'a, 'b, X: Ranged, Y: Ranged, DB: DrawingBackend>(
+pub fn axes_style<'m, 'a, 'b, X: Ranged, Y: Ranged, DB: DrawingBackend>(
     mesh: &'m mut plotters::chart::MeshStyle<'a, 'b, X, Y, DB>,
     x_desc: &str,
     y_desc: &str,
 ) -> &'m mut plotters::chart::MeshStyle<'a, 'b, X, Y, DB> {
     mesh.axis_style(RGBColor(60, 60, 60))
-        .label_style((FAMILY, LABEL_SIZE))
-        .axis_desc_style((FAMILY, DESC_SIZE))
+        .label_style((FONT_FAMILY, LABEL_SIZE))
+        .axis_desc_style((FONT_FAMILY, DESC_SIZE))
         .x_desc(x_desc)
         .y_desc(y_desc)
 }
@@ -109,10 +102,10 @@ pub struct Panel<'a> {
     pub values: &'a [f64],
 }
 
-const FAMILY: &str = "sans-serif";
+pub const FONT_FAMILY: &str = "sans-serif";
 const FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
 
-const TITLE_SIZE: u32 = 26;
+pub const TITLE_SIZE: u32 = 26;
 const PANEL_TITLE_SIZE: u32 = 21;
 const LABEL_SIZE: u32 = 17;
 const DESC_SIZE: u32 = 20;
@@ -134,7 +127,7 @@ const PALETTE: [RGBColor; 10] = [
 
 fn ensure_font() -> Result<(), PlotError> {
     static REGISTERED: OnceLock<bool> = OnceLock::new();
-    let ok = *REGISTERED.get_or_init(|| plotters::style::register_font(FAMILY, FontStyle::Normal, FONT).is_ok());
+    let ok = *REGISTERED.get_or_init(|| plotters::style::register_font(FONT_FAMILY, FontStyle::Normal, FONT).is_ok());
     if ok { Ok(()) } else { Err(PlotError::Font) }
 }
 
@@ -160,20 +153,20 @@ fn io_err(path: &Path) -> impl FnOnce(std::io::Error) -> PlotError + '_ {
 }
 
 /// Drawing errors carried as text until the file they belong to is known.
-type DrawResult = Result<(), String>;
+pub type DrawResult = Result<(), String>;
 
-fn de<E: std::fmt::Display>(e: E) -> String {
+pub fn de<E: std::fmt::Display>(e: E) -> String {
     e.to_string()
 }
 
 /// A figure that can be drawn on any plotters backend.
-trait Figure {
+pub trait Figure {
     fn size(&self) -> (u32, u32);
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult;
 }
 
 /// Renders `fig` to STEM.png and STEM.svg (temporary file, then rename) and returns both paths.
-fn write_figure(stem: &Path, fig: &impl Figure) -> Result<Vec<PathBuf>, PlotError> {
+pub fn write_figure(stem: &Path, fig: &impl Figure) -> Result<Vec<PathBuf>, PlotError> {
     ensure_font()?;
     if let Some(dir) = stem.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).map_err(io_err(dir))?;
@@ -213,7 +206,7 @@ fn write_figure(stem: &Path, fig: &impl Figure) -> Result<Vec<PathBuf>, PlotErro
     Ok(vec![png, svg])
 }
 
-fn data_err(stem: &Path, message: impl Into<String>) -> PlotError {
+pub fn data_err(stem: &Path, message: impl Into<String>) -> PlotError {
     PlotError::Data { path: stem.to_path_buf(), message: message.into() }
 }
 
@@ -261,12 +254,12 @@ pub fn line_plot(
     write_figure(path_stem, &fig)
 }
 
-fn min_max(it: impl Iterator<Item = f64>) -> (f64, f64) {
+pub fn min_max(it: impl Iterator<Item = f64>) -> (f64, f64) {
     it.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)))
 }
 
 /// Range widened by `frac` of its span on each side; a degenerate range gets a unit-ish width.
-fn padded((lo, hi): (f64, f64), frac: f64) -> (f64, f64) {
+pub fn padded((lo, hi): (f64, f64), frac: f64) -> (f64, f64) {
     if hi > lo {
         let pad = (hi - lo) * frac;
         (lo - pad, hi + pad)
@@ -378,7 +371,7 @@ impl Figure for LineFigure<'_> {
 
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult {
         root.fill(&WHITE).map_err(de)?;
-        let body = root.margin(8, 0, 0, 0).titled(self.title, (FAMILY, TITLE_SIZE)).map_err(de)?;
+        let body = root.margin(8, 0, 0, 0).titled(self.title, (FONT_FAMILY, TITLE_SIZE)).map_err(de)?;
         let x_ticks = ticks::linear(self.x.0, self.x.1, 8);
         // The y tick labels' width depends on the range only weakly; size the label area from
         // the data range's labels plus slack for a longer label after headroom.
@@ -438,7 +431,7 @@ impl Figure for LineFigure<'_> {
                 .position(position)
                 .margin(LEGEND_MARGIN)
                 .legend_area_size(LEGEND_GLYPH_AREA)
-                .label_font((FAMILY, LEGEND_SIZE))
+                .label_font((FONT_FAMILY, LEGEND_SIZE))
                 .background_style(WHITE.mix(0.9))
                 .border_style(RGBColor(160, 160, 160))
                 .draw()
@@ -450,14 +443,14 @@ impl Figure for LineFigure<'_> {
 
 /// A linear f64 axis whose ticks are ours (plotters' own key points are replaced), labelled
 /// through the mesh's label formatter.
-struct Axis {
+pub struct Axis {
     inner: plotters::coord::types::RangedCoordf64,
     ticks: Vec<f64>,
     minor: Vec<f64>,
 }
 
 impl Axis {
-    fn new((lo, hi): (f64, f64), ticks: &Ticks) -> Self {
+    pub fn new((lo, hi): (f64, f64), ticks: &Ticks) -> Self {
         Self { inner: (lo..hi).into(), ticks: ticks.values.clone(), minor: ticks.minor.clone() }
     }
 }
@@ -482,7 +475,7 @@ impl Ranged for Axis {
 /// Width in pixels of `text` in the embedded font at `size` (a rough estimate if the font
 /// cannot lay it out).
 fn text_width(text: &str, size: u32) -> u32 {
-    (FAMILY, size as f64)
+    (FONT_FAMILY, size as f64)
         .into_font()
         .box_size(text)
         .map(|(w, _)| w)
@@ -490,7 +483,7 @@ fn text_width(text: &str, size: u32) -> u32 {
 }
 
 /// Pixel width of the widest tick label, to size the label area.
-fn label_width(t: &Ticks) -> u32 {
+pub fn label_width(t: &Ticks) -> u32 {
     t.values.iter().map(|&v| text_width(&t.label(v), LABEL_SIZE)).max().unwrap_or(0)
 }
 
@@ -579,7 +572,7 @@ pub fn symmetric_range<'a>(values: impl IntoIterator<Item = &'a f64>) -> (f64, f
 }
 
 /// Cell boundaries around strictly increasing centres: midpoints, ends extended by half a step.
-fn cell_edges(c: &[f64]) -> Vec<f64> {
+pub fn cell_edges(c: &[f64]) -> Vec<f64> {
     if c.len() == 1 {
         return vec![c[0] - 0.5, c[0] + 0.5];
     }
@@ -692,7 +685,7 @@ impl Figure for HeatmapFigure<'_> {
 
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult {
         root.fill(&WHITE).map_err(de)?;
-        let body = root.margin(8, 0, 0, 0).titled(self.title, (FAMILY, TITLE_SIZE)).map_err(de)?;
+        let body = root.margin(8, 0, 0, 0).titled(self.title, (FONT_FAMILY, TITLE_SIZE)).map_err(de)?;
         let (w, _) = body.dim_in_pixel();
         let (plots, bar) = body.split_horizontally(w.saturating_sub(self.bar_area()));
         let cells = plots.split_evenly((self.rows, self.columns));
@@ -704,7 +697,7 @@ impl Figure for HeatmapFigure<'_> {
             let mut builder = ChartBuilder::on(area);
             builder.margin(12).x_label_area_size(58).y_label_area_size(label_width(&self.y_ticks) + 12 + 44);
             if !panel.title.is_empty() {
-                builder.caption(panel.title, (FAMILY, PANEL_TITLE_SIZE));
+                builder.caption(panel.title, (FONT_FAMILY, PANEL_TITLE_SIZE));
             }
             let (x0, x1) = (self.x_edges[0], self.x_edges[nx]);
             let (y0, y1) = (self.y_edges[0], self.y_edges[self.y_edges.len() - 1]);
@@ -757,7 +750,7 @@ impl Figure for HeatmapFigure<'_> {
             .disable_x_axis()
             .set_all_tick_mark_size(6)
             .axis_style(RGBColor(60, 60, 60))
-            .label_style((FAMILY, LABEL_SIZE))
+            .label_style((FONT_FAMILY, LABEL_SIZE))
             .y_label_formatter(&bf)
             .draw()
             .map_err(de)?;
@@ -767,7 +760,7 @@ impl Figure for HeatmapFigure<'_> {
         if !self.colorbar_label.is_empty() {
             let (xr, yr) = chart.plotting_area().get_pixel_range();
             let x = xr.end + 14 + label_width(&self.bar_ticks) as i32 + 12 + DESC_SIZE as i32 / 2;
-            let style = TextStyle::from((FAMILY, DESC_SIZE).into_font())
+            let style = TextStyle::from((FONT_FAMILY, DESC_SIZE).into_font())
                 .transform(FontTransform::Rotate270)
                 .pos(Pos::new(HPos::Center, VPos::Center));
             root.draw(&Text::new(self.colorbar_label, (x, (yr.start + yr.end) / 2), style)).map_err(de)?;

@@ -3,7 +3,7 @@
 
 /// Tick positions on one axis, with the formatting shared by all of them.
 #[derive(Clone, Debug)]
-pub(crate) struct Ticks {
+pub struct Ticks {
     /// Positions in axis coordinates (log10 of the value on a log axis).
     pub values: Vec<f64>,
     /// Unlabelled minor positions (2×…9× each decade on a log axis of at most 6 decades).
@@ -16,7 +16,7 @@ pub(crate) struct Ticks {
 }
 
 /// At most `target` + 1 round ticks inside [lo, hi], as many as that allows.
-pub(crate) fn linear(lo: f64, hi: f64, target: usize) -> Ticks {
+pub fn linear(lo: f64, hi: f64, target: usize) -> Ticks {
     // The smallest step of 1, 2 or 5 times a power of ten giving at most target + 1 ticks.
     let count = |step: f64| (hi / step + 1e-9).floor() - (lo / step - 1e-9).ceil() + 1.0;
     let mut p = 10f64.powf(((hi - lo) / target.max(2) as f64).log10().floor() - 1.0);
@@ -42,7 +42,7 @@ pub(crate) fn linear(lo: f64, hi: f64, target: usize) -> Ticks {
 
 /// Ticks of a log10 axis spanning the integer exponents [lo_exp, hi_exp]: every decade
 /// (every other one past 8 decades), plus 2× and 5× when the axis spans at most 2 decades.
-pub(crate) fn log_decades(lo_exp: i32, hi_exp: i32) -> Ticks {
+pub fn log_decades(lo_exp: i32, hi_exp: i32) -> Ticks {
     let every = if hi_exp - lo_exp > 8 { 2 } else { 1 };
     let mut values = Vec::new();
     for e in lo_exp..=hi_exp {
@@ -64,7 +64,7 @@ pub(crate) fn log_decades(lo_exp: i32, hi_exp: i32) -> Ticks {
 
 impl Ticks {
     /// Label of the tick at `v` (axis coordinates).
-    pub(crate) fn label(&self, v: f64) -> String {
+    pub fn label(&self, v: f64) -> String {
         if self.log {
             let e = v.floor();
             let mantissa = 10f64.powf(v - e).round() as i64;

@@ -4,41 +4,40 @@
 //! Schema (see README "Spec files"):
 //!
 //! ```toml
-//! name = "gloss_length"            # output stem; must match the file stem
-//! kind = "fit"                     # "fit" (a model fitted to samples) or "table" (a LUT)
-//! quantity = "gloss-length"        # see `shadefit eval --help`
+//! name = "my_fit"                  # output stem; must match the file stem
+//! kind = "fit"                     # "fit" (a model fitted to samples), "table" (a LUT),
+//!                                  # "fields", or a kind a family defines (`KindDef`)
+//! quantity = "some-quantity"       # see `shadefit eval --help`
 //! description = "..."
 //!
 //! [[axis]]                         # one per quantity parameter, in the quantity's order
-//! name = "gloss"
+//! name = "x"
 //! range = [0.0, 1.0]
 //! count = 256                      # samples (uniform, ends included)
 //! verify = 1024                    # verification grid for the measured error (fits/tables)
 //!
 //! [model]                          # kind = "fit" only
-//! numerator = ["1", "gloss", "gloss^2", "gloss^3"]
-//! denominator = ["gloss", "gloss^2"]  # the constant 1 is implicit
+//! numerator = ["1", "x", "x^2", "x^3"]
+//! denominator = ["x", "x^2"]       # the constant 1 is implicit
 //! clamp = [0.0, 1.0]               # optional: clamp-aware objective
 //! fixed = { "1" = 0.0 }            # optional: numerator terms fixed (prefix "den:" for denominator)
 //! [[model.pin]]                    # optional: f(at) = value (value defaults to the integral)
 //! at = [1.0]
-//! eliminate = "gloss^3"
+//! eliminate = "x^3"
 //!
 //! [fit]
 //! objective = "minimax"            # or "lsq", or "l4" (Σ r⁴: between the two)
 //!
 //! [emit]
-//! function = "gloss_to_normal_length"
-//! args = ["gloss"]                # optional: argument names (default: the axis names)
+//! function = "my_function"
+//! args = ["x"]                     # optional: argument names (default: the axis names)
 //! ```
 
 pub mod data;
-pub mod profile;
-pub mod skin;
 
 use crate::fit::model::{Derived, ModelError, ModelParts, Pin, RationalModel, Term};
 use crate::fit::Objective;
-use crate::quantity::{self, QuantityDef};
+use crate::quantity::{QuantityDef, QuantityError};
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -224,28 +223,69 @@ impl ModelSpec {
     }
 }
 
-#[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq)]
-#[serde(rename_all = "lowercase")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Kind {
     Fit,
     Table,
-    /// Skin LUT textures (RGB): checked and spelled out by [`skin`].
-    #[serde(rename = "skin-lut")]
-    SkinLut,
     /// Two-stage fit: the quantity's inner basis at every outer grid point, each coefficient
     /// a rational field over the outer axes (see `fit::fields`).
     Fields,
+    /// A kind a family defines ([`KindDef`]): its own checker spells the spec out as a common
+    /// [`SpecFile`] and its own builder builds it. Never read from TOML directly.
+    Custom(&'static str),
+}
+
+impl<'de> Deserialize<'de> for Kind {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Kind, D::Error> {
+        let s = String::deserialize(d)?;
+        match s.as_str() {
+            "fit" => Ok(Kind::Fit),
+            "table" => Ok(Kind::Table),
+            "fields" => Ok(Kind::Fields),
+            other => Err(serde::de::Error::unknown_variant(other, &["fit", "table", "fields", "or a family kind"])),
+        }
+    }
 }
 
 impl Kind {
-    /// The spec's spelling ("fit", "table", "skin-lut").
+    /// The spec's spelling ("fit", "table", "fields" or the family kind's name).
     pub fn name(self) -> &'static str {
         match self {
             Kind::Fit => "fit",
             Kind::Table => "table",
-            Kind::SkinLut => "skin-lut",
             Kind::Fields => "fields",
+            Kind::Custom(name) => name,
         }
+    }
+}
+
+/// A spec kind of a family's own (`kind = "NAME"`): the checker returns the common spec it
+/// enters the pipeline as (axes spelled out), or `None` when the text is not of this kind.
+#[derive(Debug)]
+pub struct KindDef {
+    pub name: &'static str,
+    pub spec_file: fn(&Path, &str) -> Result<Option<SpecFile>, SpecError>,
+    /// Why `shadefit samples` has nothing to print for specs of this kind ({name}: the spec).
+    pub samples_note: &'static str,
+}
+
+/// What specs may name: every quantity and every family spec kind (built from the family
+/// registry by the caller; the spec layer names no family).
+#[derive(Debug, Default)]
+pub struct Catalog {
+    pub quantities: Vec<&'static QuantityDef>,
+    pub kinds: Vec<&'static KindDef>,
+}
+
+impl Catalog {
+    pub fn lookup(&self, name: &str) -> Result<&'static QuantityDef, QuantityError> {
+        self.quantities.iter().copied().find(|q| q.name == name).ok_or_else(|| {
+            QuantityError::Unknown(name.to_string(), self.quantities.iter().map(|q| q.name).collect::<Vec<_>>().join(", "))
+        })
+    }
+
+    pub fn kind(&self, name: &str) -> Option<&'static KindDef> {
+        self.kinds.iter().copied().find(|k| k.name == name)
     }
 }
 
@@ -341,14 +381,21 @@ pub(crate) fn is_identifier(s: &str) -> bool {
 }
 
 impl Spec {
-    pub fn load(path: &Path) -> Result<Spec, SpecError> {
+    pub fn load(path: &Path, catalog: &Catalog) -> Result<Spec, SpecError> {
         let text = std::fs::read_to_string(path)
             .map_err(|e| SpecError::new(path, 0, "(file)", format!("cannot read: {e}")))?;
-        Spec::parse(path, text)
+        Spec::parse(path, text, catalog)
     }
 
-    pub fn parse(path: &Path, text: String) -> Result<Spec, SpecError> {
-        let file: SpecFile = match skin::spec_file(path, &text)? {
+    pub fn parse(path: &Path, text: String, catalog: &Catalog) -> Result<Spec, SpecError> {
+        let mut custom = None;
+        for k in &catalog.kinds {
+            if let Some(f) = (k.spec_file)(path, &text)? {
+                custom = Some(f);
+                break;
+            }
+        }
+        let file: SpecFile = match custom {
             Some(f) => f,
             None => parse_toml(path, &text)?,
         };
@@ -362,7 +409,7 @@ impl Spec {
         if !is_identifier(&file.emit.function) {
             return Err(at("function", format!("'{}' is not a valid function name", file.emit.function)));
         }
-        let quantity = quantity::lookup(&file.quantity).map_err(|e| at("quantity", e.to_string()))?;
+        let quantity = catalog.lookup(&file.quantity).map_err(|e| at("quantity", e.to_string()))?;
         let n_args = match (file.kind, quantity.basis) {
             (Kind::Fields, Some(b)) => file.axis.len().saturating_sub(b.inner),
             _ => file.axis.len(),
@@ -375,10 +422,16 @@ impl Spec {
         if !(file.tolerance > 0.0 && file.tolerance < 1.0) {
             return Err(at("tolerance", format!("{} must be in (0, 1)", file.tolerance)));
         }
-        if !quantity.channels.is_empty() && file.kind != Kind::SkinLut {
+        if !quantity.channels.is_empty() && !matches!(file.kind, Kind::Custom(_)) {
+            let kinds: Vec<String> = catalog.kinds.iter().map(|k| format!("kind = \"{}\"", k.name)).collect();
             return Err(at(
                 "quantity",
-                format!("'{}' has {} channels; fits and tables take scalar quantities only (skin: kind = \"skin-lut\")", quantity.name, quantity.channels.len()),
+                format!(
+                    "'{}' has {} channels; fits and tables take scalar quantities only (vector quantities: {})",
+                    quantity.name,
+                    quantity.channels.len(),
+                    kinds.join(", ")
+                ),
             ));
         }
         let names: Vec<&str> = quantity.params.iter().map(|p| p.name).collect();
@@ -427,7 +480,7 @@ impl Spec {
             (Kind::Fit, None) => return Err(at("model", "kind = \"fit\" needs a [model] section".into())),
             (Kind::Table, Some(_)) => return Err(at("model", "kind = \"table\" takes no [model]".into())),
             (Kind::Table, None) => None,
-            (Kind::SkinLut, _) => None,
+            (Kind::Custom(_), _) => None,
             (Kind::Fields, m) => Some(fields_model(path, &text, &file, quantity, m.as_ref())?),
         };
         if file.kind != Kind::Fields && (file.fields.is_some() || file.emit.evaluator.is_some()) {
@@ -488,12 +541,12 @@ fn fields_model(
 }
 
 /// All specs in a folder (`*.toml`, sorted by name; `scenes/` is not read).
-pub fn load_dir(dir: &Path) -> Result<Vec<Spec>, SpecError> {
+pub fn load_dir(dir: &Path, catalog: &Catalog) -> Result<Vec<Spec>, SpecError> {
     let mut paths: Vec<PathBuf> = std::fs::read_dir(dir)
         .map_err(|e| SpecError::new(dir, 0, "(folder)", format!("cannot read: {e}")))?
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p| p.extension().is_some_and(|e| e == "toml") && p.is_file())
         .collect();
     paths.sort();
-    paths.iter().map(|p| Spec::load(p)).collect()
+    paths.iter().map(|p| Spec::load(p, catalog)).collect()
 }

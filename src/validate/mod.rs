@@ -3,9 +3,7 @@
 //! Each item gives its domain, the points measured, max abs and rms error, the worst point and
 //! findings: what the numbers say about the published constants (noise, typos, conventions).
 
-pub mod fuzz;
-pub mod gloss;
-
+use crate::spec::Catalog;
 use serde::Serialize;
 use std::path::Path;
 
@@ -18,7 +16,7 @@ pub struct Item {
     pub max_abs_error: f64,
     pub rms_error: f64,
     pub worst_point: Vec<f64>,
-    /// Extra measures (e.g. error in gloss units), name → value.
+    /// Extra measures (e.g. error in parameter units), name → value.
     pub extra: Vec<(String, f64)>,
     pub findings: Vec<String>,
 }
@@ -57,8 +55,8 @@ impl Item {
     /// Measure the committed refit `generated/json/NAME.json` on the same points, through the
     /// model of its spec, and add it side by side. Returns the refit's values (None when the
     /// refit is not committed).
-    pub fn add_refit(&mut self, generated: &Path, name: &str, points: &[Vec<f64>], truth: &[f64]) -> Option<Vec<f64>> {
-        let (spec, c) = committed_refit(generated, name)?;
+    pub fn add_refit(&mut self, generated: &Path, name: &str, catalog: &Catalog, points: &[Vec<f64>], truth: &[f64]) -> Option<Vec<f64>> {
+        let (spec, c) = committed_refit(generated, name, catalog)?;
         let model = spec.model.as_ref()?;
         let approx: Vec<f64> = points.iter().map(|x| model.eval_clamped(&c, x)).collect();
         let (m, r, _) = measure(points, truth, &approx);
@@ -75,21 +73,21 @@ impl Item {
 }
 
 /// The committed refit NAME: its spec (read from the path its JSON names) and coefficients.
-pub fn committed_refit(generated: &Path, name: &str) -> Option<(crate::spec::Spec, nalgebra::DVector<f64>)> {
+pub fn committed_refit(generated: &Path, name: &str, catalog: &Catalog) -> Option<(crate::spec::Spec, nalgebra::DVector<f64>)> {
     let text = std::fs::read_to_string(generated.join("json").join(format!("{name}.json"))).ok()?;
     let v: serde_json::Value = serde_json::from_str(&text).ok()?;
     let c: Vec<f64> =
         v["model"]["coefficients"].as_array()?.iter().map(serde_json::Value::as_f64).collect::<Option<_>>()?;
-    let spec = crate::spec::Spec::load(&generated.parent()?.join(v["spec"].as_str()?)).ok()?;
+    let spec = crate::spec::Spec::load(&generated.parent()?.join(v["spec"].as_str()?), catalog).ok()?;
     (spec.model.as_ref()?.n_full() == c.len()).then(|| (spec, nalgebra::DVector::from_vec(c)))
 }
 
 /// The committed two-stage refit NAME (`kind = "fields"`): the coefficient function
 /// outer point → c_k evaluated in f64 through its spec's model and offsets.
-pub fn committed_fields(generated: &Path, name: &str) -> Option<Box<dyn Fn(&[f64]) -> Vec<f64> + Send + Sync>> {
+pub fn committed_fields(generated: &Path, name: &str, catalog: &Catalog) -> Option<Box<dyn Fn(&[f64]) -> Vec<f64> + Send + Sync>> {
     let text = std::fs::read_to_string(generated.join("json").join(format!("{name}.json"))).ok()?;
     let v: serde_json::Value = serde_json::from_str(&text).ok()?;
-    let spec = crate::spec::Spec::load(&generated.parent()?.join(v["spec"].as_str()?)).ok()?;
+    let spec = crate::spec::Spec::load(&generated.parent()?.join(v["spec"].as_str()?), catalog).ok()?;
     let model = spec.model.clone()?;
     let mut fields = Vec::new();
     for f in v["fields"].as_array()? {
@@ -104,9 +102,7 @@ pub fn committed_fields(generated: &Path, name: &str) -> Option<Box<dyn Fn(&[f64
     Some(Box::new(move |x: &[f64]| fields.iter().map(|(m, c)| m.eval_full(c, x)).collect()))
 }
 
-/// Every item known to the project.
-pub fn all(generated: &std::path::Path) -> Vec<Item> {
-    let mut items = gloss::items(generated);
-    items.extend(fuzz::items(generated));
-    items
+/// Every item of the given validators (one per family, in registry order).
+pub fn all(generated: &Path, validators: &[fn(&Path) -> Vec<Item>]) -> Vec<Item> {
+    validators.iter().flat_map(|v| v(generated)).collect()
 }

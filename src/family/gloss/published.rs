@@ -1,8 +1,8 @@
 //! COD: WWII gloss constants ("Mipmapping normal and gloss", "Rational function fitting",
 //! "Combining gloss").
 
-use super::{measure, Item};
-use crate::quantity::gloss::{combine, gloss_from_length, length_from_gloss};
+use crate::validate::{measure, Item};
+use crate::family::gloss::integrals::{combine, gloss_from_length, length_from_gloss};
 use std::path::Path;
 
 /// The table rows printed on the slides: (gloss, ‖n_s‖), 6 decimals.
@@ -122,7 +122,7 @@ pub fn items(generated: &Path) -> Vec<Item> {
         ),
     ];
     item.extra.push(("max_abs_error_in_gloss".to_string(), gloss_err));
-    if let Some(ra) = item.add_refit(generated, "gloss_length", &pts, &truth) {
+    if let Some(ra) = item.add_refit(generated, "gloss_length", crate::family::catalog(), &pts, &truth) {
         let rg = g.iter().zip(&ra).map(|(&x, &v)| (gloss_from_length(v) - x).abs()).fold(0.0, f64::max);
         item.extra.push(("refit_max_abs_error_in_gloss".into(), rg));
         item.findings.push(format!("The refit's error in recovered gloss units: {rg:.2e}."));
@@ -142,7 +142,7 @@ pub fn items(generated: &Path) -> Vec<Item> {
         &truth,
         &approx,
     );
-    item.add_refit(generated, "gloss_combine", &pts, &truth);
+    item.add_refit(generated, "gloss_combine", crate::family::catalog(), &pts, &truth);
     out.push(item);
     out
 }

@@ -1,12 +1,12 @@
 //! Fuzz figures, after the appendices of the Ghost of Tsushima supplemental: the reference
-//! integrals of [`crate::quantity::fuzz`] against the published approximations of
-//! [`crate::validate::fuzz`] and shadefit's committed refits.
+//! integrals of [`crate::family::fuzz::integrals`] against the published approximations of
+//! [`crate::family::fuzz::published`] and shadefit's committed refits.
 //!
 //! - App. B, P_s over the light direction (θu ∈ [0, π/2] × φu ∈ [0, π], cell midpoints) at
 //!   α = 0.15, 0.35, 0.55, 0.75 and θf = 0.1, π/4, π/2: `fuzz_ps_alpha_A` (reference P_s and
 //!   published P̃_s, one colour scale) and `fuzz_ps_error_alpha_A` (P̃_s − P_s). The published
 //!   P̃_s is Eq. 1 with Listing 1's rows 3 and 4 exchanged
-//!   ([`crate::validate::fuzz::ps_from_coeffs_swapped`]): the table as printed puts c₄ before c₃
+//!   ([`crate::family::fuzz::published::ps_from_coeffs_swapped`]): the table as printed puts c₄ before c₃
 //!   (see `shadefit validate`). A refit of P̃_s, when given to [`fuzz_figures_with`], adds its
 //!   panels to both figures.
 //! - App. D, G(d, μv): `fuzz_g` (curves against μv for several d: reference, published G̃,
@@ -18,15 +18,15 @@
 //! Errors are signed, approximation − reference. Figure text names the approximations in words
 //! ("published fit", "refit"): the embedded rasteriser draws no combining marks, so P̃ would
 //! show a detached tilde. Angles are in radians, with the conventions of
-//! [`crate::quantity::fuzz`] (normal +z, fiber t = (sin θf, 0, cos θf), φu from the fiber
+//! [`crate::family::fuzz::integrals`] (normal +z, fiber t = (sin θf, 0, cos θf), φu from the fiber
 //! azimuth). The refits are `GENERATED/json/fuzz_{g,q,r}.json`, evaluated through the model of
 //! the spec each names, whose axis order is checked here: (μv, d) for G, (d) for Q, (α, θf)
 //! for R. The cost is the reference P_s and R integrals ([`FuzzResolution`]).
 
-use super::{Panel, PlotError, Series, SeriesStyle};
+use crate::plot::{Panel, PlotError, Series, SeriesStyle};
 use crate::fit::RationalModel;
-use crate::quantity::fuzz::{fitting_directions, g_exact, linspace, ps_grid, q_exact, r_grid};
-use crate::validate::fuzz::{
+use crate::family::fuzz::integrals::{fitting_directions, g_exact, linspace, ps_grid, q_exact, r_grid};
+use crate::family::fuzz::published::{
     ps_from_coeffs, ps_from_coeffs_swapped, published_g, published_ps_coeffs, published_q, published_r,
 };
 use nalgebra::DVector;
@@ -84,7 +84,7 @@ impl FuzzResolution {
 /// drawn; [`fuzz_figures_with`] takes one.
 pub fn fuzz_figures(out_dir: &Path, generated: &Path) -> Result<Vec<PathBuf>, PlotError> {
     // The committed two-stage refit of P̃_s (generated/json/fuzz_ps.json), when there is one.
-    let fields = crate::validate::committed_fields(generated, "fuzz_ps");
+    let fields = crate::validate::committed_fields(generated, "fuzz_ps", crate::family::catalog());
     let refit = fields.as_ref().map(|f| {
         move |alpha: f64, theta_f: f64| -> [f64; 6] {
             let c = f(&[alpha, theta_f]);
@@ -176,7 +176,7 @@ fn ps_figures(
         let errors: Vec<(String, Vec<f64>)> = error_rows.into_iter().flatten().collect();
 
         let value_panels: Vec<Panel> = values.iter().map(|(t, v)| Panel { title: t, values: v }).collect();
-        out.extend(super::grid_of_heatmaps(
+        out.extend(crate::plot::grid_of_heatmaps(
             &out_dir.join(format!("fuzz_ps_alpha_{alpha:.2}")),
             &format!("P_s at α = {alpha:.2}: reference, published fit (Listing 1 with rows 3/4 swapped){refit_note}"),
             x_label,
@@ -190,7 +190,7 @@ fn ps_figures(
             None,
         )?);
         let error_panels: Vec<Panel> = errors.iter().map(|(t, v)| Panel { title: t, values: v }).collect();
-        out.extend(super::grid_of_heatmaps(
+        out.extend(crate::plot::grid_of_heatmaps(
             &out_dir.join(format!("fuzz_ps_error_alpha_{alpha:.2}")),
             &format!("Error of the P_s fits at α = {alpha:.2} (fit − reference): published (Listing 1 with rows 3/4 swapped){refit_note}"),
             x_label,
@@ -232,7 +232,7 @@ fn g_figures(out_dir: &Path, res: &FuzzResolution, refit: &Refit) -> Result<Vec<
             Series::new("", mus.iter().map(|&m| (m, refit.eval(&[m, d]))).collect(), SeriesStyle::Dashed).color(i),
         );
     }
-    out.extend(super::line_plot(
+    out.extend(crate::plot::line_plot(
         &out_dir.join("fuzz_g"),
         "Fuzz layer hemispherical average G(d, μv): reference, published fit, refit",
         "μv = n·v (cosine of the view angle)",
@@ -250,7 +250,7 @@ fn g_figures(out_dir: &Path, res: &FuzzResolution, refit: &Refit) -> Result<Vec<
     let exact = over_grid(&|m, d| g_exact(d, m));
     let published = difference(&over_grid(&|m, d| published_g(m, d)), &exact);
     let refitted = difference(&over_grid(&|m, d| refit.eval(&[m, d])), &exact);
-    out.extend(super::grid_of_heatmaps(
+    out.extend(crate::plot::grid_of_heatmaps(
         &out_dir.join("fuzz_g_errors"),
         "Error of the G fits (fit − reference G)",
         "μv = n·v",
@@ -275,7 +275,7 @@ fn g_figures(out_dir: &Path, res: &FuzzResolution, refit: &Refit) -> Result<Vec<
 fn q_figures(out_dir: &Path, res: &FuzzResolution, refit: &Refit) -> Result<Vec<PathBuf>, PlotError> {
     let ds = linspace(0.0, D_MAX, res.curve);
     let curve = |f: &dyn Fn(f64) -> f64| -> Vec<(f64, f64)> { ds.iter().map(|&d| (d, f(d))).collect() };
-    let mut out = super::line_plot(
+    let mut out = crate::plot::line_plot(
         &out_dir.join("fuzz_q"),
         "Fuzz layer average penetration Q(d) = 2E₃(d): reference, published fit, refit",
         "density d (optical thickness)",
@@ -290,7 +290,7 @@ fn q_figures(out_dir: &Path, res: &FuzzResolution, refit: &Refit) -> Result<Vec<
     let published = curve(&|d| published_q(d) - q_exact(d));
     let refitted = curve(&|d| refit.eval(&[d]) - q_exact(d));
     let max_abs = |s: &[(f64, f64)]| s.iter().fold(0.0_f64, |m, p| m.max(p.1.abs()));
-    out.extend(super::line_plot(
+    out.extend(crate::plot::line_plot(
         &out_dir.join("fuzz_q_error"),
         "Error of the Q fits (fit − 2E₃(d))",
         "density d (optical thickness)",
@@ -325,7 +325,7 @@ fn r_figures(out_dir: &Path, res: &FuzzResolution, refit: &Refit) -> Result<Vec<
     let refitted: Vec<f64> = points().map(|(a, t)| refit.eval(&[a, t])).collect();
     let (x_label, y_label) = ("fiber polar angle θf (radians)", "α (SGGX fiber projected area)");
 
-    let mut out = super::grid_of_heatmaps(
+    let mut out = crate::plot::grid_of_heatmaps(
         &out_dir.join("fuzz_r"),
         "Cosine-weighted average of P_s, R(α, θf): reference, published fit, refit",
         x_label,
@@ -344,7 +344,7 @@ fn r_figures(out_dir: &Path, res: &FuzzResolution, refit: &Refit) -> Result<Vec<
     )?;
     let published_err = difference(&published, &exact);
     let refit_err = difference(&refitted, &exact);
-    out.extend(super::grid_of_heatmaps(
+    out.extend(crate::plot::grid_of_heatmaps(
         &out_dir.join("fuzz_r_errors"),
         &format!("Error of the R fits (fit − reference R), {}×{} grid", alphas.len(), tfs.len()),
         x_label,
@@ -381,7 +381,7 @@ fn r_figures(out_dir: &Path, res: &FuzzResolution, refit: &Refit) -> Result<Vec<
             Series::new("", dense.iter().map(|&t| (t, refit.eval(&[a, t]))).collect(), SeriesStyle::Dashed).color(k),
         );
     }
-    out.extend(super::line_plot(
+    out.extend(crate::plot::line_plot(
         &out_dir.join("fuzz_r_curves"),
         "R against the fiber angle: reference, published fit, refit",
         x_label,
@@ -430,7 +430,7 @@ impl Refit {
         let path = generated.join("json").join(format!("{name}.json"));
         let data_err = |message: String| PlotError::Data { path: path.clone(), message };
         std::fs::metadata(&path).map_err(|source| PlotError::Io { path: path.clone(), source })?;
-        let (spec, coefficients) = crate::validate::committed_refit(generated, name).ok_or_else(|| {
+        let (spec, coefficients) = crate::validate::committed_refit(generated, name, crate::family::catalog()).ok_or_else(|| {
             data_err("not a readable refit: model coefficients, the spec it names, or their count do not agree".into())
         })?;
         let names: Vec<&str> = spec.file.axis.iter().map(|a| a.name.as_str()).collect();

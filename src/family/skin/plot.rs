@@ -3,17 +3,17 @@
 //!
 //! Inputs: `GENERATED/json/skin_punctual_lut.json` and `skin_sh_lut.json` (texel values, axes
 //! and the diffusion profile they were integrated with). The kernel comparison integrates the
-//! same profile again with both kernels ([`crate::quantity::skin::punctual`]) on the LUT's grid.
+//! same profile again with both kernels ([`crate::family::skin::integrals::punctual`]) on the LUT's grid.
 //! Missing skin JSON files mean no skin figures (the family is optional); malformed ones are
 //! errors naming the file.
 //!
 //! The RGB image shows linear values sRGB-encoded for viewing (no tonemapping: D ≤ 1).
 
-use super::{Axis, DrawResult, FAMILY, Figure, Panel, PlotError, Series, SeriesStyle, TITLE_SIZE};
-use super::{de, label_width, ticks, write_figure};
+use crate::plot::{Axis, DrawResult, FONT_FAMILY, Figure, Panel, PlotError, Series, SeriesStyle, TITLE_SIZE};
+use crate::plot::{de, label_width, ticks, write_figure};
 use crate::emit::texture::srgb8;
 use crate::integrate::Tolerance;
-use crate::quantity::skin::{DEFAULT_TOLERANCE, Gaussian, Kernel, Profile, punctual_grid_estimates};
+use crate::family::skin::integrals::{DEFAULT_TOLERANCE, Gaussian, Kernel, Profile, punctual_grid_estimates};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use serde_json::Value;
@@ -127,7 +127,7 @@ fn channel(values: &[[f64; 3]], c: usize) -> Vec<f64> {
 }
 
 fn n_dot_l_axis(n: usize) -> Vec<f64> {
-    (0..n).map(|i| crate::quantity::skin::lut_n_dot_l(i, n)).collect()
+    (0..n).map(|i| crate::family::skin::integrals::lut_n_dot_l(i, n)).collect()
 }
 
 fn punctual_figures(out_dir: &Path, lut: &Lut) -> Result<Vec<PathBuf>, PlotError> {
@@ -153,7 +153,7 @@ fn punctual_figures(out_dir: &Path, lut: &Lut) -> Result<Vec<PathBuf>, PlotError
 
     // (2) One heatmap per channel on a shared [0, 1] scale.
     let chans: Vec<Vec<f64>> = (0..3).map(|c| channel(&lut.values, c)).collect();
-    out.extend(super::grid_of_heatmaps(
+    out.extend(crate::plot::grid_of_heatmaps(
         &out_dir.join("skin_punctual_lut_channels"),
         &format!("Skin LUT D(n·l, κ) per channel ({kernel} kernel)"),
         "n·l",
@@ -183,7 +183,7 @@ fn punctual_figures(out_dir: &Path, lut: &Lut) -> Result<Vec<PathBuf>, PlotError
         })
         .collect();
     series.push(Series::new("max(n·l, 0)", lambert.clone(), SeriesStyle::Dashed));
-    out.extend(super::line_plot(
+    out.extend(crate::plot::line_plot(
         &out_dir.join("skin_punctual_slices"),
         "Skin LUT rows: red D against n·l at several curvatures",
         "n·l",
@@ -201,7 +201,7 @@ fn punctual_figures(out_dir: &Path, lut: &Lut) -> Result<Vec<PathBuf>, PlotError
         })
         .collect();
     series.push(Series::new("max(n·l, 0)", lambert, SeriesStyle::Dashed));
-    out.extend(super::line_plot(
+    out.extend(crate::plot::line_plot(
         &out_dir.join("skin_punctual_slices_rgb"),
         &format!("Skin LUT row κ = {:.3}/mm: D per channel", kappas[j]),
         "n·l",
@@ -224,7 +224,7 @@ fn punctual_figures(out_dir: &Path, lut: &Lut) -> Result<Vec<PathBuf>, PlotError
     let radial = channel(&integrate(Kernel::Radial, &nls, &kappas)?, 0);
     let diff: Vec<f64> = linear.iter().zip(&radial).map(|(a, b)| a - b).collect();
     let max_diff = diff.iter().fold(0.0_f64, |m, d| m.max(d.abs()));
-    out.extend(super::grid_of_heatmaps(
+    out.extend(crate::plot::grid_of_heatmaps(
         &out_dir.join("skin_kernels"),
         &format!("Ring kernels, red D(n·l, κ): linear profile vs radial profile (max |difference| {max_diff:.3})"),
         "n·l",
@@ -250,7 +250,7 @@ fn punctual_figures(out_dir: &Path, lut: &Lut) -> Result<Vec<PathBuf>, PlotError
             series.push(Series::new(format!("{name}, κ = {kappa:.3}/mm"), pts, style));
         }
     }
-    out.extend(super::line_plot(
+    out.extend(crate::plot::line_plot(
         &out_dir.join("skin_kernel_slices"),
         "Ring kernels: red D against n·l (solid: linear profile, dashed: radial)",
         "n·l",
@@ -277,7 +277,7 @@ fn sh_figures(out_dir: &Path, lut: &Lut) -> Result<Vec<PathBuf>, PlotError> {
             series.push(Series::new(format!("k_{band} {name}"), pts, style));
         }
     }
-    super::line_plot(
+    crate::plot::line_plot(
         &out_dir.join("skin_sh_bands"),
         "SH band factors of skin scattering (solid: k_1, dashed: k_2; k_0 = 1)",
         "curvature κ (1/mm)",
@@ -305,9 +305,9 @@ impl Figure for RgbImage<'_> {
 
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult {
         root.fill(&WHITE).map_err(de)?;
-        let body = root.margin(8, 0, 0, 0).titled(&self.title, (FAMILY, TITLE_SIZE - 6)).map_err(de)?;
-        let xe = super::cell_edges(self.xs);
-        let ye = super::cell_edges(self.ys);
+        let body = root.margin(8, 0, 0, 0).titled(&self.title, (FONT_FAMILY, TITLE_SIZE - 6)).map_err(de)?;
+        let xe = crate::plot::cell_edges(self.xs);
+        let ye = crate::plot::cell_edges(self.ys);
         let (x0, x1) = (xe[0], xe[xe.len() - 1]);
         let (y0, y1) = (ye[0], ye[ye.len() - 1]);
         let xt = ticks::linear(x0, x1, 5);
@@ -328,7 +328,7 @@ impl Figure for RgbImage<'_> {
             .map_err(de)?;
         let xf = |v: &f64| xt.label(*v);
         let yf = |v: &f64| yt.label(*v);
-        super::axes_style(chart.configure_mesh().disable_mesh(), self.x_label, self.y_label)
+        crate::plot::axes_style(chart.configure_mesh().disable_mesh(), self.x_label, self.y_label)
             .x_label_formatter(&xf)
             .y_label_formatter(&yf)
             .draw()

@@ -29,9 +29,9 @@
 //! listing, staleness and the runtime index treat it like any other spec.
 
 use super::profile::{LoadedProfile, ProfileSection};
-use super::{SpecError, SpecFile, line_of, parse_toml};
+use crate::spec::{SpecError, SpecFile, line_of, parse_toml};
 use crate::emit::texture::TextureFormat;
-use crate::quantity::skin::{CurvatureMapping, Kernel, mapped_curvature};
+use super::integrals::{CurvatureMapping, Kernel, mapped_curvature};
 use serde::Deserialize;
 use serde_json::json;
 use std::path::Path;
@@ -199,7 +199,7 @@ impl SkinLut {
     }
 
     /// The LUT of a loaded spec (parsed again from its text: the spec layer checked it).
-    pub fn from_spec(spec: &super::Spec) -> Result<SkinLut, SpecError> {
+    pub fn from_spec(spec: &crate::spec::Spec) -> Result<SkinLut, SpecError> {
         SkinLut::parse(&spec.path, &spec.text)
     }
 
@@ -221,16 +221,21 @@ impl SkinLut {
             }
             SkinLutKind::Sh => json!({"name": "band", "range": [1.0, 2.0], "count": 2, "verify": 2}),
         });
+        // Read as a table, then marked as this family's kind (the common parser reads only the
+        // generic kinds).
         let v = json!({
             "name": self.name,
-            "kind": KIND,
+            "kind": "table",
             "quantity": self.quantity,
             "description": self.description,
             "tolerance": self.tolerance,
             "axis": axes,
             "emit": {"function": self.function},
         });
-        serde_json::from_value(v).map_err(|e| SpecError::new(path, line_of(text, "kind"), "kind", e.to_string()))
+        let mut file: SpecFile =
+            serde_json::from_value(v).map_err(|e| SpecError::new(path, line_of(text, "kind"), "kind", e.to_string()))?;
+        file.kind = crate::spec::Kind::Custom(KIND);
+        Ok(file)
     }
 }
 
@@ -268,8 +273,8 @@ mod tests {
         assert_eq!(s.curvatures(), [0.0, 0.125, 0.5, 1.125, 2.0]);
         let sh = PUNCTUAL.replace("skin-punctual", "skin-sh").replace("[8, 5]", "[5]");
         assert_eq!(parse(&sh).unwrap().kind, SkinLutKind::Sh);
-        let spec = super::super::Spec::parse(Path::new("fits/skin_x.toml"), PUNCTUAL.to_string()).unwrap();
-        assert_eq!(spec.file.kind, super::super::Kind::SkinLut);
+        let spec = crate::spec::Spec::parse(Path::new("fits/skin_x.toml"), PUNCTUAL.to_string(), crate::family::catalog()).unwrap();
+        assert_eq!(spec.file.kind, crate::spec::Kind::Custom(KIND));
         let axes: Vec<(&str, usize)> = spec.file.axis.iter().map(|a| (a.name.as_str(), a.count)).collect();
         assert_eq!(axes, [("curvature", 5), ("n_dot_l", 8)]);
     }
@@ -278,7 +283,7 @@ mod tests {
     fn errors_name_line_and_field() {
         let bad = |edit: (&str, &str), line: usize, field: &str, msg: &str| {
             let text = PUNCTUAL.replace(edit.0, edit.1);
-            let e = super::super::Spec::parse(Path::new("fits/skin_x.toml"), text).unwrap_err();
+            let e = crate::spec::Spec::parse(Path::new("fits/skin_x.toml"), text, crate::family::catalog()).unwrap_err();
             assert_eq!((e.line, e.field.as_str()), (line, field), "{e}");
             assert!(e.msg.contains(msg), "{e}");
         };

@@ -108,8 +108,8 @@ pub fn published_r(alpha: f64, theta_f: f64) -> f64 {
     0.5 + b * num / den
 }
 
-use super::{measure, Item};
-use crate::quantity::fuzz;
+use crate::validate::{measure, Item};
+use super::integrals as fuzz;
 use rayon::prelude::*;
 use std::path::Path;
 
@@ -135,7 +135,7 @@ pub fn items(generated: &Path) -> Vec<Item> {
     let approx: Vec<f64> = pts.iter().map(|p| published_q(p[0])).collect();
     let mut item = Item::measured("fuzz_q (Listing 4)", "Ghost of Tsushima supplemental, Eq. 4", "d ∈ [0, 0.5], 2049 points", &pts, &truth, &approx);
     item.findings = vec!["Q = 2·E₃(d) exactly; Q̃ is a quadratic fit of it (convention agrees).".to_string()];
-    item.add_refit(generated, "fuzz_q", &pts, &truth);
+    item.add_refit(generated, "fuzz_q", crate::family::catalog(), &pts, &truth);
     out.push(item);
 
     // G̃ on μv ∈ [0.001, 1], d ∈ [0, 0.5] (the grid of fits/fuzz_g.toml's verification).
@@ -151,7 +151,7 @@ pub fn items(generated: &Path) -> Vec<Item> {
          depends on d/μv and the form cannot follow it."
             .to_string(),
     ];
-    item.add_refit(generated, "fuzz_g", &pts, &truth);
+    item.add_refit(generated, "fuzz_g", crate::family::catalog(), &pts, &truth);
     out.push(item);
 
     // R̃ on α ∈ [0.15, 1], θf ∈ [0, π/2].
@@ -164,7 +164,7 @@ pub fn items(generated: &Path) -> Vec<Item> {
          of engine code; evaluated here with the function's alpha."
             .to_string(),
     ];
-    item.add_refit(generated, "fuzz_r", &pts, &truth);
+    item.add_refit(generated, "fuzz_r", crate::family::catalog(), &pts, &truth);
     out.push(item);
 
     // P̃_s (Listings 1–2 with Eq. 1) on a 17×17 (α, θf) grid × 256 light directions.
@@ -174,7 +174,7 @@ pub fn items(generated: &Path) -> Vec<Item> {
     let ps = fuzz::ps_grid(&alphas, &thetas, &dirs, 1e-9);
     let mut pts = Vec::new();
     let (mut truth, mut printed, mut swapped, mut best) = (vec![], vec![], vec![], vec![]);
-    let refit_fn = super::committed_fields(generated, "fuzz_ps");
+    let refit_fn = crate::validate::committed_fields(generated, "fuzz_ps", crate::family::catalog());
     let mut refit = vec![];
     for (k, row) in ps.iter().enumerate() {
         let (a, tf) = (alphas[k / thetas.len()], thetas[k % thetas.len()]);

@@ -9,11 +9,11 @@
 //!   with coefficients [p0, p1, p2, p3, q1, q2, q3].
 //!
 //! Errors are signed, approximation − exact, with exact values from
-//! [`crate::quantity::gloss`].
+//! [`crate::family::gloss::integrals`].
 
-use super::{Panel, PlotError, Series, SeriesStyle};
-use crate::quantity::gloss::{combine, length_from_gloss};
-use crate::validate::gloss::{PUBLISHED_ENDS, published_combine, published_fit_coefficients, rational_1d};
+use crate::plot::{Panel, PlotError, Series, SeriesStyle};
+use crate::family::gloss::integrals::{combine, length_from_gloss};
+use crate::family::gloss::published::{PUBLISHED_ENDS, published_combine, published_fit_coefficients, rational_1d};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 
@@ -64,7 +64,7 @@ pub fn gloss_figures(out_dir: &Path, generated: &Path) -> Result<Vec<PathBuf>, P
         .filter(|(i, _)| i % TABLE_MARK_EVERY == 0 || *i + 1 == table_g.len())
         .map(|(_, (&x, &v))| (x, v))
         .collect();
-    out.extend(super::line_plot(
+    out.extend(crate::plot::line_plot(
         &out_dir.join("gloss_length"),
         "GGX average normal length ‖n_s‖ against gloss",
         "gloss g",
@@ -89,7 +89,7 @@ pub fn gloss_figures(out_dir: &Path, generated: &Path) -> Result<Vec<PathBuf>, P
     let published_err = error_curve(&published_1d);
     let refit_err = error_curve(&refit_1d);
     let max_abs = |s: &[(f64, f64)]| s.iter().fold(0.0_f64, |m, p| m.max(p.1.abs()));
-    out.extend(super::line_plot(
+    out.extend(crate::plot::line_plot(
         &out_dir.join("gloss_length_error"),
         "Error of the ‖n_s‖(g) fits (fit − exact)",
         "gloss g",
@@ -108,7 +108,7 @@ pub fn gloss_figures(out_dir: &Path, generated: &Path) -> Result<Vec<PathBuf>, P
     // (3) The combine table on the refit's sample grid.
     let exact_2d: Vec<f64> = grid_y.iter().flat_map(|&y| grid_x.iter().map(move |&x| combine(x, y))).collect();
     let (x_label, y_label) = ("gloss x", "gloss y");
-    out.extend(super::heatmap(
+    out.extend(crate::plot::heatmap(
         &out_dir.join("gloss_combine_table"),
         &format!("Combined gloss g(L(x)·L(y)), {}×{} grid", grid_x.len(), grid_y.len()),
         x_label,
@@ -131,7 +131,7 @@ pub fn gloss_figures(out_dir: &Path, generated: &Path) -> Result<Vec<PathBuf>, P
     };
     let published_map = error_map(&published_combine);
     let refit_map = error_map(&|x, y| refit_combine(&refit_2d, x, y));
-    let range = super::symmetric_range(published_map.iter().chain(&refit_map));
+    let range = crate::plot::symmetric_range(published_map.iter().chain(&refit_map));
     let stats = |m: &[f64]| {
         let max = m.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
         let rms = (m.iter().map(|v| v * v).sum::<f64>() / m.len() as f64).sqrt();
@@ -143,7 +143,7 @@ pub fn gloss_figures(out_dir: &Path, generated: &Path) -> Result<Vec<PathBuf>, P
         ("gloss_combine_error_published", &published_title, &published_map),
         ("gloss_combine_error_refit", &refit_title, &refit_map),
     ] {
-        out.extend(super::heatmap_with_range(
+        out.extend(crate::plot::heatmap_with_range(
             &out_dir.join(stem),
             title,
             x_label,
@@ -156,7 +156,7 @@ pub fn gloss_figures(out_dir: &Path, generated: &Path) -> Result<Vec<PathBuf>, P
             Some(range),
         )?);
     }
-    out.extend(super::grid_of_heatmaps(
+    out.extend(crate::plot::grid_of_heatmaps(
         &out_dir.join("gloss_combine_errors"),
         "Error of the gloss-combine fits (fit − exact)",
         x_label,
@@ -281,7 +281,7 @@ mod tests {
     #[test]
     fn refit_combine_matches_published_form() {
         // With the published coefficients (q0 = 1) the two evaluations coincide.
-        use crate::validate::gloss::{PUBLISHED_COMBINE_P as P, PUBLISHED_COMBINE_Q as Q};
+        use crate::family::gloss::published::{PUBLISHED_COMBINE_P as P, PUBLISHED_COMBINE_Q as Q};
         let c = [P[0], P[1], P[2], P[3], Q[1], Q[2], Q[3]];
         for &(x, y) in &[(0.1, 0.9), (0.5, 0.5), (0.95, 0.3), (0.0, 1.0)] {
             assert_eq!(refit_combine(&c, x, y), published_combine(x, y));

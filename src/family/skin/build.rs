@@ -17,16 +17,16 @@
 //! `Mode::Committed` (build --check) takes the texel values and the measured errors from the
 //! committed JSON and re-renders every file without integrating.
 
-use super::{BuildError, Built, Mode, Verification, fmt_err, json_text, spec_rel_path};
-use crate::emit::skin::{Layout, SkinLutCode};
+use crate::pipeline::{BuildError, Built, Mode, Verification, fmt_err, json_text, spec_rel_path};
+use super::emit::{Layout, SkinLutCode};
 use crate::emit::texture::{ktx2_rgba, png_srgb_preview};
 use crate::emit::{Artifact, GENERATOR, header_lines};
 use crate::integrate::{Estimate, Tolerance};
-use crate::quantity::skin::{
-    self, DEFAULT_TOLERANCE, Kernel, lut_n_dot_l, punctual_grid_estimates, sh_bands_estimates,
+use super::integrals::{
+    self as skin, DEFAULT_TOLERANCE, Kernel, lut_n_dot_l, punctual_grid_estimates, sh_bands_estimates,
 };
 use crate::spec::Spec;
-use crate::spec::skin::{SkinLut, SkinLutKind};
+use super::spec::{SkinLut, SkinLutKind};
 use serde_json::{Value, json};
 use sha2::{Digest, Sha256};
 use std::path::Path;
@@ -64,7 +64,7 @@ fn tolerance(lut: &SkinLut) -> Tolerance {
 }
 
 fn profile_err(spec: &Spec, e: skin::ProfileError) -> BuildError {
-    BuildError::Skin { spec: spec.file.name.clone(), msg: e.to_string() }
+    BuildError::Input { spec: spec.file.name.clone(), msg: e.to_string() }
 }
 
 /// The integrals at n·l ∈ `nls` × κ ∈ `kappas` (punctual) or at κ ∈ `kappas` for bands 1, 2

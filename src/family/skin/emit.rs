@@ -15,10 +15,10 @@
 //! - WGSL only, `NAME_sample(lut, lut_sampler, ..)`: `textureSampleLevel` at `NAME_uv`, for the
 //!   KTX2 texture (generated/data/NAME.ktx2) bound with a linear, clamp-to-edge sampler.
 
-use super::expr::sanitize;
-use super::f32_literal;
-use super::texture::TextureFormat;
-use crate::quantity::skin::CurvatureMapping;
+use crate::emit::expr::sanitize;
+use crate::emit::f32_literal;
+use crate::emit::texture::TextureFormat;
+use super::integrals::CurvatureMapping;
 
 /// Texel layout of a skin LUT.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -19,8 +19,8 @@
 //! is zero, negative or NaN, a negative or NaN weight, a channel that is zero everywhere, a
 //! radius that does not increase.
 
-use super::SpecError;
-use crate::quantity::skin::{DEON_LUEBKE_SKIN, Gaussian, Profile, ProfileError};
+use crate::spec::SpecError;
+use super::integrals::{DEON_LUEBKE_SKIN, Gaussian, Profile, ProfileError};
 use serde::Deserialize;
 use serde_json::{Value, json};
 use sha2::{Digest, Sha256};
@@ -296,8 +296,8 @@ pub fn load_profile_file(path: &Path) -> Result<LoadedProfile, SpecError> {
     struct ProfileFile {
         profile: ProfileSection,
     }
-    let f: ProfileFile = super::parse_toml(path, &text)?;
-    f.profile.load(path, &text, super::line_of(&text, "profile"))
+    let f: ProfileFile = crate::spec::parse_toml(path, &text)?;
+    f.profile.load(path, &text, crate::spec::line_of(&text, "profile"))
 }
 
 #[cfg(test)]
@@ -310,8 +310,8 @@ mod tests {
             profile: ProfileSection,
         }
         let path = Path::new("fits/x.toml");
-        let f: F = super::super::parse_toml(path, text)?;
-        f.profile.load(path, text, super::super::line_of(text, "profile"))
+        let f: F = crate::spec::parse_toml(path, text)?;
+        f.profile.load(path, text, crate::spec::line_of(text, "profile"))
     }
 
     #[test]

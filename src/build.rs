@@ -1,0 +1,181 @@
+//! The build orchestration behind `shadefit build` and `build --scene`: specs built
+//! concurrently on the rayon pool (each also parallelises its own sampling on the same pool),
+//! collected in spec order so the outputs do not depend on scheduling; the spec files written
+//! before the scene modules (which read their specs' coefficients from generated/json); the
+//! runtime index last. `--check` renders everything in memory and compares instead of writing.
+//!
+//! Family spec kinds and scene features come from the registry (`crate::family`); the stages
+//! below never name a family.
+
+use crate::emit::WriteError;
+use crate::family;
+use crate::pipeline::{self, BuildError, Built, CustomBuild, Mode};
+use crate::scene::{self, Scene, SceneReport};
+use crate::spec::{self, Spec, SpecError};
+use rayon::prelude::*;
+use std::path::{Path, PathBuf};
+
+/// Errors of a build. [`Error::is_input`] tells the user's input (exit 2) from a failed job.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    #[error(transparent)]
+    Spec(#[from] SpecError),
+    #[error("no spec named '{name}' in {dir} (known: {known})")]
+    UnknownSpec { name: String, dir: PathBuf, known: String },
+    #[error("building {spec}")]
+    Build {
+        spec: String,
+        #[source]
+        source: BuildError,
+    },
+    #[error("building scene {scene}")]
+    Scene {
+        scene: String,
+        #[source]
+        source: BuildError,
+    },
+    #[error(transparent)]
+    Write(#[from] WriteError),
+    #[error("{count} generated file(s) differ from what the specs and committed coefficients produce; run `shadefit build`")]
+    Stale { count: usize },
+}
+
+impl Error {
+    /// The error is the user's input (a spec, a manifest, a name), not a failed job.
+    pub fn is_input(&self) -> bool {
+        matches!(self, Error::Spec(_) | Error::UnknownSpec { .. })
+    }
+}
+
+/// Project paths: specs in `fits/`, outputs in `generated/`.
+#[derive(Debug, Clone)]
+pub struct Paths {
+    pub fits: PathBuf,
+    pub generated: PathBuf,
+}
+
+/// The builder of a family spec kind, from the registry.
+pub fn custom_builder(kind: &str) -> Option<CustomBuild> {
+    family::spec_kind(kind).map(|k| k.build)
+}
+
+/// Build one spec (any kind) in the given mode; `root` is the generated/ folder.
+pub fn build_spec(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> {
+    pipeline::build_spec(spec, mode, root, &custom_builder)
+}
+
+/// Every spec in `paths.fits`, checking that each name in `only` is one of them.
+pub fn load_specs(paths: &Paths, only: &[String]) -> Result<Vec<Spec>, Error> {
+    let specs = spec::load_dir(&paths.fits, family::catalog())?;
+    for name in only {
+        if !specs.iter().any(|s| &s.file.name == name) {
+            return Err(Error::UnknownSpec {
+                name: name.clone(),
+                dir: paths.fits.clone(),
+                known: specs.iter().map(|s| s.file.name.as_str()).collect::<Vec<_>>().join(", "),
+            });
+        }
+    }
+    Ok(specs)
+}
+
+/// The scene manifests in `fits/scenes`.
+pub fn load_scenes(paths: &Paths) -> Result<Vec<Scene>, Error> {
+    Ok(Scene::load_dir(&paths.fits.join("scenes"))?)
+}
+
+/// What a build did: each spec's result and time, each scene module's time, files written.
+#[derive(Debug)]
+pub struct Summary {
+    pub built: Vec<(Built, f64)>,
+    pub scenes: Vec<(String, f64)>,
+    /// Files rendered in all (written or unchanged).
+    pub files: usize,
+    pub written: usize,
+    /// `--check`: the files that differ (stale or orphaned); empty when up to date.
+    pub stale: Vec<String>,
+    pub specs: usize,
+}
+
+/// `shadefit build [--only A,B] [--check]`; `tick` is called once per spec built.
+pub fn run(paths: &Paths, only: &[String], check: bool, tick: &(dyn Fn() + Sync)) -> Result<Summary, Error> {
+    let specs = load_specs(paths, only)?;
+    let selected: Vec<&Spec> = specs.iter().filter(|s| only.is_empty() || only.contains(&s.file.name)).collect();
+    let mode = if check { Mode::Committed } else { Mode::Fit };
+    let results: Vec<Result<(Built, f64), Error>> = selected
+        .par_iter()
+        .map(|s| {
+            let t = std::time::Instant::now();
+            let b = build_spec(s, mode, &paths.generated).map_err(|source| Error::Build { spec: s.file.name.clone(), source })?;
+            tick();
+            Ok((b, t.elapsed().as_secs_f64()))
+        })
+        .collect();
+    let built: Vec<(Built, f64)> = results.into_iter().collect::<Result<_, _>>()?;
+    let scenes = load_scenes(paths)?;
+    let mut artifacts: Vec<_> = built.iter().flat_map(|(b, _)| b.artifacts.clone()).collect();
+    // The scene modules read their specs' coefficients from generated/json: write this build's
+    // first, so a scene never specialises the previous build's fit.
+    let spec_files = artifacts.len();
+    let mut written = if check { 0 } else { pipeline::write_all(&paths.generated, &artifacts)? };
+    let mut scene_times = Vec::new();
+    if only.is_empty() {
+        // Every scene module, with the node files of this build recorded for its cache.
+        for sc in &scenes {
+            let t = std::time::Instant::now();
+            let nodes: Vec<scene::NodeRecord> = scene::plan(sc)
+                .nodes
+                .iter()
+                .filter_map(|n| {
+                    let (b, _) = built.iter().find(|(b, _)| &b.name == n)?;
+                    let spec = specs.iter().find(|s| &s.file.name == n)?;
+                    Some(scene::node_record(n, pipeline::input_hash(spec), &b.artifacts))
+                })
+                .collect();
+            let sb = scene::build_scene(sc, &specs, &paths.generated, &nodes)
+                .map_err(|source| Error::Scene { scene: sc.file.name.clone(), source })?;
+            artifacts.extend(sb.artifacts);
+            scene_times.push((sc.module(), t.elapsed().as_secs_f64()));
+        }
+    }
+    artifacts.push(scene::runtime_index(&specs, &scenes));
+    let mut stale = Vec::new();
+    if check {
+        stale = pipeline::stale(&paths.generated, &artifacts);
+        if only.is_empty() {
+            stale.extend(pipeline::orphans(&paths.generated, &artifacts).into_iter().map(|p| format!("{p} (no spec produces it)")));
+        }
+    } else {
+        // The spec files were written above; now the scene modules and the runtime index.
+        written += pipeline::write_all(&paths.generated, &artifacts[spec_files..])?;
+    }
+    Ok(Summary { built, scenes: scene_times, files: artifacts.len(), written, stale, specs: selected.len() })
+}
+
+/// `shadefit build --scene FILE [--force]`: only the nodes the scene reaches, each only when its
+/// inputs or files changed since the scene's last build, then the scene module.
+pub fn run_scene(paths: &Paths, file: &Path, force: bool) -> Result<SceneReport, Error> {
+    let sc = Scene::load(file)?;
+    let specs = load_specs(paths, &[])?;
+    let mut scenes = load_scenes(paths)?;
+    if !scenes.iter().any(|s| s.file.name == sc.file.name) {
+        scenes.push(sc.clone());
+    }
+    scene::build(&sc, &specs, &scenes, &paths.generated, force, &custom_builder)
+        .map_err(|source| Error::Scene { scene: sc.file.name.clone(), source })
+}
+
+/// `shadefit list`: each spec with whether its generated files are up to date (`Err`: why not).
+pub fn status(paths: &Paths) -> Result<Vec<(Spec, Result<bool, String>)>, Error> {
+    let specs = spec::load_dir(&paths.fits, family::catalog())?;
+    Ok(specs
+        .into_iter()
+        .map(|s| {
+            let st = match build_spec(&s, Mode::Committed, &paths.generated) {
+                Ok(b) => Ok(pipeline::stale(&paths.generated, &b.artifacts).is_empty()),
+                Err(e) => Err(e.to_string()),
+            };
+            (s, st)
+        })
+        .collect())
+}

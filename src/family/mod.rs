@@ -1,0 +1,140 @@
+//! The family registry. A family is everything about one shading model's terms: its
+//! quantities and integrands, its published constants and findings, its figures, its benchmark
+//! rows and shader forms, its scene features and its own spec kinds. Each lives in one folder
+//! here and describes itself with a [`Family`]; [`families`] lists them.
+//!
+//! The generic stages (`spec`, `pipeline`, `validate`, `plot`, `bench`, `scene`) never name a
+//! family: they take the hooks they need (a [`Catalog`], slices of functions) from the caller,
+//! and the build orchestration (`crate::build`) and the CLI fill them from this registry. Adding
+//! a family is one folder and one line in [`FAMILIES`] (see ARCHITECTURE.md).
+
+pub mod fuzz;
+pub mod gloss;
+pub mod skin;
+
+use crate::bench::FamilyBench;
+use crate::pipeline::{BuildError, Built, Mode};
+use crate::plot::PlotError;
+use crate::quantity::QuantityDef;
+use crate::scene::Feature;
+use crate::spec::{Catalog, KindDef, Spec};
+use crate::validate::Item;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+/// A spec kind of a family's own: how its specs are checked and how they are built.
+#[derive(Debug)]
+pub struct SpecKind {
+    pub spec: KindDef,
+    pub build: fn(&Spec, Mode, &Path) -> Result<Built, BuildError>,
+}
+
+/// `shadefit eval` options a family may take (`--profile`, `--kernel`).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct EvalOptions<'a> {
+    pub profile: Option<&'a Path>,
+    pub kernel: Option<&'a str>,
+}
+
+/// What `eval` prints for a quantity evaluated with options: one value per channel, the largest
+/// error estimate, extra JSON fields and a note for the text form.
+#[derive(Debug, Clone)]
+pub struct OptionEval {
+    pub values: Vec<f64>,
+    pub error: f64,
+    pub extra: serde_json::Map<String, serde_json::Value>,
+    pub note: String,
+}
+
+/// Evaluates a quantity (canonical parameters) with options; `Err` is bad input.
+pub type EvalWithOptions = fn(&QuantityDef, &[f64], &EvalOptions) -> Result<OptionEval, String>;
+
+/// What a family offers. Plain data and function pointers.
+pub struct Family {
+    pub name: &'static str,
+    pub doc: &'static str,
+    /// Quantities `eval` serves and specs sample.
+    pub quantities: &'static [QuantityDef],
+    /// Spec kinds of the family's own (beyond fit, table, fields).
+    pub spec_kinds: &'static [SpecKind],
+    /// `eval` with `--profile`/`--kernel`: which quantities take them, and the evaluator.
+    pub eval_options: Option<(&'static [&'static str], EvalWithOptions)>,
+    /// Published constants measured against the integrals (`shadefit validate`); the argument
+    /// is the generated/ folder (committed refits are measured beside them).
+    pub validate: fn(&Path) -> Vec<Item>,
+    /// Figures into the first folder from the committed outputs in the second.
+    pub figures: fn(&Path, &Path) -> Result<Vec<PathBuf>, PlotError>,
+    /// Benchmark rows: integrators, tables against numpy/scipy, shader forms.
+    pub bench: FamilyBench,
+    /// Scene features (`features = [...]` in scene manifests).
+    pub scene_features: &'static [Feature],
+}
+
+/// Every family, in the order `eval --help`, `validate` and `plot` list them.
+pub static FAMILIES: &[&Family] = &[&gloss::FAMILY, &fuzz::FAMILY, &skin::FAMILY];
+
+pub fn families() -> &'static [&'static Family] {
+    FAMILIES
+}
+
+/// Every quantity and family spec kind, for the spec layer.
+pub fn catalog() -> &'static Catalog {
+    static CATALOG: OnceLock<Catalog> = OnceLock::new();
+    CATALOG.get_or_init(|| Catalog {
+        quantities: FAMILIES.iter().flat_map(|f| f.quantities.iter()).collect(),
+        kinds: FAMILIES.iter().flat_map(|f| f.spec_kinds.iter().map(|k| &k.spec)).collect(),
+    })
+}
+
+/// The family spec kind named `name`.
+pub fn spec_kind(name: &str) -> Option<&'static SpecKind> {
+    FAMILIES.iter().flat_map(|f| f.spec_kinds.iter()).find(|k| k.spec.name == name)
+}
+
+/// The family that serves quantity `name`.
+pub fn of_quantity(name: &str) -> Option<&'static Family> {
+    FAMILIES.iter().copied().find(|f| f.quantities.iter().any(|q| q.name == name))
+}
+
+/// Every scene feature, by name.
+pub fn scene_features() -> BTreeMap<&'static str, &'static Feature> {
+    FAMILIES.iter().flat_map(|f| f.scene_features.iter()).map(|x| (x.name, x)).collect()
+}
+
+/// The `eval --help` text: every quantity with its parameters and what it is.
+pub fn eval_help() -> String {
+    let mut out = String::from("Quantities:\n");
+    for q in FAMILIES.iter().flat_map(|f| f.quantities.iter()) {
+        let mut params: Vec<String> = q.params.iter().map(|p| format!("{}=…", p.name)).collect();
+        for (a, _, _) in q.aliases {
+            params.push(format!("| {}=…", a.name));
+        }
+        out.push_str(&format!("  {:<18} {:<36} {}\n", q.name, params.join(" "), q.doc));
+    }
+    out.push_str("(angles in radians; README lists the domains)");
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_are_unique_across_families() {
+        let mut seen = std::collections::BTreeSet::new();
+        for f in FAMILIES {
+            assert!(seen.insert(format!("family {}", f.name)), "family {} twice", f.name);
+            for q in f.quantities {
+                assert!(seen.insert(format!("quantity {}", q.name)), "quantity {} twice", q.name);
+            }
+            for k in f.spec_kinds {
+                assert!(seen.insert(format!("kind {}", k.spec.name)), "spec kind {} twice", k.spec.name);
+                assert!(!["fit", "table", "fields"].contains(&k.spec.name), "{} shadows a generic kind", k.spec.name);
+            }
+            for x in f.scene_features {
+                assert!(seen.insert(format!("feature {}", x.name)), "scene feature {} twice", x.name);
+            }
+        }
+    }
+}
