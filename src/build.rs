@@ -47,12 +47,7 @@ impl Error {
     }
 }
 
-/// Project paths: specs in `fits/`, outputs in `generated/`.
-#[derive(Debug, Clone)]
-pub struct Paths {
-    pub fits: PathBuf,
-    pub generated: PathBuf,
-}
+pub use crate::pipeline::Paths;
 
 /// The builder of a family spec kind, from the registry.
 pub fn custom_builder(kind: &str) -> Option<CustomBuild> {

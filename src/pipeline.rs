@@ -12,7 +12,7 @@
 //! Samples are computed in parallel with rayon and collected in grid order, so outputs are
 //! byte-identical at any thread count.
 
-use crate::emit::expr;
+use crate::fit::expr;
 use crate::emit::{self, header_lines, rust, wgsl, Artifact, GENERATOR};
 use crate::fit::positivity::{prove_denominator_positive, Positivity};
 use crate::fit::{self, f32round, Data, FitOptions, FitReport};
@@ -25,6 +25,13 @@ use sha2::{Digest, Sha256};
 use std::path::Path;
 
 pub mod fields;
+
+/// Project paths: specs in `fits/`, outputs in `generated/`.
+#[derive(Debug, Clone)]
+pub struct Paths {
+    pub fits: std::path::PathBuf,
+    pub generated: std::path::PathBuf,
+}
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Mode {

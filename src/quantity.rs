@@ -1,6 +1,5 @@
-//! Quantities: what `shadefit eval` serves and specs sample. Each family (`crate::family`)
-//! declares its own [`QuantityDef`]s; this module is the generic type and the look-up over every
-//! family's quantities.
+//! Quantities: what `shadefit eval` serves and specs sample. Each family declares its own
+//! [`QuantityDef`]s (see `src/family/`); the spec layer looks them up in a `spec::Catalog`.
 
 use crate::integrate::Estimate;
 use std::collections::BTreeMap;
@@ -28,7 +27,7 @@ pub struct QuantityDef {
     /// Evaluate at canonical parameters (already inside the domain) to an absolute tolerance.
     pub eval: fn(&[f64], f64) -> Estimate,
     /// For 1-D quantities: the inverse map value → parameter, used to report a fit's error in
-    /// parameter units (e.g. gloss recovered from a fitted length).
+    /// parameter units (e.g. the parameter recovered from a fitted value).
     pub inverse: Option<fn(f64) -> f64>,
     /// Vector-valued quantities (e.g. RGB): channel names and the evaluator of all channels.
     /// Their `eval` returns channel 0; specs do not take them yet.
@@ -74,17 +73,6 @@ pub enum QuantityError {
     NotInteger { quantity: String, param: String, value: f64 },
     #[error("{quantity}: parameter '{param}' is given twice (directly or through an alias)")]
     Duplicate { quantity: String, param: String },
-}
-
-/// Every quantity of every family, in registry order.
-pub fn registry() -> impl Iterator<Item = &'static QuantityDef> {
-    crate::family::families().iter().flat_map(|f| f.quantities.iter())
-}
-
-pub fn lookup(name: &str) -> Result<&'static QuantityDef, QuantityError> {
-    registry().find(|q| q.name == name).ok_or_else(|| {
-        QuantityError::Unknown(name.to_string(), registry().map(|q| q.name).collect::<Vec<_>>().join(", "))
-    })
 }
 
 impl QuantityDef {

@@ -3,7 +3,8 @@
 //! measured error. Everything is rendered in memory first; [`write_all`] then writes each
 //! file to a temporary name and renames it, so a failed build leaves generated/ untouched.
 
-pub mod expr;
+/// The expression tree of a fitted model (it lives with the model; emit renders it).
+pub use crate::fit::expr;
 pub mod fields;
 pub mod rust;
 pub mod texture;

@@ -5,7 +5,7 @@
 //!
 //! The generic stages (`spec`, `pipeline`, `validate`, `plot`, `bench`, `scene`) never name a
 //! family: they take the hooks they need (a [`Catalog`], slices of functions) from the caller,
-//! and the build orchestration (`crate::build`) and the CLI fill them from this registry. Adding
+//! and the build orchestration (`src/build.rs`) and the CLI fill them from this registry. Adding
 //! a family is one folder and one line in [`FAMILIES`] (see ARCHITECTURE.md).
 
 pub mod fuzz;

@@ -29,7 +29,7 @@ use super::model::RationalModel;
 use super::positivity::{prove_denominator_positive, Positivity};
 use super::problem::Data;
 use super::solve::{FitError, Objective};
-use crate::emit::expr::{self, Expr};
+use crate::fit::expr::{self, Expr};
 use nalgebra::DVector;
 use serde::{Deserialize, Serialize};
 

@@ -1,7 +1,9 @@
-//! Fitting: model forms (`model`), the problem on data (`problem`), solvers (`solve`),
+//! Fitting: model forms (`model`) and their expression trees (`expr`, evaluated in f32 here and
+//! rendered by `emit`), the problem on data (`problem`), solvers (`solve`),
 //! reports (`report`), the denominator positivity proof (`positivity`) and the f32 coefficients
 //! of emitted code (`f32round`).
 
+pub mod expr;
 pub mod f32round;
 pub mod fields;
 pub mod minimax;

@@ -4,7 +4,7 @@
 //!
 //! (`lead` is the constant 1 unless the model names another term, as G̃'s d + c₂μ + c₃μ³ does)
 //! over *features*: the inputs, then derived features, each a cos, sin or affine map of one
-//! input (β = 1 − α, γ = cos θ_f, δ = sin θ_f in the fuzz fits).
+//! input (e.g. β = 1 − α, γ = cos θ_f, δ = sin θ_f).
 //!
 //! where every basis function φ_j, ψ_j is a *term*: a sum of monomials sharing one coefficient
 //! (`"x^2 + y^2"` ties the coefficients of x² and y²; `"x*y"` is one monomial; `"1"` is the
@@ -420,12 +420,6 @@ impl RationalModel {
     /// Full coefficients [a; b] from free parameters θ.
     pub fn full(&self, theta: &DVector<f64>) -> DVector<f64> {
         &self.map * theta + &self.map0
-    }
-
-    /// Least-squares projection of full coefficients onto the free parameters (exact when
-    /// `c` satisfies the constraints).
-    pub fn free_from_full(&self, c: &DVector<f64>) -> DVector<f64> {
-        DVector::from_iterator(self.free.len(), self.free.iter().map(|&i| c[i]))
     }
 
     pub fn map(&self) -> &DMatrix<f64> {

@@ -15,7 +15,7 @@
 //! it happens): the error is the form's, not the coefficients'.
 
 use super::{committed_json, input_hash, json_text, spec_rel_path, tensor, BuildError, Built, Denominators, Mode, Verification};
-use crate::emit::expr::{self, model_expr};
+use crate::fit::expr::{self, model_expr};
 use crate::emit::fields::{self as efields, Field, FieldsFunction};
 use crate::emit::{header_lines, Artifact, GENERATOR};
 use crate::fit::fields::{fit_fields, FieldOptions, PointData};

@@ -17,7 +17,7 @@ fn gloss_length(p: &[f64], _tol: f64) -> Estimate {
 }
 
 fn gloss_from_length(p: &[f64], _tol: f64) -> Estimate {
-    // Bisection to one ulp of g; the inverse amplifies L's rounding by 1/(dL/dg) ≤ 1e5.
+    // Illinois regula falsi to one ulp of g (see integrals.rs); the inverse amplifies L's rounding by 1/(dL/dg) ≤ 1e5.
     Estimate { value: integrals::gloss_from_length(p[0]), error: 1e5 * 4.0 * f64::EPSILON, evals: 64 }
 }
 

@@ -15,7 +15,7 @@
 //! - WGSL only, `NAME_sample(lut, lut_sampler, ..)`: `textureSampleLevel` at `NAME_uv`, for the
 //!   KTX2 texture (generated/data/NAME.ktx2) bound with a linear, clamp-to-edge sampler.
 
-use crate::emit::expr::sanitize;
+use crate::fit::expr::sanitize;
 use crate::emit::f32_literal;
 use crate::emit::texture::TextureFormat;
 use super::integrals::CurvatureMapping;
