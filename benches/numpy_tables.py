@@ -10,7 +10,7 @@ against the rows written here at equal max error. Only numpy, scipy and the stan
 used.
 
 These are deliberately the *straightforward* methods, not tuned ones: the defining integral as
-written (module docs of src/quantity/gloss.rs, fuzz.rs, skin.rs), handed to
+written (module docs of src/family/{gloss,fuzz,skin}/integrals.rs), handed to
 `scipy.integrate.quad` / `dblquad` point by point, or to a vectorised Gauss–Legendre rule (or
 Monte Carlo) over all points at once, with no change of variables, no splitting at features
 beyond the obvious kinks, no closed-form inner integrals. Where scipy offers a closed form a user
@@ -130,7 +130,7 @@ def chunks(count: int, per_item: int):
 
 
 # =============================================================================================
-# Gloss (src/quantity/gloss.rs): L(g) = 2α² ∫₀¹ t² / (1 − (1 − α²) t²)² dt, α² = 2/(1 + 2^(18g))
+# Gloss (src/family/gloss/integrals.rs): L(g) = 2α² ∫₀¹ t² / (1 − (1 − α²) t²)² dt, α² = 2/(1 + 2^(18g))
 
 L_FLAT = 2.0 / 3.0  # L at g = 0 (α = 1)
 
@@ -223,7 +223,7 @@ def combine_bisection(x: np.ndarray, y: np.ndarray, n: int) -> np.ndarray:
 
 
 # =============================================================================================
-# Skin (src/quantity/skin.rs): d'Eon–Luebke six Gaussians (GPU Gems 3 ch. 14), mm and mm²
+# Skin (src/family/skin/integrals.rs): d'Eon–Luebke six Gaussians (GPU Gems 3 ch. 14), mm and mm²
 
 SKIN_VARIANCES = np.array([0.0064, 0.0484, 0.187, 0.567, 1.99, 7.41])
 SKIN_WEIGHTS = np.array([  # (R, G, B) per Gaussian
@@ -326,7 +326,7 @@ def sh_gl(kappa: np.ndarray, n: int) -> np.ndarray:
 
 
 # =============================================================================================
-# Fuzz (src/quantity/fuzz.rs): n = +z, t = (sin θf, 0, cos θf), u = (sin θu cos φu, sin θu sin φu, cos θu),
+# Fuzz (src/family/fuzz/integrals.rs): n = +z, t = (sin θf, 0, cos θf), u = (sin θu cos φu, sin θu sin φu, cos θu),
 # D_F(h) = α³/(π((h·t)²(1 − α²) + α²)²), σ_F(u) = √(1 − (u·t)²(1 − α²)), p(u, v) = D_F(h)/(4σ_F(u)),
 # h = (u + v)/|u + v|; P_s(u) = ∫_{v·n<0} p(u, v) dω_v.
 

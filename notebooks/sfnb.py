@@ -111,7 +111,7 @@ def table_value(g: dict, x) -> np.ndarray:
 
 def fuzz_ps_args(theta_f, theta_u, phi_u):
     """(n·u, t·u) for the light (θu, φu) and the fiber angle θf: normal +z, fiber
-    t = (sin θf, 0, cos θf), φu from the fiber azimuth (src/quantity/fuzz.rs)."""
+    t = (sin θf, 0, cos θf), φu from the fiber azimuth (src/family/fuzz/integrals.rs)."""
     n_u = np.cos(theta_u)
     t_u = np.sin(theta_u) * np.cos(phi_u) * np.sin(theta_f) + np.cos(theta_u) * np.cos(theta_f)
     return n_u, t_u

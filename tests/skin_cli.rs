@@ -38,7 +38,7 @@ fn eval_with_profiles_and_kernels() {
     assert_eq!(own["profile"]["source"], "gaussians");
     assert_eq!(own["kernel"], "linear");
     let radial = json(&shadefit(&[&args[..], &["--kernel", "radial"]].concat(), None));
-    // The radial ring kernel scatters less across the terminator (quantity::skin tests).
+    // The radial ring kernel scatters less across the terminator (family::skin::integrals tests).
     for (a, b) in rgb(&default).iter().zip(rgb(&radial)) {
         assert!(a > &(b + 1e-3), "{a} vs {b}");
     }
@@ -189,7 +189,7 @@ fn csv_profile_spec_builds_checks_and_goes_stale_when_the_csv_changes() {
     assert_eq!(v["profile"]["source"], "csv");
     assert_eq!(v["profile"]["csv"], "profiles/skin.csv");
     // The sampled profile gives nearly the committed Gaussian LUT: piecewise-linear
-    // interpolation of R on 201 samples (quantity::skin tests bound it by 1e-3).
+    // interpolation of R on 201 samples (family::skin::integrals tests bound it by 1e-3).
     let committed: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(root().join("generated/json/skin_sh_lut.json")).unwrap()).unwrap();
     let flat = |v: &serde_json::Value| -> Vec<f64> {

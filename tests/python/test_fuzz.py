@@ -1,5 +1,5 @@
 """`shadefit eval` of the fuzz-layer integrals (fuzz-ps, fuzz-g, fuzz-q, fuzz-r) against scipy and
-numpy computations written here from the definitions only (src/quantity/fuzz.rs module doc):
+numpy computations written here from the definitions only (src/family/fuzz/integrals.rs module doc):
 
     n = +z,  t = (sin θf, 0, cos θf),  u = (sin θu cos φu, sin θu sin φu, cos θu)
     D_F(h) = α³ / (π ((h·t)²(1 − α²) + α²)²),   σ_F(u) = sqrt(1 − (u·t)²(1 − α²))

@@ -565,7 +565,7 @@ def test_fields_f32_arrays_are_rounded_coefficients(name):
 
 def fields_args_f32(quantity, outer, inner):
     """The evaluator's arguments as the build computes them: in f64 in the order of
-    src/quantity/mod.rs (fuzz_ps_args: t.u = sin theta_u cos phi_u sin theta_f + cos theta_u cos
+    src/family/fuzz/mod.rs (fuzz_ps_args: t.u = sin theta_u cos phi_u sin theta_f + cos theta_u cos
     theta_f, with the C library's sin and cos, as Rust's), then to f32, clamped to [-1, 1]."""
     if quantity != "fuzz-ps":
         raise AssertionError(f"no light-direction convention for quantity {quantity!r} in this suite")

@@ -1,7 +1,7 @@
-//! The build of a skin LUT spec (`kind = "skin-lut"`, see `spec::skin`): tabulate, verify,
+//! The build of a skin LUT spec (`kind = "skin-lut"`, see `super::spec`): tabulate, verify,
 //! emit.
 //!
-//! - tabulate: every texel is the integral of `quantity::skin` (punctual: the ring, RGB, with
+//! - tabulate: every texel is the integral of `super::integrals` (punctual: the ring, RGB, with
 //!   the spec's kernel; SH: bands 1 and 2 of the sphere) at the grid point, to the spec's
 //!   tolerance per channel; curvature rows in parallel, collected in order (byte-identical at
 //!   any thread count);
@@ -9,7 +9,7 @@
 //!   mapped coordinates), against bilinear interpolation of the f64 texels and against the
 //!   emitted f32 lookup; the texture's storage error (f16 or f32 rounding of the texels); the
 //!   largest quadrature error estimate;
-//! - emit: `wgsl/NAME.wgsl` and `src/NAME.rs` (const arrays and lookups, `emit::skin`),
+//! - emit: `wgsl/NAME.wgsl` and `src/NAME.rs` (const arrays and lookups, `super::emit`),
 //!   `data/NAME.ktx2` (linear RGBA, alpha 1), `data/NAME.png` (sRGB preview, κ = 0 row at the
 //!   top) and `json/NAME.json` (provenance: profile, kernel, mapping, tolerance, texel values in
 //!   f64, measured errors).

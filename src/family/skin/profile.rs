@@ -3,7 +3,7 @@
 //!
 //! ```toml
 //! [profile]                 # at most one of the three keys; none: preset "deon-luebke"
-//! preset = "deon-luebke"    # d'Eon & Luebke's six Gaussians (quantity::skin::DEON_LUEBKE_SKIN)
+//! preset = "deon-luebke"    # d'Eon & Luebke's six Gaussians (integrals::DEON_LUEBKE_SKIN)
 //! gaussians = [             # your own sum of Gaussians: variance in mm², RGB weights
 //!   { variance = 0.0064, weights = [0.233, 0.455, 0.649] },
 //!   { variance = 0.0484, weights = [0.100, 0.336, 0.344] },

@@ -13,7 +13,7 @@
 //! tolerance = 1e-10                # optional: quadrature tolerance per texel and channel
 //! texture_format = "rgba16float"   # optional: KTX2 texels, "rgba16float" or "rgba32float"
 //!
-//! [profile]                        # optional (see spec::profile): preset, gaussians or csv
+//! [profile]                        # optional (see super::profile): preset, gaussians or csv
 //! preset = "deon-luebke"
 //!
 //! [emit]
@@ -22,7 +22,7 @@
 //!
 //! Texel (i, j) of a skin-punctual LUT holds D at n·l = −1 + 2i/(n_u − 1) and at
 //! κ = κ_max·mapping⁻¹(j/(n_v − 1)); a skin-sh LUT has one row per band (1 and 2; band 0 is 1)
-//! and column i at κ = κ_max·mapping⁻¹(i/(n − 1)). See `pipeline::skin` for the outputs.
+//! and column i at κ = κ_max·mapping⁻¹(i/(n − 1)). See `super::build` for the outputs.
 //!
 //! The spec is checked here with errors that name the file, the line and the field; it then
 //! enters the common [`SpecFile`] with its axes (curvature, n_dot_l or band) spelled out, so
@@ -38,7 +38,7 @@ use std::path::Path;
 
 /// The `kind` value of skin LUT specs.
 pub const KIND: &str = "skin-lut";
-/// Default quadrature tolerance per texel and channel (quantity::skin::DEFAULT_TOLERANCE).
+/// Default quadrature tolerance per texel and channel (integrals::DEFAULT_TOLERANCE).
 pub const DEFAULT_TOLERANCE: f64 = 1e-10;
 /// Tolerances accepted: the LUT promises ≤ 1e-6 per channel; below 1e-14 the adaptive rule
 /// cannot converge in f64 on values of order 1.
