@@ -160,15 +160,38 @@ pub fn run_scene(paths: &Paths, file: &Path, force: bool) -> Result<SceneReport,
         .map_err(|source| Error::Scene { scene: sc.file.name.clone(), source })
 }
 
-/// `shadefit list`: each spec with whether its generated files are up to date (`Err`: why not).
-pub fn status(paths: &Paths) -> Result<Vec<(Spec, Result<bool, String>)>, Error> {
+/// Whether a spec's committed outputs were generated from it, by hashes alone.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Status {
+    /// `generated/json/NAME.json` records the spec's current input hash.
+    Current,
+    /// It records another hash: the spec (or a file it reads) changed since.
+    Changed,
+    /// No readable `generated/json/NAME.json`.
+    NotBuilt,
+}
+
+/// `shadefit list`: each spec with its [`Status`]. It compares the input hash recorded in the
+/// committed JSON with the spec's (no integration, fitting or rendering); `build --check`
+/// re-renders every file and compares the bytes.
+pub fn status(paths: &Paths) -> Result<Vec<(Spec, Status)>, Error> {
     let specs = spec::load_dir(&paths.fits, family::catalog())?;
     Ok(specs
         .into_iter()
         .map(|s| {
-            let st = match build_spec(&s, Mode::Committed, &paths.generated) {
-                Ok(b) => Ok(pipeline::stale(&paths.generated, &b.artifacts).is_empty()),
-                Err(e) => Err(e.to_string()),
+            let path = paths.generated.join("json").join(format!("{}.json", s.file.name));
+            let recorded = std::fs::read_to_string(&path)
+                .ok()
+                .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
+                .and_then(|v| v["input_hash"].as_str().map(str::to_string));
+            let current = match s.file.kind {
+                spec::Kind::Custom(kind) => family::catalog().kind(kind).map_or_else(|| pipeline::input_hash(&s), |k| (k.input_hash)(&s)),
+                _ => pipeline::input_hash(&s),
+            };
+            let st = match recorded {
+                None => Status::NotBuilt,
+                Some(h) if h == current => Status::Current,
+                Some(_) => Status::Changed,
             };
             (s, st)
         })

@@ -233,9 +233,9 @@ pub fn list(paths: &Paths) -> Result<()> {
     println!("{:<22} {:<8} {:<18} {:<28} status", "name", "kind", "quantity", "function");
     for (s, st) in &specs {
         let status = match st {
-            Ok(true) => "up to date".to_string(),
-            Ok(false) => "stale".to_string(),
-            Err(e) => format!("stale ({})", short(e)),
+            build::Status::Current => "up to date",
+            build::Status::Changed => "stale (spec changed)",
+            build::Status::NotBuilt => "not built",
         };
         println!(
             "{:<22} {:<8} {:<18} {:<28} {status}",
@@ -246,10 +246,6 @@ pub fn list(paths: &Paths) -> Result<()> {
         );
     }
     Ok(())
-}
-
-fn short(s: &str) -> String {
-    s.split(';').next().unwrap_or(s).chars().take(60).collect()
 }
 
 pub fn fit_data(

@@ -115,6 +115,13 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    // A closed pipe ends the process quietly, as it does other command-line tools (Rust ignores
+    // SIGPIPE by default, and printing to a closed pipe would then panic).
+    #[cfg(unix)]
+    // SAFETY: called first in main, before any other thread exists; SIG_DFL is a valid handler.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     let cli = Cli::parse();
     let paths = Paths { fits: cli.fits, generated: cli.generated };
     let result = match cli.command {

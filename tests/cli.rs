@@ -82,6 +82,23 @@ fn malformed_specs_exit_2_name_file_line_field_and_write_nothing() {
     // An rms cap only means something for minimax.
     let l = line_of(&spec, "objective") + 1;
     bad_spec_case("gloss_length.toml", |t| t.replace("objective = \"minimax\"", "objective = \"lsq\"\nmax_rms = 0.01"), l, "max_rms");
+    // Fixed-size arrays take exactly their size: a third number is not dropped silently.
+    let l = line_of(&spec, "range");
+    bad_spec_case("gloss_length.toml", |t| t.replace("range = [0.0, 1.0]", "range = [0.0, 0.5, 1.0]"), l, "range");
+    // (the clamp goes in on the numerator's line, the numerator one line down)
+    let l = line_of(&spec, "numerator");
+    bad_spec_case("gloss_length.toml", |t| t.replace("numerator = [", "clamp = [0.0, 0.5, 1.0]\nnumerator = ["), l, "clamp");
+    // Terms whose coefficients cannot be told apart, and an empty numerator.
+    let l = line_of(&spec, "numerator");
+    bad_spec_case("gloss_length.toml", |t| t.replace("numerator = [\"1\", \"gloss\",", "numerator = [\"1\", \"gloss\", \"gloss\","), l, "numerator");
+    bad_spec_case("gloss_length.toml", |t| t.replace("numerator = [\"1\", \"gloss\",", "numerator = [\"1\", \"gloss + gloss^2\","), l, "numerator");
+    bad_spec_case("gloss_length.toml", |t| t.replace("numerator = [\"1\", \"gloss\", \"gloss^2\", \"gloss^3\"]", "numerator = []"), l, "numerator");
+    // Function and argument names that would not compile in Rust or WGSL.
+    let l = line_of(&spec, "function");
+    for kw in ["fn", "self", "loop", "_", "override"] {
+        bad_spec_case("gloss_length.toml", |t| t.replace("function = \"gloss_to_normal_length\"", &format!("function = \"{kw}\"")), l, "function");
+    }
+    bad_spec_case("gloss_length.toml", |t| t.replace("function = \"gloss_to_normal_length\"", "function = \"gloss_to_normal_length\"\nargs = [\"let\"]"), l + 1, "args");
     // A two-stage spec whose offsets do not match its basis (6 terms), or that has no evaluator.
     let spec = std::fs::read_to_string(root().join("fits/fuzz_ps.toml")).unwrap();
     let l = line_of(&spec, "offsets");
@@ -146,8 +163,8 @@ fn build_is_byte_identical_at_any_thread_count() {
 
 fn nist_csv(name: &str, dir: &Path) -> PathBuf {
     // NIST StRD .dat: data rows after the "Data:  y  x" line; columns y then x.
-    let text = std::fs::read_to_string(root().join("../shared/data/nist").join(format!("{name}.dat")))
-        .expect("NIST data in ../shared/data/nist");
+    let text = std::fs::read_to_string(root().join("tests/data/nist").join(format!("{name}.dat")))
+        .expect("NIST data in tests/data/nist");
     let mut csv = String::from("x,y\n");
     let mut on = false;
     for line in text.lines() {
@@ -288,4 +305,43 @@ fn bench_rejects_an_unknown_section() {
     let out = shadefit(&["bench", "--only", "integrators,speed"], None);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("unknown section 'speed'"));
+}
+
+#[test]
+fn spec_names_that_collide_with_the_runtime_crate_exit_2() {
+    // A spec named like a hand-written runtime file, the emitted index or a scene module would
+    // overwrite it; a keyword would not compile.
+    for name in ["lib", "emitted", "runtime", "scene_velvet_horse", "fn", "self"] {
+        let d = scratch();
+        let text = std::fs::read_to_string(d.path().join("fits/gloss_length.toml")).unwrap();
+        std::fs::write(d.path().join(format!("fits/{name}.toml")), text.replace("name = \"gloss_length\"", &format!("name = \"{name}\""))).unwrap();
+        let o = shadefit(&["build"], Some(d.path()));
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{name}: {err}");
+        assert!(err.contains(&format!("{name}.toml:")) && err.contains("'name'"), "{name}: {err}");
+        assert_nothing_written(d.path());
+    }
+}
+
+#[test]
+fn a_closed_pipe_ends_the_cli_quietly() {
+    // `shadefit list | head -1`: the reader goes away after one line; no panic, no message.
+    use std::io::{BufRead, BufReader};
+    use std::process::{Command, Stdio};
+    for args in [vec!["list"], vec!["samples", "gloss_length"]] {
+        let mut c = Command::new(env!("CARGO_BIN_EXE_shadefit"))
+            .args(&args)
+            .current_dir(root())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        let mut first = String::new();
+        BufReader::new(c.stdout.take().unwrap()).read_line(&mut first).unwrap();
+        assert!(!first.is_empty(), "{args:?}");
+        let o = c.wait_with_output().unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(err.is_empty(), "{args:?} printed on stderr: {err}");
+        assert!(o.status.success() || std::os::unix::process::ExitStatusExt::signal(&o.status) == Some(13), "{args:?}: {:?}", o.status);
+    }
 }

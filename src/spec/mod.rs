@@ -34,6 +34,9 @@
 //! ```
 
 pub mod data;
+pub mod names;
+
+pub use names::is_identifier;
 
 use crate::fit::model::{Derived, ModelError, ModelParts, Pin, RationalModel, Term};
 use crate::fit::Objective;
@@ -100,6 +103,17 @@ pub fn parse_toml<T: for<'de> Deserialize<'de>>(path: &Path, text: &str) -> Resu
     })
 }
 
+/// Exactly two numbers (`[lo, hi]`): serde's fixed-size arrays would silently drop extra ones.
+fn pair<'de, D: serde::Deserializer<'de>>(d: D) -> Result<[f64; 2], D::Error> {
+    let v = Vec::<f64>::deserialize(d)?;
+    <[f64; 2]>::try_from(v.as_slice())
+        .map_err(|_| serde::de::Error::invalid_length(v.len(), &"exactly two numbers [lo, hi]"))
+}
+
+fn optional_pair<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<[f64; 2]>, D::Error> {
+    pair(d).map(Some)
+}
+
 #[derive(Debug, Clone, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct PinSpec {
@@ -125,6 +139,7 @@ pub struct ModelSpec {
     #[serde(default)]
     pub offset: f64,
     pub factor: Option<String>,
+    #[serde(default, deserialize_with = "optional_pair")]
     pub clamp: Option<[f64; 2]>,
     #[serde(default)]
     pub fixed: BTreeMap<String, f64>,
@@ -156,6 +171,31 @@ impl ModelSpec {
         };
         let num = parse_all("numerator", &self.numerator)?;
         let den = parse_all("denominator", &self.denominator)?;
+        if num.is_empty() {
+            return Err(SpecError::new(path, line_of(text, "numerator"), "numerator", "needs at least one term"));
+        }
+        // A monomial in two terms of one polynomial makes their coefficients inseparable: the
+        // fit is singular (only their sum is determined).
+        for (field, terms) in [("numerator", &num), ("denominator", &den)] {
+            let lead_one = field == "denominator" && self.denominator_lead.is_none();
+            let mut seen: Vec<(&crate::fit::model::Monomial, usize)> = Vec::new();
+            for (i, t) in terms.iter().enumerate() {
+                for m in &t.monomials {
+                    if lead_one && m.exps.iter().all(|&e| e == 0) {
+                        return Err(SpecError::new(path, line_of(text, field), field, "the constant 1 is implicit in the denominator: remove the term '1'"));
+                    }
+                    if let Some(&(_, j)) = seen.iter().find(|(n, _)| *n == m) {
+                        let msg = if j == i {
+                            format!("term '{}' repeats a monomial", t.label)
+                        } else {
+                            format!("terms '{}' and '{}' share a monomial: their coefficients cannot be told apart", terms[j].label, t.label)
+                        };
+                        return Err(SpecError::new(path, line_of(text, field), field, msg));
+                    }
+                    seen.push((m, i));
+                }
+            }
+        }
         let factor = match &self.factor {
             Some(f) => Some(Term::parse(f, &features).map_err(|e| err("factor", e))?),
             None => None,
@@ -267,6 +307,9 @@ pub struct KindDef {
     pub spec_file: fn(&Path, &str) -> Result<Option<SpecFile>, SpecError>,
     /// Why `shadefit samples` has nothing to print for specs of this kind ({name}: the spec).
     pub samples_note: &'static str,
+    /// The input hash its builder records in `generated/json/NAME.json` (the spec text and
+    /// whatever else the build reads, e.g. a data file the spec names).
+    pub input_hash: fn(&Spec) -> String,
 }
 
 /// What specs may name: every quantity and every family spec kind (built from the family
@@ -293,6 +336,7 @@ impl Catalog {
 #[serde(deny_unknown_fields)]
 pub struct AxisSpec {
     pub name: String,
+    #[serde(deserialize_with = "pair")]
     pub range: [f64; 2],
     pub count: usize,
     /// Verification grid size along this axis (default: 4·count + 1).
@@ -373,13 +417,6 @@ pub struct Spec {
     pub model: Option<RationalModel>,
 }
 
-/// A lowercase identifier: a-z or _, then a-z, 0-9 or _.
-pub(crate) fn is_identifier(s: &str) -> bool {
-    let mut chars = s.chars();
-    matches!(chars.next(), Some(c) if c.is_ascii_lowercase() || c == '_')
-        && chars.all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_')
-}
-
 impl Spec {
     pub fn load(path: &Path, catalog: &Catalog) -> Result<Spec, SpecError> {
         let text = std::fs::read_to_string(path)
@@ -400,14 +437,14 @@ impl Spec {
             None => parse_toml(path, &text)?,
         };
         let at = |field: &str, msg: String| SpecError::new(path, line_of(&text, field), field, msg);
-        if !is_identifier(&file.name) {
-            return Err(at("name", format!("'{}' must be a lowercase identifier (a-z, 0-9, _)", file.name)));
+        if let Some(why) = names::check_spec_name(&file.name) {
+            return Err(at("name", why));
         }
         if path.file_stem().and_then(|s| s.to_str()) != Some(file.name.as_str()) {
             return Err(at("name", format!("'{}' must match the file name", file.name)));
         }
-        if !is_identifier(&file.emit.function) {
-            return Err(at("function", format!("'{}' is not a valid function name", file.emit.function)));
+        if let Some(why) = names::check_identifier(&file.emit.function) {
+            return Err(at("function", format!("not a valid function name: {why}")));
         }
         let quantity = catalog.lookup(&file.quantity).map_err(|e| at("quantity", e.to_string()))?;
         let n_args = match (file.kind, quantity.basis) {
@@ -415,9 +452,15 @@ impl Spec {
             _ => file.axis.len(),
         };
         if let Some(args) = &file.emit.args
-            && (args.len() != n_args || args.iter().any(|a| !is_identifier(a)))
+            && (args.len() != n_args || args.iter().any(|a| names::check_identifier(a).is_some()))
         {
-            return Err(at("args", format!("needs {n_args} lowercase identifiers, one per (outer) axis")));
+            let why = args.iter().find_map(|a| names::check_identifier(a)).unwrap_or_else(|| format!("{} given", args.len()));
+            return Err(at("args", format!("needs {n_args} distinct identifiers, one per (outer) axis ({why})")));
+        }
+        if let Some(args) = &file.emit.args
+            && let Some(dup) = args.iter().enumerate().find(|(i, a)| args[..*i].contains(a)).map(|(_, a)| a)
+        {
+            return Err(at("args", format!("'{dup}' is given twice")));
         }
         if !(file.tolerance > 0.0 && file.tolerance < 1.0) {
             return Err(at("tolerance", format!("{} must be in (0, 1)", file.tolerance)));
@@ -521,7 +564,7 @@ fn fields_model(
         ));
     }
     match &file.emit.evaluator {
-        Some(e) if is_identifier(e) && *e != file.emit.function => {}
+        Some(e) if names::check_identifier(e).is_none() && *e != file.emit.function => {}
         _ => return Err(at("evaluator", "kind = \"fields\" needs emit.evaluator, a function name other than emit.function".into())),
     }
     if m.offset != 0.0 {

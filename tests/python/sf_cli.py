@@ -9,8 +9,8 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
 BIN = Path(os.environ.get("SHADEFIT_BIN", ROOT / "target" / "release" / "shadefit"))
-# NIST StRD data lives in shared/ beside the clone (../shared from the repository root).
-NIST_DIR = Path(os.environ.get("SHADEFIT_NIST_DIR", ROOT / ".." / "shared" / "data" / "nist"))
+# NIST StRD data, vendored with its headers (tests/data/nist/README.md).
+NIST_DIR = Path(os.environ.get("SHADEFIT_NIST_DIR", ROOT / "tests" / "data" / "nist"))
 OUT_DIR = Path(os.environ.get("SHADEFIT_PYTEST_OUT", ROOT / "tests" / "python" / "out"))
 
 

@@ -56,7 +56,7 @@ def normalised(name, b):
 def load_nist(name):
     """(x, y) of a NIST .dat file: rows after the line 'Data:  y  x' (CRLF line endings)."""
     path = sf_cli.NIST_DIR / f"{name}.dat"
-    assert path.is_file(), f"NIST data missing: {path} (expected shared/ beside the clone)"
+    assert path.is_file(), f"NIST data missing: {path} (vendored in tests/data/nist)"
     lines = path.read_text().splitlines()
     start = next(i for i, l in enumerate(lines) if l.startswith("Data:") and l.split()[1:2] == ["y"])
     rows = [l.split() for l in lines[start + 1:] if l.strip()]

@@ -79,6 +79,12 @@ static SKIN_LUT: SpecKind = SpecKind {
         name: spec::KIND,
         spec_file: spec::spec_file,
         samples_note: "{name} is a skin LUT: its samples are its texels, \"values\" in generated/json/{name}.json (RGB, with the axes)",
+        input_hash: |s| match spec::SkinLut::from_spec(s) {
+            Ok(lut) => build::input_hash(s, &lut),
+            // An unreadable profile: the hash of the text alone, which then differs from the
+            // recorded one and reports the spec stale.
+            Err(_) => crate::pipeline::input_hash(s),
+        },
     },
     build: build::build,
 };
