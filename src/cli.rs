@@ -259,7 +259,11 @@ pub fn fit_data(
     let model = load_model(model_arg, x_cols)?;
     let data: Data = read_csv(data_path, x_cols, y_col).map_err(input_err)?;
     let opts = FitOptions { objective, ..FitOptions::default() };
-    let f = fit::fit(&model, &data, &opts, &data_path.display().to_string())?;
+    let f = match fit::fit_rescaled(&model, &data, &opts, &data_path.display().to_string()) {
+        // Too few rows for the model, or none: the user's input.
+        Err(e @ (fit::FitError::NoData { .. } | fit::FitError::Underdetermined { .. })) => return Err(input_err(e)),
+        r => r?,
+    };
     let nn = model.numerator.len();
     let c = &f.coefficients;
     let mut den = vec![1.0];

@@ -27,9 +27,12 @@ enum Command {
     /// Evaluate an integral (not a fit) at one point: QUANTITY name=value ...
     #[command(after_help = shadefit::family::eval_help())]
     Eval {
+        /// The quantity to integrate (listed below with its parameters).
         quantity: String,
-        /// Parameters as name=value.
+        /// Parameters as name=value, every parameter of the quantity once (or an alias).
         params: Vec<String>,
+        /// Print one JSON object {"quantity", "params", "value", "error_estimate"} (RGB
+        /// quantities: "value" is an array and "channels" names its entries).
         #[arg(long)]
         json: bool,
         /// Quantities whose family takes it: a profile file (e.g. a diffusion profile, a TOML
@@ -68,11 +71,14 @@ enum Command {
         /// Target column.
         #[arg(long)]
         y: String,
-        /// `rational(m,n)` or a model spec TOML file.
+        /// `rational(m,n)` (degree m over degree n in the one --x column) or a model spec TOML
+        /// file (README "Spec files": the [model] keys plus `features`).
         #[arg(long)]
         model: String,
+        /// lsq: least squares; minimax: the smallest maximum error; l4: Σ r⁴, between the two.
         #[arg(long, default_value = "lsq")]
         objective: Objective,
+        /// Print the coefficients, errors and worst point as one JSON object.
         #[arg(long)]
         json: bool,
     },

@@ -208,6 +208,55 @@ fn nist_kirby2_certified_from_no_start_values() {
 }
 
 #[test]
+fn nist_kirby2_in_extreme_units_reports_in_those_units() {
+    // Kirby2's y times 2^500 (≈ 3e150) and 2^-990 (≈ 1e-298): squares of such values overflow
+    // or underflow the residual sums unless the data is scaled first. The certified solution
+    // times the same power of two is the answer (numerator and rss scale; the denominator,
+    // normalised to 1, does not); acceptance as for Kirby2 itself, 1e-6 relative.
+    let d = tempfile::tempdir().unwrap();
+    let csv = std::fs::read_to_string(nist_csv("Kirby2", d.path())).unwrap();
+    for k in [500, -990] {
+        let s = 2f64.powi(k);
+        let mut scaled = String::from("x,y\n");
+        for line in csv.lines().skip(1) {
+            let (x, y) = line.split_once(',').unwrap();
+            scaled.push_str(&format!("{x},{:e}\n", y.parse::<f64>().unwrap() * s));
+        }
+        let p = d.path().join(format!("kirby2_{k}.csv"));
+        std::fs::write(&p, scaled).unwrap();
+        let v = fit_json(&["fit", "--data", p.to_str().unwrap(), "--x", "x", "--y", "y", "--model", "rational(2,2)", "--json"]);
+        // rms scales by 2^k (the rss by 2^2k, representable only for k = 500).
+        let rms = v["rms_error"].as_f64().unwrap() / s;
+        let want = (3.9050739624f64 / 151.0).sqrt();
+        assert!((rms - want).abs() < 1e-6 * want, "2^{k}: rms {rms}");
+        if k == 500 {
+            let rss = v["rss"].as_f64().unwrap() / (s * s);
+            assert!((rss - 3.9050739624).abs() < 1e-6 * 3.9050739624, "2^{k}: rss {rss}");
+        }
+        let num: Vec<f64> = v["numerator"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap() / s).collect();
+        for (got, want) in num.iter().zip([1.6745063063, -1.3927397867e-1, 2.5961181191e-3]) {
+            assert!((got - want).abs() < 1e-6 * f64::abs(want), "2^{k}: {got} vs {want}");
+        }
+        let den: Vec<f64> = v["denominator"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
+        for (got, want) in den[1..].iter().zip([-1.7241811870e-3, 2.1664802578e-5]) {
+            assert!((got - want).abs() < 1e-6 * f64::abs(want), "2^{k}: {got} vs {want}");
+        }
+    }
+}
+
+#[test]
+fn too_few_rows_for_the_model_exit_2() {
+    let d = tempfile::tempdir().unwrap();
+    for rows in ["x,y\n1,2\n", "x,y\n1,2\n2,3\n"] {
+        let p = d.path().join("short.csv");
+        std::fs::write(&p, rows).unwrap();
+        let o = shadefit(&["fit", "--data", p.to_str().unwrap(), "--x", "x", "--y", "y", "--model", "rational(2,2)"], None);
+        assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+        assert!(stderr(&o).contains("short.csv") && stderr(&o).contains("5 free coefficients"), "{}", stderr(&o));
+    }
+}
+
+#[test]
 fn nist_mgh09_certified_from_no_start_values() {
     let d = tempfile::tempdir().unwrap();
     let csv = nist_csv("MGH09", d.path());

@@ -16,4 +16,4 @@ pub mod solve;
 pub use model::{Pin, RationalModel, Term};
 pub use problem::Data;
 pub use report::FitReport;
-pub use solve::{fit, Fit, FitError, FitOptions, LsqSolver, Objective};
+pub use solve::{fit, fit_rescaled, Fit, FitError, FitOptions, LsqSolver, Objective};

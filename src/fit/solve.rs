@@ -85,6 +85,12 @@ pub enum FitError {
     PoleInDomain { what: String, lower: f64, region: Vec<(f64, f64)> },
     #[error("{what}: solver failed: {msg}")]
     Solver { what: String, msg: String },
+    #[error("{what}: {source}")]
+    Model {
+        what: String,
+        #[source]
+        source: crate::fit::model::ModelError,
+    },
 }
 
 /// A fitted model: free parameters, full coefficients and the report on the fitting data.
@@ -93,6 +99,47 @@ pub struct Fit {
     pub theta: DVector<f64>,
     pub coefficients: DVector<f64>,
     pub report: FitReport,
+}
+
+/// [`fit`] of data in any units: the values are divided by a power of two 2^k near their largest
+/// magnitude before solving (exactly, so nothing is rounded), the model's offset, numerator
+/// constraints, pins and clamp with them, and the numerator coefficients and the report are
+/// multiplied back. Values near 1e±300 otherwise overflow (or underflow) the residual sums:
+/// a singular start, or an rss of 0. Data within 2^±64 of 1 is fitted unscaled, exactly as by
+/// [`fit`]. `theta` and the condition number are the scaled problem's. The features are not
+/// scaled (a monomial's coefficient would scale with its degree, and terms tie monomials).
+pub fn fit_rescaled(model: &RationalModel, data: &Data, opts: &FitOptions, what: &str) -> Result<Fit, FitError> {
+    let top = data.y.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let k = if top > 0.0 && top.is_finite() { top.log2().round() as i32 } else { 0 };
+    if k.abs() < 64 {
+        return fit(model, data, opts, what);
+    }
+    let scale = 2f64.powi(k);
+    let nn = model.numerator.len();
+    let parts = crate::fit::model::ModelParts {
+        inputs: model.features[..model.n_inputs].to_vec(),
+        derived: model.derived.clone(),
+        numerator: model.numerator.clone(),
+        denominator: model.denominator.clone(),
+        lead: model.lead.clone(),
+        offset: model.offset / scale,
+        factor: model.factor.clone(),
+        fixed: model.fixed.iter().map(|&(i, v)| (i, if i < nn { v / scale } else { v })).collect(),
+        pins: model.pins.iter().map(|p| crate::fit::model::Pin { value: p.value / scale, ..p.clone() }).collect(),
+        clamp: model.clamp.map(|(a, b)| (a / scale, b / scale)),
+    };
+    let scaled = RationalModel::new(parts).map_err(|e| FitError::Model { what: what.into(), source: e })?;
+    let y: Vec<f64> = data.y.iter().map(|v| v / scale).collect();
+    let mut f = fit(&scaled, &Data { x: data.x.clone(), y }, opts, what)?;
+    for j in 0..nn {
+        f.coefficients[j] *= scale;
+    }
+    let r = &mut f.report;
+    r.rss *= scale * scale;
+    r.max_abs_error *= scale;
+    r.rms_error *= scale;
+    r.worst_residual *= scale;
+    Ok(f)
 }
 
 /// Fit `model` to `data` from no start values.

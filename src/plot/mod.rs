@@ -93,6 +93,17 @@ impl Series {
         self.color = Some(index);
         self
     }
+
+    /// The same series in the colour of an RGB channel ("red", "green" or "blue": tab10's red,
+    /// green and blue), whatever its position in the plot; other names keep the position's.
+    pub fn channel(self, name: &str) -> Self {
+        match name {
+            "red" => self.color(3),
+            "green" => self.color(2),
+            "blue" => self.color(0),
+            _ => self,
+        }
+    }
 }
 
 /// One panel of [`grid_of_heatmaps`]: its title and its values (same layout as [`heatmap`]).
@@ -818,6 +829,26 @@ mod tests {
         for (p, b) in second.iter().zip(&bytes) {
             assert!(std::fs::read(p).unwrap() == *b, "{} differs between renders", p.display());
         }
+    }
+
+    #[test]
+    fn rgb_channels_are_drawn_in_their_own_colours() {
+        // Series named red, green, blue in that order: by position they would take tab10's
+        // blue, orange and green; by channel they take its red, green and blue.
+        let dir = tempfile::tempdir().unwrap();
+        let xs: Vec<f64> = (0..8).map(|i| i as f64).collect();
+        let series: Vec<Series> = ["red", "green", "blue"]
+            .iter()
+            .enumerate()
+            .map(|(k, n)| Series::new(*n, xs.iter().map(|&x| (x, x + k as f64)).collect(), SeriesStyle::Line).channel(n))
+            .collect();
+        let files = line_plot(&dir.path().join("rgb"), "rgb", "x", "y", &series, false).unwrap();
+        let svg = std::fs::read_to_string(files.iter().find(|p| p.extension().unwrap() == "svg").unwrap()).unwrap().to_uppercase();
+        let hex = |c: RGBColor| format!("#{:02X}{:02X}{:02X}", c.0, c.1, c.2);
+        for want in [PALETTE[3], PALETTE[2], PALETTE[0]] {
+            assert!(svg.contains(&hex(want)), "{} missing", hex(want));
+        }
+        assert!(!svg.contains(&hex(PALETTE[1])), "orange (position 1) drawn");
     }
 
     #[test]

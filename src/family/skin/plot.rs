@@ -197,7 +197,7 @@ fn punctual_figures(out_dir: &Path, lut: &Lut) -> Result<Vec<PathBuf>, PlotError
         .enumerate()
         .map(|(c, name)| {
             let pts = nls.iter().enumerate().map(|(i, &x)| (x, lut.values[j * w + i][c])).collect();
-            Series::new(*name, pts, SeriesStyle::Line)
+            Series::new(*name, pts, SeriesStyle::Line).channel(name)
         })
         .collect();
     series.push(Series::new("max(n·l, 0)", lambert, SeriesStyle::Dashed));
@@ -274,7 +274,7 @@ fn sh_figures(out_dir: &Path, lut: &Lut) -> Result<Vec<PathBuf>, PlotError> {
     for (c, name) in ["red", "green", "blue"].iter().enumerate() {
         for (band, style) in [(1, SeriesStyle::Line), (2, SeriesStyle::Dashed)] {
             let pts = kappas.iter().enumerate().map(|(i, &k)| (k, lut.values[(band - 1) * w + i][c])).collect();
-            series.push(Series::new(format!("k_{band} {name}"), pts, style));
+            series.push(Series::new(format!("k_{band} {name}"), pts, style).channel(name));
         }
     }
     crate::plot::line_plot(
