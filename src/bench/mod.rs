@@ -10,6 +10,10 @@
 //! - [`forms`]: shader cost (op counts from naga's IR, [`ops`]) against max error, several
 //!   approximation forms per quantity.
 //!
+//! The harness names no family: what each section runs comes from the [`FamilyBench`] hooks the
+//! caller passes (the CLI passes every registered family's), and the helpers here (timing,
+//! ladders, rows, the Pareto front, rendering) are what the families build their rows with.
+//!
 //! Quick mode (`--quick`, what the test command runs) uses fewer points and settings; both
 //! modes print one table per section, or one JSON document with `--json`.
 
@@ -19,10 +23,10 @@ pub mod integrals;
 pub mod ops;
 pub mod tables;
 
-use crate::spec::Spec;
-use anyhow::Result;
+use crate::spec::{Catalog, Spec};
 use serde::Serialize;
 use std::fmt::Write as _;
+use std::path::Path;
 use std::time::Instant;
 
 /// Quick (CI) or full run.
@@ -43,7 +47,7 @@ impl Mode {
 }
 
 /// Seconds per call of `f` (repeated until `min_seconds` have passed) and its last result.
-pub(crate) fn time_it<T>(min_seconds: f64, mut f: impl FnMut() -> T) -> (f64, T) {
+pub fn time_it<T>(min_seconds: f64, mut f: impl FnMut() -> T) -> (f64, T) {
     let start = Instant::now();
     let mut runs = 0u32;
     loop {
@@ -57,7 +61,7 @@ pub(crate) fn time_it<T>(min_seconds: f64, mut f: impl FnMut() -> T) -> (f64, T)
 }
 
 /// splitmix64: the fixed-seed generator of the Monte Carlo baselines and the sample subsets.
-pub(crate) struct SplitMix(pub u64);
+pub struct SplitMix(pub u64);
 
 impl SplitMix {
     pub fn next_f64(&mut self) -> f64 {
@@ -91,32 +95,40 @@ pub struct Report {
     pub forms: Vec<forms::FormRow>,
 }
 
-/// Run the selected sections.
-pub fn run(
-    mode: Mode,
-    sections: Sections,
-    specs: &[Spec],
-    paths: &crate::cli::Paths,
-    python: Option<&tables::Python>,
-) -> Result<Report> {
+/// What the sections run on.
+pub struct Inputs<'a> {
+    /// The specs in fits/ (the fits and tables sections pick theirs by name).
+    pub specs: &'a [Spec],
+    /// The catalog the specs load with (the forms section loads specs and variants of them).
+    pub catalog: &'a Catalog,
+    /// The spec folder (fits/) and the committed outputs (generated/).
+    pub fits: &'a Path,
+    pub generated: &'a Path,
+    /// The numpy/scipy side of the tables section; `None`: shadefit's side only.
+    pub python: Option<&'a tables::Python>,
+}
+
+/// Run the selected sections over the rows of `families`.
+pub fn run(mode: Mode, sections: Sections, inputs: &Inputs, families: &[&FamilyBench]) -> anyhow::Result<Report> {
     let start = Instant::now();
     let integrators = if sections.integrators {
-        integrals::all(&mode)
+        integrals::all(&mode, families)
     } else {
         Vec::new()
     };
     let fits = if sections.fits {
-        fits::all(&mode, specs)
+        fits::all(&mode, inputs.specs, families)
     } else {
         Vec::new()
     };
     let tables = if sections.tables {
-        tables::all(&mode, specs, python)?
+        tables::all(&mode, inputs.specs, families, inputs.python)?
     } else {
         Vec::new()
     };
     let forms = if sections.forms {
-        forms::shader_forms_at(&paths.fits, &paths.generated, mode.quick)?
+        let ctx = forms::Ctx { fits: inputs.fits, generated: inputs.generated, quick: mode.quick, catalog: inputs.catalog };
+        forms::all(&ctx, families)?
     } else {
         Vec::new()
     };
@@ -305,10 +317,29 @@ fn ratio_line(label: &str, ratio: &Option<tables::Ratio>, note: &str) -> String 
     )
 }
 
-/// A family's benchmark rows (see `crate::family::Family::bench`).
-#[derive(Clone, Copy)]
-pub struct FamilyBench {}
+/// A family's benchmark rows (the `bench` field of its `Family` descriptor): plain data and
+/// function pointers. Each item has an `order`, its place in its section across families: a
+/// section runs and reports its items by `order` (ties in the order the families are passed).
+#[derive(Debug, Clone, Copy)]
+pub struct FamilyBench {
+    /// Integrator tables (the integrators section).
+    pub integrators: &'static [integrals::IntegratorBench],
+    /// Fit specs timed with every solver and objective (the fits section).
+    pub fits: &'static [fits::FitBench],
+    /// Default tables compared with numpy/scipy (the tables section).
+    pub tables: &'static [tables::TableBench],
+    /// Shader forms, one set per quantity (the forms section).
+    pub forms: &'static [forms::FormSet],
+}
 
 impl FamilyBench {
-    pub const NONE: FamilyBench = FamilyBench {};
+    /// No rows.
+    pub const NONE: FamilyBench = FamilyBench { integrators: &[], fits: &[], tables: &[], forms: &[] };
+}
+
+/// The items `field` picks from every family, by `order` (stable: ties keep the families' order).
+fn ordered<'a, T>(families: &[&'a FamilyBench], field: impl Fn(&'a FamilyBench) -> &'a [T], order: impl Fn(&T) -> u32) -> Vec<&'a T> {
+    let mut items: Vec<&T> = families.iter().flat_map(|f| field(f).iter()).collect();
+    items.sort_by_key(|t| order(t));
+    items
 }
