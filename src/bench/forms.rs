@@ -24,13 +24,12 @@
 //! thread count.
 
 use super::ops::{self, OpCounts};
-use super::FamilyBench;
+use super::{BenchError, FamilyBench};
 use crate::fit::positivity::{Positivity, prove_denominator_positive};
 use crate::fit::{Data, RationalModel};
 use crate::pipeline::{self, Built, Denominators, Reference, Verification};
 use crate::quantity::QuantityDef;
 use crate::spec::{Catalog, Spec};
-use anyhow::{Context, Result};
 use nalgebra::DVector;
 use rayon::prelude::*;
 use serde::Serialize;
@@ -65,18 +64,18 @@ pub struct FormSet {
     pub quantity: &'static str,
     /// Place in the section across families (see [`FamilyBench`]).
     pub order: u32,
-    pub forms: fn(&Ctx) -> Result<Vec<FormRow>>,
+    pub forms: fn(&Ctx) -> Result<Vec<FormRow>, BenchError>,
 }
 
 /// Every family's form sets, by order (see [`of`]).
-pub fn all(ctx: &Ctx, families: &[&FamilyBench]) -> Result<Vec<FormRow>> {
+pub fn all(ctx: &Ctx, families: &[&FamilyBench]) -> Result<Vec<FormRow>, BenchError> {
     let sets: Vec<FormSet> = super::ordered(families, |f| f.forms, |s| s.order).into_iter().copied().collect();
     of(ctx, &sets)
 }
 
 /// The rows of `sets` in the order given: each set's forms with their Pareto front, sorted by
 /// cost, then table bytes, then max error.
-pub fn of(ctx: &Ctx, sets: &[FormSet]) -> Result<Vec<FormRow>> {
+pub fn of(ctx: &Ctx, sets: &[FormSet]) -> Result<Vec<FormRow>, BenchError> {
     let mut rows = Vec::new();
     for set in sets {
         let mut r = (set.forms)(ctx)?;
@@ -113,17 +112,17 @@ impl Ctx<'_> {
     }
 
     /// The committed spec `name` in fits/.
-    pub fn spec(&self, name: &str) -> Result<Spec> {
+    pub fn spec(&self, name: &str) -> Result<Spec, BenchError> {
         Ok(Spec::load(&self.fits.join(format!("{name}.toml")), self.catalog)?)
     }
 
     /// The committed spec `base` as TOML with `edit` applied and named `name`: a spec in
     /// memory only (its path names no file).
-    pub fn variant(&self, base: &Spec, name: &str, edit: impl FnOnce(&mut toml::Table)) -> Result<Spec> {
-        let mut t: toml::Table = base.text.parse().with_context(|| format!("{}", base.path.display()))?;
+    pub fn variant(&self, base: &Spec, name: &str, edit: impl FnOnce(&mut toml::Table)) -> Result<Spec, BenchError> {
+        let mut t: toml::Table = base.text.parse().map_err(|source| BenchError::SpecToml { path: base.path.clone(), source })?;
         t.insert("name".into(), name.into());
         edit(&mut t);
-        let text = toml::to_string(&t).with_context(|| format!("variant {name}"))?;
+        let text = toml::to_string(&t).map_err(|source| BenchError::VariantToml { spec: name.to_string(), source })?;
         Ok(Spec::parse(&self.fits.join(format!("{name}.toml")), text, self.catalog)?)
     }
 }
@@ -188,36 +187,36 @@ impl Integral {
     }
 
     /// The spec's model fitted to the integral on a grid of `counts` over the spec's axes.
-    pub fn fit(&mut self, spec: &Spec, counts: &[usize]) -> Result<DVector<f64>> {
+    pub fn fit(&mut self, spec: &Spec, counts: &[usize]) -> Result<DVector<f64>, BenchError> {
         let x = pipeline::grid(spec, counts);
         let y = self.at(&x);
-        Ok(pipeline::fit_samples(spec, &Data { x, y })?.coefficients)
+        Ok(pipeline::fit_samples(spec, &Data { x, y }).map_err(BenchError::build(&spec.file.name))?.coefficients)
     }
 }
 
 /// The emitted WGSL library of a build.
-pub fn wgsl_of(built: &Built) -> Result<&str> {
+pub fn wgsl_of(built: &Built) -> Result<&str, BenchError> {
     let a = built
         .artifacts
         .iter()
         .find(|a| a.path.starts_with("wgsl"))
-        .with_context(|| format!("{}: no WGSL artifact", built.name))?;
-    Ok(std::str::from_utf8(&a.contents)?)
+        .ok_or_else(|| BenchError::NoWgsl { spec: built.name.clone() })?;
+    std::str::from_utf8(&a.contents).map_err(|source| BenchError::WgslUtf8 { spec: built.name.clone(), source })
 }
 
 /// The counts of `function` in a WGSL source of spec `spec`'s.
-pub fn count(spec: &str, wgsl: &str, function: &str) -> Result<OpCounts> {
-    ops::count(wgsl, function).with_context(|| format!("{spec}: counting the operations of `{function}`"))
+pub fn count(spec: &str, wgsl: &str, function: &str) -> Result<OpCounts, BenchError> {
+    ops::count(wgsl, function).map_err(|source| BenchError::Ops { spec: spec.to_string(), function: function.to_string(), source })
 }
 
 /// A parsed WGSL source of spec `spec`'s, for counting several of its functions.
-pub fn parse(spec: &str, wgsl: &str) -> Result<ops::Source> {
-    ops::Source::parse(wgsl).with_context(|| format!("{spec}: reading the emitted WGSL"))
+pub fn parse(spec: &str, wgsl: &str) -> Result<ops::Source, BenchError> {
+    ops::Source::parse(wgsl).map_err(|source| BenchError::Wgsl { spec: spec.to_string(), source })
 }
 
 /// The counts of `function` in a parsed source of spec `spec`'s.
-pub fn count_in(spec: &str, source: &ops::Source, function: &str) -> Result<OpCounts> {
-    source.count(function).with_context(|| format!("{spec}: counting the operations of `{function}`"))
+pub fn count_in(spec: &str, source: &ops::Source, function: &str) -> Result<OpCounts, BenchError> {
+    source.count(function).map_err(|source| BenchError::Ops { spec: spec.to_string(), function: function.to_string(), source })
 }
 
 /// Max and rms error over a number of points.
@@ -278,13 +277,13 @@ pub fn outer_domain(spec: &Spec, n: usize) -> Vec<(f64, f64)> {
 }
 
 /// A rational form: verified and emitted through the pipeline, its emitted function counted.
-pub fn fit_row(spec: &Spec, coefficients: DVector<f64>, reference: &Reference, form: &str, note: &str) -> Result<FormRow> {
+pub fn fit_row(spec: &Spec, coefficients: DVector<f64>, reference: &Reference, form: &str, note: &str) -> Result<FormRow, BenchError> {
     fit_row_f32(spec, coefficients, None, reference, form, note)
 }
 
 /// The committed fit of a spec, with the f32 coefficients its emitted code carries.
-pub fn refit_row(spec: &Spec, generated: &Path, reference: &Reference, note: &str) -> Result<FormRow> {
-    let (c, f32s) = pipeline::committed_fit(spec, generated)?;
+pub fn refit_row(spec: &Spec, generated: &Path, reference: &Reference, note: &str) -> Result<FormRow, BenchError> {
+    let (c, f32s) = pipeline::committed_fit(spec, generated).map_err(BenchError::build(&spec.file.name))?;
     fit_row_f32(spec, c, Some(f32s), reference, "refit", note)
 }
 
@@ -296,14 +295,14 @@ pub fn fit_row_f32(
     reference: &Reference,
     form: &str,
     note: &str,
-) -> Result<FormRow> {
+) -> Result<FormRow, BenchError> {
     let model = spec.model.as_ref().expect("fit specs carry a model");
     let poles = match check(form) {
         Denominators::Unchecked => unproven(model, &coefficients, &outer_domain(spec, spec.file.axis.len()), ""),
         Denominators::Proven => String::new(),
     };
     let built = pipeline::fit_from_coefficients(spec, coefficients, None, f32s, reference, check(form))
-        ?;
+        .map_err(BenchError::build(&spec.file.name))?;
     let ops = count(&spec.file.name, wgsl_of(&built)?, &spec.file.emit.function)?;
     let v = &built.verification;
     let shape = format!("{}/{} terms", model.numerator.len(), model.denominator.len());
@@ -312,9 +311,9 @@ pub fn fit_row_f32(
 }
 
 /// A table form (values at the spec's table points), verified and emitted through the pipeline.
-pub fn table_row(spec: &Spec, values: Vec<f64>, reference: &Reference, form: &str, note: &str) -> Result<FormRow> {
+pub fn table_row(spec: &Spec, values: Vec<f64>, reference: &Reference, form: &str, note: &str) -> Result<FormRow, BenchError> {
     let bytes = 4 * values.len();
-    let built = pipeline::table_from_values(spec, values, reference)?;
+    let built = pipeline::table_from_values(spec, values, reference).map_err(BenchError::build(&spec.file.name))?;
     let ops = count(&spec.file.name, wgsl_of(&built)?, &spec.file.emit.function)?;
     let v = &built.verification;
     let size: Vec<String> = spec.file.axis.iter().map(|a| a.count.to_string()).collect();
@@ -325,8 +324,8 @@ pub fn table_row(spec: &Spec, values: Vec<f64>, reference: &Reference, form: &st
 }
 
 /// The committed values of a table spec (generated/json).
-pub fn committed_values(spec: &Spec, generated: &Path) -> Result<Vec<f64>> {
-    Ok(pipeline::committed_values(spec, generated)?)
+pub fn committed_values(spec: &Spec, generated: &Path) -> Result<Vec<f64>, BenchError> {
+    pipeline::committed_values(spec, generated).map_err(BenchError::build(&spec.file.name))
 }
 
 /// A table spec's values: the integral at its grid points.
@@ -335,7 +334,7 @@ pub fn table_values(integral: &mut Integral, spec: &Spec) -> Vec<f64> {
 }
 
 /// A table over the axes of a fit or table spec, `count` points on every axis.
-pub fn table_spec(ctx: &Ctx, base: &Spec, name: &str, count: usize) -> Result<Spec> {
+pub fn table_spec(ctx: &Ctx, base: &Spec, name: &str, count: usize) -> Result<Spec, BenchError> {
     ctx.variant(base, name, |t| {
         t.remove("model");
         t.remove("fit");

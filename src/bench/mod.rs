@@ -23,11 +23,121 @@ pub mod integrals;
 pub mod ops;
 pub mod tables;
 
-use crate::spec::{Catalog, Spec};
+use crate::pipeline::BuildError;
+use crate::spec::{Catalog, Spec, SpecError};
 use serde::Serialize;
 use std::fmt::Write as _;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
+
+/// Why a benchmark run failed.
+#[derive(Debug, thiserror::Error)]
+pub enum BenchError {
+    /// A spec in fits/, or a variant of one made for a form, does not load.
+    #[error(transparent)]
+    Spec(#[from] SpecError),
+    /// A committed spec's text is not TOML (variants start from it).
+    #[error("{path}: not a TOML table")]
+    SpecToml {
+        path: PathBuf,
+        #[source]
+        source: toml::de::Error,
+    },
+    /// A variant of a spec could not be written back as TOML.
+    #[error("variant {spec}")]
+    VariantToml {
+        spec: String,
+        #[source]
+        source: toml::ser::Error,
+    },
+    /// Fitting, verifying or emitting a form through the pipeline.
+    #[error("building {spec}")]
+    Build {
+        spec: String,
+        #[source]
+        source: BuildError,
+    },
+    /// A build made no WGSL library.
+    #[error("{spec}: no WGSL artifact")]
+    NoWgsl { spec: String },
+    #[error("{spec}: the WGSL artifact is not UTF-8")]
+    WgslUtf8 {
+        spec: String,
+        #[source]
+        source: std::str::Utf8Error,
+    },
+    /// Counting the operations of a form's emitted function.
+    #[error("{spec}: counting the operations of `{function}`")]
+    Ops {
+        spec: String,
+        function: String,
+        #[source]
+        source: ops::OpsError,
+    },
+    /// A form's emitted WGSL does not parse or validate.
+    #[error("{spec}: reading the emitted WGSL")]
+    Wgsl {
+        spec: String,
+        #[source]
+        source: ops::OpsError,
+    },
+    /// The temporary folder the numpy/scipy script exchanges its files through.
+    #[error("creating a temporary folder")]
+    TempDir {
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("writing {path}")]
+    Write {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("reading {path}")]
+    Read {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("parsing {path}")]
+    Json {
+        path: PathBuf,
+        #[source]
+        source: serde_json::Error,
+    },
+    /// The numpy/scipy script could not be started.
+    #[error("running {} {}", interpreter.display(), script.display())]
+    PythonStart {
+        interpreter: PathBuf,
+        script: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    /// The numpy/scipy script failed.
+    #[error("{} exited with {status}", script.display())]
+    Python {
+        script: PathBuf,
+        status: std::process::ExitStatus,
+    },
+}
+
+impl BenchError {
+    /// `building {spec}` of a pipeline error.
+    pub fn build(spec: &str) -> impl FnOnce(BuildError) -> BenchError + '_ {
+        move |source| BenchError::Build { spec: spec.to_string(), source }
+    }
+
+    /// The message with its causes, `: `-separated.
+    pub fn chain(&self) -> String {
+        let mut s = self.to_string();
+        let mut cause = std::error::Error::source(self);
+        while let Some(c) = cause {
+            let _ = write!(s, ": {c}");
+            cause = c.source();
+        }
+        s
+    }
+}
 
 /// Quick (CI) or full run.
 #[derive(Debug, Clone, Copy)]
@@ -109,7 +219,7 @@ pub struct Inputs<'a> {
 }
 
 /// Run the selected sections over the rows of `families`.
-pub fn run(mode: Mode, sections: Sections, inputs: &Inputs, families: &[&FamilyBench]) -> anyhow::Result<Report> {
+pub fn run(mode: Mode, sections: Sections, inputs: &Inputs, families: &[&FamilyBench]) -> Result<Report, BenchError> {
     let start = Instant::now();
     let integrators = if sections.integrators {
         integrals::all(&mode, families)

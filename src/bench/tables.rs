@@ -14,10 +14,9 @@
 //! "closed form …") a second ratio leaves it out: shadefit against the numerical integration a
 //! user writes without it. Table times are seconds per point × table size.
 
-use super::{FamilyBench, Mode, SplitMix, time_it};
+use super::{BenchError, FamilyBench, Mode, SplitMix, time_it};
 use crate::pipeline;
 use crate::spec::Spec;
-use anyhow::{Context, Result};
 use serde::Serialize;
 use serde_json::{Value, json};
 use std::path::{Path, PathBuf};
@@ -239,7 +238,7 @@ pub struct Python {
 }
 
 /// Every family's tables, by order: shadefit's side, and the script's when `python` is given.
-pub fn all(mode: &Mode, specs: &[Spec], families: &[&FamilyBench], python: Option<&Python>) -> Result<Vec<TableRow>> {
+pub fn all(mode: &Mode, specs: &[Spec], families: &[&FamilyBench], python: Option<&Python>) -> Result<Vec<TableRow>, BenchError> {
     let mut tables = Vec::new();
     for bench in super::ordered(families, |f| f.tables, |t| t.order) {
         let Some(spec) = specs.iter().find(|s| s.file.name == bench.spec) else {
@@ -306,7 +305,7 @@ pub fn all(mode: &Mode, specs: &[Spec], families: &[&FamilyBench], python: Optio
             Ok(v) => v,
             Err(e) if !py.required => {
                 for row in &mut rows {
-                    row.note = format!("numpy/scipy comparison failed: {e:#}");
+                    row.note = format!("numpy/scipy comparison failed: {}", e.chain());
                 }
                 return Ok(rows);
             }
@@ -393,11 +392,11 @@ pub fn ratio(numpy: &[CurvePoint], shadefit: &[CurvePoint]) -> Option<Ratio> {
 }
 
 /// Run the script on `input`; its JSON answer.
-fn run_python(py: &Python, input: &Value) -> Result<Value> {
-    let dir = tempfile::tempdir().context("creating a temporary folder")?;
+fn run_python(py: &Python, input: &Value) -> Result<Value, BenchError> {
+    let dir = tempfile::tempdir().map_err(|source| BenchError::TempDir { source })?;
     let inp = dir.path().join("in.json");
     let out = dir.path().join("out.json");
-    std::fs::write(&inp, serde_json::to_vec(input)?)?;
+    std::fs::write(&inp, input.to_string()).map_err(|source| BenchError::Write { path: inp.clone(), source })?;
     let status = Command::new(&py.interpreter)
         .arg(&py.script)
         .arg(&inp)
@@ -407,10 +406,12 @@ fn run_python(py: &Python, input: &Value) -> Result<Value> {
         .env("OPENBLAS_NUM_THREADS", "1")
         .env("MKL_NUM_THREADS", "1")
         .status()
-        .with_context(|| format!("running {} {}", py.interpreter.display(), py.script.display()))?;
-    anyhow::ensure!(status.success(), "{} exited with {status}", py.script.display());
-    let text = std::fs::read_to_string(&out).with_context(|| format!("reading {}", out.display()))?;
-    serde_json::from_str(&text).with_context(|| format!("parsing {}", out.display()))
+        .map_err(|source| BenchError::PythonStart { interpreter: py.interpreter.clone(), script: py.script.clone(), source })?;
+    if !status.success() {
+        return Err(BenchError::Python { script: py.script.clone(), status });
+    }
+    let text = std::fs::read_to_string(&out).map_err(|source| BenchError::Read { path: out.clone(), source })?;
+    serde_json::from_str(&text).map_err(|source| BenchError::Json { path: out.clone(), source })
 }
 
 /// The default interpreter: the test suite's venv when present, else `python3`.

@@ -19,11 +19,10 @@ use crate::bench::forms::{
 use crate::bench::integrals::{IntegratorBench, IntegratorRow, Run, pick, row, self_ladder};
 use crate::bench::ops::OpCounts;
 use crate::bench::tables::{Ladder, Shape, TableBench};
-use crate::bench::{FamilyBench, Mode, SplitMix};
+use crate::bench::{BenchError, FamilyBench, Mode, SplitMix};
 use crate::emit::fields as efields;
 use crate::emit::wgsl::{self, Body, Function};
 use crate::fit::Term;
-use anyhow::Result;
 use crate::integrate::{Estimate, Tolerance, adaptive, gauss_legendre};
 use crate::pipeline::fields::{self as pfields, FieldsReference};
 use crate::pipeline::{self, Denominators, Reference};
@@ -382,14 +381,14 @@ fn fuzz_q_integrators(mode: &Mode) -> Vec<IntegratorRow> {
 // Shader forms
 
 /// Average penetration Q(d) = 2·E₃(d) (Ghost of Tsushima, Eq. 4).
-fn fuzz_q(ctx: &Ctx) -> Result<Vec<FormRow>> {
+fn fuzz_q(ctx: &Ctx) -> Result<Vec<FormRow>, BenchError> {
     let refit = ctx.spec("fuzz_q")?;
     let mut integral = Integral::of(&refit);
     let reference = integral.reference(pipeline::grid(&refit, &[ctx.pick(refit.file.axis[0].verify_count(), 513)]));
     fuzz_q_forms(ctx, &refit, &mut integral, &reference)
 }
 
-fn fuzz_q_forms(ctx: &Ctx, refit: &Spec, integral: &mut Integral, reference: &Reference) -> Result<Vec<FormRow>> {
+fn fuzz_q_forms(ctx: &Ctx, refit: &Spec, integral: &mut Integral, reference: &Reference) -> Result<Vec<FormRow>, BenchError> {
     let published_spec = ctx.variant(refit, "fuzz_q_published", |_| {})?;
     let [c0, c1] = super::published::Q_COEFFS;
     let linear = ctx.variant(refit, "fuzz_q_linear", |t| set(t, "model.numerator", strings(&["1", "d"])))?;
@@ -407,7 +406,7 @@ fn fuzz_q_forms(ctx: &Ctx, refit: &Spec, integral: &mut Integral, reference: &Re
 }
 
 /// Hemispherical average G(μv, d) of the fuzz layer (Ghost of Tsushima, Eq. 3).
-fn fuzz_g(ctx: &Ctx) -> Result<Vec<FormRow>> {
+fn fuzz_g(ctx: &Ctx) -> Result<Vec<FormRow>, BenchError> {
     let refit = ctx.spec("fuzz_g")?;
     let mut integral = Integral::of(&refit);
     // The committed verification grid (257², with the nodes and midpoints of the 17² and 33²
@@ -434,7 +433,7 @@ fn fuzz_g(ctx: &Ctx) -> Result<Vec<FormRow>> {
 const UNIFORM_MU: &str = "uniform grid: the largest errors sit at μv = 0.001, d → 0, where G depends on d/μv";
 
 /// Cosine-weighted average R(α, θf) of P_s (Ghost of Tsushima, Eq. 5).
-fn fuzz_r(ctx: &Ctx) -> Result<Vec<FormRow>> {
+fn fuzz_r(ctx: &Ctx) -> Result<Vec<FormRow>, BenchError> {
     let refit = ctx.spec("fuzz_r")?;
     let mut integral = Integral::of(&refit);
     // R costs ~20 ms a point: the committed verification grid (25²), quick 13². The cheaper
@@ -478,9 +477,9 @@ fn fields_row(
     reference: &FieldsReference,
     form: &str,
     note: &str,
-) -> Result<(FormRow, OpCounts)> {
+) -> Result<(FormRow, OpCounts), BenchError> {
     let name = &spec.file.name;
-    let built = pfields::fields_from_coefficients(spec, coefficients, None, None, reference, check(form))?;
+    let built = pfields::fields_from_coefficients(spec, coefficients, None, None, reference, check(form)).map_err(BenchError::build(name))?;
     let source = parse(name, wgsl_of(&built)?)?;
     let mut ops = count_in(name, &source, &spec.file.emit.function)?;
     let evaluator = count_in(name, &source, spec.file.emit.evaluator.as_deref().expect("fields specs name an evaluator"))?;
@@ -513,7 +512,7 @@ fn fields_row(
 }
 
 /// Fraction P_s the fuzz layer scatters toward the base (Ghost of Tsushima, Eq. 1–2).
-fn fuzz_ps(ctx: &Ctx) -> Result<Vec<FormRow>> {
+fn fuzz_ps(ctx: &Ctx) -> Result<Vec<FormRow>, BenchError> {
     let refit = ctx.spec("fuzz_ps")?;
     let reference = ps_reference(ctx, &refit);
     // Listing 1 with rows 3 and 4 exchanged (validate's finding), clamped to θf ≥ 0.1 as
@@ -521,7 +520,7 @@ fn fuzz_ps(ctx: &Ctx) -> Result<Vec<FormRow>> {
     let published_spec = ctx.variant(&refit, "fuzz_ps_published", |t| set(t, "axis.1.range", toml::Value::Array(vec![0.1.into(), FRAC_PI_2.into()])))?;
     let published: Vec<DVector<f64>> =
         [0, 1, 2, 4, 3, 5].iter().map(|&k| DVector::from_row_slice(&super::published::PS_COEFFS[k])).collect();
-    let (committed, _) = pfields::committed(&refit, ctx.generated)?;
+    let (committed, _) = pfields::committed(&refit, ctx.generated).map_err(BenchError::build(&refit.file.name))?;
     // A cheaper form: the fields of degree 2 in (β, γ, δ), fitted as fits/fuzz_ps.toml is on
     // a coarser grid.
     let (outer, inner) = (ctx.pick(17, 9), ctx.pick(12, 8));
@@ -533,7 +532,7 @@ fn fuzz_ps(ctx: &Ctx) -> Result<Vec<FormRow>> {
             set(t, &format!("axis.{i}.count"), k as i64);
         }
     })?;
-    let (cheaper_c, _) = pfields::fit(&cheaper)?;
+    let (cheaper_c, _) = pfields::fit(&cheaper).map_err(BenchError::build(&cheaper.file.name))?;
     let (refit_row, evaluator) = fields_row(&refit, &committed, &reference, "refit", "fits/fuzz_ps.toml, committed")?;
     Ok(vec![
         fields_row(&published_spec, &published, &reference, PUBLISHED, "Listings 1–2, rows 3 and 4 exchanged")?.0,
@@ -546,7 +545,7 @@ fn fuzz_ps(ctx: &Ctx) -> Result<Vec<FormRow>> {
 
 /// The six coefficients of the committed refit tabulated on n × n points of (α, θf) (its
 /// domain), bilinear, then the refit's evaluator (`evaluator`: its counts).
-fn ps_table_row(refit: &Spec, committed: &[DVector<f64>], evaluator: &OpCounts, reference: &FieldsReference, n: usize) -> Result<FormRow> {
+fn ps_table_row(refit: &Spec, committed: &[DVector<f64>], evaluator: &OpCounts, reference: &FieldsReference, n: usize) -> Result<FormRow, BenchError> {
     let basis = refit.quantity.basis.expect("fuzz-ps has an inner basis");
     let model = refit.model.as_ref().expect("fields specs carry a model");
     let offsets = &refit.file.fields.as_ref().expect("fields specs carry [fields]").offsets;

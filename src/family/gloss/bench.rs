@@ -16,8 +16,7 @@ use crate::bench::forms::{
 };
 use crate::bench::integrals::{IntegratorBench, IntegratorRow, Run, pick, row};
 use crate::bench::tables::{Ladder, Params, Shape, TableBench};
-use crate::bench::{FamilyBench, Mode};
-use anyhow::Result;
+use crate::bench::{BenchError, FamilyBench, Mode};
 use crate::integrate::gauss_legendre;
 use crate::pipeline;
 use nalgebra::DVector;
@@ -131,7 +130,7 @@ fn gloss_length_integrators(mode: &Mode) -> Vec<IntegratorRow> {
 // Shader forms
 
 /// g → ‖n_s‖ (COD: WWII).
-fn gloss_length(ctx: &Ctx) -> Result<Vec<FormRow>> {
+fn gloss_length(ctx: &Ctx) -> Result<Vec<FormRow>, BenchError> {
     let refit = ctx.spec("gloss_length")?;
     let table = ctx.spec("gloss_table")?;
     let mut integral = Integral::of(&refit);
@@ -163,7 +162,7 @@ fn gloss_length(ctx: &Ctx) -> Result<Vec<FormRow>> {
 }
 
 /// Gloss of two combined normal maps (RNM of two GGX NDFs, COD: WWII).
-fn gloss_combine(ctx: &Ctx) -> Result<Vec<FormRow>> {
+fn gloss_combine(ctx: &Ctx) -> Result<Vec<FormRow>, BenchError> {
     let refit = ctx.spec("gloss_combine")?;
     let table = ctx.spec("gloss_combine_lut")?;
     let mut integral = Integral::of(&refit);

@@ -12,8 +12,7 @@ use super::integrals as skin;
 use crate::bench::forms::{Ctx, FormRow, FormSet, count_in, parse, row as form_row, set, wgsl_of};
 use crate::bench::integrals::{IntegratorBench, IntegratorRow, Run, pick, row, self_ladder};
 use crate::bench::tables::{Ladder, Params, Shape, TableBench};
-use crate::bench::{FamilyBench, Mode};
-use anyhow::Result;
+use crate::bench::{BenchError, FamilyBench, Mode};
 use crate::integrate::{Estimate, Tolerance, gauss_legendre};
 use std::f64::consts::PI;
 
@@ -163,7 +162,7 @@ fn skin_sh_integrators(mode: &Mode) -> Vec<IntegratorRow> {
 // Shader forms
 
 /// Pre-integrated skin diffusion D(n·l, κ) for punctual lights (RGB).
-fn skin_punctual(ctx: &Ctx) -> Result<Vec<FormRow>> {
+fn skin_punctual(ctx: &Ctx) -> Result<Vec<FormRow>, BenchError> {
     let committed = ctx.spec("skin_punctual_lut")?;
     let mut rows = Vec::new();
     for (w, h) in [(33, 32), (65, 64), (129, 128)] {
@@ -175,7 +174,7 @@ fn skin_punctual(ctx: &Ctx) -> Result<Vec<FormRow>> {
             })?
         };
         let name = &spec.file.name;
-        let (built, texture) = super::build::build_with_texture_error(&spec)?;
+        let (built, texture) = super::build::build_with_texture_error(&spec).map_err(BenchError::build(name))?;
         let source = parse(name, wgsl_of(&built)?)?;
         let f = &spec.file.emit.function;
         let committed_note = if (w, h) == (65, 64) { ", committed size" } else { "" };
