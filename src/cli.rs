@@ -403,7 +403,15 @@ pub fn bench(paths: &Paths, a: &BenchArgs) -> Result<()> {
         }),
         (None, false) => Some(tables::default_python(&root)),
     };
-    let report = bench::run(Mode::new(a.quick), sections, &specs, paths, python.as_ref())?;
+    let inputs = bench::Inputs {
+        specs: &specs,
+        catalog: family::catalog(),
+        fits: &paths.fits,
+        generated: &paths.generated,
+        python: python.as_ref(),
+    };
+    let families = crate::family::families().iter().map(|f| &f.bench).collect::<Vec<_>>();
+    let report = bench::run(Mode::new(a.quick), sections, &inputs, &families)?;
     if a.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
     } else {

@@ -5,8 +5,10 @@
 //! `levenberg-marquardt` crate, argmin's Gauss–Newton with line search) and the objective
 //! (least squares, minimax by Lawson + sequential LP, Σr⁴). The least-squares solver also runs
 //! the multi-start and the starts of the other objectives. A failed fit is a row with its error.
+//! The specs are the families' ([`FitBench`]; fit specs only: the two-stage fits of fields
+//! specs are timed by `shadefit build`).
 
-use super::{Mode, time_it};
+use super::{FamilyBench, Mode, time_it};
 use crate::fit::{self, Data, FitOptions, LsqSolver, Objective};
 use crate::pipeline;
 use crate::spec::Spec;
@@ -29,26 +31,23 @@ pub struct FitRow {
     pub failure: Option<String>,
 }
 
-/// Specs benchmarked in each mode (kind = "fit" only; the two-stage fields fit of P_s is timed
-/// by `shadefit build`).
-fn names(mode: &Mode) -> &'static [&'static str] {
-    if mode.quick {
-        &["gloss_length", "fuzz_q", "fuzz_g"]
-    } else {
-        &[
-            "gloss_length",
-            "fuzz_q",
-            "fuzz_g",
-            "gloss_combine",
-            "fuzz_r",
-        ]
-    }
+/// A fit spec (kind = "fit") a family has timed.
+#[derive(Debug, Clone, Copy)]
+pub struct FitBench {
+    /// The spec's name in fits/ (skipped when absent).
+    pub spec: &'static str,
+    /// Place in the section across families (see [`FamilyBench`]).
+    pub order: u32,
+    /// Timed in quick mode too (else in full runs only).
+    pub quick: bool,
 }
 
-pub fn all(mode: &Mode, specs: &[Spec]) -> Vec<FitRow> {
+/// Every family's fit specs of this mode, by order, with every solver and objective.
+pub fn all(mode: &Mode, specs: &[Spec], families: &[&FamilyBench]) -> Vec<FitRow> {
     let mut rows = Vec::new();
-    for name in names(mode) {
-        let Some(spec) = specs.iter().find(|s| s.file.name == *name) else {
+    let names = super::ordered(families, |f| f.fits, |b| b.order).into_iter().filter(|b| b.quick || !mode.quick).map(|b| b.spec);
+    for name in names {
+        let Some(spec) = specs.iter().find(|s| s.file.name == name) else {
             continue;
         };
         let Some(model) = spec.model.as_ref() else {

@@ -10,6 +10,10 @@
 //! - [`forms`]: shader cost (op counts from naga's IR, [`ops`]) against max error, several
 //!   approximation forms per quantity.
 //!
+//! The harness names no family: what each section runs comes from the [`FamilyBench`] hooks the
+//! caller passes (the CLI passes every registered family's), and the helpers here (timing,
+//! ladders, rows, the Pareto front, rendering) are what the families build their rows with.
+//!
 //! Quick mode (`--quick`, what the test command runs) uses fewer points and settings; both
 //! modes print one table per section, or one JSON document with `--json`.
 
@@ -19,11 +23,121 @@ pub mod integrals;
 pub mod ops;
 pub mod tables;
 
-use crate::spec::Spec;
-use anyhow::Result;
+use crate::pipeline::BuildError;
+use crate::spec::{Catalog, Spec, SpecError};
 use serde::Serialize;
 use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
+
+/// Why a benchmark run failed.
+#[derive(Debug, thiserror::Error)]
+pub enum BenchError {
+    /// A spec in fits/, or a variant of one made for a form, does not load.
+    #[error(transparent)]
+    Spec(#[from] SpecError),
+    /// A committed spec's text is not TOML (variants start from it).
+    #[error("{path}: not a TOML table")]
+    SpecToml {
+        path: PathBuf,
+        #[source]
+        source: toml::de::Error,
+    },
+    /// A variant of a spec could not be written back as TOML.
+    #[error("variant {spec}")]
+    VariantToml {
+        spec: String,
+        #[source]
+        source: toml::ser::Error,
+    },
+    /// Fitting, verifying or emitting a form through the pipeline.
+    #[error("building {spec}")]
+    Build {
+        spec: String,
+        #[source]
+        source: BuildError,
+    },
+    /// A build made no WGSL library.
+    #[error("{spec}: no WGSL artifact")]
+    NoWgsl { spec: String },
+    #[error("{spec}: the WGSL artifact is not UTF-8")]
+    WgslUtf8 {
+        spec: String,
+        #[source]
+        source: std::str::Utf8Error,
+    },
+    /// Counting the operations of a form's emitted function.
+    #[error("{spec}: counting the operations of `{function}`")]
+    Ops {
+        spec: String,
+        function: String,
+        #[source]
+        source: ops::OpsError,
+    },
+    /// A form's emitted WGSL does not parse or validate.
+    #[error("{spec}: reading the emitted WGSL")]
+    Wgsl {
+        spec: String,
+        #[source]
+        source: ops::OpsError,
+    },
+    /// The temporary folder the numpy/scipy script exchanges its files through.
+    #[error("creating a temporary folder")]
+    TempDir {
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("writing {path}")]
+    Write {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("reading {path}")]
+    Read {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("parsing {path}")]
+    Json {
+        path: PathBuf,
+        #[source]
+        source: serde_json::Error,
+    },
+    /// The numpy/scipy script could not be started.
+    #[error("running {} {}", interpreter.display(), script.display())]
+    PythonStart {
+        interpreter: PathBuf,
+        script: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    /// The numpy/scipy script failed.
+    #[error("{} exited with {status}", script.display())]
+    Python {
+        script: PathBuf,
+        status: std::process::ExitStatus,
+    },
+}
+
+impl BenchError {
+    /// `building {spec}` of a pipeline error.
+    pub fn build(spec: &str) -> impl FnOnce(BuildError) -> BenchError + '_ {
+        move |source| BenchError::Build { spec: spec.to_string(), source }
+    }
+
+    /// The message with its causes, `: `-separated.
+    pub fn chain(&self) -> String {
+        let mut s = self.to_string();
+        let mut cause = std::error::Error::source(self);
+        while let Some(c) = cause {
+            let _ = write!(s, ": {c}");
+            cause = c.source();
+        }
+        s
+    }
+}
 
 /// Quick (CI) or full run.
 #[derive(Debug, Clone, Copy)]
@@ -43,7 +157,7 @@ impl Mode {
 }
 
 /// Seconds per call of `f` (repeated until `min_seconds` have passed) and its last result.
-pub(crate) fn time_it<T>(min_seconds: f64, mut f: impl FnMut() -> T) -> (f64, T) {
+pub fn time_it<T>(min_seconds: f64, mut f: impl FnMut() -> T) -> (f64, T) {
     let start = Instant::now();
     let mut runs = 0u32;
     loop {
@@ -57,7 +171,7 @@ pub(crate) fn time_it<T>(min_seconds: f64, mut f: impl FnMut() -> T) -> (f64, T)
 }
 
 /// splitmix64: the fixed-seed generator of the Monte Carlo baselines and the sample subsets.
-pub(crate) struct SplitMix(pub u64);
+pub struct SplitMix(pub u64);
 
 impl SplitMix {
     pub fn next_f64(&mut self) -> f64 {
@@ -91,32 +205,40 @@ pub struct Report {
     pub forms: Vec<forms::FormRow>,
 }
 
-/// Run the selected sections.
-pub fn run(
-    mode: Mode,
-    sections: Sections,
-    specs: &[Spec],
-    paths: &crate::cli::Paths,
-    python: Option<&tables::Python>,
-) -> Result<Report> {
+/// What the sections run on.
+pub struct Inputs<'a> {
+    /// The specs in fits/ (the fits and tables sections pick theirs by name).
+    pub specs: &'a [Spec],
+    /// The catalog the specs load with (the forms section loads specs and variants of them).
+    pub catalog: &'a Catalog,
+    /// The spec folder (fits/) and the committed outputs (generated/).
+    pub fits: &'a Path,
+    pub generated: &'a Path,
+    /// The numpy/scipy side of the tables section; `None`: shadefit's side only.
+    pub python: Option<&'a tables::Python>,
+}
+
+/// Run the selected sections over the rows of `families`.
+pub fn run(mode: Mode, sections: Sections, inputs: &Inputs, families: &[&FamilyBench]) -> Result<Report, BenchError> {
     let start = Instant::now();
     let integrators = if sections.integrators {
-        integrals::all(&mode)
+        integrals::all(&mode, families)
     } else {
         Vec::new()
     };
     let fits = if sections.fits {
-        fits::all(&mode, specs)
+        fits::all(&mode, inputs.specs, families)
     } else {
         Vec::new()
     };
     let tables = if sections.tables {
-        tables::all(&mode, specs, python)?
+        tables::all(&mode, inputs.specs, families, inputs.python)?
     } else {
         Vec::new()
     };
     let forms = if sections.forms {
-        forms::shader_forms_at(&paths.fits, &paths.generated, mode.quick)?
+        let ctx = forms::Ctx { fits: inputs.fits, generated: inputs.generated, quick: mode.quick, catalog: inputs.catalog };
+        forms::all(&ctx, families)?
     } else {
         Vec::new()
     };
@@ -305,10 +427,29 @@ fn ratio_line(label: &str, ratio: &Option<tables::Ratio>, note: &str) -> String 
     )
 }
 
-/// A family's benchmark rows (see `crate::family::Family::bench`).
-#[derive(Clone, Copy)]
-pub struct FamilyBench {}
+/// A family's benchmark rows (the `bench` field of its `Family` descriptor): plain data and
+/// function pointers. Each item has an `order`, its place in its section across families: a
+/// section runs and reports its items by `order` (ties in the order the families are passed).
+#[derive(Debug, Clone, Copy)]
+pub struct FamilyBench {
+    /// Integrator tables (the integrators section).
+    pub integrators: &'static [integrals::IntegratorBench],
+    /// Fit specs timed with every solver and objective (the fits section).
+    pub fits: &'static [fits::FitBench],
+    /// Default tables compared with numpy/scipy (the tables section).
+    pub tables: &'static [tables::TableBench],
+    /// Shader forms, one set per quantity (the forms section).
+    pub forms: &'static [forms::FormSet],
+}
 
 impl FamilyBench {
-    pub const NONE: FamilyBench = FamilyBench {};
+    /// No rows.
+    pub const NONE: FamilyBench = FamilyBench { integrators: &[], fits: &[], tables: &[], forms: &[] };
+}
+
+/// The items `field` picks from every family, by `order` (stable: ties keep the families' order).
+fn ordered<'a, T>(families: &[&'a FamilyBench], field: impl Fn(&'a FamilyBench) -> &'a [T], order: impl Fn(&T) -> u32) -> Vec<&'a T> {
+    let mut items: Vec<&T> = families.iter().flat_map(|f| field(f).iter()).collect();
+    items.sort_by_key(|t| order(t));
+    items
 }

@@ -1,22 +1,22 @@
 //! Default tables: shadefit against a straightforward numpy/scipy implementation of the same
 //! integrals (`benches/numpy_tables.py`) at equal max error.
 //!
-//! For each spec in fits/ (the samples every fit and table is built from), a seeded subset of
-//! its grid is evaluated to a tolerance 1–3 orders below the tightest setting (the reference).
-//! shadefit's integrator runs over the subset at a ladder of tolerances (one thread, like the
-//! numpy side); the numpy/scipy script runs its own methods over the same points with their own
-//! ladders (vectorised Gauss–Legendre, per-point `quad`/`dblquad`, Monte Carlo) and reports
-//! seconds per point and max error. The speed ratio at equal error compares the fastest numpy
-//! row within [`TARGET_ERROR`] with the fastest shadefit row within the same bound; when no numpy
-//! row reaches it, the most accurate numpy row is compared with the fastest shadefit row at
-//! least as accurate, and the row says so. Where scipy has the closed form (E_n for G and Q,
-//! artanh for the gloss length) a second ratio leaves it out: shadefit against the numerical
-//! integration a user writes without it. Table times are seconds per point × table size.
+//! For each spec a family compares ([`TableBench`]: a table or the fit behind one, and the
+//! samples every fit and table is built from), a seeded subset of its grid is evaluated to a
+//! tolerance 1–3 orders below the tightest setting (the reference). shadefit's integrator runs
+//! over the subset at a ladder of tolerances (one thread, like the numpy side); the numpy/scipy
+//! script runs its own methods over the same points with their own ladders (vectorised
+//! Gauss–Legendre, per-point `quad`/`dblquad`, Monte Carlo) and reports seconds per point and
+//! max error. The speed ratio at equal error compares the fastest numpy row within
+//! [`TARGET_ERROR`] with the fastest shadefit row within the same bound; when no numpy row
+//! reaches it, the most accurate numpy row is compared with the fastest shadefit row at least
+//! as accurate, and the row says so. Where scipy has the closed form (the script's rows named
+//! "closed form …") a second ratio leaves it out: shadefit against the numerical integration a
+//! user writes without it. Table times are seconds per point × table size.
 
-use super::{Mode, SplitMix, time_it};
+use super::{BenchError, FamilyBench, Mode, SplitMix, time_it};
 use crate::pipeline;
 use crate::spec::Spec;
-use anyhow::{Context, Result};
 use serde::Serialize;
 use serde_json::{Value, json};
 use std::path::{Path, PathBuf};
@@ -68,35 +68,66 @@ pub struct TableRow {
     pub note: String,
 }
 
-/// How a spec's values map to the numpy script's points and channels.
-#[derive(Clone, Copy, PartialEq)]
-enum Shape {
-    Scalar,
-    /// (curvature, n·l) → RGB; the script takes (n_dot_l, kappa).
-    SkinPunctual,
-    /// (curvature, band ∈ {1, 2}) → RGB; the script takes (kappa) → k₁ RGB, k₂ RGB.
-    SkinSh,
+/// A spec a family compares with the numpy/scipy script (which knows it by name).
+#[derive(Debug, Clone, Copy)]
+pub struct TableBench {
+    /// The spec's name in fits/ (skipped when absent) and in the script.
+    pub spec: &'static str,
+    /// Place in the section across families (see [`FamilyBench`]); the sampled subset's seed
+    /// is `0x5EED + order`.
+    pub order: u32,
+    /// Grid points sampled (with the two grid corners), quick and full.
+    pub samples: (usize, usize),
+    /// shadefit's settings.
+    pub ladder: Ladder,
+    /// Tolerance of the reference values: below the tightest setting.
+    pub reference_tolerance: f64,
+    /// How the spec's grid maps to the script's points.
+    pub shape: Shape,
 }
 
-/// The specs compared, with how many grid points each samples (quick, full).
-const TABLES: &[(&str, usize, usize)] = &[
-    ("gloss_table", 32, 128),
-    ("gloss_inverse_table", 32, 128),
-    ("gloss_combine_lut", 32, 128),
-    ("skin_punctual_lut", 24, 96),
-    ("skin_sh_lut", 8, 32),
-    ("fuzz_q", 32, 128),
-    ("fuzz_g", 32, 128),
-    ("fuzz_ps", 24, 128),
-    ("fuzz_r", 3, 8),
-];
+/// shadefit's settings of one table.
+#[derive(Debug, Clone, Copy)]
+pub enum Ladder {
+    /// A closed form: one setting, the spec's tolerance.
+    ClosedForm,
+    /// Tolerances, quick and full.
+    Tolerances(&'static [f64], &'static [f64]),
+}
+
+/// How a spec's grid and values map to the script's points and channels.
+#[derive(Debug, Clone, Copy)]
+pub struct Shape {
+    /// The script's parameters.
+    pub params: Params,
+    /// Values per script point, all channels of all the grid points behind it.
+    pub channels: usize,
+    /// One script point per value of the other axes, gathering every value of the last axis
+    /// (in axis order: its channels are those of the first value, then the second's, …).
+    pub fold_last_axis: bool,
+}
+
+impl Shape {
+    /// One value per grid point; the script's parameters are the spec's axes.
+    pub const SCALAR: Shape = Shape { params: Params::Axes { rename: &[] }, channels: 1, fold_last_axis: false };
+}
+
+/// The parameters of a script point.
+#[derive(Debug, Clone, Copy)]
+pub enum Params {
+    /// Every spec axis in order, by its name, save those the script spells otherwise
+    /// (spec name, script name).
+    Axes { rename: &'static [(&'static str, &'static str)] },
+    /// These spec axes (index, script name), in the script's order.
+    Pick(&'static [(usize, &'static str)]),
+}
 
 struct Table<'a> {
     spec: &'a Spec,
-    shape: Shape,
+    bench: &'a TableBench,
     /// Points of the numpy view (see [`Shape`]).
     points: Vec<Vec<f64>>,
-    /// Spec-grid points behind each numpy point (two for SkinSh: bands 1 and 2).
+    /// Spec-grid points behind each numpy point (several when the last axis is folded).
     grid_points: Vec<Vec<Vec<f64>>>,
     table_points: usize,
 }
@@ -120,53 +151,40 @@ impl Table<'_> {
     }
 
     fn channels(&self) -> usize {
-        match self.shape {
-            Shape::Scalar => 1,
-            Shape::SkinPunctual => 3,
-            Shape::SkinSh => 6,
-        }
+        self.bench.shape.channels
     }
 
     fn params(&self) -> Vec<String> {
-        match self.shape {
-            // The script names gloss `g`; every other axis keeps the spec's name.
-            Shape::Scalar => self
+        match self.bench.shape.params {
+            Params::Axes { rename } => self
                 .spec
                 .file
                 .axis
                 .iter()
-                .map(|a| {
-                    if a.name == "gloss" {
-                        "g".into()
-                    } else {
-                        a.name.clone()
-                    }
+                .map(|a| match rename.iter().find(|(from, _)| *from == a.name) {
+                    Some((_, to)) => to.to_string(),
+                    None => a.name.clone(),
                 })
                 .collect(),
-            Shape::SkinPunctual => vec!["n_dot_l".into(), "kappa".into()],
-            Shape::SkinSh => vec!["kappa".into()],
+            Params::Pick(axes) => axes.iter().map(|(_, name)| name.to_string()).collect(),
         }
     }
 }
 
-fn table<'a>(spec: &'a Spec, n: usize, seed: u64) -> Table<'a> {
+fn table<'a>(spec: &'a Spec, bench: &'a TableBench, n: usize, seed: u64) -> Table<'a> {
     let counts: Vec<usize> = spec.file.axis.iter().map(|a| a.count).collect();
     let grid = pipeline::grid(spec, &counts);
-    let shape = match spec.file.quantity.as_str() {
-        "skin-punctual" => Shape::SkinPunctual,
-        "skin-sh" => Shape::SkinSh,
-        _ => Shape::Scalar,
-    };
-    // SH rows are (curvature, band) with band fastest... the grid is first-axis fastest: group
-    // both bands of one curvature.
-    let units: Vec<Vec<Vec<f64>>> = match shape {
-        Shape::SkinSh => {
-            let nk = counts[0];
-            (0..nk)
-                .map(|k| vec![grid[k].clone(), grid[k + nk].clone()])
-                .collect()
-        }
-        _ => grid.into_iter().map(|g| vec![g]).collect(),
+    let shape = bench.shape;
+    // The grid is first-axis fastest: a folded point gathers the grid points k, k + m, k + 2m,
+    // … (m points per value of the last axis).
+    let units: Vec<Vec<Vec<f64>>> = if shape.fold_last_axis {
+        let last = counts.last().copied().unwrap_or(1);
+        let m = grid.len() / last;
+        (0..m)
+            .map(|k| (0..last).map(|j| grid[k + j * m].clone()).collect())
+            .collect()
+    } else {
+        grid.into_iter().map(|g| vec![g]).collect()
     };
     let table_points = units.len();
     // The two grid corners, then seeded picks without repetition, in grid order.
@@ -182,53 +200,25 @@ fn table<'a>(spec: &'a Spec, n: usize, seed: u64) -> Table<'a> {
     let grid_points: Vec<Vec<Vec<f64>>> = picks.iter().map(|&i| units[i].clone()).collect();
     let points = grid_points
         .iter()
-        .map(|gs| match shape {
-            Shape::Scalar => gs[0].clone(),
-            Shape::SkinPunctual => vec![gs[0][1], gs[0][0]],
-            Shape::SkinSh => vec![gs[0][0]],
+        .map(|gs| match shape.params {
+            Params::Axes { .. } => gs[0].clone(),
+            Params::Pick(axes) => axes.iter().map(|&(i, _)| gs[0][i]).collect(),
         })
         .collect();
     Table {
         spec,
-        shape,
+        bench,
         points,
         grid_points,
         table_points,
     }
 }
 
-/// shadefit's ladder of tolerances per quantity (closed forms: one setting).
-fn ladder(mode: &Mode, quantity: &str) -> Option<Vec<f64>> {
-    let q = mode.quick;
-    match quantity {
-        "gloss-length" | "gloss-from-length" | "gloss-combine" | "fuzz-q" => None,
-        // The skin quantities integrate to min(tol, 1e-10) (quantity::skin_tolerance): the
-        // tabulated tolerance is the only setting.
-        "skin-punctual" | "skin-sh" => Some(vec![1e-10]),
-        "fuzz-r" => Some(if q {
-            vec![1e-5, 1e-7, 1e-9]
-        } else {
-            vec![1e-5, 1e-7, 1e-9, 1e-10]
-        }),
-        "fuzz-ps" => Some(if q {
-            vec![1e-3, 1e-5, 1e-7, 1e-9]
-        } else {
-            vec![1e-3, 1e-5, 1e-7, 1e-9, 1e-11]
-        }),
-        _ => Some(if q {
-            vec![1e-4, 1e-6, 1e-8, 1e-10]
-        } else {
-            vec![1e-4, 1e-6, 1e-8, 1e-10, 1e-12]
-        }),
-    }
-}
-
-/// Reference tolerance: below the tightest ladder setting (R is capped at 1e-13 inside).
-fn reference_tolerance(quantity: &str) -> f64 {
-    match quantity {
-        "fuzz-r" => 1e-12,
-        "fuzz-ps" => 1e-13,
-        _ => 1e-14,
+/// shadefit's ladder of tolerances (closed forms: none, one setting).
+fn ladder(mode: &Mode, ladder: Ladder) -> Option<Vec<f64>> {
+    match ladder {
+        Ladder::ClosedForm => None,
+        Ladder::Tolerances(quick, full) => Some(if mode.quick { quick.to_vec() } else { full.to_vec() }),
     }
 }
 
@@ -247,25 +237,28 @@ pub struct Python {
     pub required: bool,
 }
 
-pub fn all(mode: &Mode, specs: &[Spec], python: Option<&Python>) -> Result<Vec<TableRow>> {
+/// Every family's tables, by order: shadefit's side, and the script's when `python` is given.
+pub fn all(mode: &Mode, specs: &[Spec], families: &[&FamilyBench], python: Option<&Python>) -> Result<Vec<TableRow>, BenchError> {
     let mut tables = Vec::new();
-    for (k, (name, quick_n, full_n)) in TABLES.iter().enumerate() {
-        let Some(spec) = specs.iter().find(|s| s.file.name == *name) else {
+    for bench in super::ordered(families, |f| f.tables, |t| t.order) {
+        let Some(spec) = specs.iter().find(|s| s.file.name == bench.spec) else {
             continue;
         };
+        let (quick_n, full_n) = bench.samples;
         tables.push(table(
             spec,
-            if mode.quick { *quick_n } else { *full_n },
-            0x5EED + k as u64,
+            bench,
+            if mode.quick { quick_n } else { full_n },
+            0x5EED + u64::from(bench.order),
         ));
     }
     let mut rows = Vec::new();
     let mut inputs = Vec::new();
     for t in &tables {
         let quantity = t.spec.file.quantity.clone();
-        let truth = t.eval(reference_tolerance(&quantity));
+        let truth = t.eval(t.bench.reference_tolerance);
         let mut curve = Vec::new();
-        let settings: Vec<(String, f64)> = match ladder(mode, &quantity) {
+        let settings: Vec<(String, f64)> = match ladder(mode, t.bench.ladder) {
             Some(tols) => tols
                 .into_iter()
                 .map(|tol| (format!("tol {tol:.0e}"), tol))
@@ -312,7 +305,7 @@ pub fn all(mode: &Mode, specs: &[Spec], python: Option<&Python>) -> Result<Vec<T
             Ok(v) => v,
             Err(e) if !py.required => {
                 for row in &mut rows {
-                    row.note = format!("numpy/scipy comparison failed: {e:#}");
+                    row.note = format!("numpy/scipy comparison failed: {}", e.chain());
                 }
                 return Ok(rows);
             }
@@ -364,7 +357,7 @@ fn curve_point(v: &Value) -> CurvePoint {
 }
 
 /// The comparison at equal error (see the module doc).
-pub(crate) fn ratio(numpy: &[CurvePoint], shadefit: &[CurvePoint]) -> Option<Ratio> {
+pub fn ratio(numpy: &[CurvePoint], shadefit: &[CurvePoint]) -> Option<Ratio> {
     let ok = |c: &&CurvePoint| c.max_error.is_some_and(f64::is_finite) && c.seconds_per_point > 0.0;
     let fastest_within = |rows: &[CurvePoint], bound: f64| -> Option<CurvePoint> {
         rows.iter()
@@ -399,11 +392,11 @@ pub(crate) fn ratio(numpy: &[CurvePoint], shadefit: &[CurvePoint]) -> Option<Rat
 }
 
 /// Run the script on `input`; its JSON answer.
-fn run_python(py: &Python, input: &Value) -> Result<Value> {
-    let dir = tempfile::tempdir().context("creating a temporary folder")?;
+fn run_python(py: &Python, input: &Value) -> Result<Value, BenchError> {
+    let dir = tempfile::tempdir().map_err(|source| BenchError::TempDir { source })?;
     let inp = dir.path().join("in.json");
     let out = dir.path().join("out.json");
-    std::fs::write(&inp, serde_json::to_vec(input)?)?;
+    std::fs::write(&inp, input.to_string()).map_err(|source| BenchError::Write { path: inp.clone(), source })?;
     let status = Command::new(&py.interpreter)
         .arg(&py.script)
         .arg(&inp)
@@ -413,10 +406,12 @@ fn run_python(py: &Python, input: &Value) -> Result<Value> {
         .env("OPENBLAS_NUM_THREADS", "1")
         .env("MKL_NUM_THREADS", "1")
         .status()
-        .with_context(|| format!("running {} {}", py.interpreter.display(), py.script.display()))?;
-    anyhow::ensure!(status.success(), "{} exited with {status}", py.script.display());
-    let text = std::fs::read_to_string(&out).with_context(|| format!("reading {}", out.display()))?;
-    serde_json::from_str(&text).with_context(|| format!("parsing {}", out.display()))
+        .map_err(|source| BenchError::PythonStart { interpreter: py.interpreter.clone(), script: py.script.clone(), source })?;
+    if !status.success() {
+        return Err(BenchError::Python { script: py.script.clone(), status });
+    }
+    let text = std::fs::read_to_string(&out).map_err(|source| BenchError::Read { path: out.clone(), source })?;
+    serde_json::from_str(&text).map_err(|source| BenchError::Json { path: out.clone(), source })
 }
 
 /// The default interpreter: the test suite's venv when present, else `python3`.

@@ -2,12 +2,12 @@
 //! Appendices A–H): the integrals P_s, G, Q, R of the single-scattering fuzz layer, and the
 //! published Listings 1–5 measured against them.
 
+pub mod bench;
 pub mod integrals;
 pub mod plot;
 pub mod published;
 
 use super::Family;
-use crate::bench::FamilyBench;
 use crate::integrate::Estimate;
 use crate::quantity::{InnerBasis, ParamSpec, QuantityDef};
 
@@ -125,6 +125,6 @@ pub static FAMILY: Family = Family {
     eval_options: None,
     validate: published::items,
     figures: plot::fuzz_figures,
-    bench: FamilyBench::NONE,
+    bench: bench::BENCH,
     scene_features: &[],
 };

@@ -2,12 +2,12 @@
 //! fitting", "Combining gloss"): gloss ↔ GGX average normal length, its inverse, the
 //! gloss-combine table, and the published constants measured against them.
 
+pub mod bench;
 pub mod integrals;
 pub mod plot;
 pub mod published;
 
 use super::Family;
-use crate::bench::FamilyBench;
 use crate::integrate::Estimate;
 use crate::quantity::{ParamSpec, QuantityDef};
 
@@ -82,6 +82,6 @@ pub static FAMILY: Family = Family {
     eval_options: None,
     validate: published::items,
     figures: plot::gloss_figures,
-    bench: FamilyBench::NONE,
+    bench: bench::BENCH,
     scene_features: &[],
 };

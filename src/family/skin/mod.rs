@@ -2,6 +2,7 @@
 //! ring integral and the SH band factors, and the `skin-lut` spec kind that builds them into
 //! textures and lookups.
 
+pub mod bench;
 pub mod build;
 pub mod emit;
 pub mod integrals;
@@ -12,7 +13,6 @@ pub mod spec;
 use super::Family;
 use super::{EvalOptions, OptionEval, SpecKind};
 use crate::spec::KindDef;
-use crate::bench::FamilyBench;
 use crate::integrate::Estimate;
 use crate::quantity::{ParamSpec, QuantityDef};
 
@@ -136,6 +136,6 @@ pub static FAMILY: Family = Family {
     eval_options: Some((&["skin-punctual", "skin-sh"], eval_with_options)),
     validate: |_| Vec::new(),
     figures: plot::skin_figures,
-    bench: FamilyBench::NONE,
+    bench: bench::BENCH,
     scene_features: &[],
 };
