@@ -1,7 +1,7 @@
 //! Emission: WGSL libraries, Rust modules, JSON coefficient files and CSV tables, each with
 //! an `@generated` header carrying the generator version, the spec, the input hash and the
-//! measured error. Everything is rendered in memory first; [`write_all`] then writes each
-//! file to a temporary name and renames it, so a failed build leaves generated/ untouched.
+//! measured error. Everything is rendered in memory first; a [`Transaction`] then stages the
+//! files and swaps them in together, so a failed or killed build leaves generated/ as it was.
 
 /// The expression tree of a fitted model (it lives with the model; emit renders it).
 pub use crate::fit::expr;
@@ -46,40 +46,291 @@ pub struct WriteError {
     pub source: std::io::Error,
 }
 
-/// Write every artifact atomically (temp file + rename) under `root`.
-pub fn write_all(root: &Path, artifacts: &[Artifact]) -> Result<usize, WriteError> {
-    let mut written = 0;
-    for a in artifacts {
-        let path = root.join(&a.path);
-        if std::fs::read(&path).is_ok_and(|old| old == a.contents) {
-            continue;
+/// The lock file under the generated/ root: one build writes at a time.
+pub const LOCK_FILE: &str = ".shadefit.lock";
+/// Staged files, backups and the journal of a transaction, under the generated/ root.
+pub const STAGING_DIR: &str = ".staging";
+const JOURNAL: &str = "journal";
+
+/// A set of writes under the generated/ root that lands whole or not at all.
+///
+/// [`Transaction::begin`] takes an exclusive lock on `ROOT/.shadefit.lock` (a second build waits
+/// for the first, saying so on stderr) and first undoes what an interrupted transaction left:
+/// the journal in `ROOT/.staging` lists every file it swapped, each restored from its backup or
+/// removed if it was new, and stale staged files go with the folder. [`Transaction::write`] writes
+/// the changed files to `.staging` (synced), then for each one records it in the journal
+/// (synced), moves the old file to a backup and renames the new one into place.
+/// [`Transaction::commit`] drops the journal and the backups. A failure, or a transaction
+/// dropped without `commit`, restores every file the transaction replaced; a killed process
+/// leaves the journal, and the next `begin` restores. Renames within one file system are atomic,
+/// so at every instant each file is either old or new, and after recovery all of them are old.
+///
+/// Fault injection for tests: `SHADEFIT_FAULT_AFTER_SWAPS=N` makes the swap after the N-th fail
+/// with an I/O error; `SHADEFIT_ABORT_AFTER_SWAPS=N` aborts the process there (a kill).
+pub struct Transaction {
+    root: PathBuf,
+    _lock: std::fs::File,
+    journal: Option<std::fs::File>,
+    /// (target, backup) of every swap so far; `None`: the target was new.
+    swaps: Vec<(PathBuf, Option<PathBuf>)>,
+    staged: usize,
+    committed: bool,
+    /// Fault injection (from the environment at `begin`).
+    pub fail_after: Option<usize>,
+    abort_after: Option<usize>,
+}
+
+fn fault_point(var: &str) -> Option<usize> {
+    std::env::var(var).ok()?.parse().ok()
+}
+
+impl Transaction {
+    pub fn begin(root: &Path) -> Result<Transaction, WriteError> {
+        let err = |p: &Path| {
+            let path = p.display().to_string();
+            move |e| WriteError { path, source: e }
+        };
+        std::fs::create_dir_all(root).map_err(err(root))?;
+        let lock_path = root.join(LOCK_FILE);
+        let lock = std::fs::OpenOptions::new().create(true).truncate(false).write(true).open(&lock_path).map_err(err(&lock_path))?;
+        match lock.try_lock() {
+            Ok(()) => {}
+            Err(std::fs::TryLockError::WouldBlock) => {
+                eprintln!("waiting for another shadefit build writing {} (lock {})", root.display(), lock_path.display());
+                lock.lock().map_err(err(&lock_path))?;
+            }
+            Err(std::fs::TryLockError::Error(e)) => return Err(err(&lock_path)(e)),
         }
-        let err = |e| WriteError { path: path.display().to_string(), source: e };
-        if let Some(dir) = path.parent() {
-            std::fs::create_dir_all(dir).map_err(err)?;
-        }
-        let tmp = path.with_extension(format!(
-            "{}.tmp",
-            path.extension().and_then(|e| e.to_str()).unwrap_or("")
-        ));
-        let result = (|| {
-            let mut f = std::fs::File::create(&tmp)?;
-            f.write_all(&a.contents)?;
-            f.sync_all()?;
-            std::fs::rename(&tmp, &path)
-        })();
-        if let Err(e) = result {
-            let _ = std::fs::remove_file(&tmp);
-            return Err(err(e));
-        }
-        written += 1;
+        recover(root)?;
+        Ok(Transaction {
+            root: root.to_path_buf(),
+            _lock: lock,
+            journal: None,
+            swaps: Vec::new(),
+            staged: 0,
+            committed: false,
+            fail_after: fault_point("SHADEFIT_FAULT_AFTER_SWAPS"),
+            abort_after: fault_point("SHADEFIT_ABORT_AFTER_SWAPS"),
+        })
     }
-    Ok(written)
+
+    /// Stage and swap in every artifact whose bytes differ from the file on disk; returns how
+    /// many were written. On error, everything this transaction swapped is restored.
+    pub fn write(&mut self, artifacts: &[Artifact]) -> Result<usize, WriteError> {
+        let staging = self.root.join(STAGING_DIR);
+        let err = |p: &Path| {
+            let path = p.display().to_string();
+            move |e| WriteError { path, source: e }
+        };
+        let changed: Vec<&Artifact> =
+            artifacts.iter().filter(|a| std::fs::read(self.root.join(&a.path)).map_or(true, |old| old != a.contents)).collect();
+        if changed.is_empty() {
+            return Ok(0);
+        }
+        std::fs::create_dir_all(&staging).map_err(err(&staging))?;
+        // Stage every file first: a failure here has swapped nothing.
+        let mut tmps = Vec::new();
+        for a in &changed {
+            let tmp = staging.join(format!("new-{}", self.staged));
+            self.staged += 1;
+            let r = (|| {
+                let mut f = std::fs::File::create(&tmp)?;
+                f.write_all(&a.contents)?;
+                f.sync_all()
+            })();
+            if let Err(e) = r {
+                for t in tmps.iter().chain(std::iter::once(&tmp)) {
+                    let _ = std::fs::remove_file(t);
+                }
+                return Err(err(&self.root.join(&a.path))(e));
+            }
+            tmps.push(tmp);
+        }
+        if self.journal.is_none() {
+            let j = staging.join(JOURNAL);
+            self.journal = Some(std::fs::File::create(&j).map_err(err(&j))?);
+        }
+        let (fail_after, abort_after) = (self.fail_after, self.abort_after);
+        for (a, tmp) in changed.iter().zip(&tmps) {
+            let path = self.root.join(&a.path);
+            if abort_after == Some(self.swaps.len()) {
+                std::process::abort();
+            }
+            let r = if fail_after == Some(self.swaps.len()) {
+                Err(std::io::Error::other("injected write failure (SHADEFIT_FAULT_AFTER_SWAPS)"))
+            } else {
+                self.swap(&path, tmp, &a.path)
+            };
+            if let Err(e) = r {
+                for t in &tmps {
+                    let _ = std::fs::remove_file(t);
+                }
+                self.rollback();
+                return Err(err(&path)(e));
+            }
+        }
+        Ok(changed.len())
+    }
+
+    fn swap(&mut self, path: &Path, tmp: &Path, rel: &Path) -> std::io::Result<()> {
+        if let Some(dir) = path.parent() {
+            std::fs::create_dir_all(dir)?;
+        }
+        let backup = path.exists().then(|| self.root.join(STAGING_DIR).join(format!("old-{}", self.swaps.len())));
+        let journal = self.journal.as_mut().expect("opened before the swaps");
+        match &backup {
+            Some(b) => writeln!(journal, "replaced\t{}\t{}", rel.display(), b.file_name().and_then(|n| n.to_str()).unwrap_or(""))?,
+            None => writeln!(journal, "created\t{}", rel.display())?,
+        }
+        journal.sync_all()?;
+        if let Some(b) = &backup {
+            std::fs::rename(path, b)?;
+        }
+        self.swaps.push((path.to_path_buf(), backup));
+        std::fs::rename(tmp, path)
+    }
+
+    fn rollback(&mut self) {
+        for (path, backup) in self.swaps.drain(..).rev() {
+            match backup {
+                Some(b) => {
+                    let _ = std::fs::rename(&b, &path);
+                }
+                None => {
+                    let _ = std::fs::remove_file(&path);
+                }
+            }
+        }
+        self.journal = None;
+        let _ = std::fs::remove_dir_all(self.root.join(STAGING_DIR));
+    }
+
+    /// Keep every file written; drop the backups and the journal.
+    pub fn commit(mut self) -> Result<(), WriteError> {
+        self.committed = true;
+        self.journal = None;
+        let staging = self.root.join(STAGING_DIR);
+        match std::fs::remove_dir_all(&staging) {
+            Ok(()) => Ok(()),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
+            Err(e) => Err(WriteError { path: staging.display().to_string(), source: e }),
+        }
+    }
+}
+
+impl Drop for Transaction {
+    fn drop(&mut self) {
+        if !self.committed {
+            self.rollback();
+        }
+    }
+}
+
+/// Undo an interrupted transaction under `root` (see [`Transaction`]); remove stale staging.
+fn recover(root: &Path) -> Result<(), WriteError> {
+    let staging = root.join(STAGING_DIR);
+    if let Ok(text) = std::fs::read_to_string(staging.join(JOURNAL)) {
+        for line in text.lines().rev() {
+            let parts: Vec<&str> = line.split('\t').collect();
+            match parts.as_slice() {
+                ["replaced", rel, backup] => {
+                    let b = staging.join(backup);
+                    if b.exists() {
+                        std::fs::rename(&b, root.join(rel)).map_err(|e| WriteError { path: root.join(rel).display().to_string(), source: e })?;
+                    }
+                }
+                ["created", rel] => {
+                    let _ = std::fs::remove_file(root.join(rel));
+                }
+                // A line cut short by the kill: its swap never started.
+                _ => {}
+            }
+        }
+    }
+    match std::fs::remove_dir_all(&staging) {
+        Ok(()) => Ok(()),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
+        Err(e) => Err(WriteError { path: staging.display().to_string(), source: e }),
+    }
+}
+
+/// Write every artifact under `root` as one [`Transaction`]: all or nothing.
+pub fn write_all(root: &Path, artifacts: &[Artifact]) -> Result<usize, WriteError> {
+    let mut tx = Transaction::begin(root)?;
+    let n = tx.write(artifacts)?;
+    tx.commit()?;
+    Ok(n)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn art(path: &str, text: &str) -> Artifact {
+        Artifact { path: PathBuf::from(path), contents: text.as_bytes().to_vec() }
+    }
+
+    fn tree(root: &Path) -> Vec<(String, String)> {
+        let mut out = Vec::new();
+        for dir in ["", "a", "b"] {
+            let Ok(rd) = std::fs::read_dir(root.join(dir)) else { continue };
+            for e in rd.flatten() {
+                let p = e.path();
+                if p.is_file() && !p.ends_with(LOCK_FILE) {
+                    out.push((p.strip_prefix(root).unwrap().display().to_string(), std::fs::read_to_string(&p).unwrap()));
+                }
+            }
+        }
+        out.sort();
+        out
+    }
+
+    #[test]
+    fn a_failed_write_restores_every_file() {
+        let d = tempfile::tempdir().unwrap();
+        let old = [art("a/x.txt", "old x"), art("b/y.txt", "old y")];
+        assert_eq!(write_all(d.path(), &old).unwrap(), 2);
+        assert_eq!(write_all(d.path(), &old).unwrap(), 0, "unchanged files are not rewritten");
+        let before = tree(d.path());
+        let new = [art("a/x.txt", "new x"), art("b/y.txt", "new y"), art("a/z.txt", "new z")];
+        // A failure at every point of the swap: nothing changes, nothing is left behind.
+        for k in 0..3 {
+            let mut tx = Transaction::begin(d.path()).unwrap();
+            tx.fail_after = Some(k);
+            assert!(tx.write(&new).is_err(), "fault after {k} swaps");
+            drop(tx);
+            assert_eq!(tree(d.path()), before, "fault after {k} swaps");
+            assert!(!d.path().join(STAGING_DIR).exists());
+        }
+        // Two writes in one transaction, dropped before commit: both undone.
+        let mut tx = Transaction::begin(d.path()).unwrap();
+        tx.write(&new[..1]).unwrap();
+        tx.write(&new[1..]).unwrap();
+        drop(tx);
+        assert_eq!(tree(d.path()), before);
+        // Committed: all new.
+        write_all(d.path(), &new).unwrap();
+        assert_eq!(tree(d.path()).len(), 3);
+        assert!(tree(d.path()).iter().all(|(_, t)| t.starts_with("new")));
+    }
+
+    #[test]
+    fn an_interrupted_transaction_is_undone_by_the_next() {
+        // What a kill between two swaps leaves: the journal, one backup, one new file in place.
+        let d = tempfile::tempdir().unwrap();
+        write_all(d.path(), &[art("a/x.txt", "old x"), art("b/y.txt", "old y")]).unwrap();
+        let before = tree(d.path());
+        let staging = d.path().join(STAGING_DIR);
+        std::fs::create_dir_all(&staging).unwrap();
+        std::fs::rename(d.path().join("a/x.txt"), staging.join("old-0")).unwrap();
+        std::fs::write(d.path().join("a/x.txt"), "new x").unwrap();
+        std::fs::write(d.path().join("a/z.txt"), "new z").unwrap();
+        std::fs::write(staging.join("new-7"), "staged, never swapped").unwrap();
+        std::fs::write(staging.join(JOURNAL), "replaced\ta/x.txt\told-0\ncreated\ta/z.txt\nrepl").unwrap();
+        Transaction::begin(d.path()).unwrap().commit().unwrap();
+        assert_eq!(tree(d.path()), before);
+        assert!(!staging.exists());
+    }
 
     #[test]
     fn f32_literals_round_trip() {
