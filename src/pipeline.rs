@@ -24,6 +24,7 @@ use serde_json::{json, Value};
 use sha2::{Digest, Sha256};
 use std::path::Path;
 
+pub mod committed;
 pub mod fields;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -53,6 +54,9 @@ pub enum BuildError {
     /// A spec input a family's builder rejects (e.g. a diffusion profile it cannot integrate).
     #[error("{spec}: {msg}")]
     Input { spec: String, msg: String },
+    /// A committed file read as a kind its spec is not.
+    #[error("{spec}: not a spec of kind = \"{expected}\"")]
+    NotKind { spec: String, expected: &'static str },
     #[error("{spec}: no builder for kind = \"{kind}\"")]
     UnknownKind { spec: String, kind: String },
 }

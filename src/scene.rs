@@ -337,7 +337,7 @@ fn fuzz_ps(specs: &[Spec], generated: &Path, material: &str, alpha: f64, theta_f
         vd.iter().map(|u| basis(u).iter().zip(coef).map(|(b, c)| b * c).sum::<f64>().clamp(lo, hi)).collect()
     };
     let ours = eval_at(c.as_slice());
-    let general = crate::validate::committed_fields(generated, "fuzz_ps", crate::family::catalog()).map(|f| max_err(&truth, &eval_at(&f(&outer))));
+    let general = crate::pipeline::committed::Fields::load(generated, "fuzz_ps", crate::family::catalog()).ok().map(|f| max_err(&truth, &eval_at(&f.eval(&outer))));
     let arg_refs: Vec<&str> = ib.args.to_vec();
     let m = model(&arg_refs, ib.terms, &[], vec![], Some((lo, hi)));
     let ps = Emitted {
@@ -351,8 +351,9 @@ fn fuzz_ps(specs: &[Spec], generated: &Path, material: &str, alpha: f64, theta_f
         coefficients: c,
     };
     let r = fuzz::r(alpha, theta_f, 1e-10);
-    let general_r = crate::validate::committed_refit(generated, "fuzz_r", crate::family::catalog())
-        .map(|(s, cf)| (s.model.as_ref().map_or(f64::NAN, |m| m.eval_clamped(&cf, &[alpha, theta_f])) - r.value).abs());
+    let general_r = crate::pipeline::committed::Refit::load(generated, "fuzz_r", crate::family::catalog())
+        .ok()
+        .map(|f| (f.eval(&[alpha, theta_f]) - r.value).abs());
     let rc = Constant {
         name: format!("{}_AVERAGE_PS", material.to_uppercase()),
         value: r.value,
@@ -375,10 +376,9 @@ fn fuzz_g(specs: &[Spec], generated: &Path, material: &str, d: f64) -> Result<(E
     let vx: Vec<f64> = ax.points(ax.verify_count() * 4 + 1);
     let truth: Vec<f64> = vx.iter().map(|&mu| fuzz::g_exact(d, mu)).collect();
     let ours: Vec<f64> = vx.iter().map(|&mu| m.eval_clamped(&f.coefficients, &[mu])).collect();
-    let general = crate::validate::committed_refit(generated, "fuzz_g", crate::family::catalog()).map(|(s, c)| {
-        let gm = s.model.expect("fit specs carry a model");
-        max_err(&truth, &vx.iter().map(|&mu| gm.eval_clamped(&c, &[mu, d])).collect::<Vec<_>>())
-    });
+    let general = crate::pipeline::committed::Refit::load(generated, "fuzz_g", crate::family::catalog())
+        .ok()
+        .map(|f| max_err(&truth, &vx.iter().map(|&mu| f.eval(&[mu, d])).collect::<Vec<_>>()));
     let g = Emitted {
         name: format!("{material}_fuzz_g"),
         args: vec!["n_dot_v".into()],
@@ -389,8 +389,7 @@ fn fuzz_g(specs: &[Spec], generated: &Path, material: &str, d: f64) -> Result<(E
         coefficients: f.coefficients,
     };
     let q = fuzz::q_exact(d);
-    let general_q = crate::validate::committed_refit(generated, "fuzz_q", crate::family::catalog())
-        .map(|(s, c)| (s.model.as_ref().map_or(f64::NAN, |m| m.eval_clamped(&c, &[d])) - q).abs());
+    let general_q = crate::pipeline::committed::Refit::load(generated, "fuzz_q", crate::family::catalog()).ok().map(|f| (f.eval(&[d]) - q).abs());
     let qc = Constant {
         name: format!("{}_AVERAGE_PENETRATION", material.to_uppercase()),
         value: q,
@@ -427,10 +426,9 @@ fn gloss_length(specs: &[Spec], generated: &Path, material: &str, lo: f64, hi: f
     let vx: Vec<f64> = (0..nv).map(|i| lo + (hi - lo) * i as f64 / (nv - 1) as f64).collect();
     let truth: Vec<f64> = vx.iter().map(|&g| gloss::length_from_gloss(g)).collect();
     let ours: Vec<f64> = vx.iter().map(|&g| m.eval_clamped(&f.coefficients, &[g])).collect();
-    let general_err = crate::validate::committed_refit(generated, "gloss_length", crate::family::catalog()).map(|(s, c)| {
-        let gm = s.model.expect("fit specs carry a model");
-        max_err(&truth, &vx.iter().map(|&g| gm.eval_clamped(&c, &[g])).collect::<Vec<_>>())
-    });
+    let general_err = crate::pipeline::committed::Refit::load(generated, "gloss_length", crate::family::catalog())
+        .ok()
+        .map(|f| max_err(&truth, &vx.iter().map(|&g| f.eval(&[g])).collect::<Vec<_>>()));
     Ok(Emitted {
         name: format!("{material}_gloss_to_normal_length"),
         args: vec![ax.name.clone()],
