@@ -623,6 +623,10 @@ pub fn build(
         nodes.push(node_record(name, h, &b.artifacts));
         artifacts.extend(b.artifacts);
     }
+    // The specialisations compare themselves with the committed fits of the specs they read
+    // (hash-checked): write the rebuilt nodes first, so they read this build's.
+    let mut written = emit::write_all(generated, &artifacts)?;
+    artifacts.clear();
     let hash = scene_hash(scene, specs, &p)?;
     // The scene JSON records the scene node itself like any other node (input hash, files).
     let scene_fresh = !force && built.is_empty() && recorded_fresh(generated, &previous, &hash);
@@ -638,7 +642,7 @@ pub fn build(
     if !built.is_empty() {
         artifacts.push(runtime_index(specs, scenes));
     }
-    let written = emit::write_all(generated, &artifacts)?;
+    written += emit::write_all(generated, &artifacts)?;
     let skipped = specs.iter().map(|s| s.file.name.clone()).filter(|n| !p.nodes.contains(n)).collect();
     Ok(SceneReport { built, up_to_date, skipped, records, written })
 }
