@@ -43,8 +43,8 @@ pub enum BuildError {
     NoCommitted { spec: String, why: String },
     #[error("{spec}: the spec changed since generated/json/{spec}.json was written (hash {committed} ≠ {current}); run `shadefit build`")]
     SpecChanged { spec: String, committed: String, current: String },
-    #[error("scene: {0}")]
-    Scene(String),
+    #[error(transparent)]
+    Scene(#[from] SceneError),
     #[error(transparent)]
     Write(#[from] crate::emit::WriteError),
     #[error("{spec}: the f32 code returns a non-finite value at {at:?}")]
@@ -59,6 +59,25 @@ pub enum BuildError {
     NotKind { spec: String, expected: &'static str },
     #[error("{spec}: no builder for kind = \"{kind}\"")]
     UnknownKind { spec: String, kind: String },
+}
+
+/// Errors of a scene's own build (its specialisations), beyond those of the specs it reads.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// The scene reaches or reads a spec that `fits/` does not have.
+    #[error("scene {scene} needs fits/{spec}.toml")]
+    MissingSpec { scene: String, spec: String },
+    /// A linear system of a material's specialisation has no solution.
+    #[error("{material}: the {system} is singular")]
+    Singular { material: String, system: String },
+    /// A specialisation's model could not be formed (e.g. a general fit's form without its pins).
+    #[error("{material}: cannot form the model of {function}")]
+    Model {
+        material: String,
+        function: String,
+        #[source]
+        source: Box<crate::fit::model::ModelError>,
+    },
 }
 
 /// Errors of an emitted function against the integral on the verification grid.

@@ -5,6 +5,7 @@
 pub mod integrals;
 pub mod plot;
 pub mod published;
+pub mod scene;
 
 use super::Family;
 use crate::bench::FamilyBench;
@@ -126,5 +127,5 @@ pub static FAMILY: Family = Family {
     validate: published::items,
     figures: plot::fuzz_figures,
     bench: FamilyBench::NONE,
-    scene_features: &[],
+    scene_features: scene::FEATURES,
 };

@@ -7,6 +7,7 @@ pub mod emit;
 pub mod integrals;
 pub mod plot;
 pub mod profile;
+pub mod scene;
 pub mod spec;
 
 use super::Family;
@@ -131,5 +132,5 @@ pub static FAMILY: Family = Family {
     validate: |_| Vec::new(),
     figures: plot::skin_figures,
     bench: FamilyBench::NONE,
-    scene_features: &[],
+    scene_features: scene::FEATURES,
 };
