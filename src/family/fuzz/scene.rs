@@ -194,3 +194,39 @@ fn g_build(m: &MaterialSpec, inputs: &Inputs) -> Result<Pieces, BuildError> {
     };
     Ok(Pieces { functions: vec![g], constants: vec![qc] })
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::scene::{plan, Feature, Scene};
+
+    fn features() -> Vec<&'static Feature> {
+        crate::family::families().iter().flat_map(|f| f.scene_features.iter()).collect()
+    }
+
+    fn load(params: &str) -> Result<Scene, crate::spec::SpecError> {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("t.toml");
+        std::fs::write(&p, format!("name = \"t\"\n[[material]]\nname = \"m\"\nfeatures = [\"fuzz\"]\nparams = {{ {params} }}\n")).unwrap();
+        Scene::load(&p, &features())
+    }
+
+    #[test]
+    fn fixed_parameters_specialise_ranges_reach_the_general_nodes() {
+        let p = plan(&load("alpha = 0.5, theta_f = 0.3, density = 0.2").unwrap());
+        assert!(p.nodes.is_empty(), "{:?}", p.nodes);
+        let inputs: Vec<&[&str]> = p.special.iter().map(|s| s.what.inputs).collect();
+        assert_eq!(inputs, [&["fuzz_ps", "fuzz_r"][..], &["fuzz_g", "fuzz_q"][..]]);
+        let p = plan(&load("alpha = [0.3, 0.6], theta_f = 0.3, density = [0.0, 0.3]").unwrap());
+        assert_eq!(p.nodes, ["fuzz_g", "fuzz_ps", "fuzz_q", "fuzz_r"]);
+        assert!(p.special.is_empty());
+    }
+
+    #[test]
+    fn a_fixed_density_must_be_positive() {
+        let e = load("density = 0.0").unwrap_err().to_string();
+        assert!(e.contains("density > 0 when fixed"), "{e}");
+        assert!(load("density = 0.5").is_ok());
+        assert!(load("density = 0.6").is_err());
+        assert!(load("alpha = 0.1").is_err());
+    }
+}

@@ -86,3 +86,39 @@ fn length_build(mat: &MaterialSpec, inputs: &Inputs) -> Result<Pieces, BuildErro
     };
     Ok(Pieces { functions: vec![length], constants: vec![] })
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::scene::{plan, scene_functions, Feature, Scene};
+
+    fn features() -> Vec<&'static Feature> {
+        crate::family::families().iter().flat_map(|f| f.scene_features.iter()).collect()
+    }
+
+    fn load(features_line: &str, params: &str) -> Result<Scene, crate::spec::SpecError> {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("t.toml");
+        std::fs::write(&p, format!("name = \"t\"\n[[material]]\nname = \"m\"\nfeatures = {features_line}\nparams = {{ {params} }}\n"))
+            .unwrap();
+        Scene::load(&p, &features())
+    }
+
+    #[test]
+    fn a_gloss_range_refits_the_length_a_fixed_gloss_does_not() {
+        let s = load("[\"gloss_mips\", \"gloss_combine\"]", "gloss = [0.3, 0.9]").unwrap();
+        let p = plan(&s);
+        assert_eq!(p.nodes, ["gloss_combine_lut", "gloss_inverse_table"]);
+        assert_eq!(scene_functions(&s, &[]), [("m_gloss_to_normal_length".to_string(), vec![(0.3, 0.9)])]);
+        let p = plan(&load("[\"gloss_mips\"]", "gloss = 0.5").unwrap());
+        assert_eq!(p.nodes, ["gloss_inverse_table", "gloss_length"]);
+        assert!(p.special.is_empty());
+    }
+
+    #[test]
+    fn parameters_belong_to_the_material_features() {
+        let e = load("[\"gloss_combine\"]", "gloss = 0.5").unwrap_err().to_string();
+        assert!(e.contains("not a parameter"), "{e}");
+        let e = load("[\"glossy\"]", "").unwrap_err().to_string();
+        assert!(e.contains("unknown feature 'glossy'") && e.contains("gloss_mips"), "{e}");
+    }
+}
