@@ -10,7 +10,7 @@
 use crate::emit::WriteError;
 use crate::family;
 use crate::pipeline::{self, BuildError, Built, CustomBuild, Mode};
-use crate::scene::{self, Scene, SceneReport};
+use crate::scene::{self, Feature, Scene, SceneReport};
 use crate::spec::{self, Spec, SpecError};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
@@ -74,9 +74,14 @@ pub fn load_specs(paths: &Paths, only: &[String]) -> Result<Vec<Spec>, Error> {
     Ok(specs)
 }
 
+/// Every family's scene features, in registry order.
+pub fn scene_features() -> Vec<&'static Feature> {
+    family::families().iter().flat_map(|f| f.scene_features.iter()).collect()
+}
+
 /// The scene manifests in `fits/scenes`.
 pub fn load_scenes(paths: &Paths) -> Result<Vec<Scene>, Error> {
-    Ok(Scene::load_dir(&paths.fits.join("scenes"))?)
+    Ok(Scene::load_dir(&paths.fits.join("scenes"), &scene_features())?)
 }
 
 /// What a build did: each spec's result and time, each scene module's time, files written.
@@ -150,7 +155,7 @@ pub fn run(paths: &Paths, only: &[String], check: bool, tick: &(dyn Fn() + Sync)
 /// `shadefit build --scene FILE [--force]`: only the nodes the scene reaches, each only when its
 /// inputs or files changed since the scene's last build, then the scene module.
 pub fn run_scene(paths: &Paths, file: &Path, force: bool) -> Result<SceneReport, Error> {
-    let sc = Scene::load(file)?;
+    let sc = Scene::load(file, &scene_features())?;
     let specs = load_specs(paths, &[])?;
     let mut scenes = load_scenes(paths)?;
     if !scenes.iter().any(|s| s.file.name == sc.file.name) {

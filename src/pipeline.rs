@@ -24,6 +24,7 @@ use serde_json::{json, Value};
 use sha2::{Digest, Sha256};
 use std::path::Path;
 
+pub mod committed;
 pub mod fields;
 
 /// Project paths: specs in `fits/`, outputs in `generated/`.
@@ -49,8 +50,8 @@ pub enum BuildError {
     NoCommitted { spec: String, why: String },
     #[error("{spec}: the spec changed since generated/json/{spec}.json was written (hash {committed} ≠ {current}); run `shadefit build`")]
     SpecChanged { spec: String, committed: String, current: String },
-    #[error("scene: {0}")]
-    Scene(String),
+    #[error(transparent)]
+    Scene(#[from] SceneError),
     #[error(transparent)]
     Write(#[from] crate::emit::WriteError),
     #[error("{spec}: the f32 code returns a non-finite value at {at:?}")]
@@ -60,8 +61,30 @@ pub enum BuildError {
     /// A spec input a family's builder rejects (e.g. a diffusion profile it cannot integrate).
     #[error("{spec}: {msg}")]
     Input { spec: String, msg: String },
+    /// A committed file read as a kind its spec is not.
+    #[error("{spec}: not a spec of kind = \"{expected}\"")]
+    NotKind { spec: String, expected: &'static str },
     #[error("{spec}: no builder for kind = \"{kind}\"")]
     UnknownKind { spec: String, kind: String },
+}
+
+/// Errors of a scene's own build (its specialisations), beyond those of the specs it reads.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// The scene reaches or reads a spec that `fits/` does not have.
+    #[error("scene {scene} needs fits/{spec}.toml")]
+    MissingSpec { scene: String, spec: String },
+    /// A linear system of a material's specialisation has no solution.
+    #[error("{material}: the {system} is singular")]
+    Singular { material: String, system: String },
+    /// A specialisation's model could not be formed (e.g. a general fit's form without its pins).
+    #[error("{material}: cannot form the model of {function}")]
+    Model {
+        material: String,
+        function: String,
+        #[source]
+        source: Box<crate::fit::model::ModelError>,
+    },
 }
 
 /// Errors of an emitted function against the integral on the verification grid.

@@ -4,26 +4,19 @@
 //! fixed for the whole material (a number) or confined to a range (`[lo, hi]`):
 //!
 //! ```toml
-//! name = "velvet_horse"             # must equal the file stem
+//! name = "my_scene"                 # must equal the file stem
 //! description = "..."
 //! [[material]]
-//! name = "velvet"                   # lowercase identifier, prefixes the emitted names
-//! features = ["fuzz"]               # fuzz | skin | gloss_mips | gloss_combine
-//! params = { alpha = 0.53, theta_f = 0.4014, density = 0.2 }
+//! name = "cloth"                    # lowercase identifier, prefixes the emitted names
+//! features = ["FEATURE"]            # features the families offer
+//! params = { a = 0.5, b = [0.2, 0.8] }
 //! ```
 //!
-//! Features, their parameters and what a scene build makes of them:
-//! - `fuzz` (alpha ∈ [0.15, 1], theta_f ∈ [0, π/2], density ∈ (0, 0.5]): with alpha and theta_f
-//!   fixed, the six P_s coefficients come straight from the integrals (the per-direction
-//!   minimax optimum at that point, emitted as `{material}_fuzz_ps(n_dot_u, t_dot_u)`) and R is
-//!   a constant (`{MATERIAL}_AVERAGE_PS`); otherwise the general `fuzz_ps` and `fuzz_r` nodes are
-//!   reached. With density fixed, Q is a constant (`{MATERIAL}_AVERAGE_PENETRATION`) and G̃'s form
-//!   is refitted in μv alone (`{material}_fuzz_g(n_dot_v)`); otherwise `fuzz_q`, `fuzz_g`.
-//! - `skin`: the `skin_punctual_lut` and `skin_sh_lut` nodes.
-//! - `gloss_mips` (gloss range): `gloss_inverse_table`, and with a gloss range the form of
-//!   `gloss_length` refitted on that range (`{material}_gloss_to_normal_length(gloss)`, no end
-//!   pins), else the general `gloss_length`.
-//! - `gloss_combine`: the `gloss_combine_lut` node.
+//! The features are the families' ([`Feature`], listed in each family's `scene.rs` and given to
+//! [`Scene::load`] by the caller): each names its parameters and their domains, the general
+//! spec nodes a material reaches, and the specialisations the scene module builds instead when
+//! parameters are fixed or narrowed (functions refitted at the material's parameters, constants
+//! from the integrals, each with a record of its measured error beside the general fit's).
 //!
 //! The build graph's nodes are the specs of `fits/` (inputs: the spec text and the generator
 //! version, i.e. [`pipeline::input_hash`]) and the scene itself (inputs: the manifest, the
@@ -33,13 +26,10 @@
 //! files), then the scene module `scene_NAME` (WGSL + Rust, one include per scene).
 
 use crate::emit::{self, expr, header_lines, rust, wgsl, Artifact, GENERATOR};
-use crate::fit::model::{ModelParts, Term};
-use crate::fit::{self, Data, FitOptions, Objective, RationalModel};
-use crate::pipeline::{self, input_hash, BuildError, Mode};
-use crate::family::fuzz::integrals as fuzz;
-use crate::family::gloss::integrals as gloss;
+use crate::fit::RationalModel;
+use crate::pipeline::{self, input_hash, BuildError, Mode, SceneError};
 use crate::spec::{is_identifier, line_of, parse_toml, Spec, SpecError};
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DVector;
 use serde::Deserialize;
 use serde_json::{json, Value};
 use sha2::{Digest, Sha256};
@@ -62,6 +52,24 @@ pub struct MaterialSpec {
     pub params: BTreeMap<String, ParamValue>,
 }
 
+impl MaterialSpec {
+    /// The parameter `k` when the material fixes it.
+    pub fn fixed(&self, k: &str) -> Option<f64> {
+        match self.params.get(k) {
+            Some(ParamValue::Fixed(v)) => Some(*v),
+            _ => None,
+        }
+    }
+
+    /// The range `[lo, hi]` the material confines parameter `k` to.
+    pub fn range(&self, k: &str) -> Option<(f64, f64)> {
+        match self.params.get(k) {
+            Some(ParamValue::Range([lo, hi])) => Some((*lo, *hi)),
+            _ => None,
+        }
+    }
+}
+
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SceneFile {
@@ -71,24 +79,109 @@ pub struct SceneFile {
     pub material: Vec<MaterialSpec>,
 }
 
-/// A validated scene manifest.
+/// A validated scene manifest, with the features of each material resolved.
 #[derive(Debug, Clone)]
 pub struct Scene {
     pub path: PathBuf,
     pub text: String,
     pub file: SceneFile,
+    /// The features of each material (same order as `file.material` and its `features`).
+    pub features: Vec<Vec<&'static Feature>>,
 }
 
-/// Features, their parameters and domains (closed unless noted in the check).
-const FEATURES: &[(&str, &[(&str, f64, f64)])] = &[
-    ("fuzz", &[("alpha", 0.15, 1.0), ("theta_f", 0.0, std::f64::consts::FRAC_PI_2), ("density", 0.0, 0.5)]),
-    ("skin", &[]),
-    ("gloss_mips", &[("gloss", 0.0, 1.0)]),
-    ("gloss_combine", &[]),
-];
+/// A scene feature a family offers (`features = [...]` in scene manifests; each family lists
+/// its own in its descriptor's `scene_features`). Plain data and function pointers.
+#[derive(Debug)]
+pub struct Feature {
+    pub name: &'static str,
+    /// The parameters a material with this feature may fix or confine.
+    pub params: &'static [Param],
+    /// What the feature needs for one material (already checked against `params`).
+    pub reach: fn(&MaterialSpec) -> Reach,
+}
+
+/// A parameter of a feature and its domain `[lo, hi]`.
+#[derive(Debug, Clone, Copy)]
+pub struct Param {
+    pub name: &'static str,
+    pub lo: f64,
+    pub hi: f64,
+    /// A fixed value must lie above `lo` (a range may still start at it).
+    pub fixed_above_lo: bool,
+}
+
+/// What a feature makes of one material: the general spec nodes it reaches and the
+/// specialisations the scene module builds for it.
+#[derive(Debug, Default)]
+pub struct Reach {
+    pub nodes: Vec<&'static str>,
+    pub special: Vec<&'static Specialisation>,
+}
+
+/// A specialisation a feature builds for one material from its parameters: functions
+/// refitted at those parameters and constants from the integrals, each with its record.
+#[derive(Debug)]
+pub struct Specialisation {
+    /// The specs it reads (their input hashes enter the scene's; they must be in `fits/`).
+    pub inputs: &'static [&'static str],
+    /// The scalar functions it emits (name, domain), from the manifest and specs alone: what
+    /// the runtime index lists without building the scene.
+    pub functions: fn(&MaterialSpec, &[Spec]) -> Vec<IndexedFunction>,
+    /// Build it: the functions and constants the scene module emits, in order.
+    pub build: fn(&MaterialSpec, &Inputs) -> Result<Pieces, BuildError>,
+}
+
+/// A scalar function of a scene module as the runtime index lists it: name and domain.
+pub type IndexedFunction = (String, Vec<(f64, f64)>);
+
+/// What a specialisation reads: the scene's specs and the generated/ folder (the committed
+/// general fits it compares itself with, through `pipeline::committed`).
+pub struct Inputs<'a> {
+    pub scene: &'a str,
+    pub specs: &'a [Spec],
+    pub generated: &'a Path,
+}
+
+impl<'a> Inputs<'a> {
+    /// The spec `name` (one of the specialisation's `inputs`).
+    pub fn spec(&self, name: &str) -> Result<&'a Spec, BuildError> {
+        find(self.scene, self.specs, name)
+    }
+}
+
+/// The pieces of a scene module a specialisation emits.
+#[derive(Default)]
+pub struct Pieces {
+    pub functions: Vec<SceneFunction>,
+    pub constants: Vec<SceneConstant>,
+}
+
+/// One emitted scalar function of a scene, with its record (`what`, its measured
+/// `max_abs_error` and the general fit's at the same parameters).
+pub struct SceneFunction {
+    pub name: String,
+    pub args: Vec<String>,
+    pub domain: Vec<(f64, f64)>,
+    pub model: RationalModel,
+    pub coefficients: DVector<f64>,
+    pub record: Value,
+}
+
+/// A constant of a scene (a value from the integrals) with its record (`what`, ...).
+pub struct SceneConstant {
+    pub name: String,
+    pub value: f64,
+    pub record: Value,
+}
+
+/// Max |approx − truth| over a set of points.
+pub fn max_err(truth: &[f64], approx: &[f64]) -> f64 {
+    truth.iter().zip(approx).map(|(t, a)| (t - a).abs()).fold(0.0, f64::max)
+}
 
 impl Scene {
-    pub fn load(path: &Path) -> Result<Scene, SpecError> {
+    /// Read and check a manifest; `features` are every feature the families offer.
+    pub fn load(path: &Path, features: &[&'static Feature]) -> Result<Scene, SpecError> {
         let text = std::fs::read_to_string(path)
             .map_err(|e| SpecError::new(path, 0, "(file)", format!("cannot read: {e}")))?;
         let file: SceneFile = parse_toml(path, &text)?;
@@ -104,6 +197,7 @@ impl Scene {
             return Err(at("material", "a scene needs at least one [[material]]".into()));
         }
         let mut seen = Vec::new();
+        let mut resolved = Vec::new();
         for (i, m) in file.material.iter().enumerate() {
             let line = material_line(i);
             let err = |field: &str, msg: String| SpecError::new(path, line, &format!("material[{i}].{field}"), msg);
@@ -114,40 +208,43 @@ impl Scene {
             if m.features.is_empty() {
                 return Err(err("features", "list at least one feature".into()));
             }
-            let mut allowed: Vec<(&str, f64, f64)> = Vec::new();
+            let mut mine: Vec<&'static Feature> = Vec::new();
             for f in &m.features {
-                let Some((_, params)) = FEATURES.iter().find(|(n, _)| n == f) else {
-                    let known: Vec<&str> = FEATURES.iter().map(|(n, _)| *n).collect();
+                let Some(feature) = features.iter().copied().find(|x| x.name == f) else {
+                    let known: Vec<&str> = features.iter().map(|x| x.name).collect();
                     return Err(err("features", format!("unknown feature '{f}' (known: {})", known.join(", "))));
                 };
-                allowed.extend(params.iter().copied());
+                mine.push(feature);
             }
             for (k, v) in &m.params {
-                let Some(&(_, lo, hi)) = allowed.iter().find(|(n, _, _)| n == k) else {
+                let Some(p) = mine.iter().flat_map(|f| f.params.iter()).find(|p| p.name == k) else {
                     return Err(err("params", format!("'{k}' is not a parameter of features [{}]", m.features.join(", "))));
                 };
+                let (lo, hi) = (p.lo, p.hi);
                 let ok = match *v {
-                    ParamValue::Fixed(x) => x.is_finite() && x >= lo && x <= hi && !(k == "density" && x == 0.0),
+                    ParamValue::Fixed(x) => x.is_finite() && x >= lo && x <= hi && !(p.fixed_above_lo && x == lo),
                     ParamValue::Range([a, b]) => a.is_finite() && b.is_finite() && a >= lo && b <= hi && a < b,
                 };
                 if !ok {
+                    let note = if p.fixed_above_lo { format!(" ({k} > {lo} when fixed)") } else { String::new() };
                     return Err(err(
                         "params",
-                        format!("'{k}' = {v:?} must be a finite value or increasing range inside [{lo}, {hi}] (density > 0 when fixed)"),
+                        format!("'{k}' = {v:?} must be a finite value or increasing range inside [{lo}, {hi}]{note}"),
                     ));
                 }
             }
+            resolved.push(mine);
         }
-        Ok(Scene { path: path.to_path_buf(), text, file })
+        Ok(Scene { path: path.to_path_buf(), text, file, features: resolved })
     }
 
     /// Every scene in `dir` (`*.toml`, sorted); a missing folder is no scene.
-    pub fn load_dir(dir: &Path) -> Result<Vec<Scene>, SpecError> {
+    pub fn load_dir(dir: &Path, features: &[&'static Feature]) -> Result<Vec<Scene>, SpecError> {
         let Ok(rd) = std::fs::read_dir(dir) else { return Ok(vec![]) };
         let mut paths: Vec<PathBuf> =
             rd.filter_map(|e| e.ok().map(|e| e.path())).filter(|p| p.extension().is_some_and(|e| e == "toml")).collect();
         paths.sort();
-        paths.iter().map(|p| Scene::load(p)).collect()
+        paths.iter().map(|p| Scene::load(p, features)).collect()
     }
 
     pub fn module(&self) -> String {
@@ -162,51 +259,21 @@ pub struct Plan {
     pub special: Vec<Special>,
 }
 
+/// A specialisation of one material.
 #[derive(Debug, Clone)]
-pub enum Special {
-    FuzzPs { material: String, alpha: f64, theta_f: f64 },
-    FuzzG { material: String, density: f64 },
-    GlossLength { material: String, lo: f64, hi: f64 },
-}
-
-fn fixed(m: &MaterialSpec, k: &str) -> Option<f64> {
-    match m.params.get(k) {
-        Some(ParamValue::Fixed(v)) => Some(*v),
-        _ => None,
-    }
+pub struct Special {
+    pub material: MaterialSpec,
+    pub what: &'static Specialisation,
 }
 
 pub fn plan(scene: &Scene) -> Plan {
     let mut nodes = Vec::new();
     let mut special = Vec::new();
-    for m in &scene.file.material {
-        for f in &m.features {
-            match f.as_str() {
-                "fuzz" => {
-                    match (fixed(m, "alpha"), fixed(m, "theta_f")) {
-                        (Some(alpha), Some(theta_f)) => {
-                            special.push(Special::FuzzPs { material: m.name.clone(), alpha, theta_f })
-                        }
-                        _ => nodes.extend(["fuzz_ps", "fuzz_r"]),
-                    }
-                    match fixed(m, "density") {
-                        Some(density) => special.push(Special::FuzzG { material: m.name.clone(), density }),
-                        None => nodes.extend(["fuzz_g", "fuzz_q"]),
-                    }
-                }
-                "skin" => nodes.extend(["skin_punctual_lut", "skin_sh_lut"]),
-                "gloss_mips" => {
-                    nodes.push("gloss_inverse_table");
-                    match m.params.get("gloss") {
-                        Some(ParamValue::Range([lo, hi])) => {
-                            special.push(Special::GlossLength { material: m.name.clone(), lo: *lo, hi: *hi })
-                        }
-                        _ => nodes.push("gloss_length"),
-                    }
-                }
-                "gloss_combine" => nodes.push("gloss_combine_lut"),
-                _ => {}
-            }
+    for (m, features) in scene.file.material.iter().zip(&scene.features) {
+        for f in features {
+            let r = (f.reach)(m);
+            nodes.extend(r.nodes);
+            special.extend(r.special.into_iter().map(|what| Special { material: m.clone(), what }));
         }
     }
     let mut nodes: Vec<String> = nodes.into_iter().map(String::from).collect();
@@ -215,17 +282,11 @@ pub fn plan(scene: &Scene) -> Plan {
     Plan { nodes, special }
 }
 
-/// The specs a specialisation reads (for the scene's input hash and its comparisons).
-fn special_inputs(s: &Special) -> &'static [&'static str] {
-    match s {
-        Special::FuzzPs { .. } => &["fuzz_ps", "fuzz_r"],
-        Special::FuzzG { .. } => &["fuzz_g", "fuzz_q"],
-        Special::GlossLength { .. } => &["gloss_length"],
-    }
-}
-
-fn find<'a>(specs: &'a [Spec], name: &str) -> Result<&'a Spec, BuildError> {
-    specs.iter().find(|s| s.file.name == name).ok_or_else(|| BuildError::Scene(format!("the scene needs fits/{name}.toml")))
+fn find<'a>(scene: &str, specs: &'a [Spec], name: &str) -> Result<&'a Spec, BuildError> {
+    specs
+        .iter()
+        .find(|s| s.file.name == name)
+        .ok_or_else(|| SceneError::MissingSpec { scene: scene.to_string(), spec: name.to_string() }.into())
 }
 
 /// The scene node's input hash: manifest, generator, and every spec it reaches or reads.
@@ -236,210 +297,18 @@ pub fn scene_hash(scene: &Scene, specs: &[Spec], plan: &Plan) -> Result<String, 
     h.update(scene.text.as_bytes());
     let mut names: Vec<&str> = plan.nodes.iter().map(String::as_str).collect();
     for s in &plan.special {
-        names.extend(special_inputs(s));
+        names.extend(s.what.inputs);
     }
     names.sort_unstable();
     names.dedup();
     for n in names {
-        h.update(format!("\n{n} {}", input_hash(find(specs, n)?)).as_bytes());
+        h.update(format!("\n{n} {}", input_hash(find(&scene.file.name, specs, n)?)).as_bytes());
     }
     Ok(format!("sha256:{}", pipeline::hex(&h.finalize())))
 }
 
 fn sha(bytes: &[u8]) -> String {
     pipeline::hex(&Sha256::digest(bytes))
-}
-
-/// One emitted scalar function of a scene, with its measured error and the general fit's at
-/// the same parameters.
-struct Emitted {
-    name: String,
-    args: Vec<String>,
-    domain: Vec<(f64, f64)>,
-    model: RationalModel,
-    coefficients: DVector<f64>,
-    record: Value,
-}
-
-/// A constant of a scene (value from the integral) with its record.
-struct Constant {
-    name: String,
-    value: f64,
-    record: Value,
-}
-
-/// Max |approx − truth| over a set of points.
-fn max_err(truth: &[f64], approx: &[f64]) -> f64 {
-    truth.iter().zip(approx).map(|(t, a)| (t - a).abs()).fold(0.0, f64::max)
-}
-
-fn model(inputs: &[&str], num: &[&str], den: &[&str], fixed: Vec<(usize, f64)>, clamp: Option<(f64, f64)>) -> RationalModel {
-    let f: Vec<String> = inputs.iter().map(|s| s.to_string()).collect();
-    let t = |s: &&str| Term::parse(s, &f).expect("scene model terms are valid");
-    RationalModel::new(ModelParts {
-        inputs: f.clone(),
-        numerator: num.iter().map(t).collect(),
-        denominator: den.iter().map(t).collect(),
-        fixed,
-        clamp,
-        ..ModelParts::default()
-    })
-    .expect("scene models are well formed")
-}
-
-/// P_s at fixed (α, θf): the coefficients of the quantity's inner basis (Eq. 1) by minimax over
-/// the spec's light directions (Lawson's iteration on the linear system), and R as a constant.
-fn fuzz_ps(specs: &[Spec], generated: &Path, material: &str, alpha: f64, theta_f: f64) -> Result<(Emitted, Constant), BuildError> {
-    let spec = find(specs, "fuzz_ps")?;
-    let ib = spec.quantity.basis.expect("fuzz-ps has an inner basis");
-    let args: Vec<String> = ib.args.iter().map(|a| a.to_string()).collect();
-    let terms: Vec<Term> = ib.terms.iter().map(|t| Term::parse(t, &args).expect("basis terms are valid")).collect();
-    let outer = [alpha, theta_f];
-    let inner_axes = &spec.file.axis[spec.file.axis.len() - ib.inner..];
-    let dirs = |verify: bool| -> Vec<Vec<f64>> {
-        let counts: Vec<usize> = inner_axes.iter().map(|a| if verify { a.verify_count() } else { a.count }).collect();
-        pipeline::tensor(inner_axes, &counts)
-    };
-    let basis = |u: &[f64]| -> Vec<f64> {
-        let a = (ib.to_args)(&outer, u);
-        terms.iter().map(|t| t.eval(&a)).collect()
-    };
-    let sample = |d: &[Vec<f64>]| -> Vec<f64> { (ib.sample)(&outer, d, spec.file.tolerance).iter().map(|e| e.value).collect() };
-    let (lo, hi) = ib.range;
-    let fit_dirs = dirs(false);
-    let b = DMatrix::from_fn(fit_dirs.len(), terms.len(), |i, k| basis(&fit_dirs[i])[k]);
-    let yv = DVector::from_vec(sample(&fit_dirs));
-    let mut w = vec![1.0; fit_dirs.len()];
-    let mut best: Option<(f64, DVector<f64>)> = None;
-    for _ in 0..200 {
-        let sw: Vec<f64> = w.iter().map(|v: &f64| v.sqrt()).collect();
-        let bw = DMatrix::from_fn(b.nrows(), b.ncols(), |i, k| b[(i, k)] * sw[i]);
-        let yw = DVector::from_fn(b.nrows(), |i, _| yv[i] * sw[i]);
-        let Ok(c) = bw.svd(true, true).solve(&yw, 1e-14) else { break };
-        let r = &b * &c - &yv;
-        let m = r.amax();
-        if best.as_ref().is_none_or(|(bm, _)| m < *bm) {
-            best = Some((m, c.clone()));
-        }
-        let top = w.iter().zip(r.iter()).map(|(wi, ri)| wi * ri.abs()).fold(0.0, f64::max);
-        if !(top > 0.0) {
-            break;
-        }
-        for (wi, ri) in w.iter_mut().zip(r.iter()) {
-            *wi = (*wi * ri.abs() / top).max(1e-6);
-        }
-    }
-    let (_, c) = best.ok_or_else(|| BuildError::Scene(format!("{material}: the P_s system at α = {alpha}, θf = {theta_f} is singular")))?;
-    // Errors on the verification directions, next to the general fit at the same (α, θf).
-    let vd = dirs(true);
-    let truth = sample(&vd);
-    let eval_at = |coef: &[f64]| -> Vec<f64> {
-        vd.iter().map(|u| basis(u).iter().zip(coef).map(|(b, c)| b * c).sum::<f64>().clamp(lo, hi)).collect()
-    };
-    let ours = eval_at(c.as_slice());
-    let general = crate::validate::committed_fields(generated, "fuzz_ps", crate::family::catalog()).map(|f| max_err(&truth, &eval_at(&f(&outer))));
-    let arg_refs: Vec<&str> = ib.args.to_vec();
-    let m = model(&arg_refs, ib.terms, &[], vec![], Some((lo, hi)));
-    let ps = Emitted {
-        name: format!("{material}_fuzz_ps"),
-        args,
-        domain: ib.arg_domain.to_vec(),
-        record: json!({"what": "P_s coefficients at fixed (alpha, theta_f)", "alpha": alpha, "theta_f": theta_f,
-            "coefficients": c.iter().copied().collect::<Vec<f64>>(), "points": vd.len(),
-            "max_abs_error": max_err(&truth, &ours), "general_fit_max_abs_error": general}),
-        model: m,
-        coefficients: c,
-    };
-    let r = fuzz::r(alpha, theta_f, 1e-10);
-    let general_r = crate::validate::committed_refit(generated, "fuzz_r", crate::family::catalog())
-        .map(|(s, cf)| (s.model.as_ref().map_or(f64::NAN, |m| m.eval_clamped(&cf, &[alpha, theta_f])) - r.value).abs());
-    let rc = Constant {
-        name: format!("{}_AVERAGE_PS", material.to_uppercase()),
-        value: r.value,
-        record: json!({"what": "R at fixed (alpha, theta_f)", "value": r.value, "error_estimate": r.error,
-            "general_fit_abs_error": general_r}),
-    };
-    Ok((ps, rc))
-}
-
-/// G̃'s form at fixed density, refitted in μv alone (minimax), and Q = 2·E₃(d) as a constant.
-fn fuzz_g(specs: &[Spec], generated: &Path, material: &str, d: f64) -> Result<(Emitted, Constant), BuildError> {
-    let spec = find(specs, "fuzz_g")?;
-    let ax = &spec.file.axis[0];
-    // d(1 + a1 μ + a2 μ²)/(d + b1 μ + b3 μ³) = (1 + a1 μ + a2 μ²)/(1 + (b1/d) μ + (b3/d) μ³).
-    let m = model(&["n_dot_v"], &["1", "n_dot_v", "n_dot_v^2"], &["n_dot_v", "n_dot_v^3"], vec![(0, 1.0)], None);
-    let x: Vec<Vec<f64>> = ax.points(ax.count * 4 + 1).into_iter().map(|v| vec![v]).collect();
-    let y: Vec<f64> = x.iter().map(|p| fuzz::g_exact(d, p[0])).collect();
-    let data = Data { x, y };
-    let f = fit::fit(&m, &data, &FitOptions { objective: Objective::Minimax, ..FitOptions::default() }, &format!("{material}_fuzz_g"))?;
-    let vx: Vec<f64> = ax.points(ax.verify_count() * 4 + 1);
-    let truth: Vec<f64> = vx.iter().map(|&mu| fuzz::g_exact(d, mu)).collect();
-    let ours: Vec<f64> = vx.iter().map(|&mu| m.eval_clamped(&f.coefficients, &[mu])).collect();
-    let general = crate::validate::committed_refit(generated, "fuzz_g", crate::family::catalog()).map(|(s, c)| {
-        let gm = s.model.expect("fit specs carry a model");
-        max_err(&truth, &vx.iter().map(|&mu| gm.eval_clamped(&c, &[mu, d])).collect::<Vec<_>>())
-    });
-    let g = Emitted {
-        name: format!("{material}_fuzz_g"),
-        args: vec!["n_dot_v".into()],
-        domain: vec![(ax.range[0], ax.range[1])],
-        record: json!({"what": "G refitted in mu_v at fixed density", "density": d, "points": vx.len(),
-            "max_abs_error": max_err(&truth, &ours), "general_fit_max_abs_error": general}),
-        model: m,
-        coefficients: f.coefficients,
-    };
-    let q = fuzz::q_exact(d);
-    let general_q = crate::validate::committed_refit(generated, "fuzz_q", crate::family::catalog())
-        .map(|(s, c)| (s.model.as_ref().map_or(f64::NAN, |m| m.eval_clamped(&c, &[d])) - q).abs());
-    let qc = Constant {
-        name: format!("{}_AVERAGE_PENETRATION", material.to_uppercase()),
-        value: q,
-        record: json!({"what": "Q = 2 E3(d) at fixed density", "value": q, "general_fit_abs_error": general_q}),
-    };
-    Ok((g, qc))
-}
-
-/// The form of gloss_length refitted (minimax, no end pins) on the material's gloss range.
-fn gloss_length(specs: &[Spec], generated: &Path, material: &str, lo: f64, hi: f64) -> Result<Emitted, BuildError> {
-    let spec = find(specs, "gloss_length")?;
-    let general = spec.model.as_ref().expect("fit specs carry a model");
-    let inputs: Vec<String> = general.features[..general.n_inputs].to_vec();
-    let m = RationalModel::new(ModelParts {
-        inputs,
-        derived: general.derived.clone(),
-        numerator: general.numerator.clone(),
-        denominator: general.denominator.clone(),
-        lead: general.lead.clone(),
-        offset: general.offset,
-        factor: general.factor.clone(),
-        fixed: general.fixed.clone(),
-        pins: vec![],
-        clamp: general.clamp,
-    })
-    .map_err(|e| BuildError::Scene(format!("{material}: {e}")))?;
-    let ax = &spec.file.axis[0];
-    let n = ax.count;
-    let x: Vec<Vec<f64>> = (0..n).map(|i| vec![lo + (hi - lo) * i as f64 / (n - 1) as f64]).collect();
-    let y: Vec<f64> = x.iter().map(|p| gloss::length_from_gloss(p[0])).collect();
-    let objective = spec.file.fit.as_ref().map_or(Objective::Minimax, |f| f.objective);
-    let f = fit::fit(&m, &Data { x, y }, &FitOptions { objective, ..FitOptions::default() }, &format!("{material}_gloss_to_normal_length"))?;
-    let nv = ax.verify_count();
-    let vx: Vec<f64> = (0..nv).map(|i| lo + (hi - lo) * i as f64 / (nv - 1) as f64).collect();
-    let truth: Vec<f64> = vx.iter().map(|&g| gloss::length_from_gloss(g)).collect();
-    let ours: Vec<f64> = vx.iter().map(|&g| m.eval_clamped(&f.coefficients, &[g])).collect();
-    let general_err = crate::validate::committed_refit(generated, "gloss_length", crate::family::catalog()).map(|(s, c)| {
-        let gm = s.model.expect("fit specs carry a model");
-        max_err(&truth, &vx.iter().map(|&g| gm.eval_clamped(&c, &[g])).collect::<Vec<_>>())
-    });
-    Ok(Emitted {
-        name: format!("{material}_gloss_to_normal_length"),
-        args: vec![ax.name.clone()],
-        domain: vec![(lo, hi)],
-        record: json!({"what": "gloss_length form refitted on the material's gloss range", "range": [lo, hi], "points": nv,
-            "max_abs_error": max_err(&truth, &ours), "general_fit_max_abs_error": general_err}),
-        model: m,
-        coefficients: f.coefficients,
-    })
 }
 
 /// The scene node's artifacts (WGSL + Rust module, JSON) and the scalar functions it emits
@@ -467,22 +336,13 @@ pub fn build_scene(
 ) -> Result<SceneBuild, BuildError> {
     let p = plan(scene);
     let hash = scene_hash(scene, specs, &p)?;
+    let inputs = Inputs { scene: &scene.file.name, specs, generated };
     let mut emitted = Vec::new();
     let mut constants = Vec::new();
     for s in &p.special {
-        match s {
-            Special::FuzzPs { material, alpha, theta_f } => {
-                let (e, c) = fuzz_ps(specs, generated, material, *alpha, *theta_f)?;
-                emitted.push(e);
-                constants.push(c);
-            }
-            Special::FuzzG { material, density } => {
-                let (e, c) = fuzz_g(specs, generated, material, *density)?;
-                emitted.push(e);
-                constants.push(c);
-            }
-            Special::GlossLength { material, lo, hi } => emitted.push(gloss_length(specs, generated, material, *lo, *hi)?),
-        }
+        let pieces = (s.what.build)(&s.material, &inputs)?;
+        emitted.extend(pieces.functions);
+        constants.extend(pieces.constants);
     }
     let module = scene.module();
     let rel = format!("fits/scenes/{}.toml", scene.file.name);
@@ -608,7 +468,7 @@ pub fn build(
     let mut nodes = Vec::new();
     let mut artifacts = Vec::new();
     for name in &p.nodes {
-        let spec = find(specs, name)?;
+        let spec = find(&scene.file.name, specs, name)?;
         let h = input_hash(spec);
         if !force && let Some(rec) = recorded(name).filter(|r| recorded_fresh(generated, r, &h)) {
             up_to_date.push(name.clone());
@@ -625,6 +485,10 @@ pub fn build(
         nodes.push(node_record(name, h, &b.artifacts));
         artifacts.extend(b.artifacts);
     }
+    // The specialisations compare themselves with the committed fits of the specs they read
+    // (hash-checked): write the rebuilt nodes first, so they read this build's.
+    let mut written = emit::write_all(generated, &artifacts)?;
+    artifacts.clear();
     let hash = scene_hash(scene, specs, &p)?;
     // The scene JSON records the scene node itself like any other node (input hash, files).
     let scene_fresh = !force && built.is_empty() && recorded_fresh(generated, &previous, &hash);
@@ -640,7 +504,7 @@ pub fn build(
     if !built.is_empty() {
         artifacts.push(runtime_index(specs, scenes));
     }
-    let written = emit::write_all(generated, &artifacts)?;
+    written += emit::write_all(generated, &artifacts)?;
     let skipped = specs.iter().map(|s| s.file.name.clone()).filter(|n| !p.nodes.contains(n)).collect();
     Ok(SceneReport { built, up_to_date, skipped, records, written })
 }
@@ -648,31 +512,11 @@ pub fn build(
 /// The runtime index with every scene's functions (read from the scenes' committed JSON-free
 /// plan: the function names follow from the manifests).
 pub fn runtime_index(specs: &[Spec], scenes: &[Scene]) -> Artifact {
-    let list: Vec<(String, Vec<(String, Vec<(f64, f64)>)>)> = scenes.iter().map(|s| (s.module(), scene_functions(s, specs))).collect();
+    let list: Vec<pipeline::SceneIndex> = scenes.iter().map(|s| (s.module(), scene_functions(s, specs))).collect();
     pipeline::runtime_index_with_scenes(specs, &list)
 }
 
 /// The scalar functions a scene emits (name, domain), from its plan alone.
-pub fn scene_functions(scene: &Scene, specs: &[Spec]) -> Vec<(String, Vec<(f64, f64)>)> {
-    plan(scene)
-        .special
-        .iter()
-        .map(|s| match s {
-            Special::FuzzPs { material, .. } => {
-                let d = crate::family::catalog().lookup("fuzz-ps").ok().and_then(|q| q.basis).map_or(vec![], |b| b.arg_domain.to_vec());
-                (format!("{material}_fuzz_ps"), d)
-            }
-            Special::FuzzG { material, .. } => {
-                let r = specs.iter().find(|s| s.file.name == "fuzz_g").map_or([0.001, 1.0], |s| s.file.axis[0].range);
-                (format!("{material}_fuzz_g"), vec![(r[0], r[1])])
-            }
-            Special::GlossLength { material, lo, hi } => (format!("{material}_gloss_to_normal_length"), vec![(*lo, *hi)]),
-        })
-        .collect()
-}
-
-/// A scene feature a family offers (see `crate::family::Family::scene_features`).
-#[derive(Debug)]
-pub struct Feature {
-    pub name: &'static str,
+pub fn scene_functions(scene: &Scene, specs: &[Spec]) -> Vec<IndexedFunction> {
+    plan(scene).special.iter().flat_map(|s| (s.what.functions)(&s.material, specs)).collect()
 }

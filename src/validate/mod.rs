@@ -3,6 +3,7 @@
 //! Each item gives its domain, the points measured, max abs and rms error, the worst point and
 //! findings: what the numbers say about the published constants (noise, typos, conventions).
 
+use crate::pipeline::committed::Refit;
 use crate::spec::Catalog;
 use serde::Serialize;
 use std::path::Path;
@@ -54,13 +55,12 @@ impl Item {
 
     /// Measure the committed refit `generated/json/NAME.json` on the same points, through the
     /// model of its spec, and add it side by side. Returns the refit's values (None when the
-    /// refit is not committed).
+    /// refit is not committed, or was written for another version of its spec).
     pub fn add_refit(&mut self, generated: &Path, name: &str, catalog: &Catalog, points: &[Vec<f64>], truth: &[f64]) -> Option<Vec<f64>> {
-        let (spec, c) = committed_refit(generated, name, catalog)?;
-        let model = spec.model.as_ref()?;
-        let approx: Vec<f64> = points.iter().map(|x| model.eval_clamped(&c, x)).collect();
+        let refit = Refit::load(generated, name, catalog).ok()?;
+        let approx: Vec<f64> = points.iter().map(|x| refit.eval(x)).collect();
         let (m, r, _) = measure(points, truth, &approx);
-        let objective = spec.file.fit.as_ref().map_or("?".to_string(), |f| format!("{:?}", f.objective).to_lowercase());
+        let objective = refit.spec.file.fit.as_ref().map_or("?".to_string(), |f| format!("{:?}", f.objective).to_lowercase());
         self.extra.push(("refit_max_abs_error".into(), m));
         self.extra.push(("refit_rms_error".into(), r));
         self.findings.push(format!(
@@ -70,36 +70,6 @@ impl Item {
         ));
         Some(approx)
     }
-}
-
-/// The committed refit NAME: its spec (read from the path its JSON names) and coefficients.
-pub fn committed_refit(generated: &Path, name: &str, catalog: &Catalog) -> Option<(crate::spec::Spec, nalgebra::DVector<f64>)> {
-    let text = std::fs::read_to_string(generated.join("json").join(format!("{name}.json"))).ok()?;
-    let v: serde_json::Value = serde_json::from_str(&text).ok()?;
-    let c: Vec<f64> =
-        v["model"]["coefficients"].as_array()?.iter().map(serde_json::Value::as_f64).collect::<Option<_>>()?;
-    let spec = crate::spec::Spec::load(&generated.parent()?.join(v["spec"].as_str()?), catalog).ok()?;
-    (spec.model.as_ref()?.n_full() == c.len()).then(|| (spec, nalgebra::DVector::from_vec(c)))
-}
-
-/// The committed two-stage refit NAME (`kind = "fields"`): the coefficient function
-/// outer point → c_k evaluated in f64 through its spec's model and offsets.
-pub fn committed_fields(generated: &Path, name: &str, catalog: &Catalog) -> Option<Box<dyn Fn(&[f64]) -> Vec<f64> + Send + Sync>> {
-    let text = std::fs::read_to_string(generated.join("json").join(format!("{name}.json"))).ok()?;
-    let v: serde_json::Value = serde_json::from_str(&text).ok()?;
-    let spec = crate::spec::Spec::load(&generated.parent()?.join(v["spec"].as_str()?), catalog).ok()?;
-    let model = spec.model.clone()?;
-    let mut fields = Vec::new();
-    for f in v["fields"].as_array()? {
-        let c: Vec<f64> = f["coefficients"].as_array()?.iter().map(serde_json::Value::as_f64).collect::<Option<_>>()?;
-        if c.len() != model.n_full() {
-            return None;
-        }
-        let mut m = model.clone();
-        m.offset = f["offset"].as_f64()?;
-        fields.push((m, nalgebra::DVector::from_vec(c)));
-    }
-    Some(Box::new(move |x: &[f64]| fields.iter().map(|(m, c)| m.eval_full(c, x)).collect()))
 }
 
 /// Every item of the given validators (one per family, in registry order).

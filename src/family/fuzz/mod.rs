@@ -6,6 +6,7 @@ pub mod bench;
 pub mod integrals;
 pub mod plot;
 pub mod published;
+pub mod scene;
 
 use super::Family;
 use crate::integrate::Estimate;
@@ -126,5 +127,5 @@ pub static FAMILY: Family = Family {
     validate: published::items,
     figures: plot::fuzz_figures,
     bench: bench::BENCH,
-    scene_features: &[],
+    scene_features: scene::FEATURES,
 };

@@ -84,10 +84,10 @@ impl FuzzResolution {
 /// drawn; [`fuzz_figures_with`] takes one.
 pub fn fuzz_figures(out_dir: &Path, generated: &Path) -> Result<Vec<PathBuf>, PlotError> {
     // The committed two-stage refit of P̃_s (generated/json/fuzz_ps.json), when there is one.
-    let fields = crate::validate::committed_fields(generated, "fuzz_ps", crate::family::catalog());
+    let fields = crate::pipeline::committed::Fields::load(generated, "fuzz_ps", crate::family::catalog()).ok();
     let refit = fields.as_ref().map(|f| {
         move |alpha: f64, theta_f: f64| -> [f64; 6] {
-            let c = f(&[alpha, theta_f]);
+            let c = f.eval(&[alpha, theta_f]);
             std::array::from_fn(|k| c.get(k).copied().unwrap_or(f64::NAN))
         }
     });
@@ -430,9 +430,9 @@ impl Refit {
         let path = generated.join("json").join(format!("{name}.json"));
         let data_err = |message: String| PlotError::Data { path: path.clone(), message };
         std::fs::metadata(&path).map_err(|source| PlotError::Io { path: path.clone(), source })?;
-        let (spec, coefficients) = crate::validate::committed_refit(generated, name, crate::family::catalog()).ok_or_else(|| {
-            data_err("not a readable refit: model coefficients, the spec it names, or their count do not agree".into())
-        })?;
+        let refit = crate::pipeline::committed::Refit::load(generated, name, crate::family::catalog())
+            .map_err(|e| data_err(format!("not a readable refit of its spec: {e}")))?;
+        let (spec, coefficients) = (refit.spec, refit.coefficients);
         let names: Vec<&str> = spec.file.axis.iter().map(|a| a.name.as_str()).collect();
         if names != axes {
             return Err(data_err(format!("its spec {} has axes {names:?}, expected {axes:?}", spec.path.display())));

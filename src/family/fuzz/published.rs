@@ -174,12 +174,12 @@ pub fn items(generated: &Path) -> Vec<Item> {
     let ps = fuzz::ps_grid(&alphas, &thetas, &dirs, 1e-9);
     let mut pts = Vec::new();
     let (mut truth, mut printed, mut swapped, mut best) = (vec![], vec![], vec![], vec![]);
-    let refit_fn = crate::validate::committed_fields(generated, "fuzz_ps", crate::family::catalog());
+    let refit_fn = crate::pipeline::committed::Fields::load(generated, "fuzz_ps", crate::family::catalog()).ok();
     let mut refit = vec![];
     for (k, row) in ps.iter().enumerate() {
         let (a, tf) = (alphas[k / thetas.len()], thetas[k % thetas.len()]);
         let c = published_ps_coeffs(a, tf);
-        let rc: Option<[f64; 6]> = refit_fn.as_ref().and_then(|f| f(&[a, tf]).try_into().ok());
+        let rc: Option<[f64; 6]> = refit_fn.as_ref().and_then(|f| f.eval(&[a, tf]).try_into().ok());
         // Best 6-term least-squares fit at this (α, θf): the floor for any c_i(α, θf).
         let mut basis = nalgebra::DMatrix::zeros(dirs.len(), 6);
         let mut y = nalgebra::DVector::zeros(dirs.len());

@@ -6,6 +6,7 @@ pub mod bench;
 pub mod integrals;
 pub mod plot;
 pub mod published;
+pub mod scene;
 
 use super::Family;
 use crate::integrate::Estimate;
@@ -83,5 +84,5 @@ pub static FAMILY: Family = Family {
     validate: published::items,
     figures: plot::gloss_figures,
     bench: bench::BENCH,
-    scene_features: &[],
+    scene_features: scene::FEATURES,
 };

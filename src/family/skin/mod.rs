@@ -8,6 +8,7 @@ pub mod emit;
 pub mod integrals;
 pub mod plot;
 pub mod profile;
+pub mod scene;
 pub mod spec;
 
 use super::Family;
@@ -137,5 +138,5 @@ pub static FAMILY: Family = Family {
     validate: |_| Vec::new(),
     figures: plot::skin_figures,
     bench: bench::BENCH,
-    scene_features: &[],
+    scene_features: scene::FEATURES,
 };
