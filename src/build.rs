@@ -7,7 +7,7 @@
 //! Family spec kinds and scene features come from the registry (`crate::family`); the stages
 //! below never name a family.
 
-use crate::emit::WriteError;
+use crate::emit::{self, Transaction, WriteError};
 use crate::family;
 use crate::pipeline::{self, BuildError, Built, CustomBuild, Mode};
 use crate::scene::{self, Feature, Scene, SceneReport};
@@ -38,6 +38,8 @@ pub enum Error {
     Write(#[from] WriteError),
     #[error("{count} generated file(s) differ from what the specs and committed coefficients produce; run `shadefit build`")]
     Stale { count: usize },
+    #[error("generated/ holds an interrupted build ({}); the next `shadefit build` restores the files it replaced first", journal.display())]
+    Interrupted { journal: PathBuf },
 }
 
 impl Error {
@@ -102,6 +104,13 @@ pub fn run(paths: &Paths, only: &[String], check: bool, tick: &(dyn Fn() + Sync)
     let specs = load_specs(paths, only)?;
     let selected: Vec<&Spec> = specs.iter().filter(|s| only.is_empty() || only.contains(&s.file.name)).collect();
     let mode = if check { Mode::Committed } else { Mode::Fit };
+    // One transaction for every file of the build, its lock held from here: a second build
+    // waits, and a failure anywhere leaves generated/ as it was. `--check` writes nothing.
+    let mut tx = if check { None } else { Some(Transaction::begin(&paths.generated)?) };
+    let journal = paths.generated.join(emit::STAGING_DIR).join("journal");
+    if check && journal.exists() {
+        return Err(Error::Interrupted { journal });
+    }
     let results: Vec<Result<(Built, f64), Error>> = selected
         .par_iter()
         .map(|s| {
@@ -117,7 +126,10 @@ pub fn run(paths: &Paths, only: &[String], check: bool, tick: &(dyn Fn() + Sync)
     // The scene modules read their specs' coefficients from generated/json: write this build's
     // first, so a scene never specialises the previous build's fit.
     let spec_files = artifacts.len();
-    let mut written = if check { 0 } else { pipeline::write_all(&paths.generated, &artifacts)? };
+    let mut written = match tx.as_mut() {
+        Some(tx) => tx.write(&artifacts)?,
+        None => 0,
+    };
     let mut scene_times = Vec::new();
     if only.is_empty() {
         // Every scene module, with the node files of this build recorded for its cache.
@@ -141,13 +153,15 @@ pub fn run(paths: &Paths, only: &[String], check: bool, tick: &(dyn Fn() + Sync)
     artifacts.push(scene::runtime_index(&specs, &scenes));
     let mut stale = Vec::new();
     if check {
-        stale = pipeline::stale(&paths.generated, &artifacts);
+        stale.extend(pipeline::stale(&paths.generated, &artifacts));
         if only.is_empty() {
             stale.extend(pipeline::orphans(&paths.generated, &artifacts).into_iter().map(|p| format!("{p} (no spec produces it)")));
         }
-    } else {
+    }
+    if let Some(mut tx) = tx {
         // The spec files were written above; now the scene modules and the runtime index.
-        written += pipeline::write_all(&paths.generated, &artifacts[spec_files..])?;
+        written += tx.write(&artifacts[spec_files..])?;
+        tx.commit()?;
     }
     Ok(Summary { built, scenes: scene_times, files: artifacts.len(), written, stale, specs: selected.len() })
 }
@@ -161,8 +175,11 @@ pub fn run_scene(paths: &Paths, file: &Path, force: bool) -> Result<SceneReport,
     if !scenes.iter().any(|s| s.file.name == sc.file.name) {
         scenes.push(sc.clone());
     }
-    scene::build(&sc, &specs, &scenes, &paths.generated, force, &custom_builder)
-        .map_err(|source| Error::Scene { scene: sc.file.name.clone(), source })
+    let mut tx = Transaction::begin(&paths.generated)?;
+    let report = scene::build(&sc, &specs, &scenes, &paths.generated, force, &custom_builder, &mut tx)
+        .map_err(|source| Error::Scene { scene: sc.file.name.clone(), source })?;
+    tx.commit()?;
+    Ok(report)
 }
 
 /// Whether a spec's committed outputs were generated from it, by hashes alone.

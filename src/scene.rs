@@ -456,6 +456,7 @@ pub fn build(
     generated: &Path,
     force: bool,
     custom: &dyn Fn(&str) -> Option<pipeline::CustomBuild>,
+    tx: &mut emit::Transaction,
 ) -> Result<SceneReport, BuildError> {
     let p = plan(scene);
     let json_path = generated.join("json").join(format!("{}.json", scene.module()));
@@ -487,7 +488,7 @@ pub fn build(
     }
     // The specialisations compare themselves with the committed fits of the specs they read
     // (hash-checked): write the rebuilt nodes first, so they read this build's.
-    let mut written = emit::write_all(generated, &artifacts)?;
+    let mut written = tx.write(&artifacts)?;
     artifacts.clear();
     let hash = scene_hash(scene, specs, &p)?;
     // The scene JSON records the scene node itself like any other node (input hash, files).
@@ -504,7 +505,7 @@ pub fn build(
     if !built.is_empty() {
         artifacts.push(runtime_index(specs, scenes));
     }
-    written += emit::write_all(generated, &artifacts)?;
+    written += tx.write(&artifacts)?;
     let skipped = specs.iter().map(|s| s.file.name.clone()).filter(|n| !p.nodes.contains(n)).collect();
     Ok(SceneReport { built, up_to_date, skipped, records, written })
 }
