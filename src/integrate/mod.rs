@@ -16,8 +16,6 @@
 
 mod adaptive;
 
-use std::sync::OnceLock;
-
 pub use adaptive::{Control, GaussPair, Options, PanelError, Rule, VecEstimate, integrate, quadpack_error};
 
 /// Result of one numerical integral.
@@ -89,39 +87,6 @@ fn legendre_and_derivative(n: usize, z: f64) -> (f64, f64) {
     (p1, d)
 }
 
-/// A fixed Gauss–Legendre rule mapped to any interval.
-#[derive(Debug, Clone)]
-pub struct FixedRule {
-    nodes: Vec<f64>,
-    weights: Vec<f64>,
-}
-
-impl FixedRule {
-    pub fn new(n: usize) -> Self {
-        let (nodes, weights) = gauss_legendre(n);
-        FixedRule { nodes, weights }
-    }
-
-    pub fn len(&self) -> usize {
-        self.nodes.len()
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.nodes.is_empty()
-    }
-
-    /// (abscissa, weight) pairs of the rule on [a, b].
-    pub fn points(&self, a: f64, b: f64) -> impl Iterator<Item = (f64, f64)> + '_ {
-        let c = 0.5 * (a + b);
-        let h = 0.5 * (b - a);
-        self.nodes.iter().zip(&self.weights).map(move |(x, w)| (c + h * x, h * w))
-    }
-
-    pub fn integrate(&self, a: f64, b: f64, mut f: impl FnMut(f64) -> f64) -> f64 {
-        self.points(a, b).map(|(x, w)| w * f(x)).sum()
-    }
-}
-
 /// Tolerance and budget of [`adaptive()`].
 #[derive(Debug, Clone, Copy)]
 pub struct Tolerance {
@@ -151,12 +116,6 @@ pub fn adaptive(a: f64, b: f64, tol: Tolerance, mut f: impl FnMut(f64) -> f64) -
     }
     let r = integrate(&[(a, b)], &Options::scalar(tol), |x| [f(x)]);
     Estimate { value: r.value[0], error: r.error, evals: r.evals }
-}
-
-/// A shared 64-point Gauss–Legendre rule (used for smooth inner integrals).
-pub fn gl64() -> &'static FixedRule {
-    static RULE: OnceLock<FixedRule> = OnceLock::new();
-    RULE.get_or_init(|| FixedRule::new(64))
 }
 
 #[cfg(test)]
