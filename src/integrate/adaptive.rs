@@ -8,9 +8,11 @@
 //! # Contract (tested in this module against closed forms)
 //!
 //! - **Estimates.** Every panel carries, per component, an error estimate from the difference
-//!   of the rule's two quadratures ([`PanelError`]). For smooth integrands it is an upper
-//!   estimate of the panel's true error (not a proven bound: the lower-order rule's error stands
-//!   in for the higher-order one's); the reported error is the sum over panels.
+//!   of the rule's two quadratures ([`PanelError`]). For integrands smooth on the scale of the
+//!   panels it is an upper estimate of the panel's true error (not a proven bound: the
+//!   lower-order rule's error stands in for the higher-order one's; a feature no node sees is
+//!   missed). The reported error is the sum over panels; the rounding of the sums (a few ulps of
+//!   the value) is in QUADPACK's floor but not in the raw estimate.
 //! - **Tolerance.** The run ends when the summed estimate meets the target of its [`Control`]
 //!   (checked before every bisection), so a returned error is ≤ the target unless a limit below
 //!   ended the run first.
@@ -23,7 +25,10 @@
 //!   With one interval that is at most `max_panels − 1` bisections. The estimate is returned
 //!   with its (then unmet) error.
 //! - **Unsplittable panels.** A panel whose midpoint is not strictly inside it in f64 is never
-//!   split again: its error moves to a "stuck" sum that stays in the reported error.
+//!   split: its error moves to a "stuck" sum that stays in the reported error, and its own
+//!   becomes 0. Should such a panel, error 0, still be the one picked (only possible without
+//!   `stop_when_exhausted`, when no panel has error left), the run ends there rather than pick
+//!   it forever.
 //!
 //! # Options, and who uses which
 //!
@@ -41,8 +46,16 @@
 //! | `sum_from_negative_zero` | yes (`Iterator::sum`) | no | no |
 //! | intervals | one | one | several (the kinks) |
 //!
-//! The last three rows only matter in degenerate cases (every panel estimate 0, an infinite or
-//! NaN estimate, every panel value −0.0) but change bits there, so they stay options.
+//! Why: the scalar rule is the plain QAG loop with the raw (generous) estimate. Fuzz integrates
+//! mapped integrands whose raw estimates are orders of magnitude too pessimistic, so it uses
+//! QUADPACK's; it integrates up to 15 η_u nodes of one K15 rule at once and controls their sum
+//! weighted by the rule's weights (nodes with their own integration get weight 0), and R's outer
+//! integral carries the inner error estimates as an unchecked component. Skin integrates RGB,
+//! each channel to its own tolerance (scaled by that channel's denominator), on intervals split
+//! at the kinks of the clamped cosine and the profile.
+//!
+//! The stop and sum rows only matter in degenerate cases (every panel estimate 0, an infinite
+//! or NaN estimate, every panel value −0.0) but change bits there, so they stay options.
 
 // The QUADPACK constants keep their published digits.
 #![allow(clippy::excessive_precision)]
@@ -159,7 +172,8 @@ pub struct Options<'r, const N: usize> {
     pub max_panels: usize,
     /// Stop when no panel has an error left to reduce (every weighted panel error is 0, or,
     /// per component, every score is 0), even if stuck panels keep the error above target.
-    /// Without it such a run keeps bisecting (leftmost first) until the panel limit.
+    /// Without it such a run keeps bisecting (leftmost first) until the panel limit, or until
+    /// the panel it picks cannot be split.
     pub stop_when_exhausted: bool,
     /// Stop as soon as the controlled error is infinite or NaN (for `PerComponent`: any
     /// component's). Without it the non-finite panel is bisected like any other (NaN sorts
@@ -283,7 +297,7 @@ pub fn integrate<const N: usize>(
     let mut stuck = [0.0; N];
     let mut stuck_weighted = 0.0;
     loop {
-        let (worst, errors, error) = match opts.control {
+        let (worst, error) = match opts.control {
             Control::Weighted { weights, abs, rel } => {
                 let error = panels.iter().map(|p| p.weighted).sum::<f64>() + stuck_weighted;
                 let (values, _) = totals(&panels, stuck);
@@ -304,8 +318,7 @@ pub fn integrate<const N: usize>(
                         .max_by(|(_, p), (_, q)| p.weighted.total_cmp(&q.weighted).then(q.a.total_cmp(&p.a)))
                         .map(|(k, _)| k)
                 };
-                let errors = if worst.is_none() { totals(&panels, stuck).1 } else { [0.0; N] };
-                (worst, errors, error)
+                (worst, error)
             }
             Control::PerComponent { abs, rel } => {
                 let (val, err) = totals(&panels, stuck);
@@ -332,10 +345,17 @@ pub fn integrate<const N: usize>(
                         .filter(|&(_, best)| !(opts.stop_when_exhausted && best == 0.0))
                         .map(|(k, _)| k)
                 };
-                (worst, err, error)
+                (worst, error)
             }
         };
+        // A panel that cannot be split and has no error left would be picked again forever.
+        let worst = worst.filter(|&k| {
+            let p = &panels[k];
+            let mid = 0.5 * (p.a + p.b);
+            !(mid <= p.a || mid >= p.b) || p.weighted != 0.0 || p.error.iter().any(|&e| e != 0.0)
+        });
         let Some(worst) = worst else {
+            let (_, errors) = totals(&panels, stuck);
             // Sum in position order for a result independent of the refinement history.
             panels.sort_by(|p, q| p.a.total_cmp(&q.a));
             let mut value = [if opts.sum_from_negative_zero { -0.0 } else { 0.0 }; N];
