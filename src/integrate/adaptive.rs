@@ -489,3 +489,267 @@ fn gauss_pair<const N: usize>(
     }
     (value, error)
 }
+
+#[cfg(test)]
+#[allow(clippy::needless_range_loop)]
+mod tests {
+    use super::*;
+    use crate::integrate::{Tolerance, adaptive};
+
+    /// ∫_a^b dx/(x² + ε²) = (atan(b/ε) − atan(a/ε))/ε: a peak of width ε at 0.
+    fn peak(eps: f64) -> impl Fn(f64) -> f64 {
+        move |x| 1.0 / (x * x + eps * eps)
+    }
+    fn peak_exact(eps: f64, a: f64, b: f64) -> f64 {
+        ((b / eps).atan() - (a / eps).atan()) / eps
+    }
+
+    /// Each estimate with each control on one component, and the scalar preset, at absolute `tol`.
+    fn variants(tol: f64, max_panels: usize) -> Vec<(&'static str, Options<'static, 1>)> {
+        let w = Options::quadpack([1.0], tol, max_panels);
+        let c = Options::per_component([tol], 0.0, max_panels);
+        vec![
+            ("weighted raw", Options { estimate: PanelError::Raw, ..w }),
+            ("weighted quadpack", w),
+            ("per-component raw", c),
+            ("per-component quadpack", Options { estimate: PanelError::Quadpack, ..c }),
+            ("scalar", Options::scalar(Tolerance { abs: tol, rel: 0.0, max_panels })),
+        ]
+    }
+
+    #[test]
+    fn one_kronrod_panel_is_exact_for_polynomials_to_degree_31() {
+        // ∫_0^1 x^d dx = 1/(d+1). K21 is exact to degree 31, G10 to 19: above 19 the estimate
+        // is the G10 error and must cover the (rounding-level) K21 error; to 31 the value is
+        // the closed form to rounding.
+        for d in 0..=31 {
+            for (name, opts) in variants(0.0, 1) {
+                let est = integrate(&[(0.0, 1.0)], &opts, |x| [x.powi(d)]);
+                let exact = 1.0 / (d + 1) as f64;
+                let err = (est.value[0] - exact).abs();
+                assert_eq!(est.evals, 21, "{name} d={d}: one panel");
+                assert!(err <= 16.0 * f64::EPSILON * exact, "{name} d={d}: {} vs {exact}", est.value[0]);
+                if d >= 20 {
+                    assert!(est.error >= err, "{name} d={d}: estimate {} < error {err}", est.error);
+                    assert!(est.error > 16.0 * f64::EPSILON * exact, "{name} d={d}: the G10 error shows ({})", est.error);
+                }
+            }
+        }
+        // Beyond degree 31 one panel is no longer exact; the estimate still covers the error.
+        for (name, opts) in variants(0.0, 1) {
+            for d in [32, 40, 60] {
+                let est = integrate(&[(0.0, 1.0)], &opts, |x| [x.powi(d)]);
+                let err = (est.value[0] - 1.0 / (d + 1) as f64).abs();
+                assert!(est.error >= err, "{name} d={d}: {} vs {err}", est.error);
+            }
+        }
+    }
+
+    #[test]
+    fn gauss_pair_is_exact_to_its_degrees() {
+        // GL32 is exact to degree 63, GL24 to 47: the estimate (difference) is rounding below 48.
+        let pair = GaussPair::new(32, 24);
+        for (name, opts) in variants(0.0, 1) {
+            let opts = Options { rule: Rule::GaussPair(&pair), ..opts };
+            for d in [0, 10, 47, 60, 63] {
+                let est = integrate(&[(0.0, 1.0)], &opts, |x| [x.powi(d)]);
+                let exact = 1.0 / (d + 1) as f64;
+                let err = (est.value[0] - exact).abs();
+                assert_eq!(est.evals, 56, "{name}");
+                assert!(err <= 16.0 * f64::EPSILON * exact, "{name} d={d}: {} vs {exact}", est.value[0]);
+                if d >= 48 {
+                    // GL24's error is tiny here too: covered up to rounding.
+                    assert!(err <= est.error + 16.0 * f64::EPSILON * exact, "{name} d={d}: {}", est.error);
+                } else {
+                    // Rounding, or QUADPACK's floor 50 ε ∫|f|.
+                    assert!(est.error <= 64.0 * f64::EPSILON * exact, "{name} d={d}: {}", est.error);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn peaked_integrands_meet_the_tolerance_and_the_estimate_bounds_the_error() {
+        for eps in [1e-1, 1e-2, 1e-3, 1e-4] {
+            for (a, b) in [(0.0, 1.0), (-0.3, 1.0), (-1.0, 1.0)] {
+                let exact = peak_exact(eps, a, b);
+                for rel_tol in [1e-6, 1e-9, 1e-12] {
+                    let tol = rel_tol * exact;
+                    for (name, opts) in variants(tol, 100_000) {
+                        let f = peak(eps);
+                        let est = integrate(&[(a, b)], &opts, |x| [f(x)]);
+                        let err = (est.value[0] - exact).abs();
+                        let what = format!("{name} ε={eps} [{a}, {b}] tol={rel_tol}");
+                        assert!(est.error <= tol, "{what}: estimate {} above tol {tol}", est.error);
+                        assert!(err <= est.error, "{what}: error {err} above estimate {}", est.error);
+                        assert_eq!(est.errors[0], est.error, "{what}");
+                        assert!(est.evals < 21 * 2000, "{what}: {} evaluations", est.evals);
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn relative_tolerance_of_the_scalar_rule() {
+        // ∫_0^1 1/(x² + ε²) dx = atan(1/ε)/ε; abs 1e-9 alone would stop far earlier.
+        let eps = 1e-3_f64;
+        let exact = peak_exact(eps, 0.0, 1.0);
+        let est = adaptive(0.0, 1.0, Tolerance { abs: 1e-9, rel: 1e-13, max_panels: 5000 }, peak(eps));
+        assert!((est.value - exact).abs() <= est.error, "{} vs {exact}", est.value);
+        assert!(est.error <= 1e-13 * exact && est.error > 1e-9 * 1e-6);
+        // The same through the engine, and a == b without evaluations.
+        let tol = Tolerance { abs: 1e-9, rel: 1e-13, max_panels: 5000 };
+        let f = peak(eps);
+        let v = integrate(&[(0.0, 1.0)], &Options::scalar(tol), |x| [f(x)]);
+        assert_eq!((v.value[0].to_bits(), v.error.to_bits(), v.evals), (est.value.to_bits(), est.error.to_bits(), est.evals));
+        assert_eq!(adaptive(2.0, 2.0, tol, |_| panic!("evaluated")), crate::integrate::Estimate::exact(0.0));
+    }
+
+    #[test]
+    fn components_of_different_scales_each_meet_their_tolerance() {
+        // [1e6/(x² + 1e-4), 1e-6·cos 30x, e^x] on [0, 2].
+        let f = |x: f64| [1e6 / (x * x + 1e-4), 1e-6 * (30.0 * x).cos(), x.exp()];
+        let exact = [1e6 * peak_exact(1e-2, 0.0, 2.0), 1e-6 * (60.0f64).sin() / 30.0, 2.0f64.exp() - 1.0];
+        // Per component: each to its own absolute tolerance (relative 1e-10 of its scale).
+        let abs = [1e-10 * exact[0], 1e-10 * 1e-6, 1e-10 * exact[2]];
+        for estimate in [PanelError::Raw, PanelError::Quadpack] {
+            let opts = Options { estimate, ..Options::per_component(abs, 0.0, 10_000) };
+            let est = integrate(&[(0.0, 2.0)], &opts, f);
+            for c in 0..3 {
+                let err = (est.value[c] - exact[c]).abs();
+                assert!(est.errors[c] <= abs[c], "{estimate:?} c={c}: {} > {}", est.errors[c], abs[c]);
+                assert!(err <= est.errors[c], "{estimate:?} c={c}: error {err} > estimate {}", est.errors[c]);
+            }
+            assert_eq!(est.error, est.errors.iter().copied().fold(0.0, f64::max));
+            // Relative: the same through rel = 1e-10 (the tiny cosine component included).
+            let rel = integrate(&[(0.0, 2.0)], &Options { estimate, ..Options::per_component([0.0; 3], 1e-10, 10_000) }, f);
+            for c in 0..3 {
+                assert!(rel.errors[c] <= 1e-10 * rel.value[c].abs(), "{estimate:?} c={c}");
+                assert!((rel.value[c] - exact[c]).abs() <= rel.errors[c], "{estimate:?} c={c}");
+            }
+        }
+        // Weighted: Σ_c w_c·err_c ≤ tol with weights that undo the scales; a zero weight leaves
+        // its component integrated along but unchecked (no estimate).
+        for estimate in [PanelError::Raw, PanelError::Quadpack] {
+            let weights = [1.0 / exact[0], 1e6, 1.0 / exact[2]];
+            let opts = Options { estimate, ..Options::quadpack(weights, 1e-10, 10_000) };
+            let est = integrate(&[(0.0, 2.0)], &opts, f);
+            assert!(est.error <= 1e-10, "{estimate:?}: {}", est.error);
+            let weighted: f64 = (0..3).map(|c| weights[c] * est.errors[c]).sum();
+            assert!((weighted - est.error).abs() <= 1e-12 * est.error, "{weighted} vs {}", est.error);
+            for c in 0..3 {
+                assert!((est.value[c] - exact[c]).abs() <= est.errors[c], "{estimate:?} c={c}");
+            }
+            let unchecked = Options { estimate, ..Options::quadpack([weights[0], 0.0, weights[2]], 1e-10, 10_000) };
+            let est = integrate(&[(0.0, 2.0)], &unchecked, f);
+            assert_eq!(est.errors[1], 0.0);
+            assert!((est.value[1] - exact[1]).abs() < 1e-6, "integrated along");
+        }
+    }
+
+    #[test]
+    fn per_component_nan_channel_counts_as_done() {
+        let f = peak(1e-3);
+        let est = integrate(&[(0.0, 1.0)], &Options::per_component([1e-9, 1e-9], 0.0, 5000), |x| [f64::NAN, f(x)]);
+        assert!(est.value[0].is_nan());
+        assert!(est.errors[1] <= 1e-9 && (est.value[1] - peak_exact(1e-3, 0.0, 1.0)).abs() <= est.errors[1]);
+    }
+
+    /// The evaluation points of one run.
+    fn trace(opts: &Options<'_, 1>, a: f64, b: f64, f: impl Fn(f64) -> f64) -> (VecEstimate<1>, Vec<f64>) {
+        let mut xs = Vec::new();
+        let est = integrate(&[(a, b)], opts, |x| {
+            xs.push(x);
+            [f(x)]
+        });
+        (est, xs)
+    }
+
+    #[test]
+    fn split_order_is_largest_error_first_with_ties_to_the_left() {
+        for (name, opts) in variants(0.0, 3) {
+            // Even integrand on [-1, 1]: after the first bisection both halves have the same
+            // estimate (mirrored nodes, same sums), and the left one is split.
+            let (est, xs) = trace(&opts, -1.0, 1.0, peak(0.1));
+            assert_eq!((est.evals, xs.len()), (105, 105), "{name}: 3 panels");
+            assert!(xs[21..42].iter().all(|&x| x < 0.0) && xs[42..63].iter().all(|&x| x > 0.0), "{name}");
+            assert!(xs[63..].iter().all(|&x| x < 0.0), "{name}: the left of two equal panels first");
+            assert!(xs[63..84].iter().all(|&x| x < -0.5) && xs[84..].iter().all(|&x| x > -0.5), "{name}");
+            // Smooth (exact) on the left half, a peak on the right: the right half is split.
+            let f = |x: f64| if x < 0.5 { x * x } else { 1.0 / ((x - 0.75).powi(2) + 1e-3) };
+            let (_, xs) = trace(&opts, 0.0, 1.0, f);
+            assert!(xs[63..].iter().all(|&x| x > 0.5), "{name}: the larger error first");
+        }
+    }
+
+    #[test]
+    fn results_are_deterministic() {
+        let f = |x: f64| (10.0 * x).sin() * (-x).exp() + peak(1e-3)(x - 1.3);
+        for (name, opts) in variants(1e-11, 5000) {
+            let (a, xa) = trace(&opts, 0.0, 3.0, f);
+            let (b, xb) = trace(&opts, 0.0, 3.0, f);
+            assert_eq!(a.value[0].to_bits(), b.value[0].to_bits(), "{name}");
+            assert_eq!(a.error.to_bits(), b.error.to_bits(), "{name}");
+            assert_eq!(xa.iter().map(|x| x.to_bits()).collect::<Vec<_>>(), xb.iter().map(|x| x.to_bits()).collect::<Vec<_>>());
+        }
+    }
+
+    #[test]
+    fn panel_limit_stops_the_run_with_the_estimate() {
+        // Tolerance 0 is not met by this integrand with so few panels: the limit decides.
+        let f = peak(0.1);
+        let exact = peak_exact(0.1, 0.0, 1.0);
+        for (name, opts) in variants(0.0, 0) {
+            for max_panels in [0, 1, 2, 5, 9] {
+                let opts = Options { max_panels, ..opts };
+                let est = integrate(&[(0.0, 1.0)], &opts, |x| [f(x)]);
+                let bisections = max_panels.max(1) as u64 - 1;
+                assert_eq!(est.evals, 21 + 42 * bisections, "{name} max_panels={max_panels}");
+                let err = (est.value[0] - exact).abs();
+                let rounding = 4.0 * f64::EPSILON * exact;
+                assert!(est.error > 0.0 && err <= est.error + rounding, "{name}: the unmet estimate is returned");
+            }
+            // Several intervals: the limit is at least their number (no bisection below it).
+            let thirds = [(0.0, 0.25), (0.25, 0.5), (0.5, 1.0)];
+            let est = integrate(&thirds, &Options { max_panels: 2, ..opts }, |x| [f(x)]);
+            assert_eq!(est.evals, 63, "{name}");
+            let est = integrate(&thirds, &Options { max_panels: 4, ..opts }, |x| [f(x)]);
+            assert_eq!(est.evals, 63 + 42, "{name}");
+        }
+    }
+
+    #[test]
+    fn unsplittable_panels_keep_their_error() {
+        // Tolerance 0 on 8 ulps: bisection goes down to 8 panels one ulp wide, which cannot be
+        // split; their (rounding-level, non-zero) estimates stay in the error and the run ends
+        // (by stop_when_exhausted, or because the picked panel cannot be split).
+        let (a, b) = (1.0, 1.0 + 8.0 * f64::EPSILON);
+        for (name, opts) in variants(0.0, 1000) {
+            let est = integrate(&[(a, b)], &opts, |_| [1.0 / 3.0]);
+            assert_eq!(est.evals, 21 + 42 * 7, "{name}: 7 bisections");
+            assert!(est.error > 0.0 && est.errors[0] == est.error, "{name}: the stuck error stays");
+            assert!((est.value[0] - (b - a) / 3.0).abs() <= 1e-15 * (b - a), "{name}");
+        }
+    }
+
+    #[test]
+    fn degenerate_stops() {
+        // An infinite value at the centre node: stop_when_non_finite ends the run at once; the
+        // scalar rule bisects it (the halves do not evaluate x = 0.5 and are exact).
+        let f = |x: f64| [if x == 0.5 { f64::INFINITY } else { 1.0 }];
+        let w = integrate(&[(0.0, 1.0)], &Options::quadpack([1.0], 1e-12, 100), f);
+        assert_eq!((w.evals, w.error), (21, f64::INFINITY));
+        let s = integrate(&[(0.0, 1.0)], &Options::scalar(Tolerance { rel: 0.0, ..Tolerance::default() }), f);
+        assert_eq!(s.evals, 63);
+        assert!((s.value[0] - 1.0).abs() < 1e-15 && s.error < 1e-15);
+        // The sign of a sum of −0.0 panels.
+        let s = integrate(&[(0.0, 1.0)], &Options::scalar(Tolerance::default()), |_| [-0.0]);
+        assert!(s.value[0] == 0.0 && s.value[0].is_sign_negative());
+        let c = integrate(&[(0.0, 1.0)], &Options::per_component([1e-12], 0.0, 100), |_| [-0.0]);
+        assert!(c.value[0] == 0.0 && c.value[0].is_sign_positive());
+        // No intervals: zero, no evaluations.
+        let e = integrate(&[], &Options::per_component([1e-12; 2], 0.0, 100), |_| panic!("evaluated"));
+        assert_eq!((e.value, e.errors, e.evals), ([0.0; 2], [0.0; 2], 0));
+    }
+}
