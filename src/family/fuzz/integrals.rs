@@ -113,7 +113,10 @@
 //!
 //! # Error estimates
 //!
-//! Panels use QUADPACK's estimate resasc · min(1, (200 |Q_hi − Q_lo| / resasc)^{3/2}), floored at
+//! The adaptive integrals (K21 and GL32/GL24 panels) run on `crate::integrate::integrate` with
+//! `Options::quadpack`; the G7/K15 η_u rule of R is bisected here (its panels share a budget in
+//! proportion to their width). Panels use QUADPACK's estimate (`crate::integrate::quadpack_error`)
+//! resasc · min(1, (200 |Q_hi − Q_lo| / resasc)^{3/2}), floored at
 //! 50 ε resabs (ε = f64 epsilon), with (Q_hi, Q_lo) = (K21, G10), (K15, G7) or (GL32, GL24). For
 //! the mapped integrands this is far closer to the true error than the raw |Q_hi − Q_lo| and
 //! still above it: the tests compare default-tolerance values with tight ones and with
@@ -141,8 +144,7 @@
 
 #![allow(clippy::excessive_precision)]
 
-use crate::integrate::{WG10, WGK21, XGK21};
-use crate::integrate::{Estimate, Tolerance, adaptive};
+use crate::integrate::{Estimate, GaussPair, Options, Rule, Tolerance, adaptive, integrate, quadpack_error};
 use rayon::prelude::*;
 use std::f64::consts::{FRAC_PI_2, PI};
 
@@ -228,124 +230,11 @@ pub fn sggx_phase(alpha: f64, t: [f64; 3], u: [f64; 3], v: [f64; 3]) -> f64 {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Private adaptive Gauss–Kronrod (G10/K21) on vector integrands, QUADPACK error estimate.
+// Adaptive quadrature: `crate::integrate::integrate` with QUADPACK estimates.
 
-/// Gauss 10-point weights of the Kronrod nodes 1, 3, 5, 7, 9.
-
-/// QUADPACK's error estimate of one Kronrod panel (all quantities already scaled by the
-/// half-width): raw = |K − G|, resasc = ∫|f − mean|, resabs = ∫|f|.
-fn quadpack_error(raw: f64, resasc: f64, resabs: f64) -> f64 {
-    let mut err = raw;
-    if resasc != 0.0 && err != 0.0 {
-        err = resasc * (200.0 * err / resasc).powf(1.5).min(1.0);
-    }
-    err.max(50.0 * f64::EPSILON * resabs)
-}
-
-#[derive(Clone, Copy)]
-struct Panel<const N: usize> {
-    a: f64,
-    b: f64,
-    value: [f64; N],
-    error: f64,
-}
-
-/// One G10/K21 panel of a vector integrand. Its error is Σ_i ew[i]·err_i, err_i the QUADPACK
-/// estimate of component i (components with ew[i] = 0 are integrated along, unchecked).
-fn gk21_panel<const N: usize>(
-    a: f64,
-    b: f64,
-    ew: &[f64; N],
-    f: &mut impl FnMut(f64) -> [f64; N],
-) -> Panel<N> {
-    let c = 0.5 * (a + b);
-    let h = 0.5 * (b - a);
-    let mut fv = [[0.0; N]; 21];
-    fv[10] = f(c);
-    for j in 0..10 {
-        let dx = h * XGK21[j];
-        fv[j] = f(c - dx);
-        fv[20 - j] = f(c + dx);
-    }
-    let mut value = [0.0; N];
-    let mut error = 0.0;
-    let ha = h.abs();
-    for i in 0..N {
-        let mut resk = WGK21[10] * fv[10][i];
-        let mut resg = 0.0;
-        let mut resabs = WGK21[10] * fv[10][i].abs();
-        for j in 0..10 {
-            resk += WGK21[j] * (fv[j][i] + fv[20 - j][i]);
-            resabs += WGK21[j] * (fv[j][i].abs() + fv[20 - j][i].abs());
-            if j % 2 == 1 {
-                resg += WG10[j / 2] * (fv[j][i] + fv[20 - j][i]);
-            }
-        }
-        value[i] = resk * h;
-        if ew[i] != 0.0 {
-            let mean = 0.5 * resk;
-            let mut resasc = WGK21[10] * (fv[10][i] - mean).abs();
-            for j in 0..10 {
-                resasc += WGK21[j] * ((fv[j][i] - mean).abs() + (fv[20 - j][i] - mean).abs());
-            }
-            error += ew[i] * quadpack_error(((resk - resg) * ha).abs(), resasc * ha, resabs * ha);
-        }
-    }
-    Panel { a, b, value, error }
-}
-
-/// Globally adaptive integration of a vector integrand over [a, b] with the panel rule
-/// `panel`: bisects the panel with the largest error until the summed panel errors are ≤ tol.
-/// Returns the component integrals (summed in position order), the error and the number of
-/// evaluations.
-fn adaptive_vec<const N: usize, F: FnMut(f64) -> [f64; N]>(
-    a: f64,
-    b: f64,
-    tol: f64,
-    max_panels: usize,
-    panel: impl Fn(f64, f64, &mut F) -> (Panel<N>, u64),
-    mut f: F,
-) -> ([f64; N], f64, u64) {
-    let (p0, mut evals) = panel(a, b, &mut f);
-    let mut panels: Vec<Panel<N>> = Vec::with_capacity(8);
-    panels.push(p0);
-    let mut stuck = 0.0;
-    loop {
-        let error: f64 = panels.iter().map(|p| p.error).sum::<f64>() + stuck;
-        if error <= tol || panels.len() >= max_panels || !error.is_finite() {
-            panels.sort_by(|p, q| p.a.total_cmp(&q.a));
-            let mut value = [0.0; N];
-            for p in &panels {
-                for (v, pv) in value.iter_mut().zip(p.value) {
-                    *v += pv;
-                }
-            }
-            return (value, error, evals);
-        }
-        let Some((worst, _)) = panels
-            .iter()
-            .enumerate()
-            .max_by(|(_, p), (_, q)| p.error.total_cmp(&q.error).then(q.a.total_cmp(&p.a)))
-        else {
-            continue;
-        };
-        let p = panels.swap_remove(worst);
-        let mid = 0.5 * (p.a + p.b);
-        if mid <= p.a || mid >= p.b {
-            stuck += p.error;
-            panels.push(Panel { error: 0.0, ..p });
-            continue;
-        }
-        let (p1, n1) = panel(p.a, mid, &mut f);
-        let (p2, n2) = panel(mid, p.b, &mut f);
-        evals += n1 + n2;
-        panels.push(p1);
-        panels.push(p2);
-    }
-}
-
-/// Adaptive G10/K21 (QUADPACK error estimates, weighted by `ew`) of a vector integrand; see
-/// [`adaptive_vec`] and [`gk21_panel`].
+/// Adaptive G10/K21 over [a, b] of a vector integrand, QUADPACK panel estimates weighted by
+/// `ew` (components with ew[i] = 0 are integrated along, unchecked) to absolute `tol`:
+/// (values, weighted error, evals). See [`Options::quadpack`].
 fn gk21_adaptive<const N: usize>(
     a: f64,
     b: f64,
@@ -353,56 +242,15 @@ fn gk21_adaptive<const N: usize>(
     ew: &[f64; N],
     f: impl FnMut(f64) -> [f64; N],
 ) -> ([f64; N], f64, u64) {
-    adaptive_vec(a, b, tol, MAX_PANELS, |a, b, f| (gk21_panel(a, b, ew, f), 21), f)
-}
-
-/// A pair of Gauss–Legendre rules (n_hi > n_lo points) on [-1, 1], used as a panel rule:
-/// value from the larger, error from QUADPACK's formula applied to |Q_hi − Q_lo| (conservative:
-/// for analytic integrands the Q_hi error is far below |Q_hi − Q_lo|).
-struct GlPair {
-    hi: (Vec<f64>, Vec<f64>),
-    lo: (Vec<f64>, Vec<f64>),
+    let r = integrate(&[(a, b)], &Options::quadpack(*ew, tol, MAX_PANELS), f);
+    (r.value, r.error, r.evals)
 }
 
 /// GL32/GL24: the outer A-integral of R (its analytic integrand usually needs one panel, where
 /// G10/K21 needs several bisections because its estimate is the G10 error).
-fn gl_pair_32() -> &'static GlPair {
-    static RULES: std::sync::OnceLock<GlPair> = std::sync::OnceLock::new();
-    RULES.get_or_init(|| GlPair {
-        hi: crate::integrate::gauss_legendre(32),
-        lo: crate::integrate::gauss_legendre(24),
-    })
-}
-
-/// One panel of a GL pair on [a, b]; error Σ_i ew[i]·err_i as in [`gk21_panel`].
-fn gl_pair_panel<const N: usize>(
-    rules: &GlPair,
-    a: f64,
-    b: f64,
-    ew: &[f64; N],
-    f: &mut impl FnMut(f64) -> [f64; N],
-) -> (Panel<N>, u64) {
-    let (xh, wh) = &rules.hi;
-    let (xl, wl) = &rules.lo;
-    let c = 0.5 * (a + b);
-    let h = 0.5 * (b - a);
-    let ha = h.abs();
-    let fh: Vec<[f64; N]> = xh.iter().map(|x| f(c + h * x)).collect();
-    let fl: Vec<[f64; N]> = xl.iter().map(|x| f(c + h * x)).collect();
-    let mut value = [0.0; N];
-    let mut error = 0.0;
-    for i in 0..N {
-        let qh: f64 = fh.iter().zip(wh).map(|(fx, w)| w * fx[i]).sum();
-        value[i] = qh * h;
-        if ew[i] != 0.0 {
-            let ql: f64 = fl.iter().zip(wl).map(|(fx, w)| w * fx[i]).sum();
-            let mean = 0.5 * qh;
-            let resasc: f64 = fh.iter().zip(wh).map(|(fx, w)| w * (fx[i] - mean).abs()).sum();
-            let resabs: f64 = fh.iter().zip(wh).map(|(fx, w)| w * fx[i].abs()).sum();
-            error += ew[i] * quadpack_error(((qh - ql) * ha).abs(), resasc * ha, resabs * ha);
-        }
-    }
-    (Panel { a, b, value, error }, (xh.len() + xl.len()) as u64)
+fn gl_pair_32() -> &'static GaussPair {
+    static RULES: std::sync::OnceLock<GaussPair> = std::sync::OnceLock::new();
+    RULES.get_or_init(|| GaussPair::new(32, 24))
 }
 
 // G7/K15 on [-1, 1] (QUADPACK qk15), used for the η_u rule of R.
@@ -1192,25 +1040,26 @@ impl Layer {
         let mut evals = 0;
         for &(lo, hi, ls, hs) in &pieces {
             let d = hi - lo;
-            let ew = [1.0, 0.0];
-            let rules = gl_pair_32();
-            let panel = |a: f64, b: f64, f: &mut _| gl_pair_panel(rules, a, b, &ew, f);
-            let (v, e, _) =
-                adaptive_vec(0.0, 1.0, 0.1 * tol / pieces.len() as f64, 64, panel, |t| {
-                    let (g, gp) = end_map(t, ls, hs);
-                    let jac = d * gp;
-                    if jac == 0.0 {
-                        return [0.0, 0.0];
-                    }
-                    let (sa, a) = (lo + d * g).sin_cos();
-                    let wgt = 2.0 / PI * sa * jac;
-                    let tol_j = (0.9 * tol / pieces.len() as f64 / wgt).min(1.0);
-                    let (j, ej, n) = self.j_of_a(a, sa, tol_j);
-                    evals += n;
-                    [wgt * j, wgt * ej]
-                });
-            value += v[0];
-            error += e + v[1];
+            // Component 1 carries the inner errors along (weight 0: integrated, not checked).
+            let opts = Options {
+                rule: Rule::GaussPair(gl_pair_32()),
+                ..Options::quadpack([1.0, 0.0], 0.1 * tol / pieces.len() as f64, 64)
+            };
+            let est = integrate(&[(0.0, 1.0)], &opts, |t| {
+                let (g, gp) = end_map(t, ls, hs);
+                let jac = d * gp;
+                if jac == 0.0 {
+                    return [0.0, 0.0];
+                }
+                let (sa, a) = (lo + d * g).sin_cos();
+                let wgt = 2.0 / PI * sa * jac;
+                let tol_j = (0.9 * tol / pieces.len() as f64 / wgt).min(1.0);
+                let (j, ej, n) = self.j_of_a(a, sa, tol_j);
+                evals += n;
+                [wgt * j, wgt * ej]
+            });
+            value += est.value[0];
+            error += est.error + est.value[1];
         }
         Estimate { value, error: error.max(ERROR_FLOOR), evals }
     }

@@ -94,8 +94,7 @@
 // RGB loops index several arrays by channel; the QUADPACK constants keep their published digits.
 #![allow(clippy::needless_range_loop, clippy::excessive_precision)]
 
-use crate::integrate::{WG10, WGK21, XGK21};
-use crate::integrate::{Estimate, Tolerance};
+use crate::integrate::{Estimate, Options, Tolerance, integrate};
 use rayon::prelude::*;
 use std::f64::consts::PI;
 use std::fmt;
@@ -552,117 +551,21 @@ impl PreparedKernel {
 // ---------------------------------------------------------------------------------------------
 // Vector-valued globally adaptive Gauss–Kronrod (G10/K21), all channels on shared panels.
 
-
-#[derive(Clone, Copy)]
-struct Panel<const N: usize> {
-    a: f64,
-    b: f64,
-    v: [f64; N],
-    e: [f64; N],
-}
-
-fn gk21_vec<const N: usize>(a: f64, b: f64, f: &mut impl FnMut(f64) -> [f64; N]) -> Panel<N> {
-    let c = 0.5 * (a + b);
-    let h = 0.5 * (b - a);
-    let fc = f(c);
-    let mut resk: [f64; N] = std::array::from_fn(|i| fc[i] * WGK21[10]);
-    let mut resg = [0.0; N];
-    for j in 0..10 {
-        let dx = h * XGK21[j];
-        let f1 = f(c - dx);
-        let f2 = f(c + dx);
-        for i in 0..N {
-            let s = f1[i] + f2[i];
-            resk[i] += WGK21[j] * s;
-            if j % 2 == 1 {
-                resg[i] += WG10[j / 2] * s;
-            }
-        }
-    }
-    Panel {
-        a,
-        b,
-        v: std::array::from_fn(|i| resk[i] * h),
-        e: std::array::from_fn(|i| ((resk[i] - resg[i]) * h).abs()),
-    }
-}
-
-/// Integrates the N-channel `f` over the union of `intervals` (disjoint), bisecting the panel
-/// that is worst relative to its channel's target until every channel's summed error estimate
-/// is ≤ max(abs[c], rel·|value[c]|), or `max_panels` is reached. Deterministic: ties broken by
-/// position, final sums in position order.
+/// Integrates the N-channel `f` over the union of `intervals` (disjoint; empty or reversed
+/// ones are skipped) with `crate::integrate::integrate` and [`Options::per_component`]:
+/// raw |K21 − G10| estimates, bisecting the panel that is worst relative to its channel's
+/// target until every channel's summed error estimate is ≤ max(abs[c], rel·|value[c]|), or
+/// `max_panels` is reached. Deterministic: ties broken by position, final sums in position order.
 fn adaptive_vec<const N: usize>(
     intervals: &[(f64, f64)],
     abs: [f64; N],
     rel: f64,
     max_panels: usize,
-    mut f: impl FnMut(f64) -> [f64; N],
+    f: impl FnMut(f64) -> [f64; N],
 ) -> [Estimate; N] {
-    let mut panels: Vec<Panel<N>> =
-        intervals.iter().filter(|(a, b)| b > a).map(|&(a, b)| gk21_vec(a, b, &mut f)).collect();
-    let mut evals = 21 * panels.len() as u64;
-    let mut stuck = [0.0; N];
-    let max_panels = max_panels.max(panels.len());
-    loop {
-        let mut val = [0.0; N];
-        let mut err = stuck;
-        for p in &panels {
-            for i in 0..N {
-                val[i] += p.v[i];
-                err[i] += p.e[i];
-            }
-        }
-        let target: [f64; N] = std::array::from_fn(|i| abs[i].max(rel * val[i].abs()));
-        let open: [bool; N] = std::array::from_fn(|i| err[i] > target[i]);
-        if !open.iter().any(|&o| o) || panels.len() >= max_panels {
-            panels.sort_by(|p, q| p.a.total_cmp(&q.a));
-            let mut value = [0.0; N];
-            for p in &panels {
-                for i in 0..N {
-                    value[i] += p.v[i];
-                }
-            }
-            return std::array::from_fn(|i| Estimate { value: value[i], error: err[i], evals });
-        }
-        let score = |p: &Panel<N>| -> f64 {
-            (0..N)
-                .filter(|&i| open[i])
-                .map(|i| p.e[i] / target[i].max(f64::MIN_POSITIVE))
-                .fold(0.0, f64::max)
-        };
-        let (worst, best_score) = panels
-            .iter()
-            .enumerate()
-            .map(|(k, p)| (k, score(p)))
-            .max_by(|(ka, sa), (kb, sb)| {
-                sa.total_cmp(sb).then(panels[*kb].a.total_cmp(&panels[*ka].a))
-            })
-            .expect("at least one panel");
-        if best_score == 0.0 {
-            // Open channels whose error lies only in stuck panels: nothing left to refine.
-            let mut p = panels;
-            p.sort_by(|x, y| x.a.total_cmp(&y.a));
-            let mut value = [0.0; N];
-            for q in &p {
-                for i in 0..N {
-                    value[i] += q.v[i];
-                }
-            }
-            return std::array::from_fn(|i| Estimate { value: value[i], error: err[i], evals });
-        }
-        let p = panels.swap_remove(worst);
-        let mid = 0.5 * (p.a + p.b);
-        if mid <= p.a || mid >= p.b {
-            for i in 0..N {
-                stuck[i] += p.e[i];
-            }
-            panels.push(Panel { e: [0.0; N], ..p });
-            continue;
-        }
-        panels.push(gk21_vec(p.a, mid, &mut f));
-        panels.push(gk21_vec(mid, p.b, &mut f));
-        evals += 42;
-    }
+    let intervals: Vec<(f64, f64)> = intervals.iter().copied().filter(|(a, b)| b > a).collect();
+    let r = integrate(&intervals, &Options::per_component(abs, rel, max_panels), f);
+    std::array::from_fn(|i| Estimate { value: r.value[i], error: r.errors[i], evals: r.evals })
 }
 
 // ---------------------------------------------------------------------------------------------
