@@ -64,6 +64,8 @@ pub enum BuildError {
     /// A committed file read as a kind its spec is not.
     #[error("{spec}: not a spec of kind = \"{expected}\"")]
     NotKind { spec: String, expected: &'static str },
+    #[error("{spec}: the emitted f32 code's max abs error {measured:e} exceeds the spec's max_error {bound:e}")]
+    ErrorBound { spec: String, measured: f64, bound: f64 },
     #[error("{spec}: no builder for kind = \"{kind}\"")]
     UnknownKind { spec: String, kind: String },
 }
@@ -203,6 +205,18 @@ pub type CustomBuild = fn(&Spec, Mode, &Path) -> Result<Built, BuildError>;
 /// Build one spec in the given mode; `root` is the generated/ folder; `custom` finds the builder
 /// of a family spec kind by name.
 pub fn build_spec(spec: &Spec, mode: Mode, root: &Path, custom: &dyn Fn(&str) -> Option<CustomBuild>) -> Result<Built, BuildError> {
+    let b = build_any(spec, mode, root, custom)?;
+    // A spec's `max_error` bounds the measured error of its emitted f32 code (NaN fails too).
+    let measured = b.verification.max_abs_error_f32;
+    if let Some(bound) = spec.file.max_error
+        && !(measured <= bound)
+    {
+        return Err(BuildError::ErrorBound { spec: spec.file.name.clone(), measured, bound });
+    }
+    Ok(b)
+}
+
+fn build_any(spec: &Spec, mode: Mode, root: &Path, custom: &dyn Fn(&str) -> Option<CustomBuild>) -> Result<Built, BuildError> {
     match spec.file.kind {
         Kind::Fit => build_fit(spec, mode, root),
         Kind::Table => build_table(spec, mode, root),

@@ -394,3 +394,43 @@ fn a_closed_pipe_ends_the_cli_quietly() {
         assert!(o.status.success() || std::os::unix::process::ExitStatusExt::signal(&o.status) == Some(13), "{args:?}: {:?}", o.status);
     }
 }
+
+#[test]
+fn a_stated_error_bound_fails_the_build_when_exceeded() {
+    // gloss_length's emitted f32 code measures 2.7e-4 max abs error: a bound of 1e-5 fails the
+    // build (exit 1, the spec named, nothing written), 1e-3 passes, a negative bound is bad input.
+    let with_bound = |b: &str| {
+        let d = scratch();
+        let p = d.path().join("fits/gloss_length.toml");
+        let t = std::fs::read_to_string(&p).unwrap();
+        let t = t.replacen("\n[[axis]]", &format!("\nmax_error = {b}\n\n[[axis]]"), 1);
+        std::fs::write(&p, t).unwrap();
+        let o = shadefit(&["build", "--only", "gloss_length"], Some(d.path()));
+        (d, o)
+    };
+    let (d, o) = with_bound("1e-5");
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("gloss_length") && stderr(&o).contains("max_error"), "{}", stderr(&o));
+    assert!(!d.path().join("generated/json/gloss_length.json").exists(), "nothing written");
+    let (_, o) = with_bound("1e-3");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (_, o) = with_bound("-1.0");
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("'max_error'"), "{}", stderr(&o));
+}
+
+#[test]
+fn subnormal_fuzz_arguments_give_the_limits() {
+    // G(d, μv) → 1 as μv → 0 and → 0 as d → 0 (the fuzz family's module doc); at subnormal
+    // arguments eval reports the limit with an error estimate that covers the distance to it.
+    for (args, limit) in [(["mu_v=1e-310", "d=0.2"], 1.0), (["mu_v=0.2", "d=1e-310"], 0.0), (["mu_v=5e-324", "d=1"], 1.0)] {
+        let o = shadefit(&["eval", "fuzz-g", args[0], args[1], "--json"], None);
+        assert!(o.status.success(), "{args:?}: {}", stderr(&o));
+        let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        let (value, err) = (v["value"].as_f64().unwrap(), v["error_estimate"].as_f64().unwrap());
+        assert!(value.is_finite() && (value - limit).abs() <= err && err < 1e-300, "{args:?}: {value} ± {err}");
+    }
+    let o = shadefit(&["eval", "fuzz-q", "d=1e-310", "--json"], None);
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!((v["value"].as_f64().unwrap() - 1.0).abs() < 1e-15, "Q(0) = 2E₃(0) = 1: {v}");
+}

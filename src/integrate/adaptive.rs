@@ -36,9 +36,9 @@
 //! differences are options here ([`Options`], presets [`Options::scalar`],
 //! [`Options::quadpack`], [`Options::per_component`]):
 //!
-//! | option | [`super::adaptive()`] (gloss, fuzz G/Q, tests) | fuzz P_s, R | skin |
+//! | option | [`super::adaptive()`] (scalar integrals, tests) | [`Options::quadpack`] (mapped multi-node integrands) | [`Options::per_component`] (RGB on split intervals) |
 //! |---|---|---|---|
-//! | [`Rule`] | K21 | K21; GL32/GL24 pair (outer A of R) | K21 |
+//! | [`Rule`] | K21 | K21, or a GL32/GL24 pair (an outer integral) | K21 |
 //! | [`PanelError`] | raw \|K − G\| | QUADPACK | raw \|K − G\| |
 //! | [`Control`] | `Weighted([1])`, abs + rel | `Weighted(w)`, abs | `PerComponent`, abs[c] + rel |
 //! | `stop_when_exhausted` | yes | no | yes |
@@ -46,13 +46,13 @@
 //! | `sum_from_negative_zero` | yes (`Iterator::sum`) | no | no |
 //! | intervals | one | one | several (the kinks) |
 //!
-//! Why: the scalar rule is the plain QAG loop with the raw (generous) estimate. Fuzz integrates
-//! mapped integrands whose raw estimates are orders of magnitude too pessimistic, so it uses
-//! QUADPACK's; it integrates up to 15 η_u nodes of one K15 rule at once and controls their sum
-//! weighted by the rule's weights (nodes with their own integration get weight 0), and R's outer
-//! integral carries the inner error estimates as an unchecked component. Skin integrates RGB,
-//! each channel to its own tolerance (scaled by that channel's denominator), on intervals split
-//! at the kinks of the clamped cosine and the profile.
+//! Why: the scalar rule is the plain QAG loop with the raw (generous) estimate. Mapped
+//! integrands whose raw estimates are orders of magnitude too pessimistic use QUADPACK's; an
+//! integrand that carries up to 15 nodes of an outer K15 rule at once controls their sum
+//! weighted by the rule's weights (nodes with their own integration get weight 0), and an outer
+//! integral can carry the inner error estimates as an unchecked component. RGB integrands take
+//! each channel to its own tolerance, on intervals split at the integrand's kinks. Which family
+//! integral uses which preset is said where it calls the engine.
 //!
 //! The stop and sum rows only matter in degenerate cases (every panel estimate 0, an infinite
 //! or NaN estimate, every panel value −0.0) but change bits there, so they stay options.
@@ -203,7 +203,7 @@ impl Options<'static, 1> {
 
 impl<const N: usize> Options<'static, N> {
     /// K21 with QUADPACK estimates, weighted by `weights`, to absolute `tol`; stops on a
-    /// non-finite error (fuzz: P_s and the inner integrals of R).
+    /// non-finite error (mapped multi-node integrands).
     pub fn quadpack(weights: [f64; N], tol: f64, max_panels: usize) -> Self {
         Options {
             rule: Rule::Kronrod21,
@@ -216,7 +216,7 @@ impl<const N: usize> Options<'static, N> {
         }
     }
 
-    /// K21 with raw estimates, every component to max(abs[c], rel·|value_c|) (skin).
+    /// K21 with raw estimates, every component to max(abs[c], rel·|value_c|) (RGB integrands).
     pub fn per_component(abs: [f64; N], rel: f64, max_panels: usize) -> Self {
         Options {
             rule: Rule::Kronrod21,

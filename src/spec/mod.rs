@@ -396,6 +396,9 @@ pub struct SpecFile {
     /// Integrator absolute tolerance for every sample.
     #[serde(default = "default_tolerance")]
     pub tolerance: f64,
+    /// The largest max abs error of the emitted f32 code on the verification grid the build
+    /// accepts; above it the build fails, naming the spec.
+    pub max_error: Option<f64>,
     pub axis: Vec<AxisSpec>,
     pub model: Option<ModelSpec>,
     pub fit: Option<FitSection>,
@@ -461,6 +464,11 @@ impl Spec {
             && let Some(dup) = args.iter().enumerate().find(|(i, a)| args[..*i].contains(a)).map(|(_, a)| a)
         {
             return Err(at("args", format!("'{dup}' is given twice")));
+        }
+        if let Some(b) = file.max_error
+            && !(b > 0.0 && b.is_finite())
+        {
+            return Err(at("max_error", format!("{b} must be positive and finite")));
         }
         if !(file.tolerance > 0.0 && file.tolerance < 1.0) {
             return Err(at("tolerance", format!("{} must be in (0, 1)", file.tolerance)));

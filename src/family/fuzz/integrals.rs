@@ -1194,6 +1194,20 @@ pub fn g(d: f64, mu_v: f64, tol: f64) -> Estimate {
     if mu_v == 0.0 {
         return Estimate::exact(1.0);
     }
+    // Subnormal arguments: the graded nodes would need 1/d or 1/μv, which overflow. Take the
+    // limit with a bound on the distance to it. The integrand (1 − e^{−d(1/μv + 1/μ)})·μ/(μ + μv)
+    // is at most d/μv, so G ≤ d/μv; and 1 − G ≤ c ln((1 + c)/c) + e^{−d/c} E₂(d) + c E₁(d(1 + c)/c)
+    // from the closed form ([`g_exact`], c = μv; E₂ ≤ 1, E₁(x) ≤ e^{−x} ln(1 + 1/x)).
+    if d < f64::MIN_POSITIVE || mu_v < f64::MIN_POSITIVE {
+        let to_zero = (d / mu_v).min(1.0);
+        let c = mu_v;
+        let to_one = c * (1.0 - c.ln()) + (-d / c).exp() + c * expn(1, d * (1.0 + c) / c);
+        return if to_zero <= to_one {
+            Estimate { value: 0.0, error: to_zero, evals: 0 }
+        } else {
+            Estimate { value: 1.0, error: to_one.min(1.0), evals: 0 }
+        };
+    }
     let mut e = graded_unit_integral(&[d, mu_v], clean_tol(tol), |mu| {
         if mu <= 0.0 {
             return 0.0;
