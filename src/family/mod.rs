@@ -117,8 +117,26 @@ pub fn eval_help() -> String {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
+    use crate::bench::forms::{testing, FormRow};
+
+    /// The quick run of each family's shader forms, by family name (computed once).
+    pub(crate) fn quick_forms(family: &str) -> &'static [FormRow] {
+        static ROWS: OnceLock<BTreeMap<&'static str, Vec<FormRow>>> = OnceLock::new();
+        ROWS.get_or_init(|| FAMILIES.iter().map(|f| (f.name, testing::quick(f.bench.forms, catalog()))).collect())[family].as_slice()
+    }
+
+    #[test]
+    fn every_family_s_forms_are_sorted_by_cost_with_a_front_and_tables_converge() {
+        for f in FAMILIES {
+            let quantities: Vec<&str> = f.bench.forms.iter().map(|s| s.quantity).collect();
+            assert!(!quantities.is_empty(), "{} benchmarks no shader form", f.name);
+            let rows = quick_forms(f.name);
+            testing::every_quantity_has_three_forms_sorted_by_cost_with_a_front(rows, &quantities);
+            testing::table_error_decreases_with_resolution(rows, &quantities);
+        }
+    }
 
     #[test]
     fn names_are_unique_across_families() {

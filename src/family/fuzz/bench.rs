@@ -617,28 +617,9 @@ fn ps_table_row(refit: &Spec, committed: &[DVector<f64>], evaluator: &OpCounts, 
 mod tests {
     use super::*;
     use crate::bench::forms::testing;
-    use std::sync::OnceLock;
-
-    const QUANTITIES: [&str; 4] = ["fuzz-q", "fuzz-g", "fuzz-r", "fuzz-ps"];
-
-    /// The quick run, shared by the tests that read it.
-    fn quick() -> &'static [FormRow] {
-        static ROWS: OnceLock<Vec<FormRow>> = OnceLock::new();
-        ROWS.get_or_init(|| testing::quick(BENCH.forms, crate::family::catalog()))
-    }
 
     fn ctx(quick: bool) -> Ctx<'static> {
         testing::ctx(quick, crate::family::catalog())
-    }
-
-    #[test]
-    fn every_quantity_has_three_forms_sorted_by_cost_with_a_front() {
-        testing::every_quantity_has_three_forms_sorted_by_cost_with_a_front(quick(), &QUANTITIES);
-    }
-
-    #[test]
-    fn table_error_decreases_with_resolution() {
-        testing::table_error_decreases_with_resolution(quick(), &QUANTITIES);
     }
 
     #[test]

@@ -188,28 +188,3 @@ fn gloss_combine(ctx: &Ctx) -> Result<Vec<FormRow>, BenchError> {
         table_row(&small, table_values(&mut integral, &small), &reference, "table 22²", "")?,
     ])
 }
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::bench::forms::testing;
-    use std::sync::OnceLock;
-
-    const QUANTITIES: [&str; 2] = ["gloss-length", "gloss-combine"];
-
-    /// The quick run, shared by the tests that read it.
-    fn quick() -> &'static [FormRow] {
-        static ROWS: OnceLock<Vec<FormRow>> = OnceLock::new();
-        ROWS.get_or_init(|| testing::quick(BENCH.forms, crate::family::catalog()))
-    }
-
-    #[test]
-    fn every_quantity_has_three_forms_sorted_by_cost_with_a_front() {
-        testing::every_quantity_has_three_forms_sorted_by_cost_with_a_front(quick(), &QUANTITIES);
-    }
-
-    #[test]
-    fn table_error_decreases_with_resolution() {
-        testing::table_error_decreases_with_resolution(quick(), &QUANTITIES);
-    }
-}

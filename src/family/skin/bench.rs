@@ -65,11 +65,7 @@ fn skin_punctual_integrators(mode: &Mode) -> Vec<IntegratorRow> {
                     skin::Kernel::Linear,
                     p[0],
                     p[1],
-                    Tolerance {
-                        abs: tol,
-                        rel: 0.0,
-                        max_panels: 2000,
-                    },
+                    ladder_tolerance(tol),
                 )
                 .expect("the preset profile is valid")
             })
@@ -137,11 +133,7 @@ fn skin_sh_integrators(mode: &Mode) -> Vec<IntegratorRow> {
                     &profile,
                     kappa,
                     band,
-                    Tolerance {
-                        abs: tol,
-                        rel: 0.0,
-                        max_panels: 2000,
-                    },
+                    ladder_tolerance(tol),
                 )
                 .expect("the preset profile is valid")
             })
@@ -203,27 +195,7 @@ fn skin_punctual(ctx: &Ctx) -> Result<Vec<FormRow>, BenchError> {
     Ok(rows)
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::bench::forms::testing;
-    use std::sync::OnceLock;
-
-    const QUANTITIES: [&str; 1] = ["skin-punctual"];
-
-    /// The quick run, shared by the tests that read it.
-    fn quick() -> &'static [FormRow] {
-        static ROWS: OnceLock<Vec<FormRow>> = OnceLock::new();
-        ROWS.get_or_init(|| testing::quick(BENCH.forms, crate::family::catalog()))
-    }
-
-    #[test]
-    fn every_quantity_has_three_forms_sorted_by_cost_with_a_front() {
-        testing::every_quantity_has_three_forms_sorted_by_cost_with_a_front(quick(), &QUANTITIES);
-    }
-
-    #[test]
-    fn table_error_decreases_with_resolution() {
-        testing::table_error_decreases_with_resolution(quick(), &QUANTITIES);
-    }
+/// The integrators' tolerance at one rung of a ladder: absolute only, a generous panel budget.
+fn ladder_tolerance(abs: f64) -> Tolerance {
+    Tolerance { abs, rel: 0.0, max_panels: 2000 }
 }
