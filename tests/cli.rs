@@ -21,7 +21,8 @@ fn eval_json_contract() {
     // (2/3)² = 4/9 < 2/3: below the table, clamped to gloss 0.
     assert_eq!(v["value"].as_f64().unwrap(), 0.0);
 
-    // Round trip: gloss-from-length of gloss-length(0.3) is 0.3 (bisection to ~1e-11).
+    // Round trip: gloss-from-length of gloss-length(0.3) is 0.3 (the inverse to about one ulp of g;
+    // 1e-9 leaves room for the length printed to 17 digits and dL/dg).
     let o = shadefit(&["eval", "gloss-length", "gloss=0.3", "--json"], None);
     let l = serde_json::from_slice::<serde_json::Value>(&o.stdout).unwrap()["value"].as_f64().unwrap();
     let o = shadefit(&["eval", "gloss-from-length", &format!("length={l:.17e}"), "--json"], None);

@@ -70,7 +70,7 @@ proptest! {
     fn gloss_round_trip(g0 in 0.0f64..=1.0) {
         let back = gloss_from_length(length_from_gloss(g0));
         // L is a few ulps (≤ 4e-16) accurate and dL/dg ≥ 1e-5, so g is determined to
-        // ≤ 4e-11; bisection adds one ulp of g.
+        // ≤ 4e-11; the root finder adds about one ulp of g.
         prop_assert!((back - g0).abs() <= 1e-10, "g = {g0} -> {back}");
     }
 
