@@ -45,7 +45,20 @@ pub enum Error {
 impl Error {
     /// The error is the user's input (a spec, a manifest, a name), not a failed job.
     pub fn is_input(&self) -> bool {
-        matches!(self, Error::Spec(_) | Error::UnknownSpec { .. })
+        use crate::fit::FitError;
+        use crate::pipeline::SceneError;
+        match self {
+            Error::Spec(_) | Error::UnknownSpec { .. } => true,
+            // A spec whose model cannot avoid a pole on its domain or whose basis is degenerate on
+            // its samples (e.g. fixed denominator coefficients forcing a pole), or a scene naming a spec that fits/ lacks: the spec or
+            // the manifest is what must change.
+            Error::Build { source, .. } | Error::Scene { source, .. } => matches!(
+                source,
+                BuildError::Fit(FitError::PoleInDomain { .. } | FitError::SingularStart { .. })
+                    | BuildError::Scene(SceneError::MissingSpec { .. })
+            ),
+            _ => false,
+        }
     }
 }
 

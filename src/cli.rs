@@ -85,7 +85,12 @@ fn load_specs(paths: &Paths, only: &[String]) -> Result<Vec<Spec>> {
 
 /// A build error for the CLI edge: the user's input exits 2, a failed job 1.
 fn build_err(e: build::Error) -> anyhow::Error {
-    if e.is_input() { input_err(e) } else { anyhow::Error::new(e) }
+    if e.is_input() {
+        // The whole chain in the message: InputError keeps only its text.
+        input_err(format!("{:#}", anyhow::Error::new(e)))
+    } else {
+        anyhow::Error::new(e)
+    }
 }
 
 fn progress(len: usize, what: &str) -> ProgressBar {

@@ -435,3 +435,21 @@ fn subnormal_fuzz_arguments_give_the_limits() {
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert!((v["value"].as_f64().unwrap() - 1.0).abs() < 1e-15, "Q(0) = 2E₃(0) = 1: {v}");
 }
+
+#[test]
+fn a_model_the_spec_forces_into_a_pole_is_bad_input() {
+    // Both denominator coefficients fixed: Q = 1 − 3g has its root at g = 1/3, inside the
+    // domain. The spec must change, so exit 2 naming it, and nothing written.
+    let d = scratch();
+    let p = d.path().join("fits/gloss_length.toml");
+    let t = std::fs::read_to_string(&p).unwrap().replacen(
+        "numerator = [\"1\", \"gloss\", \"gloss^2\", \"gloss^3\"]",
+        "numerator = [\"1\", \"gloss\", \"gloss^2\", \"gloss^3\"]\nfixed = { \"den:gloss\" = -3.0, \"den:gloss^2\" = 0.0 }",
+        1,
+    );
+    std::fs::write(&p, t).unwrap();
+    let o = shadefit(&["build", "--only", "gloss_length"], Some(d.path()));
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("gloss_length"), "{}", stderr(&o));
+    assert_nothing_written(d.path());
+}

@@ -8,9 +8,9 @@ use common::*;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-/// The snapshot without the lock file (an empty file a build leaves for the next one).
+/// Every file under generated/ with its bytes.
 fn files(d: &Path) -> Vec<(PathBuf, Vec<u8>)> {
-    snapshot(&d.join("generated")).into_iter().filter(|(p, _)| !p.ends_with(".shadefit.lock")).collect()
+    snapshot(&d.join("generated"))
 }
 
 /// A project with the committed generated/ and a gloss table spec edited, so that a build

@@ -138,3 +138,16 @@ fn bad_manifests_exit_2_name_file_line_field_and_write_nothing() {
     bad_scene(|t| t.replace("name = \"velvet_horse\"", "name = \"velvet\""), line_of("name ="), "name");
     bad_scene(|t| t.replace("features = [\"fuzz\"]", "features = [\"fuzz\"]\nshiny = true"), m + 3, "shiny");
 }
+
+#[test]
+fn a_scene_naming_a_spec_fits_lacks_is_bad_input() {
+    // cobblestone_gloss reaches gloss_combine_lut; without it the manifest (or fits/) must
+    // change: exit 2 naming the spec, nothing written.
+    let d = scratch_with_scenes();
+    std::fs::remove_file(d.path().join("fits/gloss_combine_lut.toml")).unwrap();
+    let (_, o) = build_scene(d.path(), "cobblestone_gloss", &[]);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("gloss_combine_lut"), "{err}");
+    assert_nothing_written(d.path());
+}

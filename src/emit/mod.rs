@@ -46,7 +46,8 @@ pub struct WriteError {
     pub source: std::io::Error,
 }
 
-/// The lock file under the generated/ root: one build writes at a time.
+/// The lock file under the generated/ root where the root folder itself cannot be locked (not
+/// Unix); on Unix the folder is locked and no file is left.
 pub const LOCK_FILE: &str = ".shadefit.lock";
 /// Staged files, backups and the journal of a transaction, under the generated/ root.
 pub const STAGING_DIR: &str = ".staging";
@@ -54,8 +55,8 @@ const JOURNAL: &str = "journal";
 
 /// A set of writes under the generated/ root that lands whole or not at all.
 ///
-/// [`Transaction::begin`] takes an exclusive lock on `ROOT/.shadefit.lock` (a second build waits
-/// for the first, saying so on stderr) and first undoes what an interrupted transaction left:
+/// [`Transaction::begin`] takes an exclusive lock on the root folder (elsewhere than Unix, on
+/// `ROOT/.shadefit.lock`; a second build waits for the first, saying so on stderr) and first undoes what an interrupted transaction left:
 /// the journal in `ROOT/.staging` lists every file it swapped, each restored from its backup or
 /// removed if it was new, and stale staged files go with the folder. [`Transaction::write`] writes
 /// the changed files to `.staging` (synced), then for each one records it in the journal
@@ -91,8 +92,14 @@ impl Transaction {
             move |e| WriteError { path, source: e }
         };
         std::fs::create_dir_all(root).map_err(err(root))?;
-        let lock_path = root.join(LOCK_FILE);
-        let lock = std::fs::OpenOptions::new().create(true).truncate(false).write(true).open(&lock_path).map_err(err(&lock_path))?;
+        #[cfg(unix)]
+        let (lock_path, lock) = (root.to_path_buf(), std::fs::File::open(root).map_err(err(root))?);
+        #[cfg(not(unix))]
+        let (lock_path, lock) = {
+            let p = root.join(LOCK_FILE);
+            let f = std::fs::OpenOptions::new().create(true).truncate(false).write(true).open(&p).map_err(err(&p))?;
+            (p, f)
+        };
         match lock.try_lock() {
             Ok(()) => {}
             Err(std::fs::TryLockError::WouldBlock) => {
@@ -276,7 +283,7 @@ mod tests {
             let Ok(rd) = std::fs::read_dir(root.join(dir)) else { continue };
             for e in rd.flatten() {
                 let p = e.path();
-                if p.is_file() && !p.ends_with(LOCK_FILE) {
+                if p.is_file() {
                     out.push((p.strip_prefix(root).unwrap().display().to_string(), std::fs::read_to_string(&p).unwrap()));
                 }
             }
