@@ -725,14 +725,6 @@ pub enum CurvatureMapping {
 }
 
 impl CurvatureMapping {
-    /// t of κ/κ_max ∈ [0, 1].
-    pub fn to_unit(self, kappa_over_max: f64) -> f64 {
-        match self {
-            CurvatureMapping::Linear => kappa_over_max,
-            CurvatureMapping::Sqrt => kappa_over_max.sqrt(),
-        }
-    }
-
     /// κ/κ_max of t ∈ [0, 1].
     pub fn from_unit(self, t: f64) -> f64 {
         match self {
