@@ -3,32 +3,59 @@
 //! Q(x) = 1 + Σ b_j ψ_j(x) is evaluated over a box with interval arithmetic (each monomial
 //! an interval product of interval powers). If the lower bound is positive the box is done;
 //! otherwise it is bisected along its widest side, down to a budget of boxes. Interval
-//! evaluation over-estimates the range, never under-estimates it, so a positive lower bound
-//! on every leaf is a proof (up to f64 rounding of the bound itself, which we absorb by
-//! requiring the bound to exceed 1e-12).
+//! evaluation over-estimates the range, never under-estimates it, and every interval end is
+//! rounded outward (`next_down`/`next_up`), so a lower bound on every leaf is a proof in f64.
+//! A denominator is accepted when that bound exceeds 1e-12: closer to zero is a pole for
+//! shader arithmetic.
 
 use super::model::RationalModel;
 use nalgebra::DVector;
 
-#[derive(Debug, Clone, Copy)]
+/// The largest f64 below `x` (below every real number `x` may have rounded from).
+fn down(x: f64) -> f64 {
+    if x.is_nan() { f64::NEG_INFINITY } else { x.next_down() }
+}
+
+/// The smallest f64 above `x`.
+fn up(x: f64) -> f64 {
+    if x.is_nan() { f64::INFINITY } else { x.next_up() }
+}
+
+/// A closed interval whose ends are rounded outward after every operation, so that it always
+/// contains the exact real result: each operation's f64 result is within half an ulp of the
+/// real one, and one step of `next_down`/`next_up` covers it (a NaN end becomes ∓∞).
+#[derive(Debug, Clone, Copy, PartialEq)]
 struct Iv(f64, f64);
 
 impl Iv {
+    fn add(self, o: Iv) -> Iv {
+        Iv(down(self.0 + o.0), up(self.1 + o.1))
+    }
+
     fn mul(self, o: Iv) -> Iv {
         let p = [self.0 * o.0, self.0 * o.1, self.1 * o.0, self.1 * o.1];
-        Iv(p.iter().cloned().fold(f64::INFINITY, f64::min), p.iter().cloned().fold(f64::NEG_INFINITY, f64::max))
+        if p.iter().any(|v| v.is_nan()) {
+            // 0 · ∞: no finite bound.
+            return Iv(f64::NEG_INFINITY, f64::INFINITY);
+        }
+        Iv(down(p.iter().copied().fold(f64::INFINITY, f64::min)), up(p.iter().copied().fold(f64::NEG_INFINITY, f64::max)))
     }
+
+    fn scale(self, b: f64) -> Iv {
+        Iv(b, b).mul(self)
+    }
+
+    /// xᵉ by repeated outward-rounded products (`powi` is not correctly rounded); even powers
+    /// are ≥ 0 whatever the interval.
     fn powi(self, e: u32) -> Iv {
-        if e == 0 {
-            return Iv(1.0, 1.0);
+        let mut r = Iv(1.0, 1.0);
+        for _ in 0..e {
+            r = r.mul(self);
         }
-        let a = self.0.powi(e as i32);
-        let b = self.1.powi(e as i32);
-        if e % 2 == 0 && self.0 <= 0.0 && self.1 >= 0.0 {
-            Iv(0.0, a.max(b))
-        } else {
-            Iv(a.min(b), a.max(b))
+        if e % 2 == 0 {
+            r.0 = r.0.max(0.0);
         }
+        r
     }
 }
 
@@ -42,30 +69,35 @@ pub enum Positivity {
     NotProven { lower: f64, region: Vec<(f64, f64)>, sample: f64 },
 }
 
-fn term_range(t: &crate::fit::model::Term, feats: &[(f64, f64)]) -> Iv {
+fn term_range(t: &crate::fit::model::Term, feats: &[Iv]) -> Iv {
     let mut term = Iv(0.0, 0.0);
     for m in &t.monomials {
         let mut v = Iv(1.0, 1.0);
         for (e, r) in m.exps.iter().zip(feats) {
-            v = v.mul(Iv(r.0, r.1).powi(*e));
+            if *e > 0 {
+                v = v.mul(r.powi(*e));
+            }
         }
-        term = Iv(term.0 + v.0, term.1 + v.1);
+        term = term.add(v);
     }
     term
 }
 
+/// A lower bound of Q on `region`, rigorous in f64: interval arithmetic rounded outward, the
+/// derived features' ranges widened by two ulps each side (their cos, sin and affine maps are
+/// within an ulp or two of exact).
 fn bound(model: &RationalModel, c: &DVector<f64>, region: &[(f64, f64)]) -> f64 {
     let nn = model.numerator.len();
-    // Feature ranges: the inputs' box, then each derived feature's exact range over it.
-    let mut feats = region.to_vec();
-    feats.extend(model.derived.iter().map(|d| d.range(region)));
-    let mut lo = model.lead.as_ref().map_or(1.0, |t| term_range(t, &feats).0);
+    let mut feats: Vec<Iv> = region.iter().map(|&(a, b)| Iv(a, b)).collect();
+    feats.extend(model.derived.iter().map(|d| {
+        let (a, b) = d.range(region);
+        Iv(down(down(a)), up(up(b)))
+    }));
+    let mut q = model.lead.as_ref().map_or(Iv(1.0, 1.0), |t| term_range(t, &feats));
     for (j, t) in model.denominator.iter().enumerate() {
-        let term = term_range(t, &feats);
-        let b = c[nn + j];
-        lo += if b >= 0.0 { b * term.0 } else { b * term.1 };
+        q = q.add(term_range(t, &feats).scale(c[nn + j]));
     }
-    lo
+    q.0
 }
 
 /// Prove Q > 0 on the box `domain` (one (min, max) per feature).
@@ -113,17 +145,105 @@ pub fn prove_denominator_positive(
 mod tests {
     use super::*;
 
+    fn prove(n_den: u32, den: &[f64], domain: (f64, f64)) -> Positivity {
+        let m = RationalModel::rational_1d("x", 0, n_den);
+        let mut c = vec![1.0];
+        c.extend_from_slice(den);
+        prove_denominator_positive(&m, &DVector::from_vec(c), &[domain])
+    }
+
+    fn proven(p: &Positivity) -> Option<f64> {
+        match p {
+            Positivity::Proven { lower, .. } => Some(*lower),
+            Positivity::NotProven { .. } => None,
+        }
+    }
+
     #[test]
     fn detects_pole_and_proves_positive() {
-        let m = RationalModel::rational_1d("x", 0, 1);
         // Q = 1 − 2x has a root at ½ inside [0, 1].
-        let c = DVector::from_vec(vec![1.0, -2.0]);
-        assert!(matches!(prove_denominator_positive(&m, &c, &[(0.0, 1.0)]), Positivity::NotProven { .. }));
+        assert!(proven(&prove(1, &[-2.0], (0.0, 1.0))).is_none());
         // Q = 1 − 0.9x ≥ 0.1 on [0, 1].
-        let c = DVector::from_vec(vec![1.0, -0.9]);
-        match prove_denominator_positive(&m, &c, &[(0.0, 1.0)]) {
-            Positivity::Proven { lower, .. } => assert!(lower > 0.0 && lower <= 0.1 + 1e-12),
-            other => panic!("{other:?}"),
+        let lower = proven(&prove(1, &[-0.9], (0.0, 1.0))).expect("proven");
+        assert!(lower > 0.0 && lower <= 0.1 + 1e-12, "{lower}");
+    }
+
+    #[test]
+    fn the_threshold_is_kept_exactly() {
+        // Q = 1 − (1 − t)x on [0, 1]: its minimum is t, at the box edge x = 1.
+        // t = 2e-12 is above the 1e-12 threshold: proven, with a bound no higher than t.
+        let t = 2e-12;
+        let lower = proven(&prove(1, &[-(1.0 - t)], (0.0, 1.0))).expect("2e-12 above the threshold");
+        assert!(lower > 1e-12 && lower <= t * (1.0 + 1e-3), "{lower}");
+        // Just below the threshold, at zero (a root on the box edge), and below zero (a root
+        // inside, 5e-10 from the edge): never proven.
+        for t in [5e-13, 0.0, -5e-10, -1e-9] {
+            assert!(proven(&prove(1, &[-(1.0 - t)], (0.0, 1.0))).is_none(), "min {t} proven");
         }
+    }
+
+    #[test]
+    fn tangent_roots_and_near_tangents() {
+        // Q = (4(x − ½)² + ε)/(1 + ε) = 1 − 4x/(1+ε) + 4x²/(1+ε): minimum ε/(1+ε) at x = ½.
+        let q = |eps: f64| prove(2, &[-4.0 / (1.0 + eps), 4.0 / (1.0 + eps)], (0.0, 1.0));
+        let lower = proven(&q(1e-6)).expect("min 1e-6 is proven after bisection");
+        assert!(lower > 1e-12 && lower <= 1e-6, "{lower}");
+        for eps in [1e-13, 0.0, -1e-9] {
+            assert!(proven(&q(eps)).is_none(), "ε = {eps} proven");
+        }
+    }
+
+    #[test]
+    fn huge_and_tiny_coefficients() {
+        // Q = 1 + 1e300·x ≥ 1 on [0, 1]; Q = 1 − 1e-300·x ≈ 1; Q = 1 − 1e300·x has its root at
+        // 1e-300, inside; Q = 1 − 1e-300·x on [0, 2e300] has its root at 1e300.
+        assert!(proven(&prove(1, &[1e300], (0.0, 1.0))).is_some_and(|l| l > 0.99));
+        assert!(proven(&prove(1, &[-1e-300], (0.0, 1.0))).is_some_and(|l| l > 0.99));
+        assert!(proven(&prove(1, &[-1e300], (0.0, 1.0))).is_none());
+        assert!(proven(&prove(1, &[-1e-300], (0.0, 2e300))).is_none());
+        // An overflowing bound is no proof.
+        assert!(proven(&prove(2, &[1e300, -1e300], (0.0, 1e10))).is_none());
+    }
+
+    #[test]
+    fn intervals_round_outward() {
+        // 0.1 + 0.2 is not 0.3 in f64; the interval must contain the real sum on both sides.
+        let s = Iv(0.1, 0.1).add(Iv(0.2, 0.2));
+        assert!(s.0 < 0.1 + 0.2 && s.1 > 0.1 + 0.2);
+        let p = Iv(-1.0, 2.0).powi(2);
+        assert_eq!(p.0, 0.0, "even powers are non-negative");
+        assert!(p.1 >= 4.0);
+        assert_eq!(Iv(0.0, f64::INFINITY).mul(Iv(-1.0, 1.0)), Iv(f64::NEG_INFINITY, f64::INFINITY));
+    }
+
+    #[test]
+    fn a_proof_is_never_contradicted_by_dense_sampling() {
+        // 3000 random cubic denominators 1 + b₁x + b₂x² + b₃x³ on random boxes inside [−2, 2]:
+        // whenever the proof holds, Q at 4001 points of the box (evaluated in f64, to ~1e-15)
+        // stays above its bound, and the bound is above the threshold.
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut uniform = |lo: f64, hi: f64| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            lo + (hi - lo) * (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let (mut yes, mut no) = (0, 0);
+        for _ in 0..3000 {
+            let b = [uniform(-3.0, 3.0), uniform(-3.0, 3.0), uniform(-3.0, 3.0)];
+            let (a, w) = (uniform(-2.0, 1.5), uniform(0.01, 2.0));
+            let dom = (a, (a + w).min(2.0));
+            let q = |x: f64| 1.0 + b[0] * x + b[1] * x * x + b[2] * x * x * x;
+            let min = (0..=4000).map(|i| q(dom.0 + (dom.1 - dom.0) * i as f64 / 4000.0)).fold(f64::INFINITY, f64::min);
+            match proven(&prove(3, &b, dom)) {
+                Some(lower) => {
+                    yes += 1;
+                    assert!(lower > 1e-12 && min >= lower - 1e-14, "b = {b:?} on {dom:?}: bound {lower}, sampled min {min}");
+                }
+                None => no += 1,
+            }
+        }
+        // Both outcomes occur, so the property was exercised both ways.
+        assert!(yes > 300 && no > 300, "{yes} proven, {no} not");
     }
 }
