@@ -187,6 +187,8 @@ impl ModelSpec {
                     if let Some(&(_, j)) = seen.iter().find(|(n, _)| *n == m) {
                         let msg = if j == i {
                             format!("term '{}' repeats a monomial", t.label)
+                        } else if terms[j].label == t.label {
+                            format!("term '{}' is given twice", t.label)
                         } else {
                             format!("terms '{}' and '{}' share a monomial: their coefficients cannot be told apart", terms[j].label, t.label)
                         };
