@@ -19,7 +19,7 @@ pub const FUZZ_G_NUM: [f32; 3] = [
 ];
 /// Denominator coefficients (the constant term 1 is implicit).
 pub const FUZZ_G_DEN: [f32; 2] = [
-    6.282831e-1_f32, 1.00874774e-1_f32,
+    6.282831e-1_f32, 1.0087476e-1_f32,
 ];
 
 /// CPU version of the WGSL function of the same name.

@@ -15,7 +15,7 @@ const FUZZ_G_NUM: array<f32, 3> = array<f32, 3>(
     1e0f, -1.1518276e0f, 7.885459e-1f,
 );
 const FUZZ_G_DEN: array<f32, 2> = array<f32, 2>(
-    6.282831e-1f, 1.00874774e-1f,
+    6.282831e-1f, 1.0087476e-1f,
 );
 
 fn fuzz_g(n_dot_v: f32, density: f32) -> f32 {
