@@ -10,7 +10,7 @@
 use crate::emit::{self, Transaction, WriteError};
 use crate::family;
 use crate::pipeline::{self, BuildError, Built, CustomBuild, Mode};
-use crate::scene::{self, Feature, Scene, SceneReport};
+use crate::scene::{self, Scene, SceneReport};
 use crate::spec::{self, Spec, SpecError};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
@@ -89,14 +89,9 @@ pub fn load_specs(paths: &Paths, only: &[String]) -> Result<Vec<Spec>, Error> {
     Ok(specs)
 }
 
-/// Every family's scene features, in registry order.
-pub fn scene_features() -> Vec<&'static Feature> {
-    family::families().iter().flat_map(|f| f.scene_features.iter()).collect()
-}
-
 /// The scene manifests in `fits/scenes`.
 pub fn load_scenes(paths: &Paths) -> Result<Vec<Scene>, Error> {
-    Ok(Scene::load_dir(&paths.fits.join("scenes"), &scene_features())?)
+    Ok(Scene::load_dir(&paths.fits.join("scenes"), &family::scene_features())?)
 }
 
 /// What a build did: each spec's result and time, each scene module's time, files written.
@@ -112,16 +107,15 @@ pub struct Summary {
     pub specs: usize,
 }
 
-/// `shadefit build [--only A,B] [--check]`; `tick` is called once per spec built.
-pub fn run(paths: &Paths, only: &[String], check: bool, tick: &(dyn Fn() + Sync)) -> Result<Summary, Error> {
+/// `shadefit build [--only A,B] [--check]`; `tick(total)` is called once per spec built.
+pub fn run(paths: &Paths, only: &[String], check: bool, tick: &(dyn Fn(usize) + Sync)) -> Result<Summary, Error> {
     let specs = load_specs(paths, only)?;
     let selected: Vec<&Spec> = specs.iter().filter(|s| only.is_empty() || only.contains(&s.file.name)).collect();
     let mode = if check { Mode::Committed } else { Mode::Fit };
     // One transaction for every file of the build, its lock held from here: a second build
     // waits, and a failure anywhere leaves generated/ as it was. `--check` writes nothing.
     let mut tx = if check { None } else { Some(Transaction::begin(&paths.generated)?) };
-    let journal = paths.generated.join(emit::STAGING_DIR).join("journal");
-    if check && journal.exists() {
+    if check && let Some(journal) = emit::interrupted(&paths.generated) {
         return Err(Error::Interrupted { journal });
     }
     let results: Vec<Result<(Built, f64), Error>> = selected
@@ -129,7 +123,7 @@ pub fn run(paths: &Paths, only: &[String], check: bool, tick: &(dyn Fn() + Sync)
         .map(|s| {
             let t = std::time::Instant::now();
             let b = build_spec(s, mode, &paths.generated).map_err(|source| Error::Build { spec: s.file.name.clone(), source })?;
-            tick();
+            tick(selected.len());
             Ok((b, t.elapsed().as_secs_f64()))
         })
         .collect();
@@ -182,7 +176,7 @@ pub fn run(paths: &Paths, only: &[String], check: bool, tick: &(dyn Fn() + Sync)
 /// `shadefit build --scene FILE [--force]`: only the nodes the scene reaches, each only when its
 /// inputs or files changed since the scene's last build, then the scene module.
 pub fn run_scene(paths: &Paths, file: &Path, force: bool) -> Result<SceneReport, Error> {
-    let sc = Scene::load(file, &scene_features())?;
+    let sc = Scene::load(file, &family::scene_features())?;
     let specs = load_specs(paths, &[])?;
     let mut scenes = load_scenes(paths)?;
     if !scenes.iter().any(|s| s.file.name == sc.file.name) {
@@ -214,19 +208,14 @@ pub fn status(paths: &Paths) -> Result<Vec<(Spec, Status)>, Error> {
     Ok(specs
         .into_iter()
         .map(|s| {
-            let path = paths.generated.join("json").join(format!("{}.json", s.file.name));
-            let recorded = std::fs::read_to_string(&path)
-                .ok()
-                .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
-                .and_then(|v| v["input_hash"].as_str().map(str::to_string));
             let current = match s.file.kind {
                 spec::Kind::Custom(kind) => family::catalog().kind(kind).map_or_else(|| pipeline::input_hash(&s), |k| (k.input_hash)(&s)),
                 _ => pipeline::input_hash(&s),
             };
-            let st = match recorded {
-                None => Status::NotBuilt,
-                Some(h) if h == current => Status::Current,
-                Some(_) => Status::Changed,
+            let st = match pipeline::committed_json_with_hash(&paths.generated, &s, &current) {
+                Ok(_) => Status::Current,
+                Err(BuildError::SpecChanged { .. }) => Status::Changed,
+                Err(_) => Status::NotBuilt,
             };
             (s, st)
         })

@@ -103,9 +103,11 @@ fn progress(len: usize, what: &str) -> ProgressBar {
 
 pub fn build(paths: &Paths, only: &[String], check: bool) -> Result<()> {
     let start = std::time::Instant::now();
-    let n = if only.is_empty() { load_specs(paths, only)?.len() } else { only.len() };
-    let pb = progress(n, if check { "check" } else { "build" });
-    let summary = build::run(paths, only, check, &|| pb.inc(1));
+    let pb = progress(0, if check { "check" } else { "build" });
+    let summary = build::run(paths, only, check, &|total| {
+        pb.set_length(total as u64);
+        pb.inc(1);
+    });
     pb.finish_and_clear();
     let summary = summary.map_err(build_err)?;
     if check {

@@ -174,6 +174,13 @@ pub fn spec_rel_path(spec: &Spec) -> String {
 }
 
 fn committed_json(root: &Path, spec: &Spec) -> Result<Value, BuildError> {
+    committed_json_with_hash(root, spec, &input_hash(spec))
+}
+
+/// `generated/json/NAME.json` of a spec, if it records `hash` as its input hash (a spec kind
+/// whose build reads more than the spec text passes its own hash): `NoCommitted` when it is
+/// missing or unreadable, `SpecChanged` when it records another hash.
+pub fn committed_json_with_hash(root: &Path, spec: &Spec, hash: &str) -> Result<Value, BuildError> {
     let name = &spec.file.name;
     let path = root.join("json").join(format!("{name}.json"));
     let text = std::fs::read_to_string(&path)
@@ -181,9 +188,8 @@ fn committed_json(root: &Path, spec: &Spec) -> Result<Value, BuildError> {
     let v: Value = serde_json::from_str(&text)
         .map_err(|e| BuildError::NoCommitted { spec: name.clone(), why: e.to_string() })?;
     let committed = v["input_hash"].as_str().unwrap_or("").to_string();
-    let current = input_hash(spec);
-    if committed != current {
-        return Err(BuildError::SpecChanged { spec: name.clone(), committed, current });
+    if committed != hash {
+        return Err(BuildError::SpecChanged { spec: name.clone(), committed, current: hash.to_string() });
     }
     Ok(v)
 }

@@ -46,6 +46,12 @@ pub struct WriteError {
     pub source: std::io::Error,
 }
 
+/// The error of an I/O operation on `p`, for `map_err`.
+fn err(p: &Path) -> impl FnOnce(std::io::Error) -> WriteError {
+    let path = p.display().to_string();
+    move |source| WriteError { path, source }
+}
+
 /// The lock file under the generated/ root where the root folder itself cannot be locked (not
 /// Unix); on Unix the folder is locked and no file is left.
 pub const LOCK_FILE: &str = ".shadefit.lock";
@@ -87,10 +93,6 @@ fn fault_point(var: &str) -> Option<usize> {
 
 impl Transaction {
     pub fn begin(root: &Path) -> Result<Transaction, WriteError> {
-        let err = |p: &Path| {
-            let path = p.display().to_string();
-            move |e| WriteError { path, source: e }
-        };
         std::fs::create_dir_all(root).map_err(err(root))?;
         #[cfg(unix)]
         let (lock_path, lock) = (root.to_path_buf(), std::fs::File::open(root).map_err(err(root))?);
@@ -125,10 +127,6 @@ impl Transaction {
     /// many were written. On error, everything this transaction swapped is restored.
     pub fn write(&mut self, artifacts: &[Artifact]) -> Result<usize, WriteError> {
         let staging = self.root.join(STAGING_DIR);
-        let err = |p: &Path| {
-            let path = p.display().to_string();
-            move |e| WriteError { path, source: e }
-        };
         let changed: Vec<&Artifact> =
             artifacts.iter().filter(|a| std::fs::read(self.root.join(&a.path)).map_or(true, |old| old != a.contents)).collect();
         if changed.is_empty() {
@@ -209,19 +207,14 @@ impl Transaction {
             }
         }
         self.journal = None;
-        let _ = std::fs::remove_dir_all(self.root.join(STAGING_DIR));
+        let _ = remove_staging(&self.root);
     }
 
     /// Keep every file written; drop the backups and the journal.
     pub fn commit(mut self) -> Result<(), WriteError> {
         self.committed = true;
         self.journal = None;
-        let staging = self.root.join(STAGING_DIR);
-        match std::fs::remove_dir_all(&staging) {
-            Ok(()) => Ok(()),
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
-            Err(e) => Err(WriteError { path: staging.display().to_string(), source: e }),
-        }
+        remove_staging(&self.root)
     }
 }
 
@@ -231,6 +224,12 @@ impl Drop for Transaction {
             self.rollback();
         }
     }
+}
+
+/// The journal of a transaction under `root` that was interrupted (killed), if there is one.
+pub fn interrupted(root: &Path) -> Option<PathBuf> {
+    let j = root.join(STAGING_DIR).join(JOURNAL);
+    j.exists().then_some(j)
 }
 
 /// Undo an interrupted transaction under `root` (see [`Transaction`]); remove stale staging.
@@ -243,7 +242,7 @@ fn recover(root: &Path) -> Result<(), WriteError> {
                 ["replaced", rel, backup] => {
                     let b = staging.join(backup);
                     if b.exists() {
-                        std::fs::rename(&b, root.join(rel)).map_err(|e| WriteError { path: root.join(rel).display().to_string(), source: e })?;
+                        std::fs::rename(&b, root.join(rel)).map_err(err(&root.join(rel)))?;
                     }
                 }
                 ["created", rel] => {
@@ -254,10 +253,16 @@ fn recover(root: &Path) -> Result<(), WriteError> {
             }
         }
     }
+    remove_staging(root)
+}
+
+/// Remove `ROOT/.staging` with everything in it (nothing to do when it is not there).
+fn remove_staging(root: &Path) -> Result<(), WriteError> {
+    let staging = root.join(STAGING_DIR);
     match std::fs::remove_dir_all(&staging) {
         Ok(()) => Ok(()),
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
-        Err(e) => Err(WriteError { path: staging.display().to_string(), source: e }),
+        Err(e) => Err(err(&staging)(e)),
     }
 }
 

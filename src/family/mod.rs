@@ -19,7 +19,6 @@ use crate::quantity::QuantityDef;
 use crate::scene::Feature;
 use crate::spec::{Catalog, KindDef, Spec};
 use crate::validate::Item;
-use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
@@ -97,9 +96,9 @@ pub fn of_quantity(name: &str) -> Option<&'static Family> {
     FAMILIES.iter().copied().find(|f| f.quantities.iter().any(|q| q.name == name))
 }
 
-/// Every scene feature, by name.
-pub fn scene_features() -> BTreeMap<&'static str, &'static Feature> {
-    FAMILIES.iter().flat_map(|f| f.scene_features.iter()).map(|x| (x.name, x)).collect()
+/// Every family's scene features, in registry order.
+pub fn scene_features() -> Vec<&'static Feature> {
+    FAMILIES.iter().flat_map(|f| f.scene_features.iter()).collect()
 }
 
 /// The `eval --help` text: every quantity with its parameters and what it is.
@@ -120,6 +119,7 @@ pub fn eval_help() -> String {
 pub(crate) mod tests {
     use super::*;
     use crate::bench::forms::{testing, FormRow};
+    use std::collections::BTreeMap;
 
     /// The quick run of each family's shader forms, by family name (computed once).
     pub(crate) fn quick_forms(family: &str) -> &'static [FormRow] {

@@ -196,20 +196,6 @@ fn verify(
         .collect()
 }
 
-fn committed(root: &Path, spec: &Spec, hash: &str) -> Result<Value, BuildError> {
-    let name = &spec.file.name;
-    let path = root.join("json").join(format!("{name}.json"));
-    let text = std::fs::read_to_string(&path)
-        .map_err(|e| BuildError::NoCommitted { spec: name.clone(), why: e.to_string() })?;
-    let v: Value =
-        serde_json::from_str(&text).map_err(|e| BuildError::NoCommitted { spec: name.clone(), why: e.to_string() })?;
-    let committed = v["input_hash"].as_str().unwrap_or("").to_string();
-    if committed != hash {
-        return Err(BuildError::SpecChanged { spec: name.clone(), committed, current: hash.to_string() });
-    }
-    Ok(v)
-}
-
 fn committed_parts(v: &Value, name: &str, texels: usize) -> Result<(Vec<[f64; 3]>, Verification, Quadrature), BuildError> {
     let bad = |why: &str| BuildError::NoCommitted { spec: name.into(), why: why.into() };
     let values: Vec<[f64; 3]> = v["values"]
@@ -327,7 +313,7 @@ fn build_verified(spec: &Spec, mode: Mode, root: &Path, texture: bool) -> Result
             (values, emitted_ver, q, ver.next())
         }
         None => {
-            let (values, ver, q) = committed_parts(&committed(root, spec, &hash)?, &name, w * h)?;
+            let (values, ver, q) = committed_parts(&crate::pipeline::committed_json_with_hash(root, spec, &hash)?, &name, w * h)?;
             (values, ver, q, None)
         }
     };
