@@ -13,6 +13,9 @@ pub struct ParamSpec {
     pub doc: &'static str,
     /// Only whole numbers are accepted (e.g. an SH band).
     pub integer: bool,
+    /// The value `eval` uses when the parameter is not given (None: it must be given). Specs
+    /// still name every parameter as an axis.
+    pub default: Option<f64>,
 }
 
 /// A quantity `shadefit eval` serves and specs sample.
@@ -116,7 +119,7 @@ impl QuantityDef {
         out.into_iter()
             .zip(self.params)
             .map(|(v, p)| {
-                v.ok_or_else(|| QuantityError::MissingParam {
+                v.or(p.default).ok_or_else(|| QuantityError::MissingParam {
                     quantity: self.name.into(),
                     param: p.name.into(),
                 })

@@ -9,6 +9,7 @@
 //! a family is one folder and one line in [`FAMILIES`] (see ARCHITECTURE.md).
 
 pub mod fuzz;
+pub mod ggx;
 pub mod gloss;
 pub mod skin;
 
@@ -71,7 +72,7 @@ pub struct Family {
 }
 
 /// Every family, in the order `eval --help`, `validate` and `plot` list them.
-pub static FAMILIES: &[&Family] = &[&gloss::FAMILY, &fuzz::FAMILY, &skin::FAMILY];
+pub static FAMILIES: &[&Family] = &[&gloss::FAMILY, &fuzz::FAMILY, &skin::FAMILY, &ggx::FAMILY];
 
 pub fn families() -> &'static [&'static Family] {
     FAMILIES
@@ -105,7 +106,14 @@ pub fn scene_features() -> Vec<&'static Feature> {
 pub fn eval_help() -> String {
     let mut out = String::from("Quantities:\n");
     for q in FAMILIES.iter().flat_map(|f| f.quantities.iter()) {
-        let mut params: Vec<String> = q.params.iter().map(|p| format!("{}=…", p.name)).collect();
+        let mut params: Vec<String> = q
+            .params
+            .iter()
+            .map(|p| match p.default {
+                Some(d) => format!("[{}={d}]", p.name),
+                None => format!("{}=…", p.name),
+            })
+            .collect();
         for (a, _, _) in q.aliases {
             params.push(format!("| {}=…", a.name));
         }

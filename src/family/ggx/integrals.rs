@@ -1,0 +1,503 @@
+//! The GGX split-sum integrals: the environment BRDF ("DFG") scale and bias, the directional
+//! albedo E(μ) and its cosine-weighted average E_avg, and the hemispherical Fresnel averages.
+//!
+//! # Conventions (the contract)
+//!
+//! Normal n = +z; the view v = (sin θv, 0, μv) lies in the xz-plane, μv = n·v ∈ [0, 1]; a light
+//! direction l has μl = n·l. GGX (Trowbridge–Reitz) with α = perceptual roughness²:
+//! ```text
+//! D(h)   = α² / (π ((n·h)²(α² − 1) + 1)²)
+//! Λ(μ)   = (−1 + sqrt(1 + α² tan²θ)) / 2,          tan²θ = (1 − μ²)/μ²
+//! G2     = 1 / (1 + Λ(μv) + Λ(μl))                 (height-correlated Smith)
+//! Fc     = (1 − v·h)⁵                              (Schlick's Fresnel weight)
+//! f      = D G2 / (4 μv μl)
+//! scale  = ∫_{μl ≥ c} (1 − Fc) f μl dω_l,    bias = ∫_{μl ≥ c} Fc f μl dω_l,    c = cos_cone
+//! E(μv)  = scale + bias  (F = 1),            E_avg = 2 ∫₀¹ E(μ) μ dμ
+//! ```
+//! so that the split-sum specular of a Schlick F0 is F0·scale + bias (F90 = 1). c = 0 is the
+//! hemisphere; c > 0 keeps the light directions in the visibility cone of half-angle acos c
+//! about n (COD: WWII specular occlusion). A second shadowing model, [`Shadowing::Separable`],
+//! is UE4's image-based-lighting G (Schlick–Smith G1(μ) = μ/(μ(1 − k) + k) for v and l,
+//! multiplied, with k = α/2): the integral Karis's mobile fit was made against.
+//!
+//! # Integrating where the mass is
+//!
+//! The half vector h carries the peak. With l = 2(v·h)h − v, dω_l = 4 (v·h) dω_h, and
+//! ```text
+//! f μl dω_l = [D(h) μh dω_h] · G2 (v·h) / (μv μh).
+//! ```
+//! D μh dω_h is the GGX sampling measure; with ξ ∈ [0, 1] and tan²θh = α² ξ/(1 − ξ) it is
+//! dξ dφ/2π exactly (the CDF of the visible-normal-free GGX sampler). In (ξ, φ) the integrand
+//! G2 (v·h)/(μv μh) has no peak at any α: the spike at α = 10⁻³ unfolds into a smooth function
+//! over the unit square. The integrand is even in φ; φ ∈ [0, π] counts twice (dξ dφ/π).
+//!
+//! The region μl ≥ c is exact in φ: with s = sin θv, v·h = s sin θh cos φ + μv μh and
+//! μl = 2 μh (v·h) − μv, so μl ≥ c ⇔ cos φ ≥ κ(θh) = (c + μv − 2 μv μh²)/(2 μh s sin θh), and
+//! φ runs over [0, acos κ] (all of [0, π] for κ ≤ −1, nothing for κ ≥ 1). In the plane of v
+//! (φ = 0 and φ = π) the reflection is l at polar angle 2θh − θv and 2θh + θv: with θc = acos c
+//! the valid θh are (θv − θc)/2 ≤ θh ≤ (θv + θc)/2 and φ is unrestricted for θh ≤ (θc − θv)/2.
+//! Those θh are the breakpoints of the outer integral (where acos κ has square-root ends); on each
+//! piece [a, b] of ξ the substitution ξ = a + (b − a)(3t² − 2t³) makes the square roots smooth.
+//! Both levels are adaptive G10/K21 with QUADPACK error estimates: the inner φ integral to half
+//! the tolerance, the outer ξ integral (of the vector [scale, bias]) to the other half, so the
+//! error estimate of each of scale and bias is ≤ the tolerance (the inner errors integrate
+//! with total weight ≤ 1, the ξ-measure).
+//!
+//! # Limits
+//! - μv → 0: G2/μv stays finite (μv Λ(μv) → α/2), so the integrand is evaluated in the product
+//!   form 1/(μv + μvΛ(μv) + μvΛ(μl)) and n·v = 0 gives the limit, not 0/0.
+//! - α → 0: D → δ(h − n), l → mirror(v): E → 1 and bias → (1 − μv)⁵ (for μv ≥ c).
+//! - c → 1: the cone closes: scale = bias = 0 (c = 1 exactly: empty region, exact 0).
+//! - E(μ = 1, α = 1) = 1 − ln 2 (height-correlated G2), derived in [`albedo_normal_rough`].
+
+use crate::integrate::{integrate, Control, Estimate, Options, PanelError, Rule, Tolerance};
+use std::cell::Cell;
+use std::f64::consts::PI;
+
+/// Default absolute tolerance of the integrators (a non-positive or NaN tolerance means this).
+pub const DEFAULT_TOL: f64 = 1e-10;
+/// Panels per adaptive level before the estimate is returned as is (with its error).
+const MAX_PANELS: usize = 400;
+
+/// The masking-shadowing term inside the integral.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Shadowing {
+    /// Height-correlated Smith G2 = 1/(1 + Λ(v) + Λ(l)) (the contract above).
+    HeightCorrelated,
+    /// Separable Schlick–Smith G1(v) G1(l), G1(μ) = μ/(μ(1 − k) + k) (UE4 IBL: k = α/2).
+    Separable { k: f64 },
+}
+
+/// scale and bias with their error estimates.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EnvEstimate {
+    pub scale: f64,
+    pub bias: f64,
+    /// Upper estimate of max(|scale − exact|, |bias − exact|).
+    pub error: f64,
+    pub evals: u64,
+}
+
+impl EnvEstimate {
+    /// E = scale + bias, with the error of the sum.
+    pub fn albedo(&self) -> Estimate {
+        Estimate { value: self.scale + self.bias, error: 2.0 * self.error, evals: self.evals }
+    }
+}
+
+fn tolerance(tol: f64) -> f64 {
+    if tol > 0.0 { tol } else { DEFAULT_TOL }
+}
+
+/// μ Λ(μ) for the height-correlated G2: α² (1 − μ²) / (2 (sqrt(μ² + α²(1 − μ²)) + μ)),
+/// finite at μ = 0 (= α/2) and free of cancellation near μ = 1.
+fn mu_lambda(alpha2: f64, mu: f64) -> f64 {
+    let s2 = (1.0 - mu) * (1.0 + mu);
+    alpha2 * s2 / (2.0 * ((mu * mu + alpha2 * s2).sqrt() + mu))
+}
+
+/// Λ(μ) = μΛ(μ)/μ (μ > 0).
+pub fn lambda(alpha: f64, mu: f64) -> f64 {
+    mu_lambda(alpha * alpha, mu) / mu
+}
+
+/// sin²θ and cos²θ of the half vector at ξ: tan²θh = α² ξ/(1 − ξ).
+fn half_angle(alpha2: f64, xi: f64) -> (f64, f64) {
+    let one_minus = 1.0 - xi;
+    let den = one_minus + alpha2 * xi;
+    (alpha2 * xi / den, one_minus / den)
+}
+
+/// ξ of the half-vector polar angle θ: sin²θ/(sin²θ + α² cos²θ).
+fn xi_of(alpha2: f64, theta: f64) -> f64 {
+    if theta <= 0.0 {
+        return 0.0;
+    }
+    let (s, c) = theta.sin_cos();
+    let (s2, c2) = (s * s, c * c);
+    (s2 / (s2 + alpha2 * c2)).min(1.0)
+}
+
+/// One point of the problem: everything the φ integrand needs at a fixed view.
+struct View {
+    alpha2: f64,
+    mu_v: f64,
+    sin_v: f64,
+    /// μv Λ(μv) (height-correlated) or the separable G1(v)/μv denominator μv(1 − k) + k.
+    v_term: f64,
+    cos_cone: f64,
+    shadowing: Shadowing,
+}
+
+impl View {
+    fn new(alpha: f64, mu_v: f64, cos_cone: f64, shadowing: Shadowing) -> Self {
+        let alpha2 = alpha * alpha;
+        let v_term = match shadowing {
+            Shadowing::HeightCorrelated => mu_lambda(alpha2, mu_v),
+            Shadowing::Separable { k } => mu_v * (1.0 - k) + k,
+        };
+        View { alpha2, mu_v, sin_v: ((1.0 - mu_v) * (1.0 + mu_v)).sqrt(), v_term, cos_cone, shadowing }
+    }
+
+    /// [(1 − Fc) w, Fc w] with w = G (v·h)/(μv μh), at a half vector of polar sin/cos (sh, ch)
+    /// and azimuth cosine cos φ; 0 outside μl ≥ c.
+    #[inline]
+    fn integrand(&self, sh: f64, ch: f64, cos_phi: f64) -> [f64; 2] {
+        let vh = self.sin_v * sh * cos_phi + self.mu_v * ch;
+        let mu_l = 2.0 * vh * ch - self.mu_v;
+        if !(mu_l > 0.0 && mu_l >= self.cos_cone && vh > 0.0) {
+            return [0.0, 0.0];
+        }
+        // G/μv in a form finite at μv = 0.
+        let g_over_mu_v = match self.shadowing {
+            Shadowing::HeightCorrelated => {
+                let l_term = self.mu_v * mu_lambda(self.alpha2, mu_l) / mu_l;
+                1.0 / (self.mu_v + self.v_term + l_term)
+            }
+            Shadowing::Separable { k } => (mu_l / (mu_l * (1.0 - k) + k)) / self.v_term,
+        };
+        let w = g_over_mu_v * vh / ch;
+        let m = 1.0 - vh;
+        let m2 = m * m;
+        let fc = m2 * m2 * m;
+        [w - fc * w, fc * w]
+    }
+
+    /// The initial φ panels of [0, φmax]: geometric towards φmax when the horizon cuts the
+    /// range. Near μl = 0 the integrand is a rational function of μl with a pole at
+    /// μl ≈ −μv(α/2)/(μv + μvΛ(μv)) (height-correlated; −k/(1 − k) separable): at grazing n·v
+    /// or small α a feature far narrower than one G10/K21 panel, which the error estimate
+    /// cannot see. Breakpoints at μl − c = (μl_max − c)·16^{−j}, down to 16× the pole's distance
+    /// from the boundary, put panels on every scale of it.
+    fn phi_panels(&self, sh: f64, ch: f64, kappa: f64, phi_max: f64) -> Vec<(f64, f64)> {
+        if phi_max >= PI {
+            return vec![(0.0, PI)];
+        }
+        let slope = 2.0 * ch * self.sin_v * sh; // dμl / d(cos φ)
+        let pole = match self.shadowing {
+            Shadowing::HeightCorrelated => self.mu_v * (0.5 * self.alpha2.sqrt()) / (self.mu_v + self.v_term),
+            Shadowing::Separable { k } => k / (1.0 - k),
+        };
+        let q_max = 1.0 - kappa;
+        let q_pole = (self.cos_cone + pole) / slope;
+        let mut out = Vec::new();
+        let mut lo = 0.0;
+        let mut q = q_max;
+        for _ in 0..24 {
+            if q <= 16.0 * q_pole {
+                break;
+            }
+            q *= 0.0625;
+            let phi = (kappa + q).min(1.0).acos();
+            if phi > lo && phi < phi_max {
+                out.push((lo, phi));
+                lo = phi;
+            }
+        }
+        out.push((lo, phi_max));
+        out
+    }
+
+    /// κ(θh): the cosine of φ above which μl ≥ c (±∞ when s sin θh = 0).
+    fn kappa(&self, sh: f64, ch: f64) -> f64 {
+        let num = self.cos_cone + self.mu_v - 2.0 * self.mu_v * ch * ch;
+        let den = 2.0 * ch * self.sin_v * sh;
+        if den > 0.0 {
+            num / den
+        } else if num <= 0.0 {
+            f64::NEG_INFINITY
+        } else {
+            f64::INFINITY
+        }
+    }
+}
+
+/// K21 with QUADPACK estimates on the sum of the first two components (scale and bias) to
+/// max(abs, rel·|scale + bias|); a third component, if any, is integrated along unchecked.
+fn options<const N: usize>(abs: f64, rel: f64) -> Options<'static, N> {
+    let weights = std::array::from_fn(|i| if i < 2 { 1.0 } else { 0.0 });
+    Options {
+        rule: Rule::Kronrod21,
+        estimate: PanelError::Quadpack,
+        control: Control::Weighted { weights, abs, rel },
+        max_panels: MAX_PANELS,
+        stop_when_exhausted: true,
+        stop_when_non_finite: true,
+        sum_from_negative_zero: false,
+    }
+}
+
+/// The split-sum scale and bias (see the module doc) to absolute tolerance `tol` on each.
+/// Parameters are taken as given (the caller checks domains): α ∈ (0, 1], μv, c ∈ [0, 1].
+pub fn env(alpha: f64, mu_v: f64, cos_cone: f64, shadowing: Shadowing, tol: f64) -> EnvEstimate {
+    let tol = tolerance(tol);
+    if cos_cone >= 1.0 {
+        return EnvEstimate { scale: 0.0, bias: 0.0, error: 0.0, evals: 0 };
+    }
+    let view = View::new(alpha, mu_v, cos_cone, shadowing);
+    let theta_v = mu_v.acos();
+    let theta_c = cos_cone.acos();
+    let lo = (0.5 * (theta_v - theta_c)).max(0.0);
+    let hi = 0.5 * (theta_v + theta_c);
+    let full = 0.5 * (theta_c - theta_v);
+    let a2 = view.alpha2;
+    let mut pieces: Vec<(f64, f64)> = Vec::with_capacity(2);
+    if full > lo {
+        pieces.push((lo, full));
+        pieces.push((full, hi));
+    } else {
+        pieces.push((lo, hi));
+    }
+    let segments = segments(&pieces, alpha);
+    if segments.is_empty() {
+        return EnvEstimate { scale: 0.0, bias: 0.0, error: 0.0, evals: 0 };
+    }
+    let inner_evals = Cell::new(0u64);
+    // The inner error target at an outer point of weight w (ξ-measure per unit s, over π) is
+    // max(tol/(4 n w), (tol/4)·|inner value|) for n segments of unit length in s: integrated
+    // with weight w it contributes ≤ tol/4 + (tol/4)·(scale + bias) ≤ tol/2. Points of small
+    // weight (short segments, smoothstep ends) get looser targets. The relative part matters
+    // at grazing n·v, where the φ integrand reaches ~1/(α n·v) over a small ξ range and an
+    // absolute target alone sits below its rounding floor.
+    let inner_tol = 0.25 * tol;
+    let n = segments.len();
+    let outer = |s: f64| -> [f64; 3] {
+        let k = (s.floor() as usize).min(n - 1);
+        let seg = &segments[k];
+        let t = s - k as f64;
+        let (u, du) = if seg.smooth { (t * t * (3.0 - 2.0 * t), 6.0 * t * (1.0 - t)) } else { (t, 1.0) };
+        let x = seg.a + (seg.b - seg.a) * u;
+        let jac = (seg.b - seg.a) * du;
+        if jac == 0.0 {
+            return [0.0; 3];
+        }
+        // (sin θh, cos θh) and the ξ-measure per unit s.
+        let (sh, ch, weight) = if seg.in_xi {
+            let (s2, c2) = half_angle(a2, x);
+            (s2.sqrt(), c2.sqrt(), jac)
+        } else {
+            let (sh, ch) = x.sin_cos();
+            let q = sh * sh + a2 * ch * ch;
+            (sh, ch, jac * 2.0 * sh * ch * a2 / (q * q))
+        };
+        let kappa = view.kappa(sh, ch);
+        let phi_max = if kappa <= -1.0 {
+            PI
+        } else if kappa >= 1.0 {
+            return [0.0; 3];
+        } else {
+            kappa.acos()
+        };
+        let panels = view.phi_panels(sh, ch, kappa, phi_max);
+        let w = weight / PI;
+        let abs = inner_tol / (n as f64 * w);
+        let r = integrate(&panels, &options::<2>(abs, inner_tol), |phi| view.integrand(sh, ch, phi.cos()));
+        inner_evals.set(inner_evals.get() + r.evals);
+        [r.value[0] * w, r.value[1] * w, r.error * w]
+    };
+    let initial: Vec<(f64, f64)> = (0..n).map(|k| (k as f64, (k + 1) as f64)).collect();
+    let r = integrate(&initial, &options::<3>(0.5 * tol, 0.0), outer);
+    // The outer error of the sum bounds each component's; the third component is the inner
+    // errors integrated over the segments.
+    EnvEstimate { scale: r.value[0], bias: r.value[1], error: r.error + r.value[2], evals: r.evals + inner_evals.get() }
+}
+
+/// One initial panel of the outer integral: half-vector angles θh ∈ [a, b] (stored as ξ when
+/// `in_xi`, else as θh). A segment with a kink at an end (a square root in the azimuth limit)
+/// goes through the smoothstep u = 3t² − 2t³, which approaches both ends quadratically and so
+/// makes the square root smooth.
+#[derive(Debug, Clone, Copy)]
+struct Segment {
+    a: f64,
+    b: f64,
+    in_xi: bool,
+    smooth: bool,
+}
+
+/// The outer panels of the pieces [θa, θb] between kinks.
+///
+/// - Variable: ξ below θ* = atan(10α), where D has its mass (ξ(θ*) = 100/101), θh above it:
+///   there ξ crowds against 1 (1 − ξ ≈ α² cot²θh) and a kink near θh = π/2 would sit
+///   within a few ulps of ξ = 1.
+/// - Geometric breakpoints at each kink θk, at distances d·4^j with d = min(θk, π/2 − θk),
+///   out to half the piece. Past a kink the azimuth limit varies on the scale of that distance:
+///   at c = 0, cos φmax = −cot θv cot 2θh ≈ −(π/2 − θv)/(2θh) for grazing v, a function of
+///   θh/θk near θk = (π/2 − θv)/2, and mirrored near θh = π/2. Uniform panels would not see it.
+fn segments(pieces: &[(f64, f64)], alpha: f64) -> Vec<Segment> {
+    let theta_star = (10.0 * alpha).atan();
+    let a2 = alpha * alpha;
+    let mut out = Vec::new();
+    for &(p, q) in pieces {
+        if !(q > p) {
+            continue;
+        }
+        let mut cuts = vec![p, q];
+        for (kink, dir) in [(p, 1.0), (q, -1.0)] {
+            let d0 = kink.min(0.5 * PI - kink);
+            if d0 > 0.0 {
+                let mut d = 4.0 * d0;
+                while d < 0.5 * (q - p) {
+                    cuts.push(kink + dir * d);
+                    d *= 4.0;
+                }
+            }
+        }
+        if theta_star > p && theta_star < q {
+            cuts.push(theta_star);
+        }
+        cuts.sort_by(f64::total_cmp);
+        cuts.dedup();
+        for w in cuts.windows(2) {
+            let (a, b) = (w[0], w[1]);
+            let in_xi = b <= theta_star;
+            let (sa, sb) = if in_xi { (xi_of(a2, a), xi_of(a2, b)) } else { (a, b) };
+            if sb > sa {
+                out.push(Segment { a: sa, b: sb, in_xi, smooth: a == p || b == q });
+            }
+        }
+    }
+    out
+}
+
+/// E(μv) = scale + bias with F = 1 (height-correlated), to absolute tolerance `tol`.
+pub fn albedo(alpha: f64, mu_v: f64, tol: f64) -> Estimate {
+    let tol = tolerance(tol);
+    env(alpha, mu_v, 0.0, Shadowing::HeightCorrelated, 0.5 * tol).albedo()
+}
+
+/// E_avg(α) = 2 ∫₀¹ E(μ) μ dμ to absolute tolerance `tol`: the outer μ integral (through the
+/// same smoothstep map, which tames the μ → 1 end where θv = acos μ has a square root) to half,
+/// each E to the other half.
+pub fn albedo_avg(alpha: f64, tol: f64) -> Estimate {
+    let tol = tolerance(tol);
+    let inner = Cell::new((0u64, 0.0f64));
+    let r = crate::integrate::adaptive(
+        0.0,
+        1.0,
+        Tolerance { abs: 0.5 * tol, rel: 0.0, max_panels: MAX_PANELS },
+        |t| {
+            let mu = t * t * (3.0 - 2.0 * t);
+            let jac = 6.0 * t * (1.0 - t);
+            if jac == 0.0 {
+                return 0.0;
+            }
+            let e = albedo(alpha, mu, 0.5 * tol);
+            let (n, worst) = inner.get();
+            inner.set((n + e.evals, worst.max(e.error)));
+            2.0 * e.value * mu * jac
+        },
+    );
+    let (n, worst) = inner.get();
+    Estimate { value: r.value, error: r.error + worst, evals: r.evals + n }
+}
+
+/// E(1) at α = 1 in closed form: 1 − ln 2.
+///
+/// At α = 1, D = 1/π (uniform in n·h over the hemisphere) and Λ(μ) = (−1 + 1/μ)/2, so for
+/// μv = 1 (Λ(v) = 0) G2 = 1/(1 + Λ(l)) = 2μl/(1 + μl) and
+/// E = ∫ D G2/(4 μl) μl dω_l = (1/4π) ∫ 2μl/(1 + μl) dω_l = ∫₀¹ μ/(1 + μ) dμ = 1 − ln 2.
+pub fn albedo_normal_rough() -> f64 {
+    1.0 - std::f64::consts::LN_2
+}
+
+/// Hemispherical (cosine-weighted) average of Schlick's Fresnel, closed form:
+/// 2∫₀¹ (F0 + (1 − F0)(1 − μ)⁵) μ dμ = F0 + (1 − F0)·2·B(2, 6) = F0 + (1 − F0)/21.
+pub fn f_avg_schlick(f0: f64) -> f64 {
+    f0 + (1.0 - f0) / 21.0
+}
+
+/// Unpolarised Fresnel reflectance of a dielectric interface of relative index η at incidence
+/// cosine c (1 under total internal reflection).
+pub fn fresnel_dielectric(c: f64, eta: f64) -> f64 {
+    let g2 = eta * eta - 1.0 + c * c;
+    if g2 <= 0.0 {
+        return 1.0;
+    }
+    let g = g2.sqrt();
+    let a = (g - c) / (g + c);
+    let b = (c * (g + c) - 1.0) / (c * (g - c) + 1.0);
+    0.5 * a * a * (1.0 + b * b)
+}
+
+/// F_avg(η) = 2∫₀¹ F(μ, η) μ dμ (numerical: no closed form is used; the integrand has a
+/// square-root kink at the critical angle μ = sqrt(1 − η²) when η < 1, a breakpoint here, and
+/// each piece goes through the smoothstep map).
+pub fn f_avg_dielectric(eta: f64, tol: f64) -> Estimate {
+    let tol = tolerance(tol);
+    let mut cuts = vec![0.0];
+    if eta < 1.0 {
+        cuts.push(((1.0 - eta) * (1.0 + eta)).sqrt());
+    }
+    cuts.push(1.0);
+    let mut out = Estimate { value: 0.0, error: 0.0, evals: 0 };
+    for w in cuts.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        if b <= a {
+            continue;
+        }
+        let r = crate::integrate::adaptive(0.0, 1.0, Tolerance { abs: 0.5 * tol, rel: 0.0, max_panels: MAX_PANELS }, |t| {
+            let mu = a + (b - a) * t * t * (3.0 - 2.0 * t);
+            2.0 * fresnel_dielectric(mu, eta) * mu * 6.0 * (b - a) * t * (1.0 - t)
+        });
+        out.value += r.value;
+        out.error += r.error;
+        out.evals += r.evals;
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const HC: Shadowing = Shadowing::HeightCorrelated;
+
+    #[test]
+    fn normal_incidence_at_alpha_one_is_one_minus_ln2() {
+        // The closed form of albedo_normal_rough; the tolerance is the integrator's requested 1e-12.
+        let e = albedo(1.0, 1.0, 1e-12);
+        assert!((e.value - albedo_normal_rough()).abs() < 2e-12, "{} vs {}", e.value, albedo_normal_rough());
+    }
+
+    #[test]
+    fn albedo_never_exceeds_one_and_smooth_limit_holds() {
+        for &alpha in &[1e-3, 1e-2, 0.1, 0.5, 1.0] {
+            for &mu in &[0.0, 1e-4, 0.01, 0.3, 0.7, 1.0] {
+                let e = albedo(alpha, mu, 1e-10);
+                assert!(e.value <= 1.0 + e.error && e.value > 0.0, "α={alpha} μ={mu}: {e:?}");
+            }
+        }
+        // α → 0: E → 1, bias → (1 − μ)⁵. At α = 1e-4 the deviation is O(α) at these μ (the
+        // lobe's width); 1e-3 bounds it with margin.
+        for &mu in &[0.2, 0.5, 0.9, 1.0] {
+            let r = env(1e-4, mu, 0.0, HC, 1e-11);
+            assert!((r.scale + r.bias - 1.0).abs() < 1e-3, "μ={mu}: {r:?}");
+            assert!((r.bias - (1.0 - mu).powi(5)).abs() < 1e-3, "μ={mu}: {r:?}");
+        }
+    }
+
+    #[test]
+    fn the_closing_cone_removes_everything() {
+        assert_eq!(env(0.3, 0.5, 1.0, HC, 1e-10).scale, 0.0);
+        // Near c = 1 the region is a cap of solid angle 2π(1 − c): the integrals vanish with it.
+        let r = env(0.3, 0.9, 0.9999, HC, 1e-12);
+        assert!(r.scale < 1e-3 && r.bias < 1e-3, "{r:?}");
+        let open = env(0.3, 0.9, 0.0, HC, 1e-12);
+        let half = env(0.3, 0.9, 0.5, HC, 1e-12);
+        assert!(half.scale < open.scale && half.bias <= open.bias);
+    }
+
+    #[test]
+    fn schlick_average_matches_quadrature() {
+        // The closed form against the 1-D integral at 1e-14 (the integrator's requested tolerance).
+        for &f0 in &[0.0, 0.04, 0.5, 1.0] {
+            let r = crate::integrate::adaptive(0.0, 1.0, Tolerance { abs: 1e-15, rel: 0.0, max_panels: 100 }, |m| {
+                2.0 * (f0 + (1.0 - f0) * (1.0 - m).powi(5)) * m
+            });
+            assert!((r.value - f_avg_schlick(f0)).abs() < 1e-14);
+        }
+        // η = 1: no reflection; η → ∞: total reflection.
+        assert!(f_avg_dielectric(1.0, 1e-14).value.abs() < 1e-14);
+        assert!(f_avg_dielectric(1e6, 1e-12).value > 0.999);
+    }
+}

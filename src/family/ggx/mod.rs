@@ -1,0 +1,188 @@
+//! The GGX split-sum family: the environment BRDF ("DFG") scale and bias, with a visibility
+//! cone; the directional albedo E(μ) and its average E_avg; the Fresnel averages; and the
+//! industry's published approximations of them measured against the integrals. Conventions
+//! (microfacet model, α = roughness², height-correlated Smith G2, Schlick Fc) are in
+//! [`integrals`].
+
+pub mod bench;
+pub mod compensation;
+pub mod integrals;
+pub mod lut;
+pub mod published;
+
+use super::Family;
+use crate::integrate::Estimate;
+use crate::quantity::{ParamSpec, QuantityDef};
+use crate::plot::PlotError;
+use crate::validate::Item;
+use integrals::Shadowing;
+use std::path::{Path, PathBuf};
+
+const ALPHA: ParamSpec = ParamSpec {
+    name: "alpha",
+    min: 1e-4,
+    max: 1.0,
+    doc: "GGX alpha (perceptual roughness²)",
+    integer: false,
+    default: None,
+};
+const ROUGHNESS: ParamSpec = ParamSpec {
+    name: "roughness",
+    min: 1e-2,
+    max: 1.0,
+    doc: "perceptual roughness (alpha = roughness²)",
+    integer: false,
+    default: None,
+};
+const N_DOT_V: ParamSpec = ParamSpec { name: "n_dot_v", min: 0.0, max: 1.0, doc: "n·v", integer: false, default: None };
+const COS_CONE: ParamSpec = ParamSpec {
+    name: "cos_cone",
+    min: 0.0,
+    max: 1.0,
+    doc: "cosine of the visibility cone's half-angle (0: the hemisphere)",
+    integer: false,
+    default: Some(0.0),
+};
+
+fn alpha_of_roughness(r: f64) -> f64 {
+    r * r
+}
+
+const ROUGHNESS_ALIAS: (ParamSpec, usize, fn(f64) -> f64) = (ROUGHNESS, 0, alpha_of_roughness);
+
+fn env_channels(p: &[f64], tol: f64, shadowing: Shadowing) -> Vec<Estimate> {
+    let r = integrals::env(p[0], p[1], p.get(2).copied().unwrap_or(0.0), shadowing, tol);
+    vec![
+        Estimate { value: r.scale, error: r.error, evals: r.evals },
+        Estimate { value: r.bias, error: r.error, evals: 0 },
+    ]
+}
+
+fn ggx_env_channels(p: &[f64], tol: f64) -> Vec<Estimate> {
+    env_channels(p, tol, Shadowing::HeightCorrelated)
+}
+
+fn ggx_env(p: &[f64], tol: f64) -> Estimate {
+    ggx_env_channels(p, tol)[0]
+}
+
+fn ue4_channels(p: &[f64], tol: f64) -> Vec<Estimate> {
+    env_channels(p, tol, Shadowing::Separable { k: 0.5 * p[0] })
+}
+
+fn ue4_env(p: &[f64], tol: f64) -> Estimate {
+    ue4_channels(p, tol)[0]
+}
+
+fn ggx_albedo(p: &[f64], tol: f64) -> Estimate {
+    integrals::albedo(p[0], p[1], tol)
+}
+
+fn ggx_albedo_avg(p: &[f64], tol: f64) -> Estimate {
+    integrals::albedo_avg(p[0], tol)
+}
+
+fn fresnel_avg_schlick(p: &[f64], _tol: f64) -> Estimate {
+    // Closed form; two roundings of a value ≤ 1.
+    Estimate { value: integrals::f_avg_schlick(p[0]), error: 4.0 * f64::EPSILON, evals: 0 }
+}
+
+fn fresnel_avg_dielectric(p: &[f64], tol: f64) -> Estimate {
+    integrals::f_avg_dielectric(p[0], tol)
+}
+
+/// The family's quantities, in `eval --help` order.
+pub static QUANTITIES: &[QuantityDef] = &[
+    QuantityDef {
+        name: "ggx-env",
+        doc: "split-sum environment BRDF [scale, bias] (F = F0·scale + bias), lights in a cone",
+        params: &[ALPHA, N_DOT_V, COS_CONE],
+        aliases: &[ROUGHNESS_ALIAS],
+        eval: ggx_env,
+        inverse: None,
+        channels: &["scale", "bias"],
+        eval_channels: Some(ggx_env_channels),
+        basis: None,
+    },
+    QuantityDef {
+        name: "ggx-env-ue4",
+        doc: "[scale, bias] with UE4's separable Schlick-Smith G (k = alpha/2), hemisphere",
+        params: &[ALPHA, N_DOT_V],
+        aliases: &[ROUGHNESS_ALIAS],
+        eval: ue4_env,
+        inverse: None,
+        channels: &["scale", "bias"],
+        eval_channels: Some(ue4_channels),
+        basis: None,
+    },
+    QuantityDef {
+        name: "ggx-albedo",
+        doc: "directional albedo E(mu) of single-scattering GGX (F = 1)",
+        params: &[ALPHA, N_DOT_V],
+        aliases: &[ROUGHNESS_ALIAS],
+        eval: ggx_albedo,
+        inverse: None,
+        channels: &[],
+        eval_channels: None,
+        basis: None,
+    },
+    QuantityDef {
+        name: "ggx-albedo-avg",
+        doc: "cosine-weighted average albedo E_avg = 2 int E(mu) mu dmu",
+        params: &[ALPHA],
+        aliases: &[ROUGHNESS_ALIAS],
+        eval: ggx_albedo_avg,
+        inverse: None,
+        channels: &[],
+        eval_channels: None,
+        basis: None,
+    },
+    QuantityDef {
+        name: "fresnel-avg-schlick",
+        doc: "cosine-weighted Schlick Fresnel average F0 + (1 - F0)/21 (closed form)",
+        params: &[ParamSpec { name: "f0", min: 0.0, max: 1.0, doc: "reflectance at normal incidence", integer: false, default: None }],
+        aliases: &[],
+        eval: fresnel_avg_schlick,
+        inverse: None,
+        channels: &[],
+        eval_channels: None,
+        basis: None,
+    },
+    QuantityDef {
+        name: "fresnel-avg-dielectric",
+        doc: "cosine-weighted dielectric Fresnel average for relative index eta (numerical)",
+        params: &[ParamSpec { name: "eta", min: 0.1, max: 10.0, doc: "relative index of refraction", integer: false, default: None }],
+        aliases: &[],
+        eval: fresnel_avg_dielectric,
+        inverse: None,
+        channels: &[],
+        eval_channels: None,
+        basis: None,
+    },
+];
+
+fn items(generated: &Path) -> Vec<Item> {
+    let mut items = published::items(generated);
+    items.extend(compensation::items(generated));
+    items
+}
+
+fn figures(out: &Path, generated: &Path) -> Result<Vec<PathBuf>, PlotError> {
+    let mut files = lut::figures(out, generated)?;
+    files.extend(published::figures(out, generated)?);
+    files.extend(compensation::figures(out, generated)?);
+    Ok(files)
+}
+
+/// The GGX split-sum family's descriptor (registered in `crate::family::FAMILIES`).
+pub static FAMILY: Family = Family {
+    name: "ggx",
+    doc: "GGX split-sum: DFG scale/bias (with a visibility cone), E(mu), E_avg, Fresnel averages, energy compensation",
+    quantities: QUANTITIES,
+    spec_kinds: lut::KINDS,
+    eval_options: None,
+    validate: items,
+    figures,
+    bench: bench::BENCH,
+    scene_features: &[],
+};
