@@ -334,6 +334,17 @@ impl Catalog {
     }
 }
 
+/// The environment variable that raises (or lowers) [`DEFAULT_GRID_BUDGET`].
+pub const GRID_BUDGET_VAR: &str = "SHADEFIT_GRID_BUDGET";
+/// Most points a spec's sampling or verification grid may have: 5·10⁷ (each point is at least
+/// one integral; the bundled specs' largest grid has about 10⁶).
+pub const DEFAULT_GRID_BUDGET: usize = 50_000_000;
+
+/// The grid budget: [`GRID_BUDGET_VAR`] when set to a whole number, else the default.
+pub fn grid_budget() -> usize {
+    std::env::var(GRID_BUDGET_VAR).ok().and_then(|v| v.trim().parse().ok()).unwrap_or(DEFAULT_GRID_BUDGET)
+}
+
 #[derive(Debug, Clone, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct AxisSpec {
@@ -508,6 +519,23 @@ impl Spec {
             }
             if a.verify_count() < 2 || a.verify_count() > 1_000_000 {
                 return Err(at("verify", format!("axis '{}' verify count must be in [2, 1000000]", a.name)));
+            }
+        }
+        for (field, what, counts) in [
+            ("count", "sampling", file.axis.iter().map(|a| a.count).collect::<Vec<_>>()),
+            ("verify", "verification", file.axis.iter().map(|a| a.verify_count()).collect()),
+        ] {
+            let budget = grid_budget();
+            let points = counts.iter().try_fold(1usize, |acc, &n| acc.checked_mul(n));
+            if points.is_none_or(|p| p > budget) {
+                let shown = points.map_or_else(|| "more than 2^64".to_string(), |p| p.to_string());
+                return Err(at(
+                    field,
+                    format!(
+                        "the {what} grid has {shown} points (the product of the axes' {field}s), over the budget of \
+                         {budget}; thin the axes, or raise the budget with {GRID_BUDGET_VAR}=<points>"
+                    ),
+                ));
             }
         }
         let model = match (file.kind, &file.model) {
