@@ -246,6 +246,41 @@ fn nist_kirby2_in_extreme_units_reports_in_those_units() {
 }
 
 #[test]
+fn nist_kirby2_with_inputs_in_extreme_units_reports_in_those_units() {
+    // Kirby2's x times 2^505 (x up to ≈ 2e155, x² past f64's range) and 2^-505: the monomials
+    // overflow unless the inputs are scaled first. With x = 2^k·x₀ the certified coefficient of
+    // x^j becomes b_j·2^{-jk} (numerator and denominator alike; the x² one near 2e-309 is
+    // subnormal, still 14 digits); the rss does not change. Acceptance as for Kirby2 itself,
+    // 1e-6 relative.
+    let d = tempfile::tempdir().unwrap();
+    let csv = std::fs::read_to_string(nist_csv("Kirby2", d.path())).unwrap();
+    for k in [505, -505] {
+        let s = 2f64.powi(k);
+        let mut scaled = String::from("x,y\n");
+        for line in csv.lines().skip(1) {
+            let (x, y) = line.split_once(',').unwrap();
+            scaled.push_str(&format!("{:e},{y}\n", x.parse::<f64>().unwrap() * s));
+        }
+        let p = d.path().join(format!("kirby2_x{k}.csv"));
+        std::fs::write(&p, scaled).unwrap();
+        let v = fit_json(&["fit", "--data", p.to_str().unwrap(), "--x", "x", "--y", "y", "--model", "rational(2,2)", "--json"]);
+        let rss = v["rss"].as_f64().unwrap();
+        assert!((rss - 3.9050739624).abs() < 1e-6 * 3.9050739624, "2^{k}: rss {rss}");
+        let unscale = |j: i32| 2f64.powi(j * k);
+        let num: Vec<f64> = v["numerator"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
+        for (j, (got, want)) in num.iter().zip([1.6745063063, -1.3927397867e-1, 2.5961181191e-3]).enumerate() {
+            let got = got * unscale(j as i32);
+            assert!((got - want).abs() < 1e-6 * f64::abs(want), "2^{k}: x^{j}: {got} vs {want}");
+        }
+        let den: Vec<f64> = v["denominator"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
+        for (j, (got, want)) in den[1..].iter().zip([-1.7241811870e-3, 2.1664802578e-5]).enumerate() {
+            let got = got * unscale(j as i32 + 1);
+            assert!((got - want).abs() < 1e-6 * f64::abs(want), "2^{k}: x^{}: {got} vs {want}", j + 1);
+        }
+    }
+}
+
+#[test]
 fn too_few_rows_for_the_model_exit_2() {
     let d = tempfile::tempdir().unwrap();
     for rows in ["x,y\n1,2\n", "x,y\n1,2\n2,3\n"] {

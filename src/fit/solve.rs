@@ -101,45 +101,101 @@ pub struct Fit {
     pub report: FitReport,
 }
 
-/// [`fit`] of data in any units: the values are divided by a power of two 2^k near their largest
-/// magnitude before solving (exactly, so nothing is rounded), the model's offset, numerator
-/// constraints, pins and clamp with them, and the numerator coefficients and the report are
-/// multiplied back. Values near 1e±300 otherwise overflow (or underflow) the residual sums:
-/// a singular start, or an rss of 0. Data within 2^±64 of 1 is fitted unscaled, exactly as by
-/// [`fit`]. `theta` and the condition number are the scaled problem's. The features are not
-/// scaled (a monomial's coefficient would scale with its degree, and terms tie monomials).
+/// [`fit`] of data in any units: values and inputs far from 1 are divided by powers of two
+/// before solving (exactly, so nothing is rounded) and the coefficients and the report are
+/// returned in the data's units. Values or inputs near 1e±300 otherwise overflow (or underflow)
+/// the residual sums and the monomials: a singular start, or an rss of 0.
+///
+/// - Values: divided by 2^k near their largest magnitude when |k| ≥ 64, with the model's
+///   offset, fixed numerator coefficients, pins and clamp; numerator coefficients and the
+///   report are multiplied back.
+/// - Inputs: input i is divided by 2^{k_i} near its largest magnitude when |k_i| ≥ 64. A
+///   monomial Π x_i^{e_i} then scales by S = 2^{Σ k_i e_i}, and its coefficient by 1/S. This
+///   is done only where it is exact: every monomial of a term scales alike (terms tie
+///   monomials under one coefficient) and the model has no derived
+///   features, denominator lead term or factor (they do not scale by a power of two). Where it
+///   is not, the inputs are fitted as given.
+///
+/// Data within 2^±64 of 1 is fitted unscaled, exactly as by [`fit`]. `theta` and the condition
+/// number are the scaled problem's.
 pub fn fit_rescaled(model: &RationalModel, data: &Data, opts: &FitOptions, what: &str) -> Result<Fit, FitError> {
-    let top = data.y.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    let k = if top > 0.0 && top.is_finite() { top.log2().round() as i32 } else { 0 };
-    if k.abs() < 64 {
+    let exponent = |top: f64| -> i32 {
+        let k = if top > 0.0 && top.is_finite() { top.log2().round() as i32 } else { 0 };
+        if k.abs() < 64 { 0 } else { k }
+    };
+    let ky = exponent(data.y.iter().fold(0.0f64, |m, v| m.max(v.abs())));
+    let n_in = model.n_inputs;
+    let mut kx: Vec<i32> =
+        (0..n_in).map(|i| exponent(data.x.iter().fold(0.0f64, |m, x| m.max(x[i].abs())))).collect();
+    let term_scale = |t: &crate::fit::model::Term, kx: &[i32]| -> Option<i32> {
+        let mut scales = t.monomials.iter().map(|m| m.exps.iter().zip(kx).map(|(&e, &k)| e as i32 * k).sum::<i32>());
+        let first = scales.next().unwrap_or(0);
+        scales.all(|s| s == first).then_some(first)
+    };
+    let x_scalable = kx.iter().any(|&k| k != 0)
+        && model.derived.is_empty()
+        && model.lead.is_none()
+        && model.factor.is_none()
+        && model.numerator.iter().chain(&model.denominator).all(|t| term_scale(t, &kx).is_some());
+    if !x_scalable {
+        kx.iter_mut().for_each(|k| *k = 0);
+    }
+    if ky == 0 && kx.iter().all(|&k| k == 0) {
         return fit(model, data, opts, what);
     }
-    let scale = 2f64.powi(k);
+    let yscale = 2f64.powi(ky);
     let nn = model.numerator.len();
+    // Power-of-two scale exponent of each coefficient's term: numerator terms, then
+    // denominator terms (2^t itself may be past f64's range; coefficients times it are not).
+    let s: Vec<i32> = model.numerator.iter().chain(&model.denominator).map(|t| term_scale(t, &kx).unwrap_or(0)).collect();
+    let xscale: Vec<f64> = kx.iter().map(|&k| 2f64.powi(k)).collect();
     let parts = crate::fit::model::ModelParts {
         inputs: model.features[..model.n_inputs].to_vec(),
         derived: model.derived.clone(),
         numerator: model.numerator.clone(),
         denominator: model.denominator.clone(),
         lead: model.lead.clone(),
-        offset: model.offset / scale,
+        offset: model.offset / yscale,
         factor: model.factor.clone(),
-        fixed: model.fixed.iter().map(|&(i, v)| (i, if i < nn { v / scale } else { v })).collect(),
-        pins: model.pins.iter().map(|p| crate::fit::model::Pin { value: p.value / scale, ..p.clone() }).collect(),
-        clamp: model.clamp.map(|(a, b)| (a / scale, b / scale)),
+        fixed: model.fixed.iter().map(|&(i, v)| (i, if i < nn { times_pow2(v, s[i]) / yscale } else { times_pow2(v, s[i]) })).collect(),
+        pins: model
+            .pins
+            .iter()
+            .map(|p| crate::fit::model::Pin {
+                at: p.at.iter().zip(&xscale).map(|(a, sc)| a / sc).collect(),
+                value: p.value / yscale,
+                ..p.clone()
+            })
+            .collect(),
+        clamp: model.clamp.map(|(a, b)| (a / yscale, b / yscale)),
     };
     let scaled = RationalModel::new(parts).map_err(|e| FitError::Model { what: what.into(), source: e })?;
-    let y: Vec<f64> = data.y.iter().map(|v| v / scale).collect();
-    let mut f = fit(&scaled, &Data { x: data.x.clone(), y }, opts, what)?;
-    for j in 0..nn {
-        f.coefficients[j] *= scale;
+    let y: Vec<f64> = data.y.iter().map(|v| v / yscale).collect();
+    let x: Vec<Vec<f64>> = data.x.iter().map(|row| row.iter().zip(&xscale).map(|(v, sc)| v / sc).collect()).collect();
+    let mut f = fit(&scaled, &Data { x, y }, opts, what)?;
+    for (j, c) in f.coefficients.iter_mut().enumerate() {
+        *c = if j < nn { times_pow2(*c * yscale, -s[j]) } else { times_pow2(*c, -s[j]) };
     }
     let r = &mut f.report;
-    r.rss *= scale * scale;
-    r.max_abs_error *= scale;
-    r.rms_error *= scale;
-    r.worst_residual *= scale;
+    r.rss *= yscale * yscale;
+    r.max_abs_error *= yscale;
+    r.rms_error *= yscale;
+    r.worst_residual *= yscale;
+    for (w, sc) in r.worst_point.iter_mut().zip(&xscale) {
+        *w *= sc;
+    }
     Ok(f)
+}
+
+/// v·2^e in steps that stay inside f64's exponent range (exact unless the result is
+/// subnormal, over- or underflows).
+fn times_pow2(mut v: f64, mut e: i32) -> f64 {
+    while e != 0 {
+        let step = e.clamp(-1000, 1000);
+        v *= 2f64.powi(step);
+        e -= step;
+    }
+    v
 }
 
 /// Fit `model` to `data` from no start values.
