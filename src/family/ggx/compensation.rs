@@ -29,6 +29,12 @@
 //! bound at grazing view and small α: as α → 0, A → 1 − (1 − μ)⁵ and B → (1 − μ)⁵, so
 //! B/A → (1 − μ)⁵/(1 − (1 − μ)⁵) (≈ 1/(5μ) as μ → 0).
 //!
+//! E(0) = 1 exactly in this model: as μv → 0, G2/μv → 1/(μvΛ(μv)) → 2/α for every light (the
+//! light's μlΛ(μl) term carries a factor μv), every visible microfacet reflects above the
+//! horizon (μl = 2(v·h)μh), and ∫ D (v·h)⁺ dωh = μv(1 + Λ(μv)) → α/2, so E(0) = (2/α)(α/2).
+//! Near mirrors E dips to ≈0.89 at n·v ~ α before it recovers towards 1: the structure a 32-wide
+//! uniform n·v table cannot resolve (the tables' error, ≈0.1, sits there).
+//!
 //! # Reciprocity
 //!
 //! f_ss is symmetric in (o, i) (D, G2 and Schlick's F on v·h = l·h all are), and so is f_ms:

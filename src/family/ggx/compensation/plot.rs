@@ -10,6 +10,8 @@ use std::path::{Path, PathBuf};
 
 /// Roughness of the E(μ) curves (Kulla–Conty plot a similar fan).
 const CURVE_ROUGHNESS: [f64; 6] = [0.1, 0.25, 0.4, 0.6, 0.8, 1.0];
+/// Samples of the E(μ) curves (uniform n·v; E varies on the scale n·v ~ α near grazing).
+const CURVE_MU: usize = 257;
 /// Map resolution: n·v × roughness.
 const MAP_MU: usize = 33;
 const MAP_R: usize = 20;
@@ -22,25 +24,26 @@ fn uniform(lo: f64, hi: f64, n: usize) -> Vec<f64> {
 /// (with committed tables) `ggx_furnace_tables`, each as PNG and SVG.
 pub fn figures(out: &Path, generated: &Path) -> Result<Vec<PathBuf>, PlotError> {
     let mut files = Vec::new();
-    let mu = uniform(0.0, 1.0, MAP_MU);
-    let curves = Grid::exact(&CURVE_ROUGHNESS, &mu);
+    let curve_mu = uniform(0.0, 1.0, CURVE_MU);
+    let curves = Grid::exact(&CURVE_ROUGHNESS, &curve_mu);
     let series: Vec<Series> = CURVE_ROUGHNESS
         .iter()
         .enumerate()
         .map(|(j, &r)| {
-            let pts = mu.iter().enumerate().map(|(i, &m)| (m, curves.at(j, i).e())).collect();
+            let pts = curve_mu.iter().enumerate().map(|(i, &m)| (m, curves.at(j, i).e())).collect();
             Series::new(format!("r = {r} (α = {:.4})", r * r), pts, SeriesStyle::Line)
         })
         .collect();
     files.extend(crate::plot::line_plot(
         &out.join("ggx_albedo_curves"),
-        "GGX directional albedo E(μ), F = 1 (height-correlated Smith)",
+        "GGX directional albedo E(μ), F = 1 (height-correlated Smith; E(0) = 1 exactly)",
         "n·v",
         "E",
         &series,
         false,
     )?);
 
+    let mu = uniform(0.0, 1.0, MAP_MU);
     let roughness = uniform(0.05, 1.0, MAP_R);
     let grid = Grid::exact(&roughness, &mu);
     let mut avg = vec![Series::new(
