@@ -13,6 +13,15 @@ pub mod fuzz_q;
 #[cfg(feature = "fuzz")]
 #[path = "fuzz_r.rs"]
 pub mod fuzz_r;
+#[cfg(feature = "ggx")]
+#[path = "ggx_albedo_avg.rs"]
+pub mod ggx_albedo_avg;
+#[cfg(feature = "ggx")]
+#[path = "ggx_albedo_avg_table.rs"]
+pub mod ggx_albedo_avg_table;
+#[cfg(feature = "ggx")]
+#[path = "ggx_albedo_table.rs"]
+pub mod ggx_albedo_table;
 #[cfg(feature = "gloss")]
 #[path = "gloss_combine.rs"]
 pub mod gloss_combine;
@@ -57,6 +66,12 @@ pub mod wgsl {
     pub const FUZZ_Q: &str = include_str!("../wgsl/fuzz_q.wgsl");
     #[cfg(feature = "fuzz")]
     pub const FUZZ_R: &str = include_str!("../wgsl/fuzz_r.wgsl");
+    #[cfg(feature = "ggx")]
+    pub const GGX_ALBEDO_AVG: &str = include_str!("../wgsl/ggx_albedo_avg.wgsl");
+    #[cfg(feature = "ggx")]
+    pub const GGX_ALBEDO_AVG_TABLE: &str = include_str!("../wgsl/ggx_albedo_avg_table.wgsl");
+    #[cfg(feature = "ggx")]
+    pub const GGX_ALBEDO_TABLE: &str = include_str!("../wgsl/ggx_albedo_table.wgsl");
     #[cfg(feature = "gloss")]
     pub const GLOSS_COMBINE: &str = include_str!("../wgsl/gloss_combine.wgsl");
     #[cfg(feature = "gloss")]
@@ -91,6 +106,12 @@ pub mod wgsl {
             "fuzz_q" => Some(FUZZ_Q),
             #[cfg(feature = "fuzz")]
             "fuzz_r" => Some(FUZZ_R),
+            #[cfg(feature = "ggx")]
+            "ggx_albedo_avg" => Some(GGX_ALBEDO_AVG),
+            #[cfg(feature = "ggx")]
+            "ggx_albedo_avg_table" => Some(GGX_ALBEDO_AVG_TABLE),
+            #[cfg(feature = "ggx")]
+            "ggx_albedo_table" => Some(GGX_ALBEDO_TABLE),
             #[cfg(feature = "gloss")]
             "gloss_combine" => Some(GLOSS_COMBINE),
             #[cfg(feature = "gloss")]
@@ -127,6 +148,12 @@ pub mod wgsl {
         "fuzz_q",
         #[cfg(feature = "fuzz")]
         "fuzz_r",
+        #[cfg(feature = "ggx")]
+        "ggx_albedo_avg",
+        #[cfg(feature = "ggx")]
+        "ggx_albedo_avg_table",
+        #[cfg(feature = "ggx")]
+        "ggx_albedo_table",
         #[cfg(feature = "gloss")]
         "gloss_combine",
         #[cfg(feature = "gloss")]
@@ -160,6 +187,12 @@ pub const FUNCTIONS: &[EmittedFunction] = &[
     EmittedFunction { module: "fuzz_q", name: "fuzz_average_penetration", domain: &[[0e0, 5e-1]], cpu: Cpu::One(fuzz_q::fuzz_average_penetration) },
     #[cfg(feature = "fuzz")]
     EmittedFunction { module: "fuzz_r", name: "fuzz_average_ps", domain: &[[1.5e-1, 1e0], [0e0, 1.5707964e0]], cpu: Cpu::Two(fuzz_r::fuzz_average_ps) },
+    #[cfg(feature = "ggx")]
+    EmittedFunction { module: "ggx_albedo_avg", name: "ggx_albedo_avg_fit", domain: &[[1e-4, 1e0]], cpu: Cpu::One(ggx_albedo_avg::ggx_albedo_avg_fit) },
+    #[cfg(feature = "ggx")]
+    EmittedFunction { module: "ggx_albedo_avg_table", name: "ggx_albedo_avg_lut", domain: &[[1e-4, 1e0]], cpu: Cpu::One(ggx_albedo_avg_table::ggx_albedo_avg_lut) },
+    #[cfg(feature = "ggx")]
+    EmittedFunction { module: "ggx_albedo_table", name: "ggx_albedo_lut", domain: &[[1e-4, 1e0], [0e0, 1e0]], cpu: Cpu::Two(ggx_albedo_table::ggx_albedo_lut) },
     #[cfg(feature = "gloss")]
     EmittedFunction { module: "gloss_combine", name: "combine_gloss", domain: &[[0e0, 1e0], [0e0, 1e0]], cpu: Cpu::Two(gloss_combine::combine_gloss) },
     #[cfg(feature = "gloss")]

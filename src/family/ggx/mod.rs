@@ -44,6 +44,17 @@ const COS_CONE: ParamSpec = ParamSpec {
     default: Some(0.0),
 };
 
+const N_DOT_L: ParamSpec = ParamSpec { name: "n_dot_l", min: 0.0, max: 1.0, doc: "n·l", integer: false, default: None };
+const F0: ParamSpec = ParamSpec { name: "f0", min: 0.0, max: 1.0, doc: "Schlick reflectance at normal incidence (1: F = 1)", integer: false, default: None };
+const SCHEME: ParamSpec = ParamSpec {
+    name: "scheme",
+    min: 0.0,
+    max: 5.0,
+    doc: "compensation scheme: 0 single, 1 Kulla-Conty, 2 Turquin, 3 Fdez-Aguera, 4 Cycles, 5 bevy<=0.18",
+    integer: true,
+    default: None,
+};
+
 fn alpha_of_roughness(r: f64) -> f64 {
     r * r
 }
@@ -154,6 +165,28 @@ pub static QUANTITIES: &[QuantityDef] = &[
         params: &[ParamSpec { name: "eta", min: 0.1, max: 10.0, doc: "relative index of refraction", integer: false, default: None }],
         aliases: &[],
         eval: fresnel_avg_dielectric,
+        inverse: None,
+        channels: &[],
+        eval_channels: None,
+        basis: None,
+    },
+    QuantityDef {
+        name: "ggx-kc-fms",
+        doc: "Kulla-Conty multiple-scattering lobe (1-E(mu_o))(1-E(mu_i))/(pi(1-E_avg)), F = 1",
+        params: &[ALPHA, N_DOT_V, N_DOT_L],
+        aliases: &[ROUGHNESS_ALIAS],
+        eval: compensation::eval_kc_fms,
+        inverse: None,
+        channels: &[],
+        eval_channels: None,
+        basis: None,
+    },
+    QuantityDef {
+        name: "ggx-furnace",
+        doc: "white-furnace albedo of a compensation scheme (0 single, 1 Kulla-Conty, 2 Turquin, 3 Fdez-Aguera, 4 Cycles, 5 bevy<=0.18)",
+        params: &[ALPHA, N_DOT_V, F0, SCHEME],
+        aliases: &[ROUGHNESS_ALIAS],
+        eval: compensation::eval_furnace,
         inverse: None,
         channels: &[],
         eval_channels: None,
