@@ -13,6 +13,9 @@ pub mod fuzz_q;
 #[cfg(feature = "fuzz")]
 #[path = "fuzz_r.rs"]
 pub mod fuzz_r;
+#[cfg(feature = "ggx")]
+#[path = "ggx_albedo_rational.rs"]
+pub mod ggx_albedo_rational;
 #[cfg(feature = "gloss")]
 #[path = "gloss_combine.rs"]
 pub mod gloss_combine;
@@ -57,6 +60,8 @@ pub mod wgsl {
     pub const FUZZ_Q: &str = include_str!("../wgsl/fuzz_q.wgsl");
     #[cfg(feature = "fuzz")]
     pub const FUZZ_R: &str = include_str!("../wgsl/fuzz_r.wgsl");
+    #[cfg(feature = "ggx")]
+    pub const GGX_ALBEDO_RATIONAL: &str = include_str!("../wgsl/ggx_albedo_rational.wgsl");
     #[cfg(feature = "gloss")]
     pub const GLOSS_COMBINE: &str = include_str!("../wgsl/gloss_combine.wgsl");
     #[cfg(feature = "gloss")]
@@ -91,6 +96,8 @@ pub mod wgsl {
             "fuzz_q" => Some(FUZZ_Q),
             #[cfg(feature = "fuzz")]
             "fuzz_r" => Some(FUZZ_R),
+            #[cfg(feature = "ggx")]
+            "ggx_albedo_rational" => Some(GGX_ALBEDO_RATIONAL),
             #[cfg(feature = "gloss")]
             "gloss_combine" => Some(GLOSS_COMBINE),
             #[cfg(feature = "gloss")]
@@ -127,6 +134,8 @@ pub mod wgsl {
         "fuzz_q",
         #[cfg(feature = "fuzz")]
         "fuzz_r",
+        #[cfg(feature = "ggx")]
+        "ggx_albedo_rational",
         #[cfg(feature = "gloss")]
         "gloss_combine",
         #[cfg(feature = "gloss")]
@@ -160,6 +169,8 @@ pub const FUNCTIONS: &[EmittedFunction] = &[
     EmittedFunction { module: "fuzz_q", name: "fuzz_average_penetration", domain: &[[0e0, 5e-1]], cpu: Cpu::One(fuzz_q::fuzz_average_penetration) },
     #[cfg(feature = "fuzz")]
     EmittedFunction { module: "fuzz_r", name: "fuzz_average_ps", domain: &[[1.5e-1, 1e0], [0e0, 1.5707964e0]], cpu: Cpu::Two(fuzz_r::fuzz_average_ps) },
+    #[cfg(feature = "ggx")]
+    EmittedFunction { module: "ggx_albedo_rational", name: "ggx_albedo", domain: &[[1e-4, 1e0], [7.8125e-3, 1e0]], cpu: Cpu::Two(ggx_albedo_rational::ggx_albedo) },
     #[cfg(feature = "gloss")]
     EmittedFunction { module: "gloss_combine", name: "combine_gloss", domain: &[[0e0, 1e0], [0e0, 1e0]], cpu: Cpu::Two(gloss_combine::combine_gloss) },
     #[cfg(feature = "gloss")]

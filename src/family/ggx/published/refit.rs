@@ -87,7 +87,7 @@ pub fn materialx() -> MaterialX {
             .values
             .iter()
             .enumerate()
-            .filter(|(k, _)| (k % full.mu.len()) % 2 == 0 && (k / full.mu.len()) % 2 == 0)
+            .filter(|(k, _)| (k % full.mu.len()).is_multiple_of(2) && (k / full.mu.len()).is_multiple_of(2))
             .map(|(_, v)| *v)
             .collect(),
     };
