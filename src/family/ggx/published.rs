@@ -1,23 +1,618 @@
-//! The industry's published approximations of the split-sum integrals, measured against them.
+//! The industry's published approximations of the split-sum integrals, measured against them,
+//! with shadefit's refit of each beside it (same form, new constants: [`refit`]):
+//!
+//! | form | source | integral it approximates (G, roughness mapping) |
+//! |---|---|---|
+//! | `EnvBRDFApprox` | Karis 2014, "Physically Based Shading on Mobile" | UE4's G: separable Schlick–Smith k = α/2, α = r² (ggx-env-ue4) |
+//! | `F_AB` | bevy ≤ 0.18.1 (Karis verbatim), 0.19 clamp | bevy's G: height-correlated Smith, α = r² (ggx-env) |
+//! | `EnvBlops2` | Lazarov 2013, Black Ops II | normalized Blinn-Phong, m = 8192^g, Schlick–Smith k = 2/sqrt(π(m + 2)); measured against GGX with α = sqrt(2/(m + 2)), height-correlated |
+//! | `mx_ggx_dir_albedo_analytic` | MaterialX | height-correlated Smith (VNDF Monte Carlo data), α input |
+//! | F_avg fit | Kulla & Conty 2017 | 2∫F(μ, η)μ dμ, exact dielectric Fresnel |
+//! | DFG LUT | Filament `cmgen` | height-correlated Smith; 128², 1024 Hammersley samples, RGB16F ([`filament`]) |
+//!
+//! Constants and formulas are in [`forms`] with their sources; the grids and the integrals on
+//! them in [`grid`].
+
+pub mod filament;
+pub mod forms;
+pub mod grid;
+pub mod refit;
 
 use crate::bench::fits::FitBench;
-use crate::bench::forms::FormSet;
-use crate::plot::PlotError;
-use crate::validate::Item;
+use crate::bench::forms::{
+    Ctx, FormRow, FormSet, Integral, Measured, PUBLISHED, count, fit_row, refit_row, row, set, strings, table_row, table_spec,
+    table_values,
+};
+use crate::bench::BenchError;
+use crate::pipeline::{self, Reference};
+use crate::plot::{Panel, PlotError};
+use crate::validate::{Item, measure};
+use forms::{KARIS, KULLA_CONTY, LAZAROV, MATERIALX, Karis, MaterialX};
+use grid::{Grid, Target};
 use std::path::{Path, PathBuf};
+
+/// MaterialX's constants before commit 77ff72f35 rounded them to four significant figures
+/// (the diff of that commit, PR #831), rows as [`forms::MATERIALX`].
+pub const MATERIALX_UNROUNDED: MaterialX = MaterialX {
+    r: [
+        [0.10031, 0.93450, 1.0, 1.0],
+        [-0.63301, -2.32352, -1.76427, 0.22797],
+        [9.74995, 2.22823, 8.26501, 15.93688],
+        [-2.02075, -3.74584, 11.54840, -55.82466],
+        [29.38247, 1.42450, 28.99991, 13.07919],
+        [-8.24713, -0.76829, -7.50867, 41.25882],
+        [-26.51510, 1.43366, -36.16186, 54.86775],
+        [19.98406, 0.29060, 15.85408, 300.10923],
+        [-5.41717, 0.62933, 33.41550, -284.73288],
+    ],
+};
+
+/// A pair form measured on a grid: both channels flattened (points [n·v, y, channel]).
+struct PairMeasure {
+    points: Vec<Vec<f64>>,
+    truth: Vec<f64>,
+    approx: Vec<f64>,
+}
+
+fn pair(g: &Grid, form: impl Fn(f64, f64) -> [f64; 2]) -> PairMeasure {
+    let mut out = PairMeasure { points: vec![], truth: vec![], approx: vec![] };
+    for ((m, y), t) in g.points().zip(&g.values) {
+        let a = form(m, y);
+        for ch in 0..2 {
+            out.points.push(vec![m, y, ch as f64]);
+            out.truth.push(t[ch]);
+            out.approx.push(a[ch]);
+        }
+    }
+    out
+}
+
+/// Max |error| of one channel.
+fn channel_max(p: &PairMeasure, ch: usize) -> f64 {
+    p.points.iter().zip(p.truth.iter().zip(&p.approx)).filter(|(x, _)| x[2] as usize == ch).fold(0.0, |m, (_, (t, a))| m.max((a - t).abs()))
+}
+
+fn domain(g: &Grid) -> String {
+    format!(
+        "n·v at 64 texel centres (i + ½)/64 × {} ∈ [0, 1] (65), both channels (scale, bias): {} points",
+        g.target.axis_name(),
+        2 * g.values.len()
+    )
+}
+
+/// An item of a pair form with its refit beside it (per-channel extras, the refit's finding).
+fn pair_item(name: &str, source: &str, g: &Grid, published: impl Fn(f64, f64) -> [f64; 2], refit: impl Fn(f64, f64) -> [f64; 2], how: &str) -> Item {
+    let p = pair(g, published);
+    let mut item = Item::measured(name, source, &domain(g), &p.points, &p.truth, &p.approx);
+    item.extra.push(("scale_max_abs_error".into(), channel_max(&p, 0)));
+    item.extra.push(("bias_max_abs_error".into(), channel_max(&p, 1)));
+    item.findings.push(format!("Measured against {} at tolerance {:.0e}; worst point is [n·v, {}, channel (0 scale, 1 bias)].", g.target.integral(), grid::TOL, g.target.axis_name()));
+    let r = pair(g, refit);
+    let (m, rms, worst) = measure(&r.points, &r.truth, &r.approx);
+    item.extra.push(("refit_max_abs_error".into(), m));
+    item.extra.push(("refit_rms_error".into(), rms));
+    item.findings.push(format!(
+        "shadefit's refit ({how}): max {m:.3e} ({:.2}× the published), rms {rms:.3e} ({:.2}×), worst at {worst:.3?}.",
+        m / item.max_abs_error,
+        rms / item.rms_error
+    ));
+    item
+}
+
+fn karis_items() -> Vec<Item> {
+    let refits = &refit::COMMITTED;
+    let ue4 = grid::standard(Target::RoughnessUe4);
+    let hc = grid::standard(Target::Roughness);
+    let mut out = Vec::new();
+
+    let mut item = pair_item(
+        "ggx-env-ue4: Karis 2014 EnvBRDFApprox",
+        "Karis 2014, 'Physically Based Shading on Mobile' (UE blog; UE BRDF.ush)",
+        ue4,
+        |m, r| KARIS.eval(r, m),
+        |m, r| refits.karis_ue4.eval(r, m),
+        "same form, all 10 constants, Nelder–Mead minimax against ggx-env-ue4",
+    );
+    // A + B = r.z + r.w: the a004 terms cancel.
+    let identity = hc.points().map(|(m, r)| {
+        let [a, b] = KARIS.eval(r, m);
+        (a + b - (1.0 - 0.55 * r)).abs()
+    }).fold(0.0f64, f64::max);
+    let spread = |g: &Grid| {
+        g.y.iter().enumerate().map(|(j, _)| {
+            let e: Vec<f64> = g.values[j * g.mu.len()..(j + 1) * g.mu.len()].iter().map(|v| v[0] + v[1]).collect();
+            e.iter().cloned().fold(f64::MIN, f64::max) - e.iter().cloned().fold(f64::MAX, f64::min)
+        }).fold(0.0f64, f64::max)
+    };
+    let p_hc = pair(hc, |m, r| KARIS.eval(r, m));
+    let (hc_max, hc_rms, hc_worst) = measure(&p_hc.points, &p_hc.truth, &p_hc.approx);
+    item.extra.push(("height_correlated_max_abs_error".into(), hc_max));
+    item.extra.push(("height_correlated_rms_error".into(), hc_rms));
+    item.findings.push(format!(
+        "A + B = r.z + r.w = 1 − 0.55 r exactly (the a004 terms cancel; |A + B − (1 − 0.55 r)| ≤ {identity:.1e} on the grid): \
+         the white-F0 albedo is linear in r and independent of n·v, while the integral's E varies with n·v by up to {:.3} \
+         at one roughness (separable G; {:.3} height-correlated). Any refit of this form keeps that floor.",
+        spread(ue4),
+        spread(hc)
+    ));
+    item.findings.push(format!(
+        "Against the height-correlated integral (ggx-env) instead: max {hc_max:.3e}, rms {hc_rms:.3e}, worst at {hc_worst:.3?}. \
+         Neither G is matched: Karis says the constants were adapted 'to fit our G term', which is not determinable from \
+         the published text; at n·v = 1 both G agree and Karis is {:.3} off in A at r = 0.5.",
+        (KARIS.eval(0.5, 1.0)[0] - grid::env(Target::Roughness, 0.25, 1.0, grid::TOL)[0]).abs()
+    ));
+    out.push(item);
+
+    // bevy's F_AB: Karis verbatim in a renderer whose G is height-correlated.
+    let mut item = pair_item(
+        "ggx-env: bevy F_AB (≤ 0.18.1, Karis verbatim)",
+        "bevy crates/bevy_pbr/src/render/pbr_lighting.wgsl (v0.15.0–v0.18.1; v0.19 clamp: PR #22833)",
+        hc,
+        |m, r| KARIS.eval(r, m),
+        |m, r| refits.karis_hc.eval(r, m),
+        "Karis's form, Nelder–Mead minimax against ggx-env",
+    );
+    let p_clamp = pair(hc, |m, r| forms::bevy_clamped(r, m));
+    let (cm, crms, _) = measure(&p_clamp.points, &p_clamp.truth, &p_clamp.approx);
+    item.extra.push(("clamped_max_abs_error".into(), cm));
+    let (mut a_min, mut a_at, mut b_neg, mut n) = (f64::MAX, (0.0, 0.0), 0usize, 0usize);
+    for (m, r) in hc.points() {
+        let [a, b] = KARIS.eval(r, m);
+        if a < a_min {
+            a_min = a;
+            a_at = (m, r);
+        }
+        b_neg += (b < 0.0) as usize;
+        n += 1;
+    }
+    item.findings.push(format!(
+        "The v0.19 clamp max(F_ab, 0.00005) changes the measured error little (max {cm:.3e}, rms {crms:.3e}): it only lifts \
+         B where it is negative ({:.0} % of the grid) and A at grazing smooth surfaces (A = {a_min:.4} at n·v = {:.4}, r = {:.3}).",
+        100.0 * b_neg as f64 / n as f64,
+        a_at.0,
+        a_at.1
+    ));
+    // The direct-light compensation 1 + F0(1/A − 1) (bevy ≤ 0.19, fixed by PR #23514) against
+    // Turquin's 1 + F0(1/E − 1), at F0 = 1: 1/A against 1/E.
+    let (mut worst, mut at) = (0.0f64, (0.0, 0.0, 0.0, 0.0));
+    let mut worst_sum = 0.0f64;
+    for ((m, r), t) in hc.points().zip(&hc.values) {
+        let [a, b] = KARIS.eval(r, m);
+        let exact = 1.0 / (t[0] + t[1]);
+        let rel = ((1.0 / a) / exact - 1.0).abs();
+        if rel > worst {
+            worst = rel;
+            at = (m, r, 1.0 / a, exact);
+        }
+        worst_sum = worst_sum.max(((1.0 / (a + b)) / exact - 1.0).abs());
+    }
+    item.extra.push(("compensation_1_over_a_max_rel_error".into(), worst));
+    item.extra.push(("compensation_1_over_a_plus_b_max_rel_error".into(), worst_sum));
+    item.findings.push(format!(
+        "Energy compensation: bevy scaled direct specular by 1 + F0(1/A − 1) (A, not A + B = E; PR #23514). At F0 = 1 \
+         that is 1/A = {:.1} where Turquin's 1/E = {:.3} (n·v = {:.4}, r = {:.3}): a relative error of up to {worst:.0}×, the \
+         fireflies of issue #22833. With A + B it would be at most {worst_sum:.2}× (the error of Karis's E = 1 − 0.55 r at grazing n·v).",
+        at.2, at.3, at.0, at.1
+    ));
+    out.push(item);
+    out
+}
+
+fn lazarov_item() -> Item {
+    let g = grid::standard(Target::Gloss);
+    let mut item = pair_item(
+        "ggx-env: Lazarov 2013 (Black Ops II) environment BRDF",
+        "Lazarov 2013, 'Getting More Physical in Call of Duty: Black Ops II' (as in OpenXRay pbr_brdf_blinn.h EnvBlops2)",
+        g,
+        |m, gl| LAZAROV.eval(gl, m),
+        |m, gl| refit::COMMITTED.lazarov.eval(gl, m),
+        "same form, 7 constants, Nelder–Mead minimax against ggx-env at α = sqrt(2/(8192^g + 2))",
+    );
+    item.findings.push(format!(
+        "Model mismatch: the fit is of normalized Blinn-Phong D = (m + 2)/(2π)(n·h)^m, m = 8192^g, with Schlick–Smith \
+         k = 2/sqrt(π(m + 2)), not GGX. Measured against GGX through m = 2/α² − 2 ⇔ α = sqrt(2/(m + 2)) (Walter et al. 2007's \
+         Phong–Beckmann correspondence): g ∈ [0, 1] is α ∈ [{:.4}, {:.4}]; part of the error is the model difference, \
+         which the refit (GGX target) removes.",
+        forms::alpha_of_gloss(1.0),
+        forms::alpha_of_gloss(0.0)
+    ));
+    item.findings.push(
+        "A + B = a1 = 0.75 + 0.25 g, independent of n·v (as Karis's, whose F0 = 0.04 curve has the same constants with \
+         g = 1 − r); every component of t is multiplied by g, so the min's cap is 0.475 g, not 0.475."
+            .into(),
+    );
+    item
+}
+
+fn materialx_item() -> Item {
+    let g = grid::standard(Target::Alpha);
+    let mut item = pair_item(
+        "ggx-env: MaterialX mx_ggx_dir_albedo_analytic",
+        "MaterialX libraries/pbrlib/genglsl/lib/mx_microfacet_specular.glsl (v1.39.5)",
+        g,
+        |m, a| MATERIALX.eval(m, a),
+        |m, a| refit::COMMITTED.materialx.eval(m, a),
+        "same biquadratic/biquadratic pair with clamp, rational minimax per channel, denominators proven positive",
+    );
+    let p = pair(g, |m, a| MATERIALX_UNROUNDED.eval(m, a));
+    let (um, urms, _) = measure(&p.points, &p.truth, &p.approx);
+    item.extra.push(("unrounded_max_abs_error".into(), um));
+    item.findings.push(format!(
+        "Input α (GGX alpha, MaterialX clamps it to ≥ M_FLOAT_EPS; α = 0 here is the mirror limit). Fitted to VNDF Monte Carlo \
+         data (16K samples per pixel) with height-correlated G2, then rounded to 4 significant figures (commit 77ff72f35): \
+         with the unrounded constants of that diff the max is {um:.3e}, rms {urms:.3e}, so the rounding is {} the error.",
+        if (um - item.max_abs_error).abs() < 0.1 * item.max_abs_error { "not" } else { "part of" }
+    ));
+    item
+}
+
+fn kulla_conty_items() -> Vec<Item> {
+    let mut out = Vec::new();
+    let r = refit::COMMITTED.kulla_conty;
+    for above in [true, false] {
+        let (eta, f) = grid::fresnel(above);
+        let pts: Vec<Vec<f64>> = eta.iter().map(|&e| vec![e]).collect();
+        let approx: Vec<f64> = eta.iter().map(|&e| KULLA_CONTY.eval(e)).collect();
+        let (name, dom) = if above {
+            ("fresnel-avg-dielectric: Kulla–Conty fit, η ≥ 1 branch", "η ∈ [1, 3], 513 points")
+        } else {
+            ("fresnel-avg-dielectric: Kulla–Conty fit, η < 1 branch", "η ∈ [1/3, 1), 513 points")
+        };
+        let mut item = Item::measured(name, "Kulla & Conty 2017, 'Revisiting Physically Based Shading at Imageworks' (as in Cycles bsdf_util.h)", dom, &pts, f, &approx);
+        let refit: Vec<f64> = eta.iter().map(|&e| r.eval(e)).collect();
+        let (m, rms, _) = measure(&pts, f, &refit);
+        item.extra.push(("refit_max_abs_error".into(), m));
+        item.extra.push(("refit_rms_error".into(), rms));
+        item.findings.push("Against the exact unpolarised dielectric Fresnel average 2∫F(μ, η)μ dμ (numerical, tolerance 1e-12; total internal reflection counts as F = 1).".into());
+        if !above {
+            let jump = KULLA_CONTY.eval(1.0 - 1e-12) - KULLA_CONTY.eval(1.0);
+            item.findings.push(format!("The branches disagree at η = 1 by {jump:.2e} (the cubic gives {:.5} where F_avg = 0).", KULLA_CONTY.eval(1.0 - 1e-12)));
+        }
+        item.findings.push(format!(
+            "shadefit's refit (same form, Nelder–Mead minimax): max {m:.3e} ({:.2}× the published), rms {rms:.3e} ({:.2}×).",
+            m / item.max_abs_error,
+            rms / item.rms_error
+        ));
+        out.push(item);
+    }
+    out
+}
+
+/// The Filament LUT's measures: the table, the integrals at every row's own roughness and at
+/// the shader's, on every other n·v column.
+struct FilamentMeasures {
+    /// Columns measured (every fourth texel column) and their n·v.
+    cols: Vec<usize>,
+    mu: Vec<f64>,
+    table: filament::Table,
+    /// [bias, E] of the integral at roughness k/2·(1/128) … : rows (k + ½)/128, k < 128, then 1.
+    grid: Grid,
+}
+
+fn filament_measures() -> &'static FilamentMeasures {
+    static M: std::sync::OnceLock<FilamentMeasures> = std::sync::OnceLock::new();
+    M.get_or_init(|| {
+        let n = filament::SIZE;
+        let cols: Vec<usize> = (0..n).step_by(4).collect();
+        let mu: Vec<f64> = cols.iter().map(|&i| (i as f64 + 0.5) / n as f64).collect();
+        let mut rows: Vec<f64> = (0..n).map(|k| (k as f64 + 0.5) / n as f64).collect();
+        rows.push(1.0);
+        let grid = Grid::compute(Target::Roughness, mu.clone(), rows, grid::TOL);
+        FilamentMeasures { cols, mu, table: filament::table(), grid }
+    })
+}
+
+impl FilamentMeasures {
+    /// [bias, E] of the integral at (column c, roughness row k of the grid).
+    fn exact(&self, c: usize, k: usize) -> [f64; 2] {
+        let v = self.grid.values[k * self.mu.len() + c];
+        [v[1], v[0] + v[1]]
+    }
+
+    /// Signed errors (texel − integral) of every measured texel, channel `ch`, `f16` or f64,
+    /// against the integral at the texel's own roughness (`own`) or at the shader's.
+    fn errors(&self, ch: usize, f16: bool, own: bool) -> Vec<f64> {
+        let n = filament::SIZE;
+        let table = if f16 { &self.table.f16s } else { &self.table.f64s };
+        let mut out = Vec::with_capacity(n * self.cols.len());
+        for j in 0..n {
+            for (c, &i) in self.cols.iter().enumerate() {
+                // Row j holds roughness (j + 1.5)/n = grid row j + 1 (row n − 1: 1.0, grid row n).
+                let k = if own { (j + 1).min(n) } else { j };
+                out.push(table[j * n + i][ch] - self.exact(c, k)[ch]);
+            }
+        }
+        out
+    }
+}
+
+fn stats(e: &[f64]) -> (f64, f64, f64) {
+    let max = e.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let rms = (e.iter().map(|v| v * v).sum::<f64>() / e.len() as f64).sqrt();
+    let mean = e.iter().sum::<f64>() / e.len() as f64;
+    (max, rms, mean)
+}
+
+fn filament_item() -> Item {
+    let fm = filament_measures();
+    let n = filament::SIZE;
+    // As shipped: f16 texels read at the shader's (n·v, r) = texel centre.
+    let mut points = Vec::new();
+    let (mut truth, mut approx) = (Vec::new(), Vec::new());
+    for j in 0..n {
+        for (c, &i) in fm.cols.iter().enumerate() {
+            for ch in 0..2 {
+                points.push(vec![fm.mu[c], (j as f64 + 0.5) / n as f64, ch as f64]);
+                truth.push(fm.exact(c, j)[ch]);
+                approx.push(fm.table.f16s[j * n + i][ch]);
+            }
+        }
+    }
+    let mut item = Item::measured(
+        "ggx-env: Filament DFG LUT (cmgen, 128², 1024 samples, RGB16F)",
+        "google/filament libs/ibl/src/CubemapIBL.cpp (DFV_Multiscatter), tools/cmgen; regenerated here from its formulas",
+        "every fourth n·v column (32) × all 128 roughness rows, channels (bias, E) at the texel centres the shader reads",
+        &points,
+        &truth,
+        &approx,
+    );
+    let names = ["bias", "E"];
+    let mut noise = Vec::new();
+    for (ch, nm) in names.iter().enumerate() {
+        let (m, r, b) = stats(&fm.errors(ch, false, true));
+        let (m16, r16, _) = stats(&fm.errors(ch, true, true));
+        let (ms, rs, bs) = stats(&fm.errors(ch, true, false));
+        item.extra.push((format!("{nm}_estimator_max_abs_error"), m));
+        item.extra.push((format!("{nm}_estimator_rms_error"), r));
+        item.extra.push((format!("{nm}_estimator_mean_error"), b));
+        item.extra.push((format!("{nm}_f16_max_abs_error"), m16));
+        item.extra.push((format!("{nm}_as_sampled_max_abs_error"), ms));
+        noise.push(format!(
+            "{nm}: estimator (f64) max {m:.2e}, rms {r:.2e}, mean {b:+.2e}; stored f16 max {m16:.2e}, rms {r16:.2e}; \
+             as sampled (one texel off) max {ms:.2e}, rms {rs:.2e}, mean {bs:+.2e}"
+        ));
+    }
+    item.findings.push(format!(
+        "Estimator against the integral at each texel's own (n·v, α) — the quadrature error of 1024 Hammersley samples \
+         (deterministic, so 'noise' is its pattern over texels; 'mean' is its bias): {}.",
+        noise.join("; ")
+    ));
+    item.findings.push(
+        "Roughness axis one texel off (derived from the generator: coord = (h − y + 0.5)/h, rows flipped for GL, so row j \
+         holds r = (j + 1.5)/h while the shader reads it at v = (j + 0.5)/h without a remap; the top two rows hold \
+         (h − 0.5)/h and 1): 'as sampled' compares each texel with the integral at the roughness the shader reads it for, \
+         the max above. The n·v axis is at true texel centres."
+            .into(),
+    );
+    item.findings.push(format!(
+        "Measured at tolerance {:.0e} against ggx-env (exact height-correlated V, as Filament's Visibility).",
+        grid::TOL
+    ));
+    item
+}
 
 /// Published forms measured against the integrals (the committed refits beside them).
 pub fn items(_generated: &Path) -> Vec<Item> {
-    Vec::new()
+    let mut out = karis_items();
+    out.push(lazarov_item());
+    out.push(materialx_item());
+    out.extend(kulla_conty_items());
+    out.push(filament_item());
+    out
 }
 
+// ---------------------------------------------------------------------------------------------
+// Bench: shader forms of E
+
 /// Fit specs timed with every solver (the bench's fits section).
-pub static FITS: &[FitBench] = &[];
+pub static FITS: &[FitBench] = &[FitBench { spec: "ggx_albedo_rational", order: 20, quick: false }];
 
 /// Shader forms per quantity (the bench's forms section).
-pub static FORMS: &[FormSet] = &[];
+pub static FORMS: &[FormSet] = &[FormSet { quantity: "ggx-albedo", order: 20, forms: albedo_forms }];
 
-/// Error maps of the published forms.
-pub fn figures(_out: &Path, _generated: &Path) -> Result<Vec<PathBuf>, PlotError> {
-    Ok(Vec::new())
+/// Karis's E = A + B as a WGSL function of (n·v, perceptual roughness), as engines call it.
+fn karis_wgsl(k: &Karis) -> String {
+    format!(
+        "fn karis_albedo(n_dot_v: f32, roughness: f32) -> f32 {{\n\
+         \x20   let c0 = vec4<f32>({:e}, {:e}, {:e}, {:e});\n\
+         \x20   let c1 = vec4<f32>({:e}, {:e}, {:e}, {:e});\n\
+         \x20   let r = roughness * c0 + c1;\n\
+         \x20   let a004 = min(r.x * r.x, exp2({:e} * n_dot_v)) * r.x + r.y;\n\
+         \x20   let ab = vec2<f32>({:e}, {:e}) * a004 + r.zw;\n\
+         \x20   return ab.x + ab.y;\n}}\n",
+        k.c0[0] as f32, k.c0[1] as f32, k.c0[2] as f32, k.c0[3] as f32,
+        k.c1[0] as f32, k.c1[1] as f32, k.c1[2] as f32, k.c1[3] as f32,
+        k.k as f32, -k.s as f32, k.s as f32
+    )
+}
+
+/// MaterialX's pair summed (E with F0 = F90 = 1, as `mx_ggx_energy_compensation` calls it).
+fn materialx_wgsl(m: &MaterialX) -> String {
+    let v = |k: usize| format!("vec4<f32>({:e}, {:e}, {:e}, {:e})", m.r[k][0] as f32, m.r[k][1] as f32, m.r[k][2] as f32, m.r[k][3] as f32);
+    format!(
+        "fn materialx_albedo(n_dot_v: f32, alpha: f32) -> f32 {{\n\
+         \x20   let x = n_dot_v;\n    let y = alpha;\n    let x2 = x * x;\n    let y2 = y * y;\n\
+         \x20   let r = {} + {} * x + {} * y + {} * x * y + {} * x2 + {} * y2 + {} * x2 * y + {} * x * y2 + {} * x2 * y2;\n\
+         \x20   let ab = clamp(r.xy / r.zw, vec2<f32>(0.0), vec2<f32>(1.0));\n\
+         \x20   return ab.x + ab.y;\n}}\n",
+        v(0), v(1), v(2), v(3), v(4), v(5), v(6), v(7), v(8)
+    )
+}
+
+/// A closed form of E(n·v, α) measured on the reference (points [α, n·v], the quantity's order;
+/// f64 evaluation of the same constants: the f32 rounding, ≤ 1e-6 here, is three decades
+/// below these forms' errors).
+fn closed_row(spec: &str, reference: &Reference, form: &str, wgsl: &str, function: &str, e: impl Fn(f64, f64) -> f64, note: &str) -> Result<FormRow, BenchError> {
+    let ops = count(spec, wgsl, function)?;
+    let approx: Vec<f64> = reference.points.iter().map(|p| e(p[1], p[0])).collect();
+    let (max, rms, _) = measure(&reference.points, &reference.values, &approx);
+    Ok(row("ggx-albedo", form, ops, 0, Measured { max, rms, points: approx.len() }, note.into()))
+}
+
+/// E(μ, α): the published closed forms and their refits, shadefit's rationals, tables.
+fn albedo_forms(ctx: &Ctx) -> Result<Vec<FormRow>, BenchError> {
+    let spec = ctx.spec("ggx_albedo_rational")?;
+    let mut integral = Integral::of(&spec);
+    let n = ctx.pick(129, 33);
+    let reference = integral.reference(pipeline::grid(&spec, &[n, n]));
+    let m = ctx.pick(spec.file.axis[0].count, 17);
+    let refits = &refit::COMMITTED;
+    let cheaper = ctx.variant(&spec, "ggx_albedo_rational_bilinear", |t| {
+        set(t, "model.numerator", strings(&["1", "n_dot_v", "alpha", "n_dot_v*alpha"]));
+        set(t, "model.denominator", strings(&["n_dot_v", "alpha", "n_dot_v*alpha"]));
+    })?;
+    let small = table_spec(ctx, &spec, "ggx_albedo_table_16", 16)?;
+    let large = table_spec(ctx, &spec, "ggx_albedo_table_32", 32)?;
+    let name = &spec.file.name;
+    let fit_note = format!("minimax on {m}×{m}");
+    Ok(vec![
+        closed_row(name, &reference, PUBLISHED, &karis_wgsl(&KARIS), "karis_albedo", |x, a| { let [p, q] = KARIS.eval(a.sqrt(), x); p + q }, "Karis 2014 EnvBRDFApprox A + B = 1 − 0.55 r (input r = sqrt(α))")?,
+        closed_row(name, &reference, "Karis refit", &karis_wgsl(&refits.karis_hc), "karis_albedo", |x, a| { let [p, q] = refits.karis_hc.eval(a.sqrt(), x); p + q }, "same form refitted to ggx-env (pair minimax)")?,
+        closed_row(name, &reference, "MaterialX", &materialx_wgsl(&MATERIALX), "materialx_albedo", |x, a| { let [p, q] = MATERIALX.eval(x, a); p + q }, "mx_ggx_dir_albedo_analytic, A + B")?,
+        closed_row(name, &reference, "MaterialX refit", &materialx_wgsl(&refits.materialx), "materialx_albedo", |x, a| { let [p, q] = refits.materialx.eval(x, a); p + q }, "same pair refitted (per channel minimax)")?,
+        refit_row(&spec, ctx.generated, &reference, "fits/ggx_albedo_rational.toml, committed")?,
+        fit_row(&cheaper, integral.fit(&cheaper, &[m, m])?, &reference, "rational bilinear", &fit_note)?,
+        table_row(&small, table_values(&mut integral, &small), &reference, "table 16²", "")?,
+        table_row(&large, table_values(&mut integral, &large), &reference, "table 32²", "")?,
+    ])
+}
+
+// ---------------------------------------------------------------------------------------------
+// Figures
+
+/// Error maps (form − integral) over (n·v, y) of each published pair form and its refit: four
+/// panels (published scale, bias; refit scale, bias) on one colour scale.
+pub fn figures(out: &Path, _generated: &Path) -> Result<Vec<PathBuf>, PlotError> {
+    let refits = &refit::COMMITTED;
+    let mut files = Vec::new();
+    type Form<'a> = Box<dyn Fn(f64, f64) -> [f64; 2] + 'a>;
+    let cases: Vec<(&str, &str, Target, Form, Form)> = vec![
+        ("ggx_karis_errors", "Karis 2014 EnvBRDFApprox against ggx-env-ue4", Target::RoughnessUe4, Box::new(|m, r| KARIS.eval(r, m)), Box::new(|m, r| refits.karis_ue4.eval(r, m))),
+        ("ggx_bevy_errors", "bevy F_AB (Karis) against ggx-env (height-correlated)", Target::Roughness, Box::new(|m, r| KARIS.eval(r, m)), Box::new(|m, r| refits.karis_hc.eval(r, m))),
+        ("ggx_lazarov_errors", "Lazarov 2013 against ggx-env, α = sqrt(2/(8192^g + 2))", Target::Gloss, Box::new(|m, g| LAZAROV.eval(g, m)), Box::new(|m, g| refits.lazarov.eval(g, m))),
+        ("ggx_materialx_errors", "MaterialX mx_ggx_dir_albedo_analytic against ggx-env", Target::Alpha, Box::new(|m, a| MATERIALX.eval(m, a)), Box::new(|m, a| refits.materialx.eval(m, a))),
+    ];
+    for (stem, title, target, published, refit) in cases {
+        let g = grid::standard(target);
+        let e = g.errors(published);
+        let f = g.errors(refit);
+        let ch = |v: &[[f64; 2]], c: usize| v.iter().map(|x| x[c]).collect::<Vec<f64>>();
+        let (pa, pb, ra, rb) = (ch(&e, 0), ch(&e, 1), ch(&f, 0), ch(&f, 1));
+        let label = |what: &str, v: &[f64]| format!("{what}: max {:.2e}", v.iter().fold(0.0f64, |m, x| m.max(x.abs())));
+        files.extend(crate::plot::grid_of_heatmaps(
+            &out.join(stem),
+            &format!("{title}: error (form − integral)"),
+            "n·v",
+            target.axis_name(),
+            &g.mu,
+            &g.y,
+            &[
+                Panel { title: &label("published scale", &pa), values: &pa },
+                Panel { title: &label("published bias", &pb), values: &pb },
+                Panel { title: &label("refit scale", &ra), values: &ra },
+                Panel { title: &label("refit bias", &rb), values: &rb },
+            ],
+            2,
+            "form − integral",
+            true,
+            None,
+        )?);
+    }
+    // Filament: the regenerated LUT's error at its own coordinates and as sampled.
+    let fm = filament_measures();
+    let n = filament::SIZE;
+    let ys: Vec<f64> = (0..n).map(|j| (j as f64 + 0.5) / n as f64).collect();
+    let (b_own, e_own, b_s, e_s) = (fm.errors(0, true, true), fm.errors(1, true, true), fm.errors(0, true, false), fm.errors(1, true, false));
+    let label = |what: &str, v: &[f64]| format!("{what}: max {:.2e}", v.iter().fold(0.0f64, |m, x| m.max(x.abs())));
+    files.extend(crate::plot::grid_of_heatmaps(
+        &out.join("ggx_filament_lut_errors"),
+        "Filament DFG LUT (128², 1024 samples, f16) against ggx-env: texel − integral",
+        "n·v",
+        "roughness r (shader's v)",
+        &fm.mu,
+        &ys,
+        &[
+            Panel { title: &label("bias, own roughness", &b_own), values: &b_own },
+            Panel { title: &label("E, own roughness", &e_own), values: &e_own },
+            Panel { title: &label("bias, as sampled", &b_s), values: &b_s },
+            Panel { title: &label("E, as sampled", &e_s), values: &e_s },
+        ],
+        2,
+        "texel − integral",
+        true,
+        None,
+    )?);
+    Ok(files)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn published_forms_at_hand_computed_points() {
+        // Karis at r = 0.5, n·v = 1, by hand from the published text: r = 0.5·c0 + c1 =
+        // (0.5, 0.02875, 0.754, −0.029); min(0.25, 2^−9.28 = 0.0016097) = 0.0016097;
+        // a004 = 0.0016097·0.5 + 0.02875 = 0.0295549; A = −1.04·a004 + 0.754 = 0.7232629,
+        // B = 1.04·a004 − 0.029 = 0.0017371. 1e-6: the digits kept by hand.
+        let [a, b] = KARIS.eval(0.5, 1.0);
+        assert!((a - 0.7232629).abs() < 1e-6 && (b - 0.0017371).abs() < 1e-6, "{a} {b}");
+        // Karis at r = 0, n·v = 0: r = (1, 0.0425, 1.04, −0.04), a004 = 1·1 + 0.0425 = 1.0425,
+        // A = 1.04 − 1.04·1.0425 = −0.0442, B = 1.04·1.0425 − 0.04 = 1.0442 (exact decimals).
+        let [a, b] = KARIS.eval(0.0, 0.0);
+        assert!((a + 0.0442).abs() < 1e-12 && (b - 1.0442).abs() < 1e-12, "{a} {b}");
+        // bevy's clamp lifts that A to 0.00005.
+        assert_eq!(forms::bevy_clamped(0.0, 0.0)[0], 0.00005);
+        // Lazarov at g = 1, n·v = 0: t = (1/0.96, 0.475, 0.0175/0.96, 0.25) + (0, 0, −0.015/0.96, 0.75)
+        // = (1.0416667, 0.475, 0.0026042, 1); a0 = 1.0416667·min(0.475, 1) + 0.0026042 = 0.4973958,
+        // A = 1 − a0 = 0.5026042. 1e-7: hand digits.
+        let [a, b] = LAZAROV.eval(1.0, 0.0);
+        assert!((b - 0.4973958).abs() < 1e-7 && (a - 0.5026042).abs() < 1e-7, "{a} {b}");
+        // MaterialX at x = y = 0: AB = (0.1003/1, 0.9345/1); at x = y = 1 the column sums:
+        // r.x = 0.1003 − 0.6303 + 9.748 − 2.038 + 29.34 − 8.245 − 26.44 + 19.99 − 5.448 = 16.377,
+        // r.z = 1 − 1.765 + 8.263 + 11.53 + 28.96 − 7.507 − 36.11 + 15.86 + 33.37 = 53.601,
+        // A = 0.3055353 (sums by hand, exact decimals; 1e-6 for the division's digits).
+        assert_eq!(MATERIALX.eval(0.0, 0.0), [0.1003, 0.9345]);
+        let [a, _] = MATERIALX.eval(1.0, 1.0);
+        assert!((a - 16.377 / 53.601).abs() < 1e-12 && (a - 0.3055353).abs() < 1e-6, "{a}");
+        // Kulla–Conty at η = 1.5: 0.5/(4.08567 + 1.501065) = 0.0894977 (by hand, 1e-7: the
+        // digits kept); below 1 at η = 0.5: 0.997118 + 0.0507 − 0.24131025 − 0.016325875
+        // = 0.790181875 (exact decimals).
+        assert!((KULLA_CONTY.eval(1.5) - 0.0894977).abs() < 1e-7);
+        assert!((KULLA_CONTY.eval(0.5) - 0.790181875).abs() < 1e-12);
+    }
+
+    #[test]
+    fn karis_scale_plus_bias_is_linear_in_roughness() {
+        // A + B = r.z + r.w = 1 − 0.55 r for every n·v: exact up to rounding of a few
+        // operations on values ≤ 1.1 (1e-15).
+        for r in [0.0, 0.1, 0.37, 0.8, 1.0] {
+            for m in [0.0, 0.01, 0.3, 1.0] {
+                let [a, b] = KARIS.eval(r, m);
+                assert!((a + b - (1.0 - 0.55 * r)).abs() < 1e-15);
+            }
+        }
+        // Lazarov: A + B = a1 = 0.75 + 0.25 g.
+        for g in [0.0, 0.5, 1.0] {
+            let [a, b] = LAZAROV.eval(g, 0.4);
+            assert!((a + b - (0.75 + 0.25 * g)).abs() < 1e-15);
+        }
+    }
+
+    #[test]
+    fn gloss_mapping_is_the_blinn_phong_correspondence() {
+        // g = 0: m = 1, α = sqrt(2/3); g = 1: m = 8192, α = sqrt(2/8194). Exact to rounding.
+        assert!((forms::alpha_of_gloss(0.0) - (2.0f64 / 3.0).sqrt()).abs() < 1e-15);
+        assert!((forms::alpha_of_gloss(1.0) - (2.0f64 / 8194.0).sqrt()).abs() < 1e-15);
+    }
+
+    #[test]
+    fn every_refit_beats_its_published_form() {
+        // The committed refits against the published constants on validate's grids: each must
+        // be at most 0.8× the published max error (the project's target), its own margin.
+        for it in items(Path::new("generated")).iter().filter(|i| !i.name.contains("Filament")) {
+            let refit = it.extra.iter().find(|(k, _)| k == "refit_max_abs_error").map(|e| e.1).expect("a refit");
+            assert!(refit <= 0.8 * it.max_abs_error, "{}: refit {refit:e} vs published {:e}", it.name, it.max_abs_error);
+        }
+    }
 }

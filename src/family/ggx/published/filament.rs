@@ -1,0 +1,126 @@
+//! Filament's DFG LUT, regenerated with its own estimator (google/filament
+//! `libs/ibl/src/CubemapIBL.cpp`, `DFV_Multiscatter` as called by `CubemapIBL::DFG`; the
+//! formulas, not the code, are reproduced here):
+//! ```text
+//! per texel (x, y) of a w × h image:   coord = saturate((h − y + 0.5)/h),  α = coord²
+//!                                      NoV = saturate((x + 0.5)/w),  V = (sqrt(1 − NoV²), 0, NoV)
+//! for i < N = 1024:  u = (i/N, radical_inverse₂(i))                     (Hammersley)
+//!   φ = 2π u.x,  cos²θ = (1 − u.y)/(1 + (α + 1)((α − 1) u.y))             (GGX D·cosθ sampling)
+//!   L = 2 (V·H) H − V;   if N·L > 0:
+//!     v = Vis(NoV, NoL, α) · NoL · (VoH/NoH),   Fc = (1 − VoH)⁵
+//!     r.x += v·Fc,   r.y += v
+//! r ·= 4/N               (r.x = bias, r.y = scale + bias = E: Filament's "multiscatter" layout)
+//! Vis = 0.5/(NoL sqrt(NoV²(1 − α²) + α²) + NoV sqrt(NoL²(1 − α²) + α²))  (exact height-correlated)
+//! ```
+//! stored RGB16F, rows flipped for GL (`cmgen` writes image row size − 1 − y at row y), and
+//! sampled in the shader at (u, v) = (NoV, perceptual roughness) without a half-texel remap.
+//!
+//! # The roughness axis is one texel off (derived from the formulas above)
+//! GL row j holds image row y = h − 1 − j, so coord = (h − (h − 1 − j) + 0.5)/h = (j + 1.5)/h,
+//! saturated at 1 for j = h − 1. The shader reads row j at v = (j + 0.5)/h: the value stored
+//! there is that of roughness v + 1/h (1/128 on desktop), and the top two rows both hold values
+//! near r = 1 ((h − 0.5)/h and 1). The n·v axis is at true texel centres.
+
+use super::super::integrals::Shadowing;
+use rayon::prelude::*;
+use std::f64::consts::PI;
+
+/// Filament's desktop LUT size and sample count.
+pub const SIZE: usize = 128;
+pub const SAMPLES: u32 = 1024;
+
+/// Filament's `Visibility`: exact height-correlated Smith V = G2/(4 NoL NoV).
+fn visibility(nov: f64, nol: f64, a: f64) -> f64 {
+    let a2 = a * a;
+    let ggxl = nov * ((nol - nol * a2) * nol + a2).sqrt();
+    let ggxv = nol * ((nov - nov * a2) * nov + a2).sqrt();
+    0.5 / (ggxv + ggxl)
+}
+
+/// `DFV_Multiscatter(NoV, α, n)` (in f64): [bias, E].
+pub fn dfv_multiscatter(nov: f64, a: f64, n: u32) -> [f64; 2] {
+    let v = [(1.0 - nov * nov).sqrt(), 0.0, nov];
+    let (mut bias, mut e) = (0.0, 0.0);
+    for i in 0..n {
+        let ux = i as f64 / n as f64;
+        let uy = i.reverse_bits() as f64 * (0.5 / 2147483648.0);
+        let phi = 2.0 * PI * ux;
+        let cos2 = (1.0 - uy) / (1.0 + (a + 1.0) * ((a - 1.0) * uy));
+        let (ct, st) = (cos2.sqrt(), (1.0 - cos2).sqrt());
+        let h = [st * phi.cos(), st * phi.sin(), ct];
+        let voh_raw = v[0] * h[0] + v[1] * h[1] + v[2] * h[2];
+        let l_z = 2.0 * voh_raw * h[2] - v[2];
+        let nol = l_z.clamp(0.0, 1.0);
+        let noh = h[2].clamp(0.0, 1.0);
+        let voh = voh_raw.clamp(0.0, 1.0);
+        if nol > 0.0 {
+            let w = visibility(nov, nol, a) * nol * (voh / noh);
+            let fc = (1.0 - voh).powi(5);
+            bias += w * fc;
+            e += w;
+        }
+    }
+    let k = 4.0 / n as f64;
+    [bias * k, e * k]
+}
+
+/// Perceptual roughness whose value GL row `j` of an `h`-row table holds: min((j + 1.5)/h, 1).
+pub fn row_roughness(j: usize, h: usize) -> f64 {
+    ((j as f64 + 1.5) / h as f64).min(1.0)
+}
+
+/// The regenerated table in GL order, texel (i, j) at `[j * SIZE + i]`: [bias, E] in f64 and
+/// rounded to f16 as stored.
+pub struct Table {
+    pub f64s: Vec<[f64; 2]>,
+    pub f16s: Vec<[f64; 2]>,
+}
+
+pub fn table() -> Table {
+    let f64s: Vec<[f64; 2]> = (0..SIZE * SIZE)
+        .into_par_iter()
+        .map(|k| {
+            let (i, j) = (k % SIZE, k / SIZE);
+            let r = row_roughness(j, SIZE);
+            dfv_multiscatter((i as f64 + 0.5) / SIZE as f64, r * r, SAMPLES)
+        })
+        .collect();
+    let f16s = f64s.iter().map(|v| v.map(|x| half::f16::from_f64(x).to_f64())).collect();
+    Table { f64s, f16s }
+}
+
+/// [bias, E] of the integral (height-correlated) at (n·v, α).
+pub fn exact(nov: f64, alpha: f64, tol: f64) -> [f64; 2] {
+    let r = super::super::integrals::env(alpha, nov, 0.0, Shadowing::HeightCorrelated, tol);
+    [r.bias, r.scale + r.bias]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hammersley_matches_the_radical_inverse() {
+        // radical_inverse₂(1) = 0.5, (2) = 0.25, (3) = 0.75, (6) = 0.375: bit reversal, by hand.
+        for (i, want) in [(1u32, 0.5), (2, 0.25), (3, 0.75), (6, 0.375)] {
+            assert_eq!(i.reverse_bits() as f64 * (0.5 / 2147483648.0), want);
+        }
+    }
+
+    #[test]
+    fn estimator_is_exact_for_a_mirror() {
+        // α → 0: every sample is H = n, L the mirror of V, Vis·NoL·VoH/NoH·4 = 1 (NoL = NoV):
+        // E = 1 and bias = (1 − NoV)⁵ up to the O(α) spread at α = 1e-6.
+        let r = dfv_multiscatter(0.5, 1e-6, 64);
+        assert!((r[1] - 1.0).abs() < 1e-5 && (r[0] - 0.5f64.powi(5)).abs() < 1e-5, "{r:?}");
+    }
+
+    #[test]
+    fn rows_are_one_texel_off() {
+        // Row j holds roughness (j + 1.5)/h: the shader's v = (j + 0.5)/h plus one texel; the top
+        // two rows hold (h − 0.5)/h and 1.
+        assert_eq!(row_roughness(0, 128), 1.5 / 128.0);
+        assert_eq!(row_roughness(126, 128), 127.5 / 128.0);
+        assert_eq!(row_roughness(127, 128), 1.0);
+    }
+}

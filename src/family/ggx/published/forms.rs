@@ -1,0 +1,173 @@
+//! The published forms, constants and formulas copied from their sources (named on each).
+//!
+//! All return the split-sum pair [scale, bias] = [A, B] of `super::super::integrals` (the
+//! environment BRDF of a Schlick F0 is F0·A + B), except the Fresnel average.
+
+use std::array::from_fn;
+
+/// Karis 2014, "Physically Based Shading on Mobile" (Unreal Engine blog), `EnvBRDFApprox`
+/// (as in UE's `BRDF.ush`; bevy's `F_AB` up to v0.18.1 is the same text):
+/// ```text
+/// c0 = (−1, −0.0275, −0.572, 0.022),  c1 = (1, 0.0425, 1.04, −0.04)
+/// r = Roughness·c0 + c1
+/// a004 = min(r.x², exp2(−9.28 n·v))·r.x + r.y
+/// AB = (−1.04, 1.04)·a004 + r.zw
+/// ```
+/// with perceptual `Roughness` (α = Roughness²). `k` is the −9.28 and `s` the 1.04: the
+/// same form with new constants is a [`Karis`] too. UE's `saturate(50·F0.g)` on B (the
+/// "specular occlusion" of F0 < 2 %) is a shading choice, not part of the fit, and is left out.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Karis {
+    pub c0: [f64; 4],
+    pub c1: [f64; 4],
+    pub k: f64,
+    pub s: f64,
+}
+
+pub const KARIS: Karis = Karis { c0: [-1.0, -0.0275, -0.572, 0.022], c1: [1.0, 0.0425, 1.04, -0.04], k: -9.28, s: 1.04 };
+
+impl Karis {
+    /// [A, B] at perceptual roughness `r` and n·v.
+    pub fn eval(&self, r: f64, n_dot_v: f64) -> [f64; 2] {
+        let v: [f64; 4] = from_fn(|i| r * self.c0[i] + self.c1[i]);
+        let a004 = (v[0] * v[0]).min((self.k * n_dot_v).exp2()) * v[0] + v[1];
+        [-self.s * a004 + v[2], self.s * a004 + v[3]]
+    }
+
+    pub fn params(&self) -> Vec<f64> {
+        self.c0.iter().chain(&self.c1).copied().chain([self.k, self.s]).collect()
+    }
+
+    pub fn from_params(p: &[f64]) -> Karis {
+        Karis { c0: from_fn(|i| p[i]), c1: from_fn(|i| p[4 + i]), k: p[8], s: p[9] }
+    }
+}
+
+/// bevy's `F_AB` from v0.19 (PR #22833): Karis's pair clamped below at 0.00005
+/// ("Keep F_ab positive to avoid divide-by-zero in downstream BRDF terms").
+pub fn bevy_clamped(r: f64, n_dot_v: f64) -> [f64; 2] {
+    KARIS.eval(r, n_dot_v).map(|v| v.max(0.00005))
+}
+
+/// Lazarov 2013, "Getting More Physical in Call of Duty: Black Ops II" (SIGGRAPH course), the
+/// environment BRDF of gloss g, as carried by OpenXRay `pbr_brdf_blinn.h` (`EnvBlops2`, "credit
+/// to Treyarch"):
+/// ```text
+/// t = (1/0.96, 0.475, (0.0275 − 0.25·0.04)/0.96, 0.25)·g + (0, 0, (0.015 − 0.75·0.04)/0.96, 0.75)
+/// a0 = t.x·min(t.y, exp2(−9.28 n·v)) + t.z,   a1 = t.w
+/// env(F0) = a0 + F0·(a1 − a0)
+/// ```
+/// so A = a1 − a0 and B = a0 (Lazarov's `saturate` of the sum is left out: the pair is what
+/// is fitted). `slope` is the g-multiplied vector, `offset` its two constant terms (z, w) and
+/// `k` the −9.28.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Lazarov {
+    pub slope: [f64; 4],
+    pub offset: [f64; 2],
+    pub k: f64,
+}
+
+pub const LAZAROV: Lazarov = Lazarov {
+    slope: [1.0 / 0.96, 0.475, (0.0275 - 0.25 * 0.04) / 0.96, 0.25],
+    offset: [(0.015 - 0.75 * 0.04) / 0.96, 0.75],
+    k: -9.28,
+};
+
+impl Lazarov {
+    /// [A, B] at gloss g and n·v.
+    pub fn eval(&self, g: f64, n_dot_v: f64) -> [f64; 2] {
+        let t = [self.slope[0] * g, self.slope[1] * g, self.slope[2] * g + self.offset[0], self.slope[3] * g + self.offset[1]];
+        let a0 = t[0] * t[1].min((self.k * n_dot_v).exp2()) + t[2];
+        [t[3] - a0, a0]
+    }
+
+    pub fn params(&self) -> Vec<f64> {
+        self.slope.iter().chain(&self.offset).copied().chain([self.k]).collect()
+    }
+
+    pub fn from_params(p: &[f64]) -> Lazarov {
+        Lazarov { slope: from_fn(|i| p[i]), offset: [p[4], p[5]], k: p[6] }
+    }
+}
+
+/// Black Ops II's gloss → Blinn-Phong exponent, m = 8192^g = 2^(13 g) (Lazarov 2013 slides).
+pub fn blinn_phong_exponent(g: f64) -> f64 {
+    (13.0 * g).exp2()
+}
+
+/// The Blinn-Phong ↔ microfacet correspondence m = 2/α² − 2 (Walter et al. 2007's
+/// Phong–Beckmann relation, commonly reused for GGX): α = sqrt(2/(m + 2)). Used to measure
+/// Lazarov's Blinn-Phong fit against the GGX integral: g ∈ [0, 1] is α ∈ [0.0156, 0.816].
+pub fn alpha_of_gloss(g: f64) -> f64 {
+    (2.0 / (blinn_phong_exponent(g) + 2.0)).sqrt()
+}
+
+/// MaterialX `mx_ggx_dir_albedo_analytic` (libraries/pbrlib/genglsl/lib/mx_microfacet_specular.glsl,
+/// v1.39.5): "Rational quadratic fit to Monte Carlo data for GGX directional albedo", x = NdotV,
+/// y = alpha (GGX α),
+/// ```text
+/// r = R[0] + R[1] x + R[2] y + R[3] x y + R[4] x² + R[5] y² + R[6] x² y + R[7] x y² + R[8] x² y²
+/// AB = clamp(r.xy / r.zw, 0, 1)
+/// ```
+/// Rows are the vec4 constants in the source's order; `R[0]` = (0.1003, 0.9345, 1.0, 1.0).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MaterialX {
+    pub r: [[f64; 4]; 9],
+}
+
+pub const MATERIALX: MaterialX = MaterialX {
+    r: [
+        [0.1003, 0.9345, 1.0, 1.0],
+        [-0.6303, -2.323, -1.765, 0.2281],
+        [9.748, 2.229, 8.263, 15.94],
+        [-2.038, -3.748, 11.53, -55.83],
+        [29.34, 1.424, 28.96, 13.08],
+        [-8.245, -0.7684, -7.507, 41.26],
+        [-26.44, 1.436, -36.11, 54.9],
+        [19.99, 0.2913, 15.86, 300.2],
+        [-5.448, 0.6286, 33.37, -285.1],
+    ],
+};
+
+/// The monomials of MaterialX's form at (x, y) = (n·v, α), in the order of [`MaterialX::r`].
+pub fn materialx_monomials(x: f64, y: f64) -> [f64; 9] {
+    let (x2, y2) = (x * x, y * y);
+    [1.0, x, y, x * y, x2, y2, x2 * y, x * y2, x2 * y2]
+}
+
+impl MaterialX {
+    /// [A, B] at n·v and α.
+    pub fn eval(&self, n_dot_v: f64, alpha: f64) -> [f64; 2] {
+        let m = materialx_monomials(n_dot_v, alpha);
+        let r: [f64; 4] = from_fn(|c| (0..9).map(|k| self.r[k][c] * m[k]).sum());
+        [(r[0] / r[2]).clamp(0.0, 1.0), (r[1] / r[3]).clamp(0.0, 1.0)]
+    }
+}
+
+/// Kulla & Conty 2017, "Revisiting Physically Based Shading at Imageworks" (SIGGRAPH PBS course),
+/// the fit of the dielectric Fresnel average F_avg(η) = 2∫₀¹ F(μ, η) μ dμ, as in Cycles
+/// (`bsdf_util.h`, "a numerical fit from 'Revisiting …'"):
+/// ```text
+/// η ≥ 1:  (η − 1)/(4.08567 + 1.00071 η)
+/// η < 1:  0.997118 + 0.1014 η − 0.965241 η² − 0.130607 η³
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct KullaConty {
+    /// η ≥ 1: (η − 1)/(above[0] + above[1] η).
+    pub above: [f64; 2],
+    /// η < 1: below[0] + below[1] η + below[2] η² + below[3] η³.
+    pub below: [f64; 4],
+}
+
+pub const KULLA_CONTY: KullaConty = KullaConty { above: [4.08567, 1.00071], below: [0.997118, 0.1014, -0.965241, -0.130607] };
+
+impl KullaConty {
+    pub fn eval(&self, eta: f64) -> f64 {
+        if eta < 1.0 {
+            let b = self.below;
+            b[0] + eta * (b[1] + eta * (b[2] + eta * b[3]))
+        } else {
+            (eta - 1.0) / (self.above[0] + self.above[1] * eta)
+        }
+    }
+}
