@@ -20,6 +20,9 @@ pub mod ggx_albedo_avg;
 #[path = "ggx_albedo_avg_table.rs"]
 pub mod ggx_albedo_avg_table;
 #[cfg(feature = "ggx")]
+#[path = "ggx_albedo_rational.rs"]
+pub mod ggx_albedo_rational;
+#[cfg(feature = "ggx")]
 #[path = "ggx_albedo_table.rs"]
 pub mod ggx_albedo_table;
 #[cfg(feature = "gloss")]
@@ -71,6 +74,8 @@ pub mod wgsl {
     #[cfg(feature = "ggx")]
     pub const GGX_ALBEDO_AVG_TABLE: &str = include_str!("../wgsl/ggx_albedo_avg_table.wgsl");
     #[cfg(feature = "ggx")]
+    pub const GGX_ALBEDO_RATIONAL: &str = include_str!("../wgsl/ggx_albedo_rational.wgsl");
+    #[cfg(feature = "ggx")]
     pub const GGX_ALBEDO_TABLE: &str = include_str!("../wgsl/ggx_albedo_table.wgsl");
     #[cfg(feature = "gloss")]
     pub const GLOSS_COMBINE: &str = include_str!("../wgsl/gloss_combine.wgsl");
@@ -110,6 +115,8 @@ pub mod wgsl {
             "ggx_albedo_avg" => Some(GGX_ALBEDO_AVG),
             #[cfg(feature = "ggx")]
             "ggx_albedo_avg_table" => Some(GGX_ALBEDO_AVG_TABLE),
+            #[cfg(feature = "ggx")]
+            "ggx_albedo_rational" => Some(GGX_ALBEDO_RATIONAL),
             #[cfg(feature = "ggx")]
             "ggx_albedo_table" => Some(GGX_ALBEDO_TABLE),
             #[cfg(feature = "gloss")]
@@ -153,6 +160,8 @@ pub mod wgsl {
         #[cfg(feature = "ggx")]
         "ggx_albedo_avg_table",
         #[cfg(feature = "ggx")]
+        "ggx_albedo_rational",
+        #[cfg(feature = "ggx")]
         "ggx_albedo_table",
         #[cfg(feature = "gloss")]
         "gloss_combine",
@@ -191,6 +200,8 @@ pub const FUNCTIONS: &[EmittedFunction] = &[
     EmittedFunction { module: "ggx_albedo_avg", name: "ggx_albedo_avg_fit", domain: &[[1e-4, 1e0]], cpu: Cpu::One(ggx_albedo_avg::ggx_albedo_avg_fit) },
     #[cfg(feature = "ggx")]
     EmittedFunction { module: "ggx_albedo_avg_table", name: "ggx_albedo_avg_lut", domain: &[[1e-4, 1e0]], cpu: Cpu::One(ggx_albedo_avg_table::ggx_albedo_avg_lut) },
+    #[cfg(feature = "ggx")]
+    EmittedFunction { module: "ggx_albedo_rational", name: "ggx_albedo", domain: &[[1e-4, 1e0], [7.8125e-3, 1e0]], cpu: Cpu::Two(ggx_albedo_rational::ggx_albedo) },
     #[cfg(feature = "ggx")]
     EmittedFunction { module: "ggx_albedo_table", name: "ggx_albedo_lut", domain: &[[1e-4, 1e0], [0e0, 1e0]], cpu: Cpu::Two(ggx_albedo_table::ggx_albedo_lut) },
     #[cfg(feature = "gloss")]
