@@ -308,7 +308,7 @@ fn ps_documented_invalid_input() {
 }
 
 // ---------------------------------------------------------------------------------------------
-// fuzz: R (≈ 10–25 ms each at tolerance 1e-8: few cases)
+// fuzz: R (≈ 1 ms each at tolerance 1e-8)
 
 const R_TOL: f64 = 1e-8;
 

@@ -39,7 +39,7 @@ claim is checked too), the reference's error (quad's estimate, each under its re
 or the reference raises; for R the two-resolution difference), and a few ulps for the final
 roundings (EPS4 = 4 · 2^-52, the values are ≤ 1; for G times ln(1/μv), see g_rounding).
 
-Run time: ~145 `eval` processes (fuzz-r ~30 ms each, the others a few ms) and the references
+Run time: ~145 `eval` processes (a few ms each) and the references
 (~0.5 s for P_s, ~0.7 s for R): ~3 s in all on an idle core.
 """
 

@@ -320,7 +320,7 @@ def test_denominator_lower_bound_holds(name):
 # features, denominator lead, offset, factor). Not independent of shadefit's integrator, but it
 # ties the file's coefficients and error claim to the integral `eval` serves.
 
-FIT_EVAL_POINTS = 12   # per file, + the worst point (fuzz-r: ~40 ms a point)
+FIT_EVAL_POINTS = 12   # per file, + the worst point (fuzz-r: a few ms a point)
 
 
 @pytest.mark.parametrize("name", [n for n in NAMES if KINDS[n] == "fit"

@@ -234,7 +234,7 @@ fn fuzz_r_integrators(mode: &Mode) -> Vec<IntegratorRow> {
     let (truth, mut rows) = self_ladder(
         mode,
         "fuzz R",
-        "nested adaptive: A by GL32/GL24, η by G7/K15, w by G10/K21 (shadefit)",
+        "whole sphere, both azimuths in closed form: A and w by G10/K21 (shadefit)",
         REF_TOL,
         pick(mode, &[1e-5, 1e-7, 1e-9], &[1e-4, 1e-5, 1e-7, 1e-9, 1e-10]),
         eval,
@@ -437,7 +437,7 @@ const UNIFORM_MU: &str = "uniform grid: the largest errors sit at μv = 0.001, d
 fn fuzz_r(ctx: &Ctx) -> Result<Vec<FormRow>, BenchError> {
     let refit = ctx.spec("fuzz_r")?;
     let mut integral = Integral::of(&refit);
-    // R costs ~20 ms a point: the committed verification grid (25²), quick 13². The cheaper
+    // R costs ~1 ms a point: the committed verification grid (25²), quick 13². The cheaper
     // fit and the tables take their samples from that grid's every other and every fourth
     // point (the tables' midpoints stay in the grid).
     let n = ctx.pick(25, 13);

@@ -55,7 +55,7 @@ const R_TOL: f64 = 1e-7;
 const KEY_COLOR: usize = 7;
 
 /// Sampling of the fuzz figures. The reference P_s (ALPHAS × 3 θf × the light directions) and
-/// R (the α × θf grid, ~10–20 ms a point) cost nearly all of the time; G and Q are closed forms.
+/// R (the α × θf grid, ~1 ms a point) cost nearly all of the time; G and Q are closed forms.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct FuzzResolution {
     /// Light directions of each P_s panel: θu × φu cell midpoints.
