@@ -13,6 +13,12 @@ pub mod fuzz_q;
 #[cfg(feature = "fuzz")]
 #[path = "fuzz_r.rs"]
 pub mod fuzz_r;
+#[cfg(feature = "ggx")]
+#[path = "ggx_dfg_lut.rs"]
+pub mod ggx_dfg_lut;
+#[cfg(feature = "ggx")]
+#[path = "ggx_dfg_lut_filament.rs"]
+pub mod ggx_dfg_lut_filament;
 #[cfg(feature = "gloss")]
 #[path = "gloss_combine.rs"]
 pub mod gloss_combine;
@@ -57,6 +63,10 @@ pub mod wgsl {
     pub const FUZZ_Q: &str = include_str!("../wgsl/fuzz_q.wgsl");
     #[cfg(feature = "fuzz")]
     pub const FUZZ_R: &str = include_str!("../wgsl/fuzz_r.wgsl");
+    #[cfg(feature = "ggx")]
+    pub const GGX_DFG_LUT: &str = include_str!("../wgsl/ggx_dfg_lut.wgsl");
+    #[cfg(feature = "ggx")]
+    pub const GGX_DFG_LUT_FILAMENT: &str = include_str!("../wgsl/ggx_dfg_lut_filament.wgsl");
     #[cfg(feature = "gloss")]
     pub const GLOSS_COMBINE: &str = include_str!("../wgsl/gloss_combine.wgsl");
     #[cfg(feature = "gloss")]
@@ -91,6 +101,10 @@ pub mod wgsl {
             "fuzz_q" => Some(FUZZ_Q),
             #[cfg(feature = "fuzz")]
             "fuzz_r" => Some(FUZZ_R),
+            #[cfg(feature = "ggx")]
+            "ggx_dfg_lut" => Some(GGX_DFG_LUT),
+            #[cfg(feature = "ggx")]
+            "ggx_dfg_lut_filament" => Some(GGX_DFG_LUT_FILAMENT),
             #[cfg(feature = "gloss")]
             "gloss_combine" => Some(GLOSS_COMBINE),
             #[cfg(feature = "gloss")]
@@ -127,6 +141,10 @@ pub mod wgsl {
         "fuzz_q",
         #[cfg(feature = "fuzz")]
         "fuzz_r",
+        #[cfg(feature = "ggx")]
+        "ggx_dfg_lut",
+        #[cfg(feature = "ggx")]
+        "ggx_dfg_lut_filament",
         #[cfg(feature = "gloss")]
         "gloss_combine",
         #[cfg(feature = "gloss")]
