@@ -174,15 +174,18 @@ impl View {
 
     #[inline]
     fn weights(&self, vh: f64, ch: f64, mu_l: f64) -> [f64; 2] {
-        // G/μv in a form finite at μv = 0.
-        let g_over_mu_v = match self.shadowing {
+        // w = (G/μv)·vh/ch in a form finite at μv = 0, with one division: height-correlated,
+        // G/μv = 1/(μv + μvΛ(μv) + μv·μlΛ(μl)/μl) and μlΛ(μl) = α² s²/(2(S + μl)), s² = 1 − μl²,
+        // S = sqrt(μl² + α² s²), so w = vh·2μl(S + μl) / (ch·((μv + μvΛ(μv))·2μl(S + μl) + μv α² s²)).
+        let w = match self.shadowing {
             Shadowing::HeightCorrelated => {
-                let l_term = self.mu_v * mu_lambda(self.alpha2, mu_l) / mu_l;
-                1.0 / (self.mu_v + self.v_term + l_term)
+                let s2 = (1.0 - mu_l) * (1.0 + mu_l);
+                let a2s2 = self.alpha2 * s2;
+                let q = 2.0 * mu_l * ((mu_l * mu_l + a2s2).sqrt() + mu_l);
+                vh * q / (ch * ((self.mu_v + self.v_term) * q + self.mu_v * a2s2))
             }
-            Shadowing::Separable { k } => (mu_l / (mu_l * (1.0 - k) + k)) / self.v_term,
+            Shadowing::Separable { k } => vh * mu_l / (ch * (mu_l * (1.0 - k) + k) * self.v_term),
         };
-        let w = g_over_mu_v * vh / ch;
         let m = 1.0 - vh;
         let m2 = m * m;
         let fc = m2 * m2 * m;
@@ -419,11 +422,10 @@ fn nested_rules() -> &'static NestedRules {
 fn nested_phi(view: &View, sh: f64, ch: f64, phi_max: f64, abs: f64, rel: f64) -> Option<NestedResult> {
     let rules = nested_rules();
     let full = phi_max >= PI;
-    // Values at node index j (NESTED_MAX grid for the trapezoid, half of it for CC).
-    let m = if full { NESTED_MAX } else { NESTED_MAX / 2 };
-    let mut g: Vec<[f64; 2]> = vec![[0.0; 2]; m + 1];
+    // Values at node index j (NESTED_MAX grid for the trapezoid, its first half for CC).
+    let mut g = [[0.0f64; 2]; NESTED_MAX + 1];
     let mut evals = 0u64;
-    let mut at = |j: usize, g: &mut Vec<[f64; 2]>| {
+    let mut at = |j: usize, g: &mut [[f64; 2]; NESTED_MAX + 1]| {
         let cos_phi = if full { rules.cos[j] } else { (phi_max * rules.cos[j]).cos() };
         g[j] = view.integrand_inside(sh, ch, cos_phi);
         evals += 1;
