@@ -81,7 +81,11 @@ mod tests {
         // Independent of the nested azimuth rules: G10/K21 panels at 1e-12. Each texel is
         // within the spec's tolerance 1e-8 (the contract of env) plus the reference's 1e-12;
         // also with a cone and in alpha rows.
-        for text in [SPEC.to_string(), SPEC.replace("[10, 7]", "[10, 7]\ncos_cone = 0.4\nroughness_mapping = \"alpha\"")] {
+        for text in [
+            SPEC.to_string(),
+            SPEC.replace("[10, 7]", "[10, 7]\ncos_cone = 0.4\nroughness_mapping = \"alpha\""),
+            SPEC.replace("ggx-env", "ggx-env-ue4"),
+        ] {
             let lut = DfgLut::parse(Path::new("fits/ggx_t.toml"), &text).unwrap();
             let (values, q) = tabulate(&lut);
             assert!(q.max_error_estimate <= 1e-8, "{q:?}");
