@@ -10,7 +10,7 @@ against the rows written here at equal max error. Only numpy, scipy and the stan
 used.
 
 These are deliberately the *straightforward* methods, not tuned ones: the defining integral as
-written (module docs of src/family/{gloss,fuzz,skin}/integrals.rs), handed to
+written (module docs of src/family/{gloss,fuzz,skin,ggx}/integrals.rs), handed to
 `scipy.integrate.quad` / `dblquad` point by point, or to a vectorised Gauss–Legendre rule (or
 Monte Carlo) over all points at once, with no change of variables, no splitting at features
 beyond the obvious kinks, no closed-form inner integrals. Where scipy offers a closed form a user
@@ -508,6 +508,81 @@ def q_gl(d: np.ndarray, n: int) -> np.ndarray:
     return out
 
 
+# =============================================================================================
+# GGX split-sum DFG (src/family/ggx/integrals.rs): n = +z, v = (√(1 − μv²), 0, μv), GGX D with α,
+# height-correlated Smith G2 = 1/(1 + Λ(v) + Λ(l)), Fc = (1 − v·h)⁵, over light directions with μl > 0:
+# scale = ∫ (1 − Fc) f μl dω_l, bias = ∫ Fc f μl dω_l. Sampling h with pdf D μh (the GGX sampler) and
+# l = 2(v·h)h − v (pdf D μh/(4 v·h)), the weight of a sample is G2 (v·h)/(μv μh).
+
+
+def ggx_lambda(alpha, mu):
+    """Smith Λ(μ) = (−1 + √(1 + α² tan²θ))/2 (μ > 0)."""
+    return 0.5 * (-1.0 + np.sqrt(1.0 + alpha * alpha * (1.0 - mu * mu) / (mu * mu)))
+
+
+def dfg_weights(alpha, mu_v, cos2_h, cos_phi):
+    """(scale, bias) weights of half vectors at cos²θh and cos φ (arrays broadcasting against
+    the points' α and μv), 0 where l is below the horizon."""
+    mu_h = np.sqrt(cos2_h)
+    sin_h = np.sqrt(np.maximum(1.0 - cos2_h, 0.0))
+    sin_v = np.sqrt(1.0 - mu_v * mu_v)
+    vh = sin_v * sin_h * cos_phi + mu_v * mu_h
+    mu_l = 2.0 * vh * mu_h - mu_v
+    ok = (mu_l > 0.0) & (vh > 0.0)
+    mu_l_safe = np.where(ok, mu_l, 1.0)
+    g2 = 1.0 / (1.0 + ggx_lambda(alpha, mu_v) + ggx_lambda(alpha, mu_l_safe))
+    w = np.where(ok, g2 * vh / (mu_v * mu_h), 0.0)
+    fc = (1.0 - vh) ** 5
+    return w * (1.0 - fc), w * fc
+
+
+def radical_inverse(i: np.ndarray) -> np.ndarray:
+    """Van der Corput radical inverse in base 2 of 32-bit integers (Hammersley's second
+    coordinate, as Filament's hammersley())."""
+    b = i.astype(np.uint32)
+    b = ((b << np.uint32(16)) | (b >> np.uint32(16))).astype(np.uint32)
+    b = (((b & np.uint32(0x55555555)) << np.uint32(1)) | ((b & np.uint32(0xAAAAAAAA)) >> np.uint32(1))).astype(np.uint32)
+    b = (((b & np.uint32(0x33333333)) << np.uint32(2)) | ((b & np.uint32(0xCCCCCCCC)) >> np.uint32(2))).astype(np.uint32)
+    b = (((b & np.uint32(0x0F0F0F0F)) << np.uint32(4)) | ((b & np.uint32(0xF0F0F0F0)) >> np.uint32(4))).astype(np.uint32)
+    b = (((b & np.uint32(0x00FF00FF)) << np.uint32(8)) | ((b & np.uint32(0xFF00FF00)) >> np.uint32(8))).astype(np.uint32)
+    return b.astype(float) * 2.0 ** -32
+
+
+def dfg_hammersley(n_dot_v, alpha, samples: int) -> np.ndarray:
+    """(scale, bias) by Filament cmgen's estimator: `samples` Hammersley points (i/N, radical
+    inverse), GGX importance sampling cos²θh = (1 − u)/(1 + (α² − 1)u), φ = 2π i/N."""
+    i = np.arange(samples)
+    u1 = i / samples
+    u2 = radical_inverse(i)
+    out = np.empty((n_dot_v.size, 2))
+    for s in chunks(n_dot_v.size, samples):
+        a = alpha[s, None]
+        cos2_h = (1.0 - u2) / (1.0 + (a * a - 1.0) * u2)
+        sc, bi = dfg_weights(a, n_dot_v[s, None], cos2_h, np.cos(TWO_PI * u1))
+        out[s, 0] = sc.mean(axis=1)
+        out[s, 1] = bi.mean(axis=1)
+    return out
+
+
+def dfg_gl(n_dot_v, alpha, n: int) -> np.ndarray:
+    """(scale, bias) by an n × n Gauss–Legendre product in the sampler's variables: ξ ∈ [0, 1]
+    (tan²θh = α² ξ/(1 − ξ)) and φ ∈ [0, π] (the integrand is even in φ), measure dξ dφ/π; the
+    horizon cut is left inside the rule (no split at it)."""
+    xi, w_xi = gauss_legendre(n, 0.0, 1.0)
+    phi, w_phi = gauss_legendre(n, 0.0, math.pi)
+    xi, phi = np.meshgrid(xi, phi, indexing="ij")
+    w = (np.outer(w_xi, w_phi) / math.pi).ravel()
+    xi, cos_phi = xi.ravel(), np.cos(phi.ravel())
+    out = np.empty((n_dot_v.size, 2))
+    for s in chunks(n_dot_v.size, xi.size):
+        a = alpha[s, None]
+        cos2_h = (1.0 - xi) / (1.0 - xi + a * a * xi)
+        sc, bi = dfg_weights(a, n_dot_v[s, None], cos2_h, cos_phi)
+        out[s, 0] = sc @ w
+        out[s, 1] = bi @ w
+    return out
+
+
 # Once-per-table work, cleared before each table so that every table pays for its own set-up.
 PER_TABLE_CACHES = (gauss_legendre, lower_hemisphere_gl, length_ends_quad, length_ends_gl)
 
@@ -619,6 +694,14 @@ TABLES: dict[str, tuple[tuple[str, ...], int, tuple[Method, ...]]] = {
         Method("numpy Gauss-Legendre", False, lambda p, n: g_gl(p["mu_v"], p["d"], n), nodes_ladder(GL_1D)),
         Method("scipy.integrate.quad", True, lambda p, eps: [g_quad(p["mu_v"], p["d"], eps)],
                eps_ladder(*EPS_STEPS)),
+    )),
+    "ggx_dfg_lut": (("n_dot_v", "alpha"), 2, (
+        Method("numpy Monte Carlo, Hammersley GGX importance sampling (Filament cmgen)", False,
+               lambda p, m: dfg_hammersley(p["n_dot_v"], p["alpha"], m),
+               samples_ladder((256, 1024, 4096, 16384, 65536, 262144, 1048576))),
+        Method("numpy tensor Gauss-Legendre (xi, phi)", False,
+               lambda p, n: dfg_gl(p["n_dot_v"], p["alpha"], n),
+               nodes_ladder((8, 16, 32, 64, 128, 256, 512, 1024), dims=2, label="n={n} ({n}x{n} nodes)")),
     )),
     "fuzz_q": (("d",), 1, (
         Method("closed form (scipy.special.expn)", False, lambda p, _: q_closed_form(p["d"]), ONE_RUNG),

@@ -16,7 +16,8 @@
 //! | aligned    | level 0 texels, row by row from the top (row 0 first), little-endian |
 //!
 //! The level data starts at a multiple of the texel size (8 bytes for RGBA16F, 16 for RGBA32F,
-//! both multiples of 4 as the specification requires). Texel values are written as given:
+//! both multiples of 4 as the specification requires). Two-channel textures (RG16F, RG32F:
+//! [`ktx2_texels`]) have two DFD samples (R, G) and start at a multiple of lcm(texel size, 4). Texel values are written as given:
 //! no tonemapping, no gamma (the DFD says so with `KHR_DF_TRANSFER_LINEAR`).
 
 use serde::{Deserialize, Serialize};
@@ -98,10 +99,31 @@ fn pad_to(out: &mut Vec<u8>, align: usize) {
     }
 }
 
+/// Channel ids of an RG (2) or RGBA (4) texel: R = 0, G = 1, B = 2, A = 15.
+fn channel_ids(channels: usize) -> &'static [u32] {
+    match channels {
+        2 => &[0, 1],
+        4 => &[0, 1, 2, 15],
+        _ => panic!("KTX2 texels have 2 (RG) or 4 (RGBA) channels, not {channels}"),
+    }
+}
+
+/// `VkFormat` of `channels` channels in the precision of `format`: R16G16_SFLOAT (83),
+/// R16G16B16A16_SFLOAT (97), R32G32_SFLOAT (103), R32G32B32A32_SFLOAT (109).
+pub fn vk_format(format: TextureFormat, channels: usize) -> u32 {
+    match (format, channels) {
+        (TextureFormat::Rgba16float, 2) => 83,
+        (TextureFormat::Rgba32float, 2) => 103,
+        (f, 4) => f.vk_format(),
+        _ => panic!("KTX2 texels have 2 (RG) or 4 (RGBA) channels, not {channels}"),
+    }
+}
+
 /// The data format descriptor: total size, then one basic descriptor block (KDF 1.3 §5).
-fn data_format_descriptor(format: TextureFormat) -> Vec<u8> {
-    const SAMPLES: u32 = 4;
-    let block_size = 24 + 16 * SAMPLES;
+fn data_format_descriptor(format: TextureFormat, channels: usize) -> Vec<u8> {
+    let ids = channel_ids(channels);
+    let samples = ids.len() as u32;
+    let block_size = 24 + 16 * samples;
     let mut d = Vec::with_capacity(4 + block_size as usize);
     put_u32(&mut d, 4 + block_size); // dfdTotalSize
     put_u32(&mut d, 0); // vendorId KHR (0), descriptorType BASICFORMAT (0)
@@ -109,12 +131,12 @@ fn data_format_descriptor(format: TextureFormat) -> Vec<u8> {
     // colorModel RGBSDA (1), primaries BT709 (1), transfer LINEAR (1), flags ALPHA_STRAIGHT (0).
     d.extend_from_slice(&[1, 1, 1, 0]);
     d.extend_from_slice(&[0, 0, 0, 0]); // texelBlockDimension 1×1×1×1 (stored minus one)
-    d.extend_from_slice(&[format.texel_size() as u8, 0, 0, 0, 0, 0, 0, 0]); // bytesPlane0..7
+    d.extend_from_slice(&[(samples * format.type_size()) as u8, 0, 0, 0, 0, 0, 0, 0]); // bytesPlane0..7
     let bits = 8 * format.type_size();
     // Channel ids R = 0, G = 1, B = 2, A = 15, with the FLOAT (0x80) and SIGNED (0x40)
     // qualifiers; sampleLower/Upper are −1.0 and 1.0 as f32 bit patterns (the convention for
     // float samples of any width).
-    for (k, channel) in [0u32, 1, 2, 15].into_iter().enumerate() {
+    for (k, &channel) in ids.iter().enumerate() {
         let offset = k as u32 * bits;
         put_u32(&mut d, offset | ((bits - 1) << 16) | ((channel | 0xC0) << 24));
         put_u32(&mut d, 0); // samplePosition0..3
@@ -152,24 +174,40 @@ pub fn ktx2_rgba(
     metadata: &[(&str, &str)],
 ) -> Vec<u8> {
     assert_eq!(texels.len(), (width * height) as usize, "texel count differs from width × height");
-    let dfd = data_format_descriptor(format);
+    let flat: Vec<f32> = texels.iter().flatten().copied().collect();
+    ktx2_texels(width, height, 4, &flat, format, metadata)
+}
+
+/// A KTX2 file of one `width`×`height` image of `channels` (2: RG, 4: RGBA) float channels
+/// per texel, `values[(y * width + x) * channels + c]`, in the precision of `format` (the
+/// layout of [`ktx2_rgba`], which is this with 4 channels).
+pub fn ktx2_texels(
+    width: u32,
+    height: u32,
+    channels: usize,
+    values: &[f32],
+    format: TextureFormat,
+    metadata: &[(&str, &str)],
+) -> Vec<u8> {
+    assert_eq!(values.len(), (width * height) as usize * channels, "value count differs from width × height × channels");
+    let dfd = data_format_descriptor(format, channels);
     let mut kv = vec![("KTXorientation", "rd"), ("KTXwriter", super::GENERATOR)];
     kv.extend_from_slice(metadata);
     let kvd = key_value_data(&kv);
     let dfd_offset = LEVEL_INDEX_END;
     let kvd_offset = dfd_offset + dfd.len();
-    let mut level = Vec::with_capacity(texels.len() * format.texel_size() as usize);
-    for t in texels {
-        for &c in t {
-            format.push(&mut level, c);
-        }
+    let texel_size = channels * format.type_size() as usize;
+    let mut level = Vec::with_capacity(values.len() * format.type_size() as usize);
+    for &c in values {
+        format.push(&mut level, c);
     }
-    let align = format.texel_size() as usize; // lcm(texel size, 4) = texel size here
+    // lcm(texel size, 4): the texel size for RGBA (8, 16) and RG32F (8); 4 for RG16F.
+    let align = texel_size.max(4);
     let level_offset = (kvd_offset + kvd.len()).next_multiple_of(align);
 
     let mut out = Vec::with_capacity(level_offset + level.len());
     out.extend_from_slice(&KTX2_IDENTIFIER);
-    for v in [format.vk_format(), format.type_size(), width, height, 0, 0, 1, 1, 0] {
+    for v in [vk_format(format, channels), format.type_size(), width, height, 0, 0, 1, 1, 0] {
         put_u32(&mut out, v);
     }
     put_u32(&mut out, dfd_offset as u32);
@@ -295,6 +333,32 @@ mod tests {
                     };
                     assert_eq!(v.to_bits(), format.stored(texel[c]).to_bits());
                 }
+            }
+        }
+    }
+
+    #[test]
+    fn rg_textures_read_back_with_the_ktx2_crate() {
+        for (format, vk) in [(TextureFormat::Rgba16float, 83), (TextureFormat::Rgba32float, 103)] {
+            let (w, h) = (3, 5);
+            let v: Vec<f32> = (0..2 * w * h).map(|k| k as f32 / 3.0 - 2.0).collect();
+            let bytes = ktx2_texels(w, h, 2, &v, format, &[]);
+            let r = ktx2::Reader::new(&bytes[..]).expect("a valid KTX2 file");
+            assert_eq!(r.header().format.map(|f| f.value()), Some(vk));
+            let basic = r.basic_dfd().expect("a basic DFD block");
+            assert_eq!(basic.bytes_planes[0] as u32, 2 * format.type_size());
+            let ids: Vec<u8> = basic.sample_information.iter().map(|s| s.channel_type).collect();
+            assert_eq!(ids, [0, 1]);
+            let level = r.levels().next().unwrap();
+            assert_eq!((level.data.as_ptr() as usize - bytes.as_ptr() as usize) % 4, 0);
+            let ts = format.type_size() as usize;
+            for (k, &x) in v.iter().enumerate() {
+                let b = &level.data[k * ts..(k + 1) * ts];
+                let got = match format {
+                    TextureFormat::Rgba16float => half::f16::from_le_bytes([b[0], b[1]]).to_f32(),
+                    TextureFormat::Rgba32float => f32::from_le_bytes([b[0], b[1], b[2], b[3]]),
+                };
+                assert_eq!(got.to_bits(), format.stored(x).to_bits());
             }
         }
     }

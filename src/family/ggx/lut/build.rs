@@ -1,0 +1,424 @@
+//! The build of a DFG LUT spec (`kind = "ggx-dfg-lut"`, see `super::spec`): tabulate, verify,
+//! emit.
+//!
+//! - tabulate: every texel is [`integrals::env`] (scale, bias) at its centre to the spec's
+//!   tolerance, rows in parallel and collected in order (byte-identical at any thread count);
+//! - verify: the integral again at the centres of a grid [`VERIFY_DENSITY`] times denser per
+//!   axis (off the texel grid everywhere, and past the outer texel centres, where
+//!   clamp-to-edge holds the edge texels) to [`VERIFY_TOLERANCE`], against the texture as a
+//!   linear sampler reads it: the f16 texels (the spec's layout) interpolated bilinearly with
+//!   exact weights. Recorded: max, rms and worst point of that error (the texture's storage
+//!   error under bilinear filtering), the same for the emitted f32 lookup and for the f64
+//!   texels (interpolation alone), per channel, and the map of its largest value per texel
+//!   footprint; the f16 rounding of the texels alone; the texels' quadrature error estimates;
+//! - emit: `wgsl/NAME.wgsl`, `src/NAME.rs` (`super::emit`), `data/NAME.ktx2` (RG16F or
+//!   RGBA16F), `data/NAME.png` (sRGB preview: R, G as stored, B = 0; row 0 at the top) and
+//!   `json/NAME.json` (provenance, settings, errors, texels in f64).
+//!
+//! `Mode::Committed` (build --check) takes the texels and the measured errors from the
+//! committed JSON and re-renders every file without integrating.
+
+use super::emit::{DfgLutCode, lookup_f32};
+use super::spec::{DfgFormat, DfgLut, RoughnessMapping};
+use crate::emit::texture::{TextureFormat, ktx2_texels, png_srgb_preview};
+use crate::emit::{Artifact, GENERATOR, header_lines};
+use crate::family::ggx::integrals::{EnvEstimate, env};
+use crate::pipeline::{BuildError, Built, Mode, Verification, fmt_err, json_text, spec_rel_path};
+use crate::spec::Spec;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use serde_json::{Value, json};
+use std::path::Path;
+
+/// Verification points per texel footprint and axis.
+pub const VERIFY_DENSITY: usize = 4;
+/// Quadrature tolerance of the verification integrals: their measured error (≲ 3e-8 against a
+/// 1e-12 reference, see the tests) is far below the f16 and interpolation errors measured
+/// (≳ 1e-5 at the worst points).
+pub const VERIFY_TOLERANCE: f64 = 1e-6;
+
+/// The integrals at row coordinates `ts` × n·v values `us` (row-major, n·v fastest), rows in
+/// parallel, collected in order.
+pub fn integrate(lut: &DfgLut, us: &[f64], ts: &[f64], tol: f64) -> Vec<EnvEstimate> {
+    ts.par_iter()
+        .map(|&t| {
+            let alpha = lut.mapping.alpha(t);
+            let sh = lut.shadowing_at(alpha);
+            us.iter().map(|&u| env(alpha, u, lut.cos_cone, sh, tol)).collect::<Vec<_>>()
+        })
+        .collect::<Vec<_>>()
+        .concat()
+}
+
+/// The texels (scale, bias) with their quadrature work.
+pub fn tabulate(lut: &DfgLut) -> (Vec<[f64; 2]>, Quadrature) {
+    let us: Vec<f64> = (0..lut.width).map(|i| lut.n_dot_v(i)).collect();
+    let ts: Vec<f64> = (0..lut.height).map(|j| lut.row_coordinate(j)).collect();
+    let est = integrate(lut, &us, &ts, lut.tolerance);
+    let evals: u64 = est.iter().map(|e| e.evals).sum();
+    let q = Quadrature {
+        tolerance: lut.tolerance,
+        max_error_estimate: est.iter().map(|e| e.error).fold(0.0, f64::max),
+        evals_per_texel: (evals as f64 / est.len() as f64).round(),
+    };
+    (est.iter().map(|e| [e.scale, e.bias]).collect(), q)
+}
+
+/// Quadrature of the texels.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Quadrature {
+    pub tolerance: f64,
+    pub max_error_estimate: f64,
+    pub evals_per_texel: f64,
+}
+
+/// One error measure on the verification grid.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Measure {
+    pub max_abs_error: f64,
+    pub rms_error: f64,
+    /// (n·v, roughness or α) of the largest error.
+    pub worst_point: [f64; 2],
+    /// Largest error per stored channel (R, G).
+    pub max_abs_error_per_channel: [f64; 2],
+}
+
+/// What the verification measured (see the module docs).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Measured {
+    pub density: usize,
+    pub points: usize,
+    pub reference_tolerance: f64,
+    pub reference_max_error_estimate: f64,
+    /// The f16 texture, bilinear with exact weights (the storage error under filtering).
+    pub texture: Measure,
+    /// The same between the outer texel centres only (no clamp-to-edge extrapolation).
+    pub texture_interior: Measure,
+    /// The emitted f32 lookup over the f16 texels.
+    pub lookup_f32: Measure,
+    /// The f64 texels, bilinear (interpolation alone).
+    pub interpolation: Measure,
+    /// Largest |f16(texel) − texel| over texels and channels (rounding alone).
+    pub max_abs_storage_error: f64,
+    /// Largest texture error per texel footprint (row-major, like the texels), 3 digits.
+    pub error_map: Vec<f64>,
+}
+
+fn f16_texture(format: DfgFormat) -> TextureFormat {
+    match format {
+        DfgFormat::Rg16float | DfgFormat::Rgba16float => TextureFormat::Rgba16float,
+    }
+}
+
+/// The stored channels in f32, as the texture holds them (f64 → f32 → f16).
+fn stored(lut: &DfgLut, values: &[[f64; 2]]) -> Vec<[f32; 2]> {
+    let f = f16_texture(lut.format);
+    values.iter().map(|v| lut.layout.encode(*v).map(|x| f.stored(x as f32))).collect()
+}
+
+/// Bilinear interpolation in f64 of `texels` at texture coordinates (u, t) (texel centres,
+/// clamp to edge, exact weights).
+fn bilinear(texels: &[[f64; 2]], (w, h): (usize, usize), u: f64, t: f64) -> [f64; 2] {
+    let axis = |p: f64, n: usize| {
+        let x = p * n as f64 - 0.5;
+        let x0 = x.floor();
+        let i0 = (x0.max(0.0) as usize).min(n - 1);
+        let i1 = ((x0 + 1.0).max(0.0) as usize).min(n - 1);
+        (i0, i1, x - x0)
+    };
+    let (i0, i1, fx) = axis(u, w);
+    let (j0, j1, fy) = axis(t, h);
+    std::array::from_fn(|c| {
+        let a = texels[j0 * w + i0][c] * (1.0 - fx) + texels[j0 * w + i1][c] * fx;
+        let b = texels[j1 * w + i0][c] * (1.0 - fx) + texels[j1 * w + i1][c] * fx;
+        a * (1.0 - fy) + b * fy
+    })
+}
+
+struct Accumulator {
+    max: f64,
+    ss: f64,
+    worst: [f64; 2],
+    per_channel: [f64; 2],
+}
+
+impl Accumulator {
+    fn new() -> Self {
+        Accumulator { max: -1.0, ss: 0.0, worst: [0.0; 2], per_channel: [0.0; 2] }
+    }
+
+    fn add(&mut self, got: [f64; 2], want: [f64; 2], at: [f64; 2]) -> f64 {
+        let mut m = 0.0f64;
+        for c in 0..2 {
+            let e = (got[c] - want[c]).abs();
+            self.ss += e * e;
+            self.per_channel[c] = self.per_channel[c].max(e);
+            m = m.max(e);
+        }
+        if m > self.max {
+            self.max = m;
+            self.worst = at;
+        }
+        m
+    }
+
+    fn finish(self, count: usize) -> Measure {
+        Measure {
+            max_abs_error: self.max.max(0.0),
+            rms_error: (self.ss / (2 * count) as f64).sqrt(),
+            worst_point: self.worst,
+            max_abs_error_per_channel: self.per_channel,
+        }
+    }
+}
+
+/// Three significant digits (the error map is a picture, not a claim).
+fn digits3(x: f64) -> f64 {
+    format!("{x:.2e}").parse().expect("a formatted float parses")
+}
+
+/// The verification of the texels `values` (see the module docs).
+pub fn verify(lut: &DfgLut, values: &[[f64; 2]]) -> Result<Measured, BuildError> {
+    let (w, h) = (lut.width, lut.height);
+    let d = VERIFY_DENSITY;
+    let us: Vec<f64> = (0..d * w).map(|k| (k as f64 + 0.5) / (d * w) as f64).collect();
+    let ts: Vec<f64> = (0..d * h).map(|k| (k as f64 + 0.5) / (d * h) as f64).collect();
+    let truth = integrate(lut, &us, &ts, VERIFY_TOLERANCE);
+    let encoded: Vec<[f64; 2]> = values.iter().map(|v| lut.layout.encode(*v)).collect();
+    let stored32 = stored(lut, values);
+    let stored64: Vec<[f64; 2]> = stored32.iter().map(|v| v.map(f64::from)).collect();
+    let (mut tex, mut l32, mut interp) = (Accumulator::new(), Accumulator::new(), Accumulator::new());
+    let (mut inner, mut inner_count) = (Accumulator::new(), 0);
+    let inside = |p: f64, n: usize| p >= 0.5 / n as f64 && p <= 1.0 - 0.5 / n as f64;
+    let mut map = vec![0.0f64; w * h];
+    for (l, &t) in ts.iter().enumerate() {
+        for (k, &u) in us.iter().enumerate() {
+            let e = &truth[l * us.len() + k];
+            if !(e.scale.is_finite() && e.bias.is_finite()) {
+                return Err(BuildError::NonFinite { spec: lut.name.clone(), at: vec![u, t] });
+            }
+            let want = lut.layout.encode([e.scale, e.bias]);
+            let got = bilinear(&stored64, (w, h), u, t);
+            let m = tex.add(got, want, [u, t]);
+            if inside(u, w) && inside(t, h) {
+                inner.add(got, want, [u, t]);
+                inner_count += 1;
+            }
+            let cell = &mut map[(l / d) * w + k / d];
+            *cell = cell.max(m);
+            l32.add(lookup_f32(&stored32, (w, h), u as f32, t as f32).map(f64::from), want, [u, t]);
+            interp.add(bilinear(&encoded, (w, h), u, t), want, [u, t]);
+        }
+    }
+    let n = truth.len();
+    let storage = encoded
+        .iter()
+        .zip(&stored64)
+        .flat_map(|(a, b)| (0..2).map(move |c| (a[c] - b[c]).abs()))
+        .fold(0.0, f64::max);
+    Ok(Measured {
+        density: d,
+        points: n,
+        reference_tolerance: VERIFY_TOLERANCE,
+        reference_max_error_estimate: truth.iter().map(|e| e.error).fold(0.0, f64::max),
+        texture: tex.finish(n),
+        texture_interior: inner.finish(inner_count.max(1)),
+        lookup_f32: l32.finish(n),
+        interpolation: interp.finish(n),
+        max_abs_storage_error: storage,
+        error_map: map.into_iter().map(digits3).collect(),
+    })
+}
+
+/// JSON text with every array of numbers on one line (the texel list stays one texel per
+/// line; everything else as serde_json's pretty printer writes it).
+fn compact_json(v: &Value) -> String {
+    let pretty = json_text(v);
+    let lines: Vec<&str> = pretty.lines().collect();
+    let is_number = |s: &str| {
+        let t = s.trim().trim_end_matches(',');
+        !t.is_empty() && t.parse::<f64>().is_ok()
+    };
+    let mut out = String::with_capacity(pretty.len());
+    let mut i = 0;
+    while i < lines.len() {
+        let line = lines[i];
+        if line.ends_with('[') {
+            let mut j = i + 1;
+            while j < lines.len() && is_number(lines[j]) {
+                j += 1;
+            }
+            if j > i + 1 && j < lines.len() && lines[j].trim_start().starts_with(']') {
+                let items: Vec<&str> = lines[i + 1..j].iter().map(|l| l.trim().trim_end_matches(',')).collect();
+                out.push_str(line);
+                out.push_str(&items.join(", "));
+                out.push_str(lines[j].trim_start());
+                out.push('\n');
+                i = j + 1;
+                continue;
+            }
+        }
+        out.push_str(line);
+        out.push('\n');
+        i += 1;
+    }
+    out
+}
+
+fn committed_parts(v: &Value, lut: &DfgLut) -> Result<(Vec<[f64; 2]>, Quadrature, Measured), BuildError> {
+    let bad = |why: String| BuildError::NoCommitted { spec: lut.name.clone(), why };
+    let values: Vec<[f64; 2]> = v["values"]
+        .as_array()
+        .and_then(|a| {
+            a.iter()
+                .map(|t| {
+                    let t = t.as_array()?;
+                    (t.len() == 2).then_some(())?;
+                    Some([t[0].as_f64()?, t[1].as_f64()?])
+                })
+                .collect::<Option<Vec<_>>>()
+        })
+        .ok_or_else(|| bad("no array 'values' of [scale, bias] numbers".into()))?;
+    if values.len() != lut.width * lut.height {
+        return Err(bad("texel count differs from the spec".into()));
+    }
+    let quadrature: Quadrature = serde_json::from_value(v["quadrature"].clone()).map_err(|e| bad(format!("quadrature: {e}")))?;
+    let measured: Measured = serde_json::from_value(v["verification"].clone()).map_err(|e| bad(format!("verification: {e}")))?;
+    if measured.error_map.len() != values.len() {
+        return Err(bad("error_map size differs from the texel count".into()));
+    }
+    Ok((values, quadrature, measured))
+}
+
+fn describe(lut: &DfgLut) -> String {
+    let g = if lut.ue4 {
+        "UE4's separable Schlick–Smith G (k = α/2)".to_string()
+    } else {
+        "height-correlated Smith G2".to_string()
+    };
+    let cone = if lut.cos_cone > 0.0 { format!(", lights in the cone n·l ≥ {}", lut.cos_cone) } else { String::new() };
+    let desc = if lut.description.is_empty() { String::new() } else { format!("{}: ", lut.description) };
+    format!(
+        "{desc}`{}` looks up the GGX split-sum environment BRDF (scale, bias) of quantity `{}` ({g}, Schlick Fc{cone}).",
+        lut.function, lut.quantity
+    )
+}
+
+fn mapping_doc(lut: &DfgLut) -> String {
+    match lut.mapping {
+        RoughnessMapping::Perceptual => format!("roughness r = (j + 0.5)/{}, α = r²", lut.height),
+        RoughnessMapping::Alpha => format!("α = (j + 0.5)/{}", lut.height),
+    }
+}
+
+/// Build one DFG LUT spec (see the module docs).
+pub fn build(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> {
+    let lut = DfgLut::from_spec(spec)?;
+    let name = spec.file.name.clone();
+    let hash = crate::pipeline::input_hash(spec);
+    let (w, h) = (lut.width, lut.height);
+    let (values, quadrature, measured) = match mode {
+        Mode::Fit => {
+            let (values, q) = tabulate(&lut);
+            if let Some(k) = values.iter().position(|v| !(v[0].is_finite() && v[1].is_finite())) {
+                return Err(BuildError::NonFinite { spec: name, at: vec![lut.n_dot_v(k % w), lut.row_coordinate(k / w)] });
+            }
+            let m = verify(&lut, &values)?;
+            (values, q, m)
+        }
+        Mode::Committed => committed_parts(&crate::pipeline::committed_json_with_hash(root, spec, &hash)?, &lut)?,
+    };
+    let stored32 = stored(&lut, &values);
+    let t = &measured.texture;
+    let err_line = format!(
+        "{} texture, bilinear (texel centres, clamp to edge) against the integral at {}x denser points: max abs {}, rms {} over {} points x 2 channels (between the outer texel centres: max abs {}); f64 texels bilinear: max abs {}; f16 storage <= {}; quadrature estimate <= {}",
+        lut.format.name(),
+        measured.density,
+        fmt_err(t.max_abs_error),
+        fmt_err(t.rms_error),
+        measured.points,
+        fmt_err(measured.texture_interior.max_abs_error),
+        fmt_err(measured.interpolation.max_abs_error),
+        fmt_err(measured.max_abs_storage_error),
+        fmt_err(quadrature.max_error_estimate),
+    );
+    let header = header_lines(&spec_rel_path(spec), &hash, &err_line);
+    let provenance = header.join("\n");
+    let channels = lut.format.channels();
+    let flat: Vec<f32> = stored32
+        .iter()
+        .flat_map(|v| if channels == 2 { vec![v[0], v[1]] } else { vec![v[0], v[1], 0.0, 1.0] })
+        .collect();
+    let ktx2 = ktx2_texels(w as u32, h as u32, channels, &flat, f16_texture(lut.format), &[("shadefit", &provenance)]);
+    let level_offset = u64::from_le_bytes(ktx2[80..88].try_into().expect("eight bytes")) as usize;
+    let code = DfgLutCode {
+        module: &name,
+        function: &lut.function,
+        width: w,
+        height: h,
+        layout: lut.layout,
+        format: lut.format,
+        row: lut.mapping.argument(),
+        level_offset,
+    };
+    let doc = describe(&lut);
+    let mdoc = mapping_doc(&lut);
+    let wgsl = code.render_wgsl(&header, &doc, &mdoc);
+    let rust = code.render_rust(&header, &doc, &mdoc);
+    let preview: Vec<[f64; 3]> = values.iter().map(|v| {
+        let [r, g] = lut.layout.encode(*v);
+        [r, g, 0.0]
+    }).collect();
+    let s = (256 / w.max(h)).max(1);
+    let png = png_srgb_preview(w, h, &preview, s, s, &[("Software", GENERATOR.to_string()), ("Comment", provenance.clone())]);
+    let (lo, hi) = values.iter().flat_map(|v| lut.layout.encode(*v)).fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(x), b.max(x)));
+    let json = json!({
+        "generator": GENERATOR,
+        "spec": spec_rel_path(spec),
+        "input_hash": hash,
+        "name": name,
+        "kind": super::spec::KIND,
+        "quantity": lut.quantity,
+        "description": lut.description,
+        "function": lut.function,
+        "shadowing": if lut.ue4 { "separable Schlick-Smith, k = alpha/2 (UE4)" } else { "height-correlated Smith G2" },
+        "cos_cone": lut.cos_cone,
+        "layout": {"name": lut.layout.name(), "channels": lut.layout.channels()},
+        "axes": [
+            {"name": "n_dot_v", "texture_axis": "x", "count": w, "mapping": "linear", "texel_centres": "n_dot_v = (i + 0.5)/width"},
+            {"name": lut.mapping.argument(), "texture_axis": "y", "count": h, "mapping": lut.mapping.name(),
+             "texel_centres": format!("t = (j + 0.5)/height, {}", if lut.mapping == RoughnessMapping::Perceptual { "alpha = t^2" } else { "alpha = t" })},
+        ],
+        "texture": {
+            "width": w,
+            "height": h,
+            "format": lut.format.name(),
+            "ktx2": format!("data/{name}.ktx2"),
+            "preview": format!("data/{name}.png"),
+            "encoding": "linear, R and G as the layout says (RGBA: B = 0, A = 1); the PNG preview is sRGB-encoded with B = 0, row 0 at the top",
+            "sampling": "uv = (n_dot_v, t) clamped to [0, 1], linear filter, clamp to edge",
+        },
+        "range": [lo, hi],
+        "quadrature": quadrature,
+        "verification": measured,
+        "values_layout": "row-major, n_dot_v fastest: values[j * width + i] = [scale, bias] in f64 (the texture stores the layout's channels of these, rounded to f32 then f16)",
+        "values": values,
+    });
+    let verification = Verification {
+        points: measured.points,
+        max_abs_error: t.max_abs_error,
+        rms_error: t.rms_error,
+        worst_point: t.worst_point.to_vec(),
+        max_abs_error_f32: measured.lookup_f32.max_abs_error,
+        rms_error_f32: measured.lookup_f32.rms_error,
+        max_abs_error_in_parameter: None,
+    };
+    let artifacts = vec![
+        Artifact { path: format!("wgsl/{name}.wgsl").into(), contents: wgsl.into() },
+        Artifact { path: format!("src/{name}.rs").into(), contents: rust.into() },
+        Artifact { path: format!("json/{name}.json").into(), contents: compact_json(&json).into() },
+        Artifact { path: format!("data/{name}.ktx2").into(), contents: ktx2 },
+        Artifact { path: format!("data/{name}.png").into(), contents: png },
+    ];
+    Ok(Built { name, artifacts, verification, fit: None })
+}

@@ -1,0 +1,370 @@
+//! DFG LUT specs (`kind = "ggx-dfg-lut"`): the split-sum scale and bias tabulated as a 2-D
+//! texture.
+//!
+//! ```toml
+//! name = "ggx_dfg_lut"             # output stem; must equal the file stem
+//! kind = "ggx-dfg-lut"
+//! quantity = "ggx-env"             # or "ggx-env-ue4" (UE4's separable G, no cone)
+//! description = "..."
+//! resolution = [128, 128]          # [n·v columns, roughness rows]
+//! roughness_mapping = "perceptual" # optional: rows at perceptual roughness r (α = r²), or
+//!                                  # "alpha" (rows at α)
+//! n_dot_v_mapping = "linear"       # optional: columns at n·v (the only mapping)
+//! layout = "scale-bias"            # optional: R = scale, G = bias (UE), or "filament":
+//!                                  # R = bias, G = scale + bias
+//! cos_cone = 0.0                   # optional, ggx-env only: the visibility cone's cosine
+//! tolerance = 1e-7                 # optional: absolute quadrature tolerance per texel
+//! texture_format = "rg16float"     # optional: "rg16float" or "rgba16float" (B = 0, A = 1)
+//!
+//! [emit]
+//! function = "ggx_dfg"             # WGSL and Rust function prefix
+//! ```
+//!
+//! Texel (i, j) holds the integrals at n·v = (i + 0.5)/width and at row coordinate
+//! t = (j + 0.5)/height, α = t² (perceptual) or α = t (alpha): texel centres, as engines sample
+//! the table at uv = (n·v, roughness) with no half-texel remap (UE's PreIntegratedGF,
+//! Filament's n·v axis, MaterialX, bevy). Row 0 is the first row of the texture (v = 0).
+//!
+//! The spec is checked here (errors name the file, the line and the field) and enters the
+//! common [`SpecFile`] with its axes spelled out: alpha (the rows' α, count = rows), n_dot_v
+//! (count = columns) and, for ggx-env, cos_cone as an axis of one point.
+
+use crate::family::ggx::integrals::Shadowing;
+use crate::spec::{SpecError, SpecFile, line_of, parse_toml};
+use serde::Deserialize;
+use serde_json::json;
+use std::path::Path;
+
+/// The `kind` value of DFG LUT specs.
+pub const KIND: &str = "ggx-dfg-lut";
+/// Default quadrature tolerance per texel (each of scale and bias): far below f16 storage
+/// (2⁻¹² relative) and what the acceptance asks of the 128² table.
+pub const DEFAULT_TOLERANCE: f64 = 1e-7;
+/// Tolerances accepted: above 1e-5 the texels would carry quadrature error comparable to f16
+/// rounding of small biases; below 1e-12 the nested rules stop converging in f64.
+pub const TOLERANCE_RANGE: [f64; 2] = [1e-12, 1e-5];
+/// Largest texture side.
+pub const MAX_RESOLUTION: usize = 1024;
+/// Largest cone cosine: the cone closes at 1 (everything 0).
+pub const MAX_COS_CONE: f64 = 0.99;
+
+/// How the rows map to α.
+#[derive(Debug, Clone, Copy, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum RoughnessMapping {
+    /// Rows at perceptual roughness r, α = r² (UE, Filament, bevy, HDRP).
+    #[default]
+    Perceptual,
+    /// Rows at α (MaterialX).
+    Alpha,
+}
+
+impl RoughnessMapping {
+    pub fn name(self) -> &'static str {
+        match self {
+            RoughnessMapping::Perceptual => "perceptual",
+            RoughnessMapping::Alpha => "alpha",
+        }
+    }
+
+    /// The emitted functions' row argument.
+    pub fn argument(self) -> &'static str {
+        match self {
+            RoughnessMapping::Perceptual => "roughness",
+            RoughnessMapping::Alpha => "alpha",
+        }
+    }
+
+    /// α at row coordinate t ∈ [0, 1].
+    pub fn alpha(self, t: f64) -> f64 {
+        match self {
+            RoughnessMapping::Perceptual => t * t,
+            RoughnessMapping::Alpha => t,
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+enum NDotVMapping {
+    #[default]
+    Linear,
+}
+
+/// What the two stored channels hold.
+#[derive(Debug, Clone, Copy, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum Layout {
+    /// R = scale, G = bias: specular = F0·R + G (UE's PreIntegratedGF, bevy, three.js).
+    #[default]
+    ScaleBias,
+    /// R = bias, G = scale + bias = E: specular = mix(R, G, F0) (Filament's multiscatter DFG).
+    Filament,
+}
+
+impl Layout {
+    pub fn name(self) -> &'static str {
+        match self {
+            Layout::ScaleBias => "scale-bias",
+            Layout::Filament => "filament",
+        }
+    }
+
+    /// Names of the stored channels (R, G).
+    pub fn channels(self) -> [&'static str; 2] {
+        match self {
+            Layout::ScaleBias => ["scale", "bias"],
+            Layout::Filament => ["bias", "scale + bias"],
+        }
+    }
+
+    /// The stored channels of (scale, bias).
+    pub fn encode(self, [scale, bias]: [f64; 2]) -> [f64; 2] {
+        match self {
+            Layout::ScaleBias => [scale, bias],
+            Layout::Filament => [bias, scale + bias],
+        }
+    }
+}
+
+/// Texel format of the KTX2 file.
+#[derive(Debug, Clone, Copy, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum DfgFormat {
+    /// R16G16_SFLOAT: the two channels.
+    #[default]
+    Rg16float,
+    /// R16G16B16A16_SFLOAT: the two channels, B = 0, A = 1 (where RG16F is not wanted).
+    Rgba16float,
+}
+
+impl DfgFormat {
+    pub fn name(self) -> &'static str {
+        match self {
+            DfgFormat::Rg16float => "rg16float",
+            DfgFormat::Rgba16float => "rgba16float",
+        }
+    }
+
+    /// Channels per texel in the file.
+    pub fn channels(self) -> usize {
+        match self {
+            DfgFormat::Rg16float => 2,
+            DfgFormat::Rgba16float => 4,
+        }
+    }
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct DfgEmit {
+    function: String,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct DfgLutFile {
+    name: String,
+    #[allow(dead_code)] // checked by the caller: "ggx-dfg-lut"
+    kind: String,
+    quantity: String,
+    #[serde(default)]
+    description: String,
+    tolerance: Option<f64>,
+    resolution: Vec<usize>,
+    #[serde(default)]
+    roughness_mapping: RoughnessMapping,
+    #[serde(default)]
+    #[allow(dead_code)] // one variant: parsing it is the check
+    n_dot_v_mapping: NDotVMapping,
+    #[serde(default)]
+    layout: Layout,
+    cos_cone: Option<f64>,
+    #[serde(default)]
+    texture_format: DfgFormat,
+    emit: DfgEmit,
+}
+
+/// A validated DFG LUT spec.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DfgLut {
+    pub name: String,
+    pub quantity: String,
+    pub description: String,
+    pub function: String,
+    /// Columns (n·v) and rows (roughness).
+    pub width: usize,
+    pub height: usize,
+    pub mapping: RoughnessMapping,
+    pub layout: Layout,
+    pub cos_cone: f64,
+    /// UE4's separable Schlick–Smith G (quantity ggx-env-ue4) instead of the height-correlated G2.
+    pub ue4: bool,
+    pub format: DfgFormat,
+    /// Absolute quadrature tolerance per texel (each of scale and bias).
+    pub tolerance: f64,
+}
+
+impl DfgLut {
+    /// Parse and check a DFG LUT spec (its `kind` must be "ggx-dfg-lut").
+    pub fn parse(path: &Path, text: &str) -> Result<DfgLut, SpecError> {
+        let f: DfgLutFile = parse_toml(path, text)?;
+        let at = |field: &str, msg: String| SpecError::new(path, line_of(text, field), field, msg);
+        let ue4 = match f.quantity.as_str() {
+            "ggx-env" => false,
+            "ggx-env-ue4" => true,
+            other => return Err(at("quantity", format!("'{other}': DFG LUTs tabulate 'ggx-env' or 'ggx-env-ue4'"))),
+        };
+        if f.resolution.len() != 2 {
+            return Err(at("resolution", format!("needs resolution = [n·v columns, roughness rows], found {} numbers", f.resolution.len())));
+        }
+        if let Some(&n) = f.resolution.iter().find(|&&n| !(2..=MAX_RESOLUTION).contains(&n)) {
+            return Err(at("resolution", format!("{n} texels: each side must be in [2, {MAX_RESOLUTION}]")));
+        }
+        let cos_cone = f.cos_cone.unwrap_or(0.0);
+        if ue4 && f.cos_cone.is_some() {
+            return Err(at("cos_cone", "ggx-env-ue4 integrates the hemisphere; 'cos_cone' applies to ggx-env only".into()));
+        }
+        if !(0.0..=MAX_COS_CONE).contains(&cos_cone) {
+            return Err(at("cos_cone", format!("{cos_cone} must be in [0, {MAX_COS_CONE}] (0: the hemisphere)")));
+        }
+        let tolerance = f.tolerance.unwrap_or(DEFAULT_TOLERANCE);
+        let [lo, hi] = TOLERANCE_RANGE;
+        if !(tolerance >= lo && tolerance <= hi) {
+            return Err(at(
+                "tolerance",
+                format!("{tolerance} must be in [{lo:e}, {hi:e}] (above, quadrature error would rival f16 rounding; below, the rules cannot converge in f64)"),
+            ));
+        }
+        Ok(DfgLut {
+            name: f.name,
+            quantity: f.quantity,
+            description: f.description,
+            function: f.emit.function,
+            width: f.resolution[0],
+            height: f.resolution[1],
+            mapping: f.roughness_mapping,
+            layout: f.layout,
+            cos_cone,
+            ue4,
+            format: f.texture_format,
+            tolerance,
+        })
+    }
+
+    /// The LUT of a loaded spec (parsed again from its text: the spec layer checked it).
+    pub fn from_spec(spec: &crate::spec::Spec) -> Result<DfgLut, SpecError> {
+        DfgLut::parse(&spec.path, &spec.text)
+    }
+
+    /// n·v of column i (texel centre).
+    pub fn n_dot_v(&self, i: usize) -> f64 {
+        (i as f64 + 0.5) / self.width as f64
+    }
+
+    /// Row coordinate t of row j (texel centre): the roughness, or α.
+    pub fn row_coordinate(&self, j: usize) -> f64 {
+        (j as f64 + 0.5) / self.height as f64
+    }
+
+    /// α of row j.
+    pub fn alpha(&self, j: usize) -> f64 {
+        self.mapping.alpha(self.row_coordinate(j))
+    }
+
+    /// The shadowing at α (UE4's separable G takes k = α/2).
+    pub fn shadowing_at(&self, alpha: f64) -> Shadowing {
+        if self.ue4 { Shadowing::Separable { k: 0.5 * alpha } } else { Shadowing::HeightCorrelated }
+    }
+
+    /// The common spec: axes alpha (rows), n_dot_v (columns), and for ggx-env cos_cone fixed.
+    fn spec_file(&self, path: &Path, text: &str) -> Result<SpecFile, SpecError> {
+        let (w, h) = (self.width, self.height);
+        let mut axes = vec![
+            json!({"name": "alpha", "range": [self.alpha(0), self.alpha(h - 1)], "count": h, "verify": 4 * h}),
+            json!({"name": "n_dot_v", "range": [self.n_dot_v(0), self.n_dot_v(w - 1)], "count": w, "verify": 4 * w}),
+        ];
+        if self.quantity == "ggx-env" {
+            axes.push(json!({"name": "cos_cone", "range": [self.cos_cone, self.cos_cone], "count": 1, "verify": 1}));
+        }
+        let v = json!({
+            "name": self.name,
+            "kind": "table",
+            "quantity": self.quantity,
+            "description": self.description,
+            "tolerance": self.tolerance,
+            "axis": axes,
+            "emit": {"function": self.function},
+        });
+        let mut file: SpecFile =
+            serde_json::from_value(v).map_err(|e| SpecError::new(path, line_of(text, "kind"), "kind", e.to_string()))?;
+        file.kind = crate::spec::Kind::Custom(KIND);
+        Ok(file)
+    }
+}
+
+/// For `Spec::parse`: the common spec of a DFG LUT spec (checked), or `None` when the text is
+/// not one (its `kind` is not "ggx-dfg-lut", or it is not TOML: the common parser reports that).
+pub fn spec_file(path: &Path, text: &str) -> Result<Option<SpecFile>, SpecError> {
+    let Ok(table) = text.parse::<toml::Table>() else { return Ok(None) };
+    if table.get("kind").and_then(|k| k.as_str()) != Some(KIND) {
+        return Ok(None);
+    }
+    let lut = DfgLut::parse(path, text)?;
+    lut.spec_file(path, text).map(Some)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    pub const SPEC: &str = "name = \"ggx_x\"\nkind = \"ggx-dfg-lut\"\nquantity = \"ggx-env\"\n\
+        resolution = [8, 4]\n\n[emit]\nfunction = \"ggx_x\"\n";
+
+    fn parse(text: &str) -> Result<DfgLut, SpecError> {
+        DfgLut::parse(Path::new("fits/ggx_x.toml"), text)
+    }
+
+    #[test]
+    fn defaults_and_texel_centres() {
+        let l = parse(SPEC).unwrap();
+        assert_eq!((l.width, l.height, l.tolerance, l.cos_cone), (8, 4, DEFAULT_TOLERANCE, 0.0));
+        assert_eq!((l.mapping, l.layout, l.format), (RoughnessMapping::Perceptual, Layout::ScaleBias, DfgFormat::Rg16float));
+        // Centres: n·v = (i + 0.5)/8, r = (j + 0.5)/4, α = r².
+        assert_eq!((l.n_dot_v(0), l.n_dot_v(7)), (0.0625, 0.9375));
+        assert_eq!((l.alpha(0), l.alpha(3)), (0.015625, 0.765625));
+        let a = parse(&SPEC.replace("[8, 4]", "[8, 4]\nroughness_mapping = \"alpha\"")).unwrap();
+        assert_eq!(a.alpha(1), 0.375);
+        let spec = crate::spec::Spec::parse(Path::new("fits/ggx_x.toml"), SPEC.to_string(), crate::family::catalog()).unwrap();
+        assert_eq!(spec.file.kind, crate::spec::Kind::Custom(KIND));
+        let axes: Vec<(&str, usize)> = spec.file.axis.iter().map(|a| (a.name.as_str(), a.count)).collect();
+        assert_eq!(axes, [("alpha", 4), ("n_dot_v", 8), ("cos_cone", 1)]);
+        let ue4 = SPEC.replace("ggx-env", "ggx-env-ue4");
+        let spec = crate::spec::Spec::parse(Path::new("fits/ggx_x.toml"), ue4, crate::family::catalog()).unwrap();
+        assert_eq!(spec.file.axis.len(), 2);
+    }
+
+    #[test]
+    fn errors_name_line_and_field() {
+        let bad = |edit: (&str, &str), line: usize, field: &str, msg: &str| {
+            let text = SPEC.replace(edit.0, edit.1);
+            let e = crate::spec::Spec::parse(Path::new("fits/ggx_x.toml"), text, crate::family::catalog()).unwrap_err();
+            assert_eq!((e.line, e.field.as_str()), (line, field), "{e}");
+            assert!(e.msg.contains(msg), "{e}");
+        };
+        bad(("[8, 4]", "[8]"), 4, "resolution", "[n·v columns, roughness rows]");
+        bad(("[8, 4]", "[8, 1]"), 4, "resolution", "[2, 1024]");
+        bad(("[8, 4]", "[8, 4]\ncos_cone = 1.0"), 5, "cos_cone", "[0, 0.99]");
+        bad(("[8, 4]", "[8, 4]\ncos_cone = nan"), 5, "cos_cone", "[0, 0.99]");
+        bad(("[8, 4]", "[8, 4]\ntolerance = 1e-3"), 5, "tolerance", "[1e-12, 1e-5]");
+        bad(("[8, 4]", "[8, 4]\nlayout = \"ue\""), 5, "layout", "unknown variant");
+        bad(("[8, 4]", "[8, 4]\nroughness_mapping = \"sqrt\""), 5, "roughness_mapping", "unknown variant");
+        bad(("[8, 4]", "[8, 4]\nn_dot_v_mapping = \"sqrt\""), 5, "n_dot_v_mapping", "unknown variant");
+        bad(("[8, 4]", "[8, 4]\ntexture_format = \"rgba32float\""), 5, "texture_format", "unknown variant");
+        bad(("quantity = \"ggx-env\"", "quantity = \"ggx-albedo\""), 3, "quantity", "'ggx-env' or 'ggx-env-ue4'");
+        bad(("quantity = \"ggx-env\"", "quantity = \"ggx-env-ue4\"\ncos_cone = 0.5"), 4, "cos_cone", "ggx-env only");
+        bad(("name = \"ggx_x\"", "name = \"ggx_y\""), 1, "name", "must match the file name");
+        bad(("function = \"ggx_x\"", "function = \"ggx-x\""), 7, "function", "not a valid function name");
+        bad(("[8, 4]", "[8, 4]\nmipmaps = 3"), 5, "mipmaps", "unknown field");
+    }
+}
