@@ -25,6 +25,12 @@ pub mod ggx_albedo_rational;
 #[cfg(feature = "ggx")]
 #[path = "ggx_albedo_table.rs"]
 pub mod ggx_albedo_table;
+#[cfg(feature = "ggx")]
+#[path = "ggx_dfg_lut.rs"]
+pub mod ggx_dfg_lut;
+#[cfg(feature = "ggx")]
+#[path = "ggx_dfg_lut_filament.rs"]
+pub mod ggx_dfg_lut_filament;
 #[cfg(feature = "gloss")]
 #[path = "gloss_combine.rs"]
 pub mod gloss_combine;
@@ -77,6 +83,10 @@ pub mod wgsl {
     pub const GGX_ALBEDO_RATIONAL: &str = include_str!("../wgsl/ggx_albedo_rational.wgsl");
     #[cfg(feature = "ggx")]
     pub const GGX_ALBEDO_TABLE: &str = include_str!("../wgsl/ggx_albedo_table.wgsl");
+    #[cfg(feature = "ggx")]
+    pub const GGX_DFG_LUT: &str = include_str!("../wgsl/ggx_dfg_lut.wgsl");
+    #[cfg(feature = "ggx")]
+    pub const GGX_DFG_LUT_FILAMENT: &str = include_str!("../wgsl/ggx_dfg_lut_filament.wgsl");
     #[cfg(feature = "gloss")]
     pub const GLOSS_COMBINE: &str = include_str!("../wgsl/gloss_combine.wgsl");
     #[cfg(feature = "gloss")]
@@ -119,6 +129,10 @@ pub mod wgsl {
             "ggx_albedo_rational" => Some(GGX_ALBEDO_RATIONAL),
             #[cfg(feature = "ggx")]
             "ggx_albedo_table" => Some(GGX_ALBEDO_TABLE),
+            #[cfg(feature = "ggx")]
+            "ggx_dfg_lut" => Some(GGX_DFG_LUT),
+            #[cfg(feature = "ggx")]
+            "ggx_dfg_lut_filament" => Some(GGX_DFG_LUT_FILAMENT),
             #[cfg(feature = "gloss")]
             "gloss_combine" => Some(GLOSS_COMBINE),
             #[cfg(feature = "gloss")]
@@ -163,6 +177,10 @@ pub mod wgsl {
         "ggx_albedo_rational",
         #[cfg(feature = "ggx")]
         "ggx_albedo_table",
+        #[cfg(feature = "ggx")]
+        "ggx_dfg_lut",
+        #[cfg(feature = "ggx")]
+        "ggx_dfg_lut_filament",
         #[cfg(feature = "gloss")]
         "gloss_combine",
         #[cfg(feature = "gloss")]
