@@ -661,7 +661,7 @@ mod tests {
         // estimate plus the reference's tolerance, and that estimate is within the requested
         // tolerance (the contract).
         for shadowing in [HC, Shadowing::Separable { k: 0.15 }] {
-            for &alpha in &[1.5e-5, 1e-3, 0.05, 0.3, 0.8, 1.0] {
+            for &alpha in &[1e-6, 1.5e-5, 1e-3, 0.05, 0.3, 0.8, 1.0] {
                 for &mu in &[0.0, 1e-4, 0.004, 0.2, 0.7, 0.999, 1.0] {
                     for &c in &[0.0, 0.3, 0.9] {
                         for &tol in &[1e-7, 1e-10] {

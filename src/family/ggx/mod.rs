@@ -20,7 +20,9 @@ use std::path::{Path, PathBuf};
 
 const ALPHA: ParamSpec = ParamSpec {
     name: "alpha",
-    min: 1e-4,
+    // The first row of a 128² LUT at texel centres is α = (1/256)² ≈ 1.5e-5; the integrators
+    // are tested down to 1e-6 (integrals.rs).
+    min: 1e-6,
     max: 1.0,
     doc: "GGX alpha (perceptual roughness²)",
     integer: false,
@@ -28,7 +30,7 @@ const ALPHA: ParamSpec = ParamSpec {
 };
 const ROUGHNESS: ParamSpec = ParamSpec {
     name: "roughness",
-    min: 1e-2,
+    min: 1e-3,
     max: 1.0,
     doc: "perceptual roughness (alpha = roughness²)",
     integer: false,
