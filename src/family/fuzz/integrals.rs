@@ -136,8 +136,9 @@
 //! On the arc range w = −sin θf cos φ: η₀ = atan2(sin φ, −cos θf cos φ), sin η₀ = sin φ/s_w,
 //! s_w = sqrt(sin²φ + cos²θf cos²φ), all analytic in φ; the whole-circle ranges use w = −cos χ
 //! (s_w = sin χ, analytic at w = ±1). J̃ is split at the cone w = −a (the cusp of f_j at ε = 0)
-//! and mapped by x = c + L_x tan ξ about it, like P_s's pieces; nothing depends on a single
-//! light azimuth any more, so no grazing bands. All pieces of J̃ share one adaptive G10/K21
+//! and mapped by x = c + L_x tan ξ about it (P_s's pieces take sinh instead; here the tan map
+//! is what the agreement below was measured with); nothing depends on a single light azimuth
+//! any more, so no grazing bands. All pieces of J̃ share one adaptive G10/K21
 //! integration. The A-integral is split at π/2 − θf, where the cone crosses w = −sin θf: J̃
 //! is not analytic there, and beyond it, for θf near π/2, varies on the scale cos θf where the
 //! cone runs into the arc's ends. So beyond the split the outer variable is the cone's own
