@@ -334,6 +334,44 @@ impl Catalog {
     }
 }
 
+/// What a family spec kind spells out as a common [`SpecFile`] (read as a table, then marked
+/// as the kind: the common parser reads only the generic kinds).
+pub struct CustomSpec<'a> {
+    pub kind: &'static str,
+    pub name: &'a str,
+    pub quantity: &'a str,
+    pub description: &'a str,
+    pub tolerance: f64,
+    /// Axes as the common schema writes them (name, range, count, verify).
+    pub axes: Vec<serde_json::Value>,
+    pub function: &'a str,
+}
+
+impl CustomSpec<'_> {
+    /// The common spec; an error names the file and the `kind` line.
+    pub fn spec_file(self, path: &Path, text: &str) -> Result<SpecFile, SpecError> {
+        let v = serde_json::json!({
+            "name": self.name,
+            "kind": "table",
+            "quantity": self.quantity,
+            "description": self.description,
+            "tolerance": self.tolerance,
+            "axis": self.axes,
+            "emit": {"function": self.function},
+        });
+        let mut file: SpecFile =
+            serde_json::from_value(v).map_err(|e| SpecError::new(path, line_of(text, "kind"), "kind", e.to_string()))?;
+        file.kind = Kind::Custom(self.kind);
+        Ok(file)
+    }
+}
+
+/// Whether `text` is TOML whose `kind` is `kind` (a family kind's reader declines the others;
+/// text that is not TOML is left to the common parser, which reports it).
+pub fn is_kind(text: &str, kind: &str) -> bool {
+    text.parse::<toml::Table>().is_ok_and(|t| t.get("kind").and_then(|k| k.as_str()) == Some(kind))
+}
+
 /// The environment variable that raises (or lowers) [`DEFAULT_GRID_BUDGET`].
 pub const GRID_BUDGET_VAR: &str = "SHADEFIT_GRID_BUDGET";
 /// Most points a spec's sampling or verification grid may have: 5·10⁷ (each point is at least

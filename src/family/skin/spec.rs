@@ -29,7 +29,7 @@
 //! listing, staleness and the runtime index treat it like any other spec.
 
 use super::profile::{LoadedProfile, ProfileSection};
-use crate::spec::{SpecError, SpecFile, line_of, parse_toml};
+use crate::spec::{CustomSpec, SpecError, SpecFile, is_kind, line_of, parse_toml};
 use crate::emit::texture::TextureFormat;
 use super::integrals::{CurvatureMapping, Kernel, mapped_curvature};
 use serde::Deserialize;
@@ -221,29 +221,23 @@ impl SkinLut {
             }
             SkinLutKind::Sh => json!({"name": "band", "range": [1.0, 2.0], "count": 2, "verify": 2}),
         });
-        // Read as a table, then marked as this family's kind (the common parser reads only the
-        // generic kinds).
-        let v = json!({
-            "name": self.name,
-            "kind": "table",
-            "quantity": self.quantity,
-            "description": self.description,
-            "tolerance": self.tolerance,
-            "axis": axes,
-            "emit": {"function": self.function},
-        });
-        let mut file: SpecFile =
-            serde_json::from_value(v).map_err(|e| SpecError::new(path, line_of(text, "kind"), "kind", e.to_string()))?;
-        file.kind = crate::spec::Kind::Custom(KIND);
-        Ok(file)
+        CustomSpec {
+            kind: KIND,
+            name: &self.name,
+            quantity: &self.quantity,
+            description: &self.description,
+            tolerance: self.tolerance,
+            axes,
+            function: &self.function,
+        }
+        .spec_file(path, text)
     }
 }
 
 /// For `Spec::parse`: the common spec of a skin LUT spec (checked), or `None` when the text is
 /// not one (its `kind` is not "skin-lut", or it is not TOML: the common parser reports that).
 pub fn spec_file(path: &Path, text: &str) -> Result<Option<SpecFile>, SpecError> {
-    let Ok(table) = text.parse::<toml::Table>() else { return Ok(None) };
-    if table.get("kind").and_then(|k| k.as_str()) != Some(KIND) {
+    if !is_kind(text, KIND) {
         return Ok(None);
     }
     let lut = SkinLut::parse(path, text)?;

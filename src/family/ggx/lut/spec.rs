@@ -30,7 +30,7 @@
 //! (count = columns) and, for ggx-env, cos_cone as an axis of one point.
 
 use crate::family::ggx::integrals::Shadowing;
-use crate::spec::{SpecError, SpecFile, line_of, parse_toml};
+use crate::spec::{CustomSpec, SpecError, SpecFile, is_kind, line_of, parse_toml};
 use serde::Deserialize;
 use serde_json::json;
 use std::path::Path;
@@ -287,27 +287,23 @@ impl DfgLut {
         if self.quantity == "ggx-env" {
             axes.push(json!({"name": "cos_cone", "range": [self.cos_cone, self.cos_cone], "count": 1, "verify": 1}));
         }
-        let v = json!({
-            "name": self.name,
-            "kind": "table",
-            "quantity": self.quantity,
-            "description": self.description,
-            "tolerance": self.tolerance,
-            "axis": axes,
-            "emit": {"function": self.function},
-        });
-        let mut file: SpecFile =
-            serde_json::from_value(v).map_err(|e| SpecError::new(path, line_of(text, "kind"), "kind", e.to_string()))?;
-        file.kind = crate::spec::Kind::Custom(KIND);
-        Ok(file)
+        CustomSpec {
+            kind: KIND,
+            name: &self.name,
+            quantity: &self.quantity,
+            description: &self.description,
+            tolerance: self.tolerance,
+            axes,
+            function: &self.function,
+        }
+        .spec_file(path, text)
     }
 }
 
 /// For `Spec::parse`: the common spec of a DFG LUT spec (checked), or `None` when the text is
 /// not one (its `kind` is not "ggx-dfg-lut", or it is not TOML: the common parser reports that).
 pub fn spec_file(path: &Path, text: &str) -> Result<Option<SpecFile>, SpecError> {
-    let Ok(table) = text.parse::<toml::Table>() else { return Ok(None) };
-    if table.get("kind").and_then(|k| k.as_str()) != Some(KIND) {
+    if !is_kind(text, KIND) {
         return Ok(None);
     }
     let lut = DfgLut::parse(path, text)?;
