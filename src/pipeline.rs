@@ -598,6 +598,41 @@ pub fn json_text(v: &Value) -> String {
     s
 }
 
+/// JSON text with every array of numbers on one line (a texel list stays one texel
+/// per line; everything else as serde_json's pretty printer writes it).
+pub fn compact_json(v: &Value) -> String {
+    let pretty = json_text(v);
+    let lines: Vec<&str> = pretty.lines().collect();
+    let is_number = |s: &str| {
+        let t = s.trim().trim_end_matches(',');
+        !t.is_empty() && t.parse::<f64>().is_ok()
+    };
+    let mut out = String::with_capacity(pretty.len());
+    let mut i = 0;
+    while i < lines.len() {
+        let line = lines[i];
+        if line.ends_with('[') {
+            let mut j = i + 1;
+            while j < lines.len() && is_number(lines[j]) {
+                j += 1;
+            }
+            if j > i + 1 && j < lines.len() && lines[j].trim_start().starts_with(']') {
+                let items: Vec<&str> = lines[i + 1..j].iter().map(|l| l.trim().trim_end_matches(',')).collect();
+                out.push_str(line);
+                out.push_str(&items.join(", "));
+                out.push_str(lines[j].trim_start());
+                out.push('\n');
+                i = j + 1;
+                continue;
+            }
+        }
+        out.push_str(line);
+        out.push('\n');
+        i += 1;
+    }
+    out
+}
+
 fn verify(spec: &Spec, vx: &[Vec<f64>], truth: &[f64], a64: &[f64], a32: &[f32]) -> Verification {
     let n = truth.len();
     let mut worst = (0usize, 0.0f64);

@@ -23,7 +23,7 @@ use super::spec::{DfgFormat, DfgLut, RoughnessMapping};
 use crate::emit::texture::{TextureFormat, ktx2_texels, png_srgb_preview};
 use crate::emit::{Artifact, GENERATOR, header_lines};
 use crate::family::ggx::integrals::{EnvEstimate, env};
-use crate::pipeline::{BuildError, Built, Mode, Verification, fmt_err, json_text, spec_rel_path};
+use crate::pipeline::{BuildError, Built, Mode, Verification, compact_json, fmt_err, spec_rel_path};
 use crate::spec::Spec;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -228,41 +228,6 @@ pub fn verify(lut: &DfgLut, values: &[[f64; 2]]) -> Result<Measured, BuildError>
         max_abs_storage_error: storage,
         error_map: map.into_iter().map(digits3).collect(),
     })
-}
-
-/// JSON text with every array of numbers on one line (the texel list stays one texel per
-/// line; everything else as serde_json's pretty printer writes it).
-fn compact_json(v: &Value) -> String {
-    let pretty = json_text(v);
-    let lines: Vec<&str> = pretty.lines().collect();
-    let is_number = |s: &str| {
-        let t = s.trim().trim_end_matches(',');
-        !t.is_empty() && t.parse::<f64>().is_ok()
-    };
-    let mut out = String::with_capacity(pretty.len());
-    let mut i = 0;
-    while i < lines.len() {
-        let line = lines[i];
-        if line.ends_with('[') {
-            let mut j = i + 1;
-            while j < lines.len() && is_number(lines[j]) {
-                j += 1;
-            }
-            if j > i + 1 && j < lines.len() && lines[j].trim_start().starts_with(']') {
-                let items: Vec<&str> = lines[i + 1..j].iter().map(|l| l.trim().trim_end_matches(',')).collect();
-                out.push_str(line);
-                out.push_str(&items.join(", "));
-                out.push_str(lines[j].trim_start());
-                out.push('\n');
-                i = j + 1;
-                continue;
-            }
-        }
-        out.push_str(line);
-        out.push('\n');
-        i += 1;
-    }
-    out
 }
 
 fn committed_parts(v: &Value, lut: &DfgLut) -> Result<(Vec<[f64; 2]>, Quadrature, Measured), BuildError> {
