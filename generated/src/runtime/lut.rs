@@ -48,6 +48,20 @@ pub struct Table {
 /// Hand-written: emitted.rs lists the functions, not the tables; the test
 /// `every_table_module_is_listed` fails when a new table module is emitted but not added here.
 pub const TABLES: &[Table] = &[
+    #[cfg(feature = "ggx")]
+    Table {
+        module: "ggx_albedo_avg_table",
+        function: "ggx_albedo_avg_lut",
+        domain: &crate::ggx_albedo_avg_table::GGX_ALBEDO_AVG_TABLE_DOMAIN,
+        values: &crate::ggx_albedo_avg_table::GGX_ALBEDO_AVG_TABLE_TABLE,
+    },
+    #[cfg(feature = "ggx")]
+    Table {
+        module: "ggx_albedo_table",
+        function: "ggx_albedo_lut",
+        domain: &crate::ggx_albedo_table::GGX_ALBEDO_TABLE_DOMAIN,
+        values: &crate::ggx_albedo_table::GGX_ALBEDO_TABLE_TABLE,
+    },
     #[cfg(feature = "gloss")]
     Table {
         module: "gloss_combine_lut",
