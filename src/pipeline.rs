@@ -592,6 +592,32 @@ fn axes_json(spec: &Spec) -> Value {
     )
 }
 
+/// The committed texels `values` of a LUT's JSON: an array of `texels` arrays of N numbers
+/// (`what` names them in the error, e.g. "[r, g, b]").
+pub fn committed_texels<const N: usize>(v: &Value, spec: &str, texels: usize, what: &str) -> Result<Vec<[f64; N]>, BuildError> {
+    let bad = |why: String| BuildError::NoCommitted { spec: spec.into(), why };
+    let values: Vec<[f64; N]> = v["values"]
+        .as_array()
+        .and_then(|a| {
+            a.iter()
+                .map(|t| {
+                    let t = t.as_array()?;
+                    (t.len() == N).then_some(())?;
+                    let mut out = [0.0; N];
+                    for (o, x) in out.iter_mut().zip(t) {
+                        *o = x.as_f64()?;
+                    }
+                    Some(out)
+                })
+                .collect::<Option<Vec<_>>>()
+        })
+        .ok_or_else(|| bad(format!("no array 'values' of {what} numbers")))?;
+    if values.len() != texels {
+        return Err(bad("texel count differs from the spec".into()));
+    }
+    Ok(values)
+}
+
 pub fn json_text(v: &Value) -> String {
     let mut s = serde_json::to_string_pretty(v).expect("JSON values serialise");
     s.push('\n');

@@ -366,6 +366,24 @@ impl CustomSpec<'_> {
     }
 }
 
+/// For family LUT kinds: every side of a texture `resolution` is in [2, max] (the message
+/// names the first that is not).
+pub fn check_resolution(resolution: &[usize], max: usize) -> Result<(), String> {
+    match resolution.iter().find(|&&n| !(2..=max).contains(&n)) {
+        Some(n) => Err(format!("{n} texels: each side must be in [2, {max}]")),
+        None => Ok(()),
+    }
+}
+
+/// For family LUT kinds: a quadrature tolerance inside `[lo, hi]`; `why` says what bounds it.
+pub fn check_tolerance(tolerance: f64, [lo, hi]: [f64; 2], why: &str) -> Result<(), String> {
+    if tolerance >= lo && tolerance <= hi {
+        Ok(())
+    } else {
+        Err(format!("{tolerance} must be in [{lo:e}, {hi:e}] ({why})"))
+    }
+}
+
 /// Whether `text` is TOML whose `kind` is `kind` (a family kind's reader declines the others;
 /// text that is not TOML is left to the common parser, which reports it).
 pub fn is_kind(text: &str, kind: &str) -> bool {

@@ -7,6 +7,7 @@
 //! - tables against numpy: the DFG LUT (`lut`).
 
 use super::integrals::{self as ggx, Shadowing};
+use super::published::filament;
 use super::{lut, published};
 use crate::bench::integrals::{IntegratorBench, IntegratorRow, Run, pick, row, self_ladder};
 use crate::bench::{FamilyBench, Mode};
@@ -74,34 +75,12 @@ fn env_integrators(mode: &Mode) -> Vec<IntegratorRow> {
     rows
 }
 
-/// The engines' estimator of [scale, bias]: n Hammersley points (i/n, radical inverse of i)
-/// mapped to half vectors by inverting the GGX D·cos θh CDF, weight G2 (v·h)/(μv μh), lights
-/// outside μl ≥ c counted as 0.
+/// The engines' estimator of [scale, bias]: Filament's (n Hammersley points mapped to half
+/// vectors through the GGX D·cos θh CDF, height-correlated V), lights outside μl ≥ c counted
+/// as 0.
 pub fn hammersley_env(alpha: f64, mu_v: f64, cos_cone: f64, n: usize) -> [f64; 2] {
-    let a2 = alpha * alpha;
-    let sin_v = ((1.0 - mu_v) * (1.0 + mu_v)).sqrt();
-    let lambda = |mu: f64| {
-        let t2 = (1.0 - mu * mu) / (mu * mu);
-        0.5 * (-1.0 + (1.0 + a2 * t2).sqrt())
-    };
-    let lv = lambda(mu_v);
-    let mut sum = [0.0; 2];
-    for i in 0..n {
-        let u1 = (i as u32).reverse_bits() as f64 / 4294967296.0;
-        let phi = 2.0 * std::f64::consts::PI * i as f64 / n as f64;
-        let c2 = (1.0 - u1) / (1.0 + (a2 - 1.0) * u1);
-        let (ch, sh) = (c2.sqrt(), (1.0 - c2).max(0.0).sqrt());
-        let vh = sin_v * sh * phi.cos() + mu_v * ch;
-        let mu_l = 2.0 * vh * ch - mu_v;
-        if !(mu_l > 0.0 && mu_l >= cos_cone && vh > 0.0) {
-            continue;
-        }
-        let w = vh / (mu_v * ch * (1.0 + lv + lambda(mu_l)));
-        let fc = (1.0 - vh).powi(5);
-        sum[0] += (1.0 - fc) * w;
-        sum[1] += fc * w;
-    }
-    [sum[0] / n as f64, sum[1] / n as f64]
+    let [bias, e] = filament::dfv_multiscatter_in_cone(mu_v, alpha, n as u32, cos_cone);
+    [e - bias, bias]
 }
 
 #[cfg(test)]

@@ -54,7 +54,8 @@
 //! # Limits
 //! - μv → 0: G2/μv stays finite (μv Λ(μv) → α/2), so the integrand is evaluated in the product
 //!   form 1/(μv + μvΛ(μv) + μvΛ(μl)) and n·v = 0 gives the limit, not 0/0.
-//! - α → 0: D → δ(h − n), l → mirror(v): E → 1 and bias → (1 − μv)⁵ (for μv ≥ c).
+//! - α → 0: D → δ(h − n), l → mirror(v): E → 1 and bias → (1 − μv)⁵ (for μv ≥ c); α = 0 gives
+//!   this limit exactly.
 //! - c → 1: the cone closes: scale = bias = 0 (c = 1 exactly: empty region, exact 0).
 //! - E(μ = 1, α = 1) = 1 − ln 2 (height-correlated G2), derived in [`albedo_normal_rough`].
 
@@ -279,6 +280,14 @@ pub fn env_with(alpha: f64, mu_v: f64, cos_cone: f64, shadowing: Shadowing, tol:
     if cos_cone >= 1.0 {
         return EnvEstimate { scale: 0.0, bias: 0.0, error: 0.0, evals: 0 };
     }
+    if alpha <= 0.0 {
+        // The mirror limit: D = δ(h − n), G = 1 (either model), l = mirror(v) with μl = μv.
+        if mu_v < cos_cone {
+            return EnvEstimate { scale: 0.0, bias: 0.0, error: 0.0, evals: 0 };
+        }
+        let b = (1.0 - mu_v).powi(5);
+        return EnvEstimate { scale: 1.0 - b, bias: b, error: 0.0, evals: 0 };
+    }
     let view = View::new(alpha, mu_v, cos_cone, shadowing);
     let theta_v = mu_v.acos();
     let theta_c = cos_cone.acos();
@@ -495,7 +504,7 @@ fn segments(pieces: &[(f64, f64)], alpha: f64) -> Vec<Segment> {
     let a2 = alpha * alpha;
     let mut out = Vec::new();
     for &(p, q) in pieces {
-        if !(q > p) {
+        if q.partial_cmp(&p) != Some(std::cmp::Ordering::Greater) {
             continue;
         }
         let mut cuts = vec![p, q];

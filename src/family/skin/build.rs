@@ -17,7 +17,7 @@
 //! `Mode::Committed` (build --check) takes the texel values and the measured errors from the
 //! committed JSON and re-renders every file without integrating.
 
-use crate::pipeline::{BuildError, Built, Mode, Verification, compact_json, fmt_err, spec_rel_path};
+use crate::pipeline::{BuildError, Built, Mode, Verification, committed_texels, compact_json, fmt_err, spec_rel_path};
 use super::emit::{Layout, SkinLutCode};
 use crate::emit::texture::{ktx2_rgba, png_srgb_preview};
 use crate::emit::{Artifact, GENERATOR, header_lines};
@@ -198,21 +198,7 @@ fn verify(
 
 fn committed_parts(v: &Value, name: &str, texels: usize) -> Result<(Vec<[f64; 3]>, Verification, Quadrature), BuildError> {
     let bad = |why: &str| BuildError::NoCommitted { spec: name.into(), why: why.into() };
-    let values: Vec<[f64; 3]> = v["values"]
-        .as_array()
-        .and_then(|a| {
-            a.iter()
-                .map(|t| {
-                    let t = t.as_array()?;
-                    (t.len() == 3).then_some(())?;
-                    Some([t[0].as_f64()?, t[1].as_f64()?, t[2].as_f64()?])
-                })
-                .collect::<Option<Vec<_>>>()
-        })
-        .ok_or_else(|| bad("no array 'values' of [r, g, b] numbers"))?;
-    if values.len() != texels {
-        return Err(bad("texel count differs from the spec"));
-    }
+    let values = committed_texels::<3>(v, name, texels, "[r, g, b]")?;
     let ver = &v["verification"];
     let num = |x: &Value, k: &str| x[k].as_f64().ok_or_else(|| bad(&format!("no number '{k}'")));
     let verification = Verification {

@@ -29,7 +29,7 @@
 //! listing, staleness and the runtime index treat it like any other spec.
 
 use super::profile::{LoadedProfile, ProfileSection};
-use crate::spec::{CustomSpec, SpecError, SpecFile, is_kind, line_of, parse_toml};
+use crate::spec::{CustomSpec, SpecError, SpecFile, check_resolution, check_tolerance, is_kind, line_of, parse_toml};
 use crate::emit::texture::TextureFormat;
 use super::integrals::{CurvatureMapping, Kernel, mapped_curvature};
 use serde::Deserialize;
@@ -135,21 +135,13 @@ impl SkinLut {
         if f.resolution.len() != if punctual { 2 } else { 1 } {
             return Err(at("resolution", format!("{} needs resolution = {want}", f.quantity)));
         }
-        if let Some(&n) = f.resolution.iter().find(|&&n| !(2..=MAX_RESOLUTION).contains(&n)) {
-            return Err(at("resolution", format!("{n} texels: each side must be in [2, {MAX_RESOLUTION}]")));
-        }
+        check_resolution(&f.resolution, MAX_RESOLUTION).map_err(|m| at("resolution", m))?;
         let k = f.curvature_max;
         if !(k.is_finite() && k > 0.0 && k <= MAX_CURVATURE) {
             return Err(at("curvature_max", format!("{k}/mm must be finite and in (0, {MAX_CURVATURE}]")));
         }
         let tolerance = f.tolerance.unwrap_or(DEFAULT_TOLERANCE);
-        let [lo, hi] = TOLERANCE_RANGE;
-        if !(tolerance >= lo && tolerance <= hi) {
-            return Err(at(
-                "tolerance",
-                format!("{tolerance} must be in [{lo:e}, {hi:e}] (the LUT promises 1e-6 per channel; below 1e-14 the quadrature cannot converge)"),
-            ));
-        }
+        check_tolerance(tolerance, TOLERANCE_RANGE, "the LUT promises 1e-6 per channel; below 1e-14 the quadrature cannot converge").map_err(|m| at("tolerance", m))?;
         let kind = if punctual {
             let kernel = match f.kernel.unwrap_or(KernelName::Linear) {
                 KernelName::Linear => Kernel::Linear,

@@ -72,19 +72,7 @@ pub fn figures(out: &Path, generated: &Path) -> Result<Vec<PathBuf>, PlotError> 
     let f1: Vec<Vec<f64>> = Scheme::ALL.iter().map(|&s| grid.furnace(s, 1.0).iter().map(|v| v - 1.0).collect()).collect();
     let panels: Vec<Panel> = titles.iter().zip(&f1).map(|(t, v)| Panel { title: t, values: v }).collect();
     // bevy's gain is unbounded near (0, 0): the shared scale is clipped to ±1.
-    files.extend(crate::plot::grid_of_heatmaps(
-        &out.join("ggx_furnace_f1"),
-        "White furnace, F = 1: albedo − 1 (clipped to ±1)",
-        "n·v",
-        "roughness",
-        &mu,
-        &roughness,
-        &panels,
-        3,
-        "albedo − 1",
-        true,
-        Some((-1.0, 1.0)),
-    )?);
+    files.extend(furnace_maps(out, "ggx_furnace_f1", "White furnace, F = 1: albedo − 1 (clipped to ±1)", &grid, &panels, "albedo − 1", Some((-1.0, 1.0)))?);
 
     let kc = grid.furnace(Scheme::KullaConty, 0.5);
     let f05: Vec<Vec<f64>> = Scheme::ALL
@@ -93,19 +81,7 @@ pub fn figures(out: &Path, generated: &Path) -> Result<Vec<PathBuf>, PlotError> 
         .collect();
     let panels: Vec<Panel> = titles.iter().zip(&f05).map(|(t, v)| Panel { title: t, values: v }).collect();
     let range = crate::plot::symmetric_range(f05[..5].iter().flatten());
-    files.extend(crate::plot::grid_of_heatmaps(
-        &out.join("ggx_furnace_f0_0.5"),
-        "White furnace, Schlick F0 = 0.5: albedo − Kulla–Conty's",
-        "n·v",
-        "roughness",
-        &mu,
-        &roughness,
-        &panels,
-        3,
-        "albedo − albedo(KC)",
-        true,
-        Some(range),
-    )?);
+    files.extend(furnace_maps(out, "ggx_furnace_f0_0.5", "White furnace, Schlick F0 = 0.5: albedo − Kulla–Conty's", &grid, &panels, "albedo − albedo(KC)", Some(range))?);
 
     if let Some((e, a)) = &tables {
         let tab: Vec<_> = roughness.iter().map(|&r| tabulated(e, a, r * r, &mu)).collect();
@@ -125,19 +101,13 @@ pub fn figures(out: &Path, generated: &Path) -> Result<Vec<PathBuf>, PlotError> 
             .collect();
         let t: Vec<String> = schemes.iter().map(|s| s.id().to_string()).collect();
         let panels: Vec<Panel> = t.iter().zip(&maps).map(|(t, v)| Panel { title: t, values: v }).collect();
-        files.extend(crate::plot::grid_of_heatmaps(
-            &out.join("ggx_furnace_tables"),
-            "White furnace, F = 1, E and E_avg from the 32×32 and 32 tables: albedo − 1",
-            "n·v",
-            "roughness",
-            &mu,
-            &roughness,
-            &panels,
-            3,
-            "albedo − 1",
-            true,
-            None,
-        )?);
+        files.extend(furnace_maps(out, "ggx_furnace_tables", "White furnace, F = 1, E and E_avg from the 32×32 and 32 tables: albedo − 1", &grid, &panels, "albedo − 1", None)?);
     }
     Ok(files)
+}
+
+/// Heat maps over the grid's (n·v, roughness), three to a row, one per scheme, on a shared
+/// scale (or the given range).
+fn furnace_maps(out: &Path, name: &str, title: &str, grid: &Grid, panels: &[Panel], label: &str, range: Option<(f64, f64)>) -> Result<Vec<PathBuf>, PlotError> {
+    crate::plot::grid_of_heatmaps(&out.join(name), title, "n·v", "roughness", &grid.mu, &grid.roughness, panels, 3, label, true, range)
 }

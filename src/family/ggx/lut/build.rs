@@ -23,7 +23,7 @@ use super::spec::{DfgFormat, DfgLut, RoughnessMapping};
 use crate::emit::texture::{TextureFormat, ktx2_texels, png_srgb_preview};
 use crate::emit::{Artifact, GENERATOR, header_lines};
 use crate::family::ggx::integrals::{EnvEstimate, env};
-use crate::pipeline::{BuildError, Built, Mode, Verification, compact_json, fmt_err, spec_rel_path};
+use crate::pipeline::{BuildError, Built, Mode, Verification, committed_texels, compact_json, fmt_err, spec_rel_path};
 use crate::spec::Spec;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -232,21 +232,7 @@ pub fn verify(lut: &DfgLut, values: &[[f64; 2]]) -> Result<Measured, BuildError>
 
 fn committed_parts(v: &Value, lut: &DfgLut) -> Result<(Vec<[f64; 2]>, Quadrature, Measured), BuildError> {
     let bad = |why: String| BuildError::NoCommitted { spec: lut.name.clone(), why };
-    let values: Vec<[f64; 2]> = v["values"]
-        .as_array()
-        .and_then(|a| {
-            a.iter()
-                .map(|t| {
-                    let t = t.as_array()?;
-                    (t.len() == 2).then_some(())?;
-                    Some([t[0].as_f64()?, t[1].as_f64()?])
-                })
-                .collect::<Option<Vec<_>>>()
-        })
-        .ok_or_else(|| bad("no array 'values' of [scale, bias] numbers".into()))?;
-    if values.len() != lut.width * lut.height {
-        return Err(bad("texel count differs from the spec".into()));
-    }
+    let values = committed_texels::<2>(v, &lut.name, lut.width * lut.height, "[scale, bias]")?;
     let quadrature: Quadrature = serde_json::from_value(v["quadrature"].clone()).map_err(|e| bad(format!("quadrature: {e}")))?;
     let measured: Measured = serde_json::from_value(v["verification"].clone()).map_err(|e| bad(format!("verification: {e}")))?;
     if measured.error_map.len() != values.len() {

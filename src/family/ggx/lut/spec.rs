@@ -30,7 +30,7 @@
 //! (count = columns) and, for ggx-env, cos_cone as an axis of one point.
 
 use crate::family::ggx::integrals::Shadowing;
-use crate::spec::{CustomSpec, SpecError, SpecFile, is_kind, line_of, parse_toml};
+use crate::spec::{CustomSpec, SpecError, SpecFile, check_resolution, check_tolerance, is_kind, line_of, parse_toml};
 use serde::Deserialize;
 use serde_json::json;
 use std::path::Path;
@@ -218,9 +218,7 @@ impl DfgLut {
         if f.resolution.len() != 2 {
             return Err(at("resolution", format!("needs resolution = [n·v columns, roughness rows], found {} numbers", f.resolution.len())));
         }
-        if let Some(&n) = f.resolution.iter().find(|&&n| !(2..=MAX_RESOLUTION).contains(&n)) {
-            return Err(at("resolution", format!("{n} texels: each side must be in [2, {MAX_RESOLUTION}]")));
-        }
+        check_resolution(&f.resolution, MAX_RESOLUTION).map_err(|m| at("resolution", m))?;
         let cos_cone = f.cos_cone.unwrap_or(0.0);
         if ue4 && f.cos_cone.is_some() {
             return Err(at("cos_cone", "ggx-env-ue4 integrates the hemisphere; 'cos_cone' applies to ggx-env only".into()));
@@ -229,13 +227,7 @@ impl DfgLut {
             return Err(at("cos_cone", format!("{cos_cone} must be in [0, {MAX_COS_CONE}] (0: the hemisphere)")));
         }
         let tolerance = f.tolerance.unwrap_or(DEFAULT_TOLERANCE);
-        let [lo, hi] = TOLERANCE_RANGE;
-        if !(tolerance >= lo && tolerance <= hi) {
-            return Err(at(
-                "tolerance",
-                format!("{tolerance} must be in [{lo:e}, {hi:e}] (above, quadrature error would rival f16 rounding; below, the rules cannot converge in f64)"),
-            ));
-        }
+        check_tolerance(tolerance, TOLERANCE_RANGE, "above, quadrature error would rival f16 rounding; below, the rules cannot converge in f64").map_err(|m| at("tolerance", m))?;
         Ok(DfgLut {
             name: f.name,
             quantity: f.quantity,

@@ -39,6 +39,11 @@ fn visibility(nov: f64, nol: f64, a: f64) -> f64 {
 
 /// `DFV_Multiscatter(NoV, α, n)` (in f64): [bias, E].
 pub fn dfv_multiscatter(nov: f64, a: f64, n: u32) -> [f64; 2] {
+    dfv_multiscatter_in_cone(nov, a, n, 0.0)
+}
+
+/// The same estimator counting only lights with NoL ≥ `cos_cone` (0: Filament's own).
+pub fn dfv_multiscatter_in_cone(nov: f64, a: f64, n: u32, cos_cone: f64) -> [f64; 2] {
     let v = [(1.0 - nov * nov).sqrt(), 0.0, nov];
     let (mut bias, mut e) = (0.0, 0.0);
     for i in 0..n {
@@ -53,7 +58,7 @@ pub fn dfv_multiscatter(nov: f64, a: f64, n: u32) -> [f64; 2] {
         let nol = l_z.clamp(0.0, 1.0);
         let noh = h[2].clamp(0.0, 1.0);
         let voh = voh_raw.clamp(0.0, 1.0);
-        if nol > 0.0 {
+        if nol > 0.0 && nol >= cos_cone {
             let w = visibility(nov, nol, a) * nol * (voh / noh);
             let fc = (1.0 - voh).powi(5);
             bias += w * fc;

@@ -63,13 +63,8 @@ impl Target {
     }
 }
 
-/// [scale, bias] at (α, n·v) with the target's G; α = 0 is the limit (mirror reflection):
-/// [1 − (1 − μ)⁵, (1 − μ)⁵].
+/// [scale, bias] at (α, n·v) with the target's G (α = 0: the mirror limit of `integrals::env`).
 pub fn env(target: Target, alpha: f64, mu: f64, tol: f64) -> [f64; 2] {
-    if alpha <= 0.0 {
-        let b = (1.0 - mu).powi(5);
-        return [1.0 - b, b];
-    }
     let shadowing = match target {
         Target::RoughnessUe4 => Shadowing::Separable { k: 0.5 * alpha },
         _ => Shadowing::HeightCorrelated,
