@@ -217,7 +217,7 @@ pub fn samples(paths: &Paths, name: &str, as_json: bool) -> Result<()> {
         });
         let out = json!({
             "name": s.file.name,
-            "quantity": s.file.quantity,
+            "quantity": s.quantity_label(),
             "features": features,
             "objective": s.file.fit.as_ref().map(|f| f.objective),
             "model": model,
@@ -248,7 +248,7 @@ pub fn list(paths: &Paths) -> Result<()> {
             "{:<22} {:<8} {:<18} {:<28} {status}",
             s.file.name,
             s.file.kind.name(),
-            s.file.quantity,
+            s.quantity_label(),
             s.file.emit.function
         );
     }

@@ -164,9 +164,8 @@ pub(crate) fn tensor(axes: &[crate::spec::AxisSpec], counts: &[usize]) -> Vec<Ve
 
 /// The integral at each point, in parallel, in order.
 pub fn sample(spec: &Spec, points: &[Vec<f64>]) -> Vec<f64> {
-    let q = spec.quantity;
-    let tol = spec.file.tolerance;
-    points.par_iter().map(|p| (q.eval)(p, tol).value).collect()
+    let sampler = spec.sampler();
+    points.par_iter().map(|p| sampler.eval(p).value).collect()
 }
 
 pub fn spec_rel_path(spec: &Spec) -> String {
@@ -438,7 +437,7 @@ pub fn fit_from_coefficients(
         "input_hash": hash,
         "name": name,
         "kind": "fit",
-        "quantity": spec.file.quantity,
+        "quantity": spec.quantity_label(),
         "description": spec.file.description,
         "function": spec.file.emit.function,
         "axes": axes_json(spec),
@@ -575,7 +574,7 @@ fn describe_fit(spec: &Spec, model: &fit::RationalModel) -> String {
             }
             if model.clamp.is_some() { format!("clamp({f})") } else { f }
         },
-        spec.file.quantity,
+        spec.quantity_label(),
         num.join(", "),
         model.lead.as_ref().map_or("1".to_string(), |t| format!("({t})")),
         den.join(", ")
@@ -742,7 +741,7 @@ pub fn table_from_values(spec: &Spec, values: Vec<f64>, reference: &Reference) -
         spec.file.description,
         spec.file.emit.function,
         counts.iter().map(|c| c.to_string()).collect::<Vec<_>>().join("×"),
-        spec.file.quantity
+        spec.quantity_label()
     );
     let json = json!({
         "generator": GENERATOR,
@@ -750,7 +749,7 @@ pub fn table_from_values(spec: &Spec, values: Vec<f64>, reference: &Reference) -
         "input_hash": hash,
         "name": name,
         "kind": "table",
-        "quantity": spec.file.quantity,
+        "quantity": spec.quantity_label(),
         "description": spec.file.description,
         "function": spec.file.emit.function,
         "axes": axes_json(spec),

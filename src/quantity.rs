@@ -33,7 +33,7 @@ pub struct QuantityDef {
     /// parameter units (e.g. the parameter recovered from a fitted value).
     pub inverse: Option<fn(f64) -> f64>,
     /// Vector-valued quantities (e.g. RGB): channel names and the evaluator of all channels.
-    /// Their `eval` returns channel 0; specs do not take them yet.
+    /// Their `eval` returns channel 0; a fit or table spec takes one (`channel`).
     pub channels: &'static [&'static str],
     pub eval_channels: Option<fn(&[f64], f64) -> Vec<Estimate>>,
     /// For two-stage fits (`kind = "fields"`): the linear basis in the quantity's trailing

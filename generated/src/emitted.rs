@@ -31,6 +31,15 @@ pub mod ggx_dfg_lut;
 #[cfg(feature = "ggx")]
 #[path = "ggx_dfg_lut_filament.rs"]
 pub mod ggx_dfg_lut_filament;
+#[cfg(feature = "ggx")]
+#[path = "ggx_env_bias_rational.rs"]
+pub mod ggx_env_bias_rational;
+#[cfg(feature = "ggx")]
+#[path = "ggx_env_scale_rational.rs"]
+pub mod ggx_env_scale_rational;
+#[cfg(feature = "ggx")]
+#[path = "ggx_published_refits.rs"]
+pub mod ggx_published_refits;
 #[cfg(feature = "gloss")]
 #[path = "gloss_combine.rs"]
 pub mod gloss_combine;
@@ -87,6 +96,12 @@ pub mod wgsl {
     pub const GGX_DFG_LUT: &str = include_str!("../wgsl/ggx_dfg_lut.wgsl");
     #[cfg(feature = "ggx")]
     pub const GGX_DFG_LUT_FILAMENT: &str = include_str!("../wgsl/ggx_dfg_lut_filament.wgsl");
+    #[cfg(feature = "ggx")]
+    pub const GGX_ENV_BIAS_RATIONAL: &str = include_str!("../wgsl/ggx_env_bias_rational.wgsl");
+    #[cfg(feature = "ggx")]
+    pub const GGX_ENV_SCALE_RATIONAL: &str = include_str!("../wgsl/ggx_env_scale_rational.wgsl");
+    #[cfg(feature = "ggx")]
+    pub const GGX_PUBLISHED_REFITS: &str = include_str!("../wgsl/ggx_published_refits.wgsl");
     #[cfg(feature = "gloss")]
     pub const GLOSS_COMBINE: &str = include_str!("../wgsl/gloss_combine.wgsl");
     #[cfg(feature = "gloss")]
@@ -133,6 +148,12 @@ pub mod wgsl {
             "ggx_dfg_lut" => Some(GGX_DFG_LUT),
             #[cfg(feature = "ggx")]
             "ggx_dfg_lut_filament" => Some(GGX_DFG_LUT_FILAMENT),
+            #[cfg(feature = "ggx")]
+            "ggx_env_bias_rational" => Some(GGX_ENV_BIAS_RATIONAL),
+            #[cfg(feature = "ggx")]
+            "ggx_env_scale_rational" => Some(GGX_ENV_SCALE_RATIONAL),
+            #[cfg(feature = "ggx")]
+            "ggx_published_refits" => Some(GGX_PUBLISHED_REFITS),
             #[cfg(feature = "gloss")]
             "gloss_combine" => Some(GLOSS_COMBINE),
             #[cfg(feature = "gloss")]
@@ -181,6 +202,12 @@ pub mod wgsl {
         "ggx_dfg_lut",
         #[cfg(feature = "ggx")]
         "ggx_dfg_lut_filament",
+        #[cfg(feature = "ggx")]
+        "ggx_env_bias_rational",
+        #[cfg(feature = "ggx")]
+        "ggx_env_scale_rational",
+        #[cfg(feature = "ggx")]
+        "ggx_published_refits",
         #[cfg(feature = "gloss")]
         "gloss_combine",
         #[cfg(feature = "gloss")]
@@ -222,6 +249,10 @@ pub const FUNCTIONS: &[EmittedFunction] = &[
     EmittedFunction { module: "ggx_albedo_rational", name: "ggx_albedo", domain: &[[1e-4, 1e0], [7.8125e-3, 1e0]], cpu: Cpu::Two(ggx_albedo_rational::ggx_albedo) },
     #[cfg(feature = "ggx")]
     EmittedFunction { module: "ggx_albedo_table", name: "ggx_albedo_lut", domain: &[[1e-4, 1e0], [0e0, 1e0]], cpu: Cpu::Two(ggx_albedo_table::ggx_albedo_lut) },
+    #[cfg(feature = "ggx")]
+    EmittedFunction { module: "ggx_env_bias_rational", name: "ggx_env_bias", domain: &[[1e-6, 1e0], [7.8125e-3, 1e0]], cpu: Cpu::Two(ggx_env_bias_rational::ggx_env_bias) },
+    #[cfg(feature = "ggx")]
+    EmittedFunction { module: "ggx_env_scale_rational", name: "ggx_env_scale", domain: &[[1e-6, 1e0], [7.8125e-3, 1e0]], cpu: Cpu::Two(ggx_env_scale_rational::ggx_env_scale) },
     #[cfg(feature = "gloss")]
     EmittedFunction { module: "gloss_combine", name: "combine_gloss", domain: &[[0e0, 1e0], [0e0, 1e0]], cpu: Cpu::Two(gloss_combine::combine_gloss) },
     #[cfg(feature = "gloss")]

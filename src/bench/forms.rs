@@ -28,8 +28,7 @@ use super::{BenchError, FamilyBench};
 use crate::fit::positivity::{Positivity, prove_denominator_positive};
 use crate::fit::{Data, RationalModel};
 use crate::pipeline::{self, Built, Denominators, Reference, Verification};
-use crate::quantity::QuantityDef;
-use crate::spec::{Catalog, Spec};
+use crate::spec::{Catalog, Sampler, Spec};
 use nalgebra::DVector;
 use rayon::prelude::*;
 use serde::Serialize;
@@ -157,23 +156,22 @@ pub fn pin(at: f64, eliminate: &str) -> toml::Value {
 
 /// The integral of one quantity, each point evaluated once.
 pub struct Integral {
-    quantity: &'static QuantityDef,
-    tolerance: f64,
+    sampler: Sampler,
     known: HashMap<Vec<u64>, f64>,
 }
 
 impl Integral {
     /// The integral of the spec's quantity at the spec's tolerance.
     pub fn of(spec: &Spec) -> Integral {
-        Integral { quantity: spec.quantity, tolerance: spec.file.tolerance, known: HashMap::new() }
+        Integral { sampler: spec.sampler(), known: HashMap::new() }
     }
 
     /// The integral at `points`, the new ones in parallel.
     pub fn at(&mut self, points: &[Vec<f64>]) -> Vec<f64> {
         let key = |p: &[f64]| p.iter().map(|v| v.to_bits()).collect::<Vec<u64>>();
         let missing: Vec<&Vec<f64>> = points.iter().filter(|p| !self.known.contains_key(&key(p))).collect();
-        let (q, tol) = (self.quantity, self.tolerance);
-        let values: Vec<f64> = missing.par_iter().map(|p| (q.eval)(p, tol).value).collect();
+        let sampler = self.sampler;
+        let values: Vec<f64> = missing.par_iter().map(|p| sampler.eval(p).value).collect();
         for (p, v) in missing.into_iter().zip(values) {
             self.known.insert(key(p), v);
         }
@@ -307,7 +305,7 @@ pub fn fit_row_f32(
     let v = &built.verification;
     let shape = format!("{}/{} terms", model.numerator.len(), model.denominator.len());
     let note = if note.is_empty() { format!("{shape}{poles}") } else { format!("{shape}; {note}{poles}") };
-    Ok(row(&spec.file.quantity, form, ops, 0, v.into(), note))
+    Ok(row(&spec.quantity_label(), form, ops, 0, v.into(), note))
 }
 
 /// A table form (values at the spec's table points), verified and emitted through the pipeline.
@@ -320,7 +318,7 @@ pub fn table_row(spec: &Spec, values: Vec<f64>, reference: &Reference, form: &st
     let kind = if size.len() == 1 { "linear" } else { "bilinear" };
     let shape = format!("{} f32 const array, {kind}", size.join("×"));
     let note = if note.is_empty() { shape } else { format!("{shape}; {note}") };
-    Ok(row(&spec.file.quantity, form, ops, bytes, v.into(), note))
+    Ok(row(&spec.quantity_label(), form, ops, bytes, v.into(), note))
 }
 
 /// The committed values of a table spec (generated/json).

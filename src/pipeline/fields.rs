@@ -348,7 +348,7 @@ pub fn fields_from_coefficients(
         "input_hash": hash,
         "name": name,
         "kind": "fields",
-        "quantity": spec.file.quantity,
+        "quantity": spec.quantity_label(),
         "description": spec.file.description,
         "function": spec.file.emit.function,
         "evaluator": evaluator,

@@ -8,9 +8,11 @@
 //! kind = "fit"                     # "fit" (a model fitted to samples), "table" (a LUT),
 //!                                  # "fields", or a kind a family defines (`KindDef`)
 //! quantity = "some-quantity"       # see `shadefit eval --help`
+//! channel = "bias"                 # vector quantities: the channel fitted or tabulated
 //! description = "..."
 //!
-//! [[axis]]                         # one per quantity parameter, in the quantity's order
+//! [[axis]]                         # one per quantity parameter, in the quantity's order;
+//!                                  # trailing parameters with a default may be left out
 //! name = "x"
 //! range = [0.0, 1.0]
 //! count = 256                      # samples (uniform, ends included)
@@ -40,6 +42,7 @@ pub use names::is_identifier;
 
 use crate::fit::model::{Derived, ModelError, ModelParts, Pin, RationalModel, Term};
 use crate::fit::Objective;
+use crate::integrate::Estimate;
 use crate::quantity::{QuantityDef, QuantityError};
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -460,6 +463,8 @@ pub struct SpecFile {
     pub name: String,
     pub kind: Kind,
     pub quantity: String,
+    /// Vector quantities: the channel a fit or table takes (see `shadefit eval --help`).
+    pub channel: Option<String>,
     #[serde(default)]
     pub description: String,
     /// Integrator absolute tolerance for every sample.
@@ -487,9 +492,53 @@ pub struct Spec {
     pub file: SpecFile,
     pub quantity: &'static QuantityDef,
     pub model: Option<RationalModel>,
+    /// The channel of a vector quantity the spec takes (`channel`), by index.
+    pub channel: Option<usize>,
+}
+
+/// How a spec evaluates its quantity at a point of its axes: the channel it takes, and the
+/// defaults of the trailing parameters its axes leave out.
+#[derive(Debug, Clone, Copy)]
+pub struct Sampler {
+    pub quantity: &'static QuantityDef,
+    pub channel: Option<usize>,
+    pub tolerance: f64,
+}
+
+impl Sampler {
+    /// The integral at `point` (the spec's axes, in order) to the spec's tolerance.
+    pub fn eval(&self, point: &[f64]) -> Estimate {
+        let q = self.quantity;
+        let full: Vec<f64>;
+        let p = if point.len() < q.params.len() {
+            // Spec::parse admits only left-out parameters that have a default.
+            full = point.iter().copied().chain(q.params[point.len()..].iter().map(|p| p.default.unwrap_or(f64::NAN))).collect();
+            &full[..]
+        } else {
+            point
+        };
+        match (self.channel, q.eval_channels) {
+            (Some(c), Some(all)) => all(p, self.tolerance)[c],
+            _ => (q.eval)(p, self.tolerance),
+        }
+    }
 }
 
 impl Spec {
+    /// The spec's evaluator of its quantity (see [`Sampler`]).
+    pub fn sampler(&self) -> Sampler {
+        Sampler { quantity: self.quantity, channel: self.channel, tolerance: self.file.tolerance }
+    }
+
+    /// The quantity as reports name it: `QUANTITY[CHANNEL]` for a channel of a vector quantity,
+    /// else the quantity's name.
+    pub fn quantity_label(&self) -> String {
+        match self.channel {
+            Some(c) => format!("{}[{}]", self.quantity.name, self.quantity.channels[c]),
+            None => self.file.quantity.clone(),
+        }
+    }
+
     pub fn load(path: &Path, catalog: &Catalog) -> Result<Spec, SpecError> {
         let text = std::fs::read_to_string(path)
             .map_err(|e| SpecError::new(path, 0, "(file)", format!("cannot read: {e}")))?;
@@ -542,24 +591,37 @@ impl Spec {
         if !(file.tolerance > 0.0 && file.tolerance < 1.0) {
             return Err(at("tolerance", format!("{} must be in (0, 1)", file.tolerance)));
         }
-        if !quantity.channels.is_empty() && !matches!(file.kind, Kind::Custom(_)) {
-            let kinds: Vec<String> = catalog.kinds.iter().map(|k| format!("kind = \"{}\"", k.name)).collect();
-            return Err(at(
-                "quantity",
-                format!(
-                    "'{}' has {} channels; fits and tables take scalar quantities only (vector quantities: {})",
-                    quantity.name,
-                    quantity.channels.len(),
-                    kinds.join(", ")
-                ),
-            ));
-        }
+        let custom_kind = matches!(file.kind, Kind::Custom(_));
+        let channel = match (&file.channel, quantity.channels) {
+            (None, []) => None,
+            (None, _) if custom_kind => None,
+            (None, names) => {
+                return Err(at(
+                    "quantity",
+                    format!(
+                        "'{}' has the channels [{}]; a fit or table takes one of them: add channel = \"{}\"",
+                        quantity.name,
+                        names.join(", "),
+                        names[0]
+                    ),
+                ));
+            }
+            (Some(c), []) => return Err(at("channel", format!("'{}' is a scalar quantity; remove channel = \"{c}\"", quantity.name))),
+            (Some(c), _) if custom_kind => return Err(at("channel", format!("kind = \"{}\" takes every channel; remove channel = \"{c}\"", file.kind.name()))),
+            (Some(c), names) => match names.iter().position(|n| n == c) {
+                Some(i) if quantity.eval_channels.is_some() => Some(i),
+                _ => return Err(at("channel", format!("'{c}' is not a channel of '{}' (channels: {})", quantity.name, names.join(", ")))),
+            },
+        };
         let names: Vec<&str> = quantity.params.iter().map(|p| p.name).collect();
         let axis_names: Vec<&str> = file.axis.iter().map(|a| a.name.as_str()).collect();
-        if axis_names != names {
+        let left_out_have_defaults = quantity.params.get(axis_names.len()..).is_some_and(|rest| rest.iter().all(|p| p.default.is_some()));
+        if axis_names.len() > names.len() || axis_names[..] != names[..axis_names.len()] || !left_out_have_defaults {
+            let optional: Vec<&str> = quantity.params.iter().filter(|p| p.default.is_some()).map(|p| p.name).collect();
+            let note = if optional.is_empty() { String::new() } else { format!(" (trailing parameters with a default may be left out: {})", optional.join(", ")) };
             return Err(at(
                 "axis",
-                format!("axes must be the quantity's parameters in order: [{}], found [{}]", names.join(", "), axis_names.join(", ")),
+                format!("axes must be the quantity's parameters in order: [{}], found [{}]{note}", names.join(", "), axis_names.join(", ")),
             ));
         }
         // A family kind spells its axes out from fields its own checker has checked (a fixed
@@ -613,9 +675,8 @@ impl Spec {
                 {
                     return Err(at("features", "a fit spec takes its features from its axes; remove 'features'".into()));
                 }
-                let q = quantity;
-                let tol = file.tolerance;
-                Some(m.build(path, &text, features, &|x: &[f64]| Some((q.eval)(x, tol).value))?)
+                let sampler = Sampler { quantity, channel, tolerance: file.tolerance };
+                Some(m.build(path, &text, features, &|x: &[f64]| Some(sampler.eval(x).value))?)
             }
             (Kind::Fit, None) => return Err(at("model", "kind = \"fit\" needs a [model] section".into())),
             (Kind::Table, Some(_)) => return Err(at("model", "kind = \"table\" takes no [model]".into())),
@@ -629,7 +690,7 @@ impl Spec {
         if file.kind == Kind::Table && file.axis.len() > 2 {
             return Err(at("axis", "tables have one or two axes".into()));
         }
-        Ok(Spec { path: path.to_path_buf(), text, file, quantity, model })
+        Ok(Spec { path: path.to_path_buf(), text, file, quantity, model, channel })
     }
 }
 

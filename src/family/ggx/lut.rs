@@ -13,7 +13,7 @@ use crate::spec::KindDef;
 use std::path::{Path, PathBuf};
 
 /// The `ggx-dfg-lut` spec kind: checked and spelled out by [`spec`], built by [`build`].
-static DFG_LUT: SpecKind = SpecKind {
+pub const DFG_LUT: SpecKind = SpecKind {
     spec: KindDef {
         name: spec::KIND,
         spec_file: spec::spec_file,
@@ -22,9 +22,6 @@ static DFG_LUT: SpecKind = SpecKind {
     },
     build: build::build,
 };
-
-/// Spec kinds of the family (the DFG LUT).
-pub static KINDS: &[SpecKind] = std::slice::from_ref(&DFG_LUT);
 
 /// Table benchmark rows: the default DFG LUT against numpy (Filament's Hammersley estimator,
 /// Gauss–Legendre in the sampling variables).

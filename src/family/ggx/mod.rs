@@ -214,7 +214,7 @@ pub static FAMILY: Family = Family {
     name: "ggx",
     doc: "GGX split-sum: DFG scale/bias (with a visibility cone), E(mu), E_avg, Fresnel averages, energy compensation",
     quantities: QUANTITIES,
-    spec_kinds: lut::KINDS,
+    spec_kinds: &[lut::DFG_LUT, published::emit::REFITS],
     eval_options: None,
     validate: items,
     figures,

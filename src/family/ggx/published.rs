@@ -13,6 +13,7 @@
 //! Constants and formulas are in [`forms`] with their sources; the grids and the integrals on
 //! them in [`grid`].
 
+pub mod emit;
 pub mod filament;
 pub mod forms;
 pub mod grid;
@@ -25,6 +26,7 @@ use crate::bench::forms::{
 };
 use crate::bench::BenchError;
 use crate::pipeline::{self, Reference};
+use crate::spec::Spec;
 use crate::plot::{Panel, PlotError};
 use crate::validate::{Item, measure};
 use forms::{KARIS, KULLA_CONTY, LAZAROV, MATERIALX, Karis, MaterialX};
@@ -231,8 +233,15 @@ fn materialx_item() -> Item {
         "MaterialX libraries/pbrlib/genglsl/lib/mx_microfacet_specular.glsl (v1.39.5)",
         g,
         |m, a| MATERIALX.eval(m, a),
-        |m, a| refit::COMMITTED.materialx.eval(m, a),
-        "same biquadratic/biquadratic pair with clamp, rational minimax per channel, denominators proven positive",
+        |m, a| refit::COMMITTED.materialx.eval(m.clamp(emit::MATERIALX_N_DOT_V.0, emit::MATERIALX_N_DOT_V.1), a),
+        "same biquadratic/biquadratic pair with clamp; scale refitted minimax, bias kept as published (below); n·v clamped to the fitted [1/128, 125/128] as the emitted code does",
+    );
+    item.findings.push(
+        "The bias channel keeps MaterialX's constants: the minimax optimum of this shape, from the linearised starts and \
+         from the published constants alike, has a bias denominator r.w that changes sign inside n·v × α (e.g. \
+         r.w = −17 at (125/128, 1) for the optimum from the linearised starts), a pole between the grid points that a \
+         grid measure misses; refits are kept only with a denominator proven positive on the whole box."
+            .into(),
     );
     let p = pair(g, |m, a| MATERIALX_UNROUNDED.eval(m, a));
     let (um, urms, _) = measure(&p.points, &p.truth, &p.approx);
@@ -408,10 +417,24 @@ pub fn items(_generated: &Path) -> Vec<Item> {
 pub static FITS: &[FitBench] = &[FitBench { spec: "ggx_albedo_rational", order: 20, quick: false }];
 
 /// Shader forms per quantity (the bench's forms section).
-pub static FORMS: &[FormSet] = &[FormSet { quantity: "ggx-albedo", order: 20, forms: albedo_forms }];
+pub static FORMS: &[FormSet] = &[
+    FormSet { quantity: "ggx-albedo", order: 20, forms: albedo_forms },
+    FormSet { quantity: "ggx-env[scale]", order: 21, forms: scale_forms },
+    FormSet { quantity: "ggx-env[bias]", order: 22, forms: bias_forms },
+];
 
-/// Karis's E = A + B as a WGSL function of (n·v, perceptual roughness), as engines call it.
-fn karis_wgsl(k: &Karis) -> String {
+/// What a WGSL form of the pair returns: E = A + B, or one channel.
+fn returned(channel: Option<usize>) -> &'static str {
+    match channel {
+        None => "ab.x + ab.y",
+        Some(0) => "ab.x",
+        Some(_) => "ab.y",
+    }
+}
+
+/// Karis's pair as a WGSL function of (n·v, perceptual roughness), as engines call it,
+/// returning E = A + B (`channel` None) or one channel.
+fn karis_wgsl(k: &Karis, channel: Option<usize>) -> String {
     format!(
         "fn karis_albedo(n_dot_v: f32, roughness: f32) -> f32 {{\n\
          \x20   let c0 = vec4<f32>({:e}, {:e}, {:e}, {:e});\n\
@@ -419,34 +442,35 @@ fn karis_wgsl(k: &Karis) -> String {
          \x20   let r = roughness * c0 + c1;\n\
          \x20   let a004 = min(r.x * r.x, exp2({:e} * n_dot_v)) * r.x + r.y;\n\
          \x20   let ab = vec2<f32>({:e}, {:e}) * a004 + r.zw;\n\
-         \x20   return ab.x + ab.y;\n}}\n",
+         \x20   return {};\n}}\n",
         k.c0[0] as f32, k.c0[1] as f32, k.c0[2] as f32, k.c0[3] as f32,
         k.c1[0] as f32, k.c1[1] as f32, k.c1[2] as f32, k.c1[3] as f32,
-        k.k as f32, -k.s as f32, k.s as f32
+        k.k as f32, -k.s as f32, k.s as f32, returned(channel)
     )
 }
 
-/// MaterialX's pair summed (E with F0 = F90 = 1, as `mx_ggx_energy_compensation` calls it).
-fn materialx_wgsl(m: &MaterialX) -> String {
+/// MaterialX's pair summed (E with F0 = F90 = 1, as `mx_ggx_energy_compensation` calls it,
+/// `channel` None) or one channel of it.
+fn materialx_wgsl(m: &MaterialX, channel: Option<usize>) -> String {
     let v = |k: usize| format!("vec4<f32>({:e}, {:e}, {:e}, {:e})", m.r[k][0] as f32, m.r[k][1] as f32, m.r[k][2] as f32, m.r[k][3] as f32);
     format!(
         "fn materialx_albedo(n_dot_v: f32, alpha: f32) -> f32 {{\n\
          \x20   let x = n_dot_v;\n    let y = alpha;\n    let x2 = x * x;\n    let y2 = y * y;\n\
          \x20   let r = {} + {} * x + {} * y + {} * x * y + {} * x2 + {} * y2 + {} * x2 * y + {} * x * y2 + {} * x2 * y2;\n\
          \x20   let ab = clamp(r.xy / r.zw, vec2<f32>(0.0), vec2<f32>(1.0));\n\
-         \x20   return ab.x + ab.y;\n}}\n",
-        v(0), v(1), v(2), v(3), v(4), v(5), v(6), v(7), v(8)
+         \x20   return {};\n}}\n",
+        v(0), v(1), v(2), v(3), v(4), v(5), v(6), v(7), v(8), returned(channel)
     )
 }
 
 /// A closed form of E(n·v, α) measured on the reference (points [α, n·v], the quantity's order;
 /// f64 evaluation of the same constants: the f32 rounding, ≤ 1e-6 here, is three decades
 /// below these forms' errors).
-fn closed_row(spec: &str, reference: &Reference, form: &str, wgsl: &str, function: &str, e: impl Fn(f64, f64) -> f64, note: &str) -> Result<FormRow, BenchError> {
-    let ops = count(spec, wgsl, function)?;
+fn closed_row(spec: &Spec, reference: &Reference, form: &str, wgsl: &str, function: &str, e: impl Fn(f64, f64) -> f64, note: &str) -> Result<FormRow, BenchError> {
+    let ops = count(&spec.file.name, wgsl, function)?;
     let approx: Vec<f64> = reference.points.iter().map(|p| e(p[1], p[0])).collect();
     let (max, rms, _) = measure(&reference.points, &reference.values, &approx);
-    Ok(row("ggx-albedo", form, ops, 0, Measured { max, rms, points: approx.len() }, note.into()))
+    Ok(row(&spec.quantity_label(), form, ops, 0, Measured { max, rms, points: approx.len() }, note.into()))
 }
 
 /// E(μ, α): the published closed forms and their refits, shadefit's rationals, tables.
@@ -463,15 +487,53 @@ fn albedo_forms(ctx: &Ctx) -> Result<Vec<FormRow>, BenchError> {
     })?;
     let small = table_spec(ctx, &spec, "ggx_albedo_table_16", 16)?;
     let large = table_spec(ctx, &spec, "ggx_albedo_table_32", 32)?;
-    let name = &spec.file.name;
+    let name = &spec;
     let fit_note = format!("minimax on {m}×{m}");
     Ok(vec![
-        closed_row(name, &reference, PUBLISHED, &karis_wgsl(&KARIS), "karis_albedo", |x, a| { let [p, q] = KARIS.eval(a.sqrt(), x); p + q }, "Karis 2014 EnvBRDFApprox A + B = 1 − 0.55 r (input r = sqrt(α))")?,
-        closed_row(name, &reference, "Karis refit", &karis_wgsl(&refits.karis_hc), "karis_albedo", |x, a| { let [p, q] = refits.karis_hc.eval(a.sqrt(), x); p + q }, "same form refitted to ggx-env (pair minimax)")?,
-        closed_row(name, &reference, "MaterialX", &materialx_wgsl(&MATERIALX), "materialx_albedo", |x, a| { let [p, q] = MATERIALX.eval(x, a); p + q }, "mx_ggx_dir_albedo_analytic, A + B")?,
-        closed_row(name, &reference, "MaterialX refit", &materialx_wgsl(&refits.materialx), "materialx_albedo", |x, a| { let [p, q] = refits.materialx.eval(x, a); p + q }, "same pair refitted (per channel minimax)")?,
+        closed_row(name, &reference, PUBLISHED, &karis_wgsl(&KARIS, None), "karis_albedo", |x, a| { let [p, q] = KARIS.eval(a.sqrt(), x); p + q }, "Karis 2014 EnvBRDFApprox A + B = 1 − 0.55 r (input r = sqrt(α))")?,
+        closed_row(name, &reference, "Karis refit", &karis_wgsl(&refits.karis_hc, None), "karis_albedo", |x, a| { let [p, q] = refits.karis_hc.eval(a.sqrt(), x); p + q }, "same form refitted to ggx-env (pair minimax)")?,
+        closed_row(name, &reference, "MaterialX", &materialx_wgsl(&MATERIALX, None), "materialx_albedo", |x, a| { let [p, q] = MATERIALX.eval(x, a); p + q }, "mx_ggx_dir_albedo_analytic, A + B")?,
+        closed_row(name, &reference, "MaterialX refit", &materialx_wgsl(&refits.materialx, None), "materialx_albedo", |x, a| { let [p, q] = refits.materialx.eval(x, a); p + q }, "same pair refitted (per channel minimax)")?,
         refit_row(&spec, ctx.generated, &reference, "fits/ggx_albedo_rational.toml, committed")?,
         fit_row(&cheaper, integral.fit(&cheaper, &[m, m])?, &reference, "rational bilinear", &fit_note)?,
+        table_row(&small, table_values(&mut integral, &small), &reference, "table 16²", "")?,
+        table_row(&large, table_values(&mut integral, &large), &reference, "table 32²", "")?,
+    ])
+}
+
+fn scale_forms(ctx: &Ctx) -> Result<Vec<FormRow>, BenchError> {
+    env_forms(ctx, 0)
+}
+
+fn bias_forms(ctx: &Ctx) -> Result<Vec<FormRow>, BenchError> {
+    env_forms(ctx, 1)
+}
+
+/// One channel of [scale, bias] (0 scale, 1 bias): the published pairs and their refits,
+/// shadefit's rational of that channel and a larger one, tables.
+fn env_forms(ctx: &Ctx, channel: usize) -> Result<Vec<FormRow>, BenchError> {
+    let which = ["scale", "bias"][channel];
+    let spec = ctx.spec(&format!("ggx_env_{which}_rational"))?;
+    let mut integral = Integral::of(&spec);
+    let n = ctx.pick(129, 33);
+    let reference = integral.reference(pipeline::grid(&spec, &[n, n]));
+    let m = ctx.pick(spec.file.axis[0].count, 17);
+    let refits = &refit::COMMITTED;
+    let cubic = ctx.variant(&spec, &format!("ggx_env_{which}_rational_cubic"), |t| {
+        set(t, "model.numerator", strings(&["1", "n_dot_v", "alpha", "n_dot_v*alpha", "n_dot_v^2", "alpha^2", "n_dot_v^3", "n_dot_v^2*alpha"]));
+        set(t, "model.denominator", strings(&["n_dot_v", "alpha", "n_dot_v*alpha", "n_dot_v^2", "alpha^2", "n_dot_v^3", "n_dot_v^2*alpha"]));
+    })?;
+    let small = table_spec(ctx, &spec, &format!("ggx_env_{which}_table_16"), 16)?;
+    let large = table_spec(ctx, &spec, &format!("ggx_env_{which}_table_32"), 32)?;
+    let fit_note = format!("minimax on {m}×{m}");
+    let c = Some(channel);
+    Ok(vec![
+        closed_row(&spec, &reference, PUBLISHED, &karis_wgsl(&KARIS, c), "karis_albedo", |x, a| KARIS.eval(a.sqrt(), x)[channel], "Karis 2014 EnvBRDFApprox (fitted to UE4's separable G; input r = sqrt(α))")?,
+        closed_row(&spec, &reference, "Karis refit", &karis_wgsl(&refits.karis_hc, c), "karis_albedo", |x, a| refits.karis_hc.eval(a.sqrt(), x)[channel], "same form refitted to ggx-env (pair minimax)")?,
+        closed_row(&spec, &reference, "MaterialX", &materialx_wgsl(&MATERIALX, c), "materialx_albedo", |x, a| MATERIALX.eval(x, a)[channel], "mx_ggx_dir_albedo_analytic")?,
+        closed_row(&spec, &reference, "MaterialX refit", &materialx_wgsl(&refits.materialx, c), "materialx_albedo", |x, a| refits.materialx.eval(x, a)[channel], "same pair refitted (per channel minimax)")?,
+        refit_row(&spec, ctx.generated, &reference, &format!("fits/ggx_env_{which}_rational.toml, committed"))?,
+        fit_row(&cubic, integral.fit(&cubic, &[m, m])?, &reference, "rational cubic in n·v", &fit_note)?,
         table_row(&small, table_values(&mut integral, &small), &reference, "table 16²", "")?,
         table_row(&large, table_values(&mut integral, &large), &reference, "table 32²", "")?,
     ])

@@ -15,9 +15,10 @@
 //! `cargo test --release -p shadefit --lib family::ggx::published::refit -- --ignored --nocapture`,
 //! which also checks that they are reproduced.
 
-use super::forms::{Karis, KullaConty, Lazarov, MaterialX};
+use super::forms::{Karis, KullaConty, Lazarov, MATERIALX, MaterialX};
 use super::grid::{self, Grid, Target};
 use crate::fit::model::{ModelParts, Term};
+use crate::fit::positivity::{Positivity, prove_denominator_positive};
 use crate::fit::{Data, FitOptions, Objective, RationalModel};
 use argmin::core::{CostFunction, Error, Executor, State};
 use argmin::solver::neldermead::NelderMead;
@@ -74,7 +75,8 @@ pub fn lazarov(start: &Lazarov) -> Lazarov {
     Lazarov::from_params(&p)
 }
 
-/// MaterialX's rational pair refitted minimax (each channel), clamp to [0, 1] as the source, on
+/// MaterialX's rational pair refitted minimax (each channel, with a denominator proven
+/// positive on the grid's box: see the body for the fallbacks), clamp to [0, 1] as the source, on
 /// every other point of the standard α grid in each direction (32 × 33: the LP polish of the
 /// full 64 × 65 takes minutes; the refit is measured on the full grid).
 pub fn materialx() -> MaterialX {
@@ -91,30 +93,55 @@ pub fn materialx() -> MaterialX {
             .map(|(_, v)| *v)
             .collect(),
     };
-    let features = vec!["x".to_string(), "y".to_string()];
-    let labels = ["1", "x", "y", "x*y", "x^2", "y^2", "x^2*y", "x*y^2", "x^2*y^2"];
-    let terms = |l: &[&str]| l.iter().map(|t| Term::parse(t, &features).expect("valid term")).collect::<Vec<_>>();
-    let model = RationalModel::new(ModelParts {
-        inputs: features.clone(),
-        numerator: terms(&labels),
-        denominator: terms(&labels[1..]),
-        clamp: Some((0.0, 1.0)),
-        ..ModelParts::default()
-    })
-    .expect("the MaterialX form is a valid model");
+    let model = materialx_model();
     let x: Vec<Vec<f64>> = g.points().map(|(m, a)| vec![m, a]).collect();
     let mut r = [[0.0; 4]; 9];
     for ch in 0..2 {
         let y: Vec<f64> = g.values.iter().map(|v| v[ch]).collect();
+        let data = Data { x: x.clone(), y };
+        let domain = data.bounds();
+        // Minimax from the linearised starts, else minimax from the published constants: the
+        // first optimum whose denominator is proven positive on the grid's box (the bias's
+        // optimum from the linearised starts has a pole inside it: Q changes sign between
+        // α = 0 and 1), else the published constants of that channel.
+        let published: Vec<f64> = (0..9).map(|k| MATERIALX.r[k][ch]).chain((1..9).map(|k| MATERIALX.r[k][ch + 2])).collect();
         let opts = FitOptions { objective: Objective::Minimax, ..FitOptions::default() };
-        let f = crate::fit::fit(&model, &Data { x: x.clone(), y }, &opts, "materialx refit").expect("the MaterialX refit");
-        let c = &f.coefficients;
+        let positive = |c: &DVector<f64>| matches!(prove_denominator_positive(&model, c, &domain), Positivity::Proven { .. });
+        let c = crate::fit::fit(&model, &data, &opts, "materialx refit")
+            .ok()
+            .map(|f| f.coefficients)
+            .filter(|c| positive(c))
+            .or_else(|| {
+                crate::fit::solve::fit_from(&model, &data, DVector::from_vec(published.clone()), &opts, "materialx refit")
+                    .ok()
+                    .map(|f| f.coefficients)
+                    .filter(|c| positive(c))
+            })
+            .unwrap_or_else(|| DVector::from_vec(published));
+        let c = &c;
         for k in 0..9 {
             r[k][ch] = c[k];
             r[k][ch + 2] = if k == 0 { 1.0 } else { c[8 + k] };
         }
     }
     MaterialX { r }
+}
+
+/// MaterialX's form as a rational model of features (x, y) = (n·v, α): the nine monomials of
+/// [`super::forms::materialx_monomials`] over the same eight and the constant 1, clamped to
+/// [0, 1]; coefficients are numerator then denominator.
+pub fn materialx_model() -> RationalModel {
+    let features = vec!["x".to_string(), "y".to_string()];
+    let labels = ["1", "x", "y", "x*y", "x^2", "y^2", "x^2*y", "x*y^2", "x^2*y^2"];
+    let terms = |l: &[&str]| l.iter().map(|t| Term::parse(t, &features).expect("valid term")).collect::<Vec<_>>();
+    RationalModel::new(ModelParts {
+        inputs: features.clone(),
+        numerator: terms(&labels),
+        denominator: terms(&labels[1..]),
+        clamp: Some((0.0, 1.0)),
+        ..ModelParts::default()
+    })
+    .expect("the MaterialX form is a valid model")
 }
 
 /// Kulla–Conty's two branches refitted minimax on their η ranges.
@@ -154,20 +181,20 @@ pub fn compute() -> Refits {
 
 /// The committed refits (see the module doc for the command that reproduces them).
 pub const COMMITTED: Refits = Refits {
-    karis_ue4: Karis { c0: [-0.9165417123600748, 0.059787007119596836, -0.5641510448097293, 0.0936748755948564], c1: [0.991611594908532, 0.008227242857253481, 1.0868003395536585, -0.15115852418152526], k: -7.2474184585866155, s: 1.0776625936320858 },
-    karis_hc: Karis { c0: [-1.0033356469988455, -0.029198445247780792, -0.5191666171839645, 0.02136543966490229], c1: [0.9959458298474733, 0.04082287461904036, 1.1444205814251402, -0.03880331827177823], k: -9.215802820843333, s: 1.022714577799823 },
-    lazarov: Lazarov { slope: [1.1146326976081844, 0.4959743703465733, 0.018495909402899267, 0.2430831002951954], offset: [-0.01402274567474898, 0.6518106204236662], k: -9.372385527057475 },
+    karis_ue4: Karis { c0: [-0.9441850444686232, -0.0018488478553383989, -0.6224102459540468, 0.005335536983318304], c1: [1.0048656482110063, 0.035720745729102506, 1.1064247655962771, -0.15154834572806947], k: -8.148840290268044, s: 1.0299811359667614 },
+    karis_hc: Karis { c0: [-1.0033356772659126, -0.029198445151315366, -0.5191666174126972, 0.021448281214781664], c1: [0.9959457964288359, 0.0408228744845678, 1.1444205814874064, -0.03865304564301961], k: -9.180113014439492, s: 1.0227145677300817 },
+    lazarov: Lazarov { slope: [1.1215121147716758, 0.49903548151203125, 0.018610064565292395, 0.2445833882877954], offset: [-0.01402274567213611, 0.651810620426457], k: -9.314638379575175 },
     materialx: MaterialX {
         r: [
-            [0.06042053513211059, 0.9876402585334446, 1.0, 1.0],
-            [0.0374381901479822, -2.5321445170190824, 20.797850622755362, 1.877357729290421],
-            [13.122244740780392, 3.85521869841727, 11.819893650384472, 19.47420175273935],
-            [19.010447823621774, -6.635827353035202, -47.41467053601549, -95.4891404432959],
-            [167.91103321723875, 1.5778566996101273, 127.80273582502072, 7.370573070116303],
-            [0.8575174511895596, -1.4557053099892197, 2.291831316553754, 61.84932285801711],
-            [-292.1588164632936, 2.76536245364642, -84.96401044958507, 189.0554668058324],
-            [-8.49522441587495, 0.42576217564414764, 82.63452541184228, 459.1748520506302],
-            [110.36205781745717, 1.0492057207270582, -75.79138933342297, -675.2614640346987],
+            [0.06042040815849504, 0.9345, 1.0, 1.0],
+            [0.03744969724815771, -2.323, 20.797608917952324, 0.2281],
+            [13.12190780441602, 2.229, 11.819431412550744, 15.94],
+            [19.00969529776062, -3.748, -47.41652683932137, -55.83],
+            [167.90971710243954, 1.424, 127.80195164557911, 13.08],
+            [0.8574839772952749, -0.7684, 2.2919208012740953, 41.26],
+            [-292.1618551421048, 1.436, -84.96497382843287, 54.9],
+            [-8.495178172659045, 0.2913, 82.63775655995582, 300.2],
+            [110.3663712312455, 0.6286, -75.79435768830767, -285.1],
         ],
     },
     kulla_conty: KullaConty { above: [3.4117167821916192, 1.3185056200577647], below: [1.0220853548162951, -0.02626728001312509, -0.7609418016792393, -0.233917182444563] },

@@ -1,0 +1,549 @@
+//! The refits of the published forms as shader code: the spec kind `ggx-refits`
+//! (`fits/ggx_published_refits.toml`), built from [`refit::COMMITTED`] into
+//! `wgsl/NAME.wgsl`, `src/NAME.rs` and `json/NAME.json`.
+//!
+//! Each function keeps its source's form and argument order, with the refitted constants (f32,
+//! round-trip digits):
+//!
+//! - `F_karis(roughness, n_dot_v)` and `F_karis_ue4(roughness, n_dot_v)` → (scale, bias): Karis's
+//!   EnvBRDFApprox refitted to the height-correlated integral and to UE4's separable G;
+//! - `F_lazarov(gloss, n_dot_v)` → (scale, bias): Lazarov's Black Ops II form;
+//! - `F_materialx(n_dot_v, alpha)` → (scale, bias): MaterialX's rational pair, clamped to
+//!   [0, 1] as in its source;
+//! - `F_fresnel_avg_dielectric(eta)`: Kulla–Conty's two branches.
+//!
+//! Inputs are clamped to the domain each refit was fitted on (NaN → the lower end): n·v, r, g
+//! and α to [0, 1] except MaterialX's n·v, fitted on [1/128, 125/128] (its denominators are
+//! proven positive on that box, not beyond), and η to [1/3, 3]. The measured errors (the forms
+//! in f64 with the emitted f32 constants, on the grids of `super::grid`, beside the published
+//! constants' on the same grid) go to the headers and the JSON; `Mode::Committed` re-renders
+//! from the constants and the committed JSON's errors. The input hash covers the spec text and
+//! the committed constants, so a new refit makes `build --check` fail until rebuilt.
+
+use super::forms::{KARIS, KULLA_CONTY, Karis, KullaConty, LAZAROV, Lazarov, MATERIALX, MaterialX};
+use super::grid::{self, Target};
+use super::refit::{self, Refits};
+use crate::emit::{Artifact, GENERATOR, f32_literal, header_lines};
+use crate::family::SpecKind;
+use crate::fit::positivity::{Positivity, prove_denominator_positive};
+use crate::pipeline::{BuildError, Built, Mode, Verification, compact_json, committed_json_with_hash, fmt_err, hex, spec_rel_path};
+use crate::spec::{CustomSpec, KindDef, Spec, SpecError, SpecFile, is_kind, line_of, parse_toml};
+use nalgebra::DVector;
+use serde::Deserialize;
+use serde_json::{Value, json};
+use sha2::{Digest, Sha256};
+use std::path::Path;
+
+pub const KIND: &str = "ggx-refits";
+
+/// The spec kind (registered in the family's descriptor).
+pub const REFITS: SpecKind = SpecKind {
+    spec: KindDef {
+        name: KIND,
+        spec_file,
+        samples_note: "{name} emits the committed refits of the published forms: it has no samples of its own (see `shadefit validate`)",
+        input_hash,
+    },
+    build,
+};
+
+/// n·v range of the MaterialX refit's fitting grid (every other texel centre of 64).
+pub const MATERIALX_N_DOT_V: (f64, f64) = (1.0 / 128.0, 125.0 / 128.0);
+/// η range of the Fresnel-average grids (both branches).
+pub const ETA: (f64, f64) = (1.0 / 3.0, 3.0);
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RefitsFile {
+    name: String,
+    #[allow(dead_code)]
+    kind: String,
+    quantity: String,
+    #[serde(default)]
+    description: String,
+    emit: EmitPrefix,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct EmitPrefix {
+    /// Prefix of the emitted function names.
+    function: String,
+}
+
+/// For `Spec::parse`: the common spec of a refits spec, or `None` when the text is not one.
+pub fn spec_file(path: &Path, text: &str) -> Result<Option<SpecFile>, SpecError> {
+    if !is_kind(text, KIND) {
+        return Ok(None);
+    }
+    let f: RefitsFile = parse_toml(path, text)?;
+    if f.quantity != "ggx-env" {
+        return Err(SpecError::new(path, line_of(text, "quantity"), "quantity", format!("kind = \"{KIND}\" refits forms of ggx-env, not '{}'", f.quantity)));
+    }
+    // Axes: the standard grid the pair forms are measured on (n·v texel centres of 64, α in [0, 1]).
+    let axes = vec![
+        json!({"name": "alpha", "range": [0.0, 1.0], "count": 65}),
+        json!({"name": "n_dot_v", "range": [1.0 / 128.0, 127.0 / 128.0], "count": 64}),
+    ];
+    let common = CustomSpec { kind: KIND, name: &f.name, quantity: &f.quantity, description: &f.description, tolerance: grid::TOL, axes, function: &f.emit.function };
+    common.spec_file(path, text).map(Some)
+}
+
+/// The spec text and the committed constants (their shortest round-trip text).
+pub fn input_hash(spec: &Spec) -> String {
+    let mut h = Sha256::new();
+    h.update(GENERATOR.as_bytes());
+    h.update(b"\n");
+    h.update(spec.text.as_bytes());
+    h.update(format!("{:?}", refit::COMMITTED).as_bytes());
+    format!("sha256:{}", hex(&h.finalize()))
+}
+
+/// Round every constant to f32 (what the emitted code carries), back in f64.
+fn f32s(p: &[f64]) -> Vec<f64> {
+    p.iter().map(|&v| v as f32 as f64).collect()
+}
+
+/// The committed refits as the emitted code carries them.
+pub fn emitted() -> Refits {
+    let r = &refit::COMMITTED;
+    let mut mx = r.materialx;
+    for row in &mut mx.r {
+        *row = row.map(|v| v as f32 as f64);
+    }
+    let kc = |k: &KullaConty| KullaConty { above: k.above.map(|v| v as f32 as f64), below: k.below.map(|v| v as f32 as f64) };
+    Refits {
+        karis_ue4: Karis::from_params(&f32s(&r.karis_ue4.params())),
+        karis_hc: Karis::from_params(&f32s(&r.karis_hc.params())),
+        lazarov: Lazarov::from_params(&f32s(&r.lazarov.params())),
+        materialx: mx,
+        kulla_conty: kc(&r.kulla_conty),
+    }
+}
+
+/// One form's errors on its grid: the published constants and the emitted refit.
+#[derive(Debug, Clone, PartialEq)]
+struct Row {
+    function: String,
+    form: &'static str,
+    grid: String,
+    published: [f64; 2],
+    refit: [f64; 2],
+    points: usize,
+}
+
+/// Max and rms of |errors| over both channels.
+fn max_rms(e: &[[f64; 2]]) -> [f64; 2] {
+    let all = e.iter().flat_map(|v| [v[0].abs(), v[1].abs()]);
+    let (max, ss) = all.fold((0.0f64, 0.0), |(m, s), x| (m.max(x), s + x * x));
+    [max, (ss / (2 * e.len()) as f64).sqrt()]
+}
+
+fn pair_row(function: String, form: &'static str, target: Target, published: impl Fn(f64, f64) -> [f64; 2], refit: impl Fn(f64, f64) -> [f64; 2]) -> Row {
+    let g = grid::standard(target);
+    Row {
+        function,
+        form,
+        grid: format!("n·v at 64 texel centres × {} ∈ [0, 1] (65), against {}", target.axis_name(), target.integral()),
+        published: max_rms(&g.errors(published)),
+        refit: max_rms(&g.errors(refit)),
+        points: 2 * g.values.len(),
+    }
+}
+
+/// Every row, measured (the grids' integrals: a few seconds).
+fn measure(prefix: &str, e: &Refits) -> Vec<Row> {
+    // MaterialX's refit is clamped to its fitted n·v range, as the emitted code does.
+    let mx_clamp = |m: f64| m.clamp(MATERIALX_N_DOT_V.0, MATERIALX_N_DOT_V.1);
+    let kc = |above: bool, k: &KullaConty| {
+        let (eta, f) = grid::fresnel(above);
+        let errs: Vec<f64> = eta.iter().zip(f).map(|(&x, &t)| k.eval(x) - t).collect();
+        let (max, ss) = errs.iter().fold((0.0f64, 0.0), |(m, s), x| (m.max(x.abs()), s + x * x));
+        [max, (ss / errs.len() as f64).sqrt()]
+    };
+    let eta_rows = |above: bool| {
+        let n = grid::fresnel(above).0.len();
+        Row {
+            function: format!("{prefix}_fresnel_avg_dielectric"),
+            form: if above { "Kulla–Conty F_avg, η ≥ 1 branch" } else { "Kulla–Conty F_avg, η < 1 branch" },
+            grid: format!("{n} values of η in {}, against the exact dielectric Fresnel average", if above { "[1, 3]" } else { "[1/3, 1)" }),
+            published: kc(above, &KULLA_CONTY),
+            refit: kc(above, &e.kulla_conty),
+            points: n,
+        }
+    };
+    vec![
+        pair_row(format!("{prefix}_karis"), "Karis 2014 EnvBRDFApprox", Target::Roughness, |m, r| KARIS.eval(r, m), |m, r| e.karis_hc.eval(r, m)),
+        pair_row(format!("{prefix}_karis_ue4"), "Karis 2014 EnvBRDFApprox", Target::RoughnessUe4, |m, r| KARIS.eval(r, m), |m, r| e.karis_ue4.eval(r, m)),
+        pair_row(format!("{prefix}_lazarov"), "Lazarov 2013 (Black Ops II)", Target::Gloss, |m, g| LAZAROV.eval(g, m), |m, g| e.lazarov.eval(g, m)),
+        pair_row(format!("{prefix}_materialx"), "MaterialX mx_ggx_dir_albedo_analytic", Target::Alpha, |m, a| MATERIALX.eval(m, a), |m, a| e.materialx.eval(mx_clamp(m), a)),
+        eta_rows(true),
+        eta_rows(false),
+    ]
+}
+
+fn row_json(r: &Row) -> Value {
+    json!({
+        "function": r.function, "form": r.form, "grid": r.grid, "points": r.points,
+        "published": {"max_abs_error": r.published[0], "rms_error": r.published[1]},
+        "refit": {"max_abs_error": r.refit[0], "rms_error": r.refit[1]},
+    })
+}
+
+fn committed_rows(v: &Value, spec: &str) -> Result<Vec<Row>, BuildError> {
+    let bad = |why: &str| BuildError::NoCommitted { spec: spec.into(), why: why.into() };
+    let rows = v["forms"].as_array().ok_or_else(|| bad("no \"forms\""))?;
+    let num = |r: &Value, a: &str, b: &str| r[a][b].as_f64().ok_or_else(|| bad(&format!("no {a}.{b}")));
+    let forms = [
+        "Karis 2014 EnvBRDFApprox",
+        "Lazarov 2013 (Black Ops II)",
+        "MaterialX mx_ggx_dir_albedo_analytic",
+        "Kulla–Conty F_avg, η ≥ 1 branch",
+        "Kulla–Conty F_avg, η < 1 branch",
+    ];
+    rows.iter()
+        .map(|r| {
+            let form = forms.iter().find(|f| r["form"].as_str() == Some(**f)).ok_or_else(|| bad("unknown form"))?;
+            Ok(Row {
+                function: r["function"].as_str().ok_or_else(|| bad("no function"))?.to_string(),
+                form,
+                grid: r["grid"].as_str().ok_or_else(|| bad("no grid"))?.to_string(),
+                published: [num(r, "published", "max_abs_error")?, num(r, "published", "rms_error")?],
+                refit: [num(r, "refit", "max_abs_error")?, num(r, "refit", "rms_error")?],
+                points: r["points"].as_u64().ok_or_else(|| bad("no points"))? as usize,
+            })
+        })
+        .collect()
+}
+
+/// The MaterialX refit's denominators (r.z, r.w) proven positive on the clamped domain.
+fn materialx_denominators_positive(m: &MaterialX) -> Result<f64, String> {
+    let model = refit::materialx_model();
+    let domain = [MATERIALX_N_DOT_V, (0.0, 1.0)];
+    let mut lowest = f64::INFINITY;
+    for ch in 2..4 {
+        // The model's coefficients: 9 numerator terms (unused here: r.x), then the 8
+        // denominator terms after the constant r[0] = 1.
+        let c: Vec<f64> = (0..9).map(|k| m.r[k][ch - 2]).chain((1..9).map(|k| m.r[k][ch])).collect();
+        match prove_denominator_positive(&model, &DVector::from_vec(c), &domain) {
+            Positivity::Proven { lower, .. } => lowest = lowest.min(lower),
+            Positivity::NotProven { lower, .. } => return Err(format!("channel {ch}: interval bound {lower:e}")),
+        }
+    }
+    Ok(lowest)
+}
+
+fn build(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> {
+    let name = spec.file.name.clone();
+    let prefix = spec.file.emit.function.clone();
+    let hash = input_hash(spec);
+    let e = emitted();
+    let rows = match mode {
+        Mode::Fit => measure(&prefix, &e),
+        Mode::Committed => committed_rows(&committed_json_with_hash(root, spec, &hash)?, &name)?,
+    };
+    let q_lower = materialx_denominators_positive(&e.materialx)
+        .map_err(|why| BuildError::NoCommitted { spec: name.clone(), why: format!("the MaterialX refit's denominators are not provably positive on its clamp box ({why})") })?;
+    let worst = rows.iter().map(|r| r.refit[0] / r.published[0]).fold(0.0f64, f64::max);
+    let largest = rows.iter().map(|r| r.refit[0]).fold(0.0f64, f64::max);
+    let err_line = format!(
+        "max abs {} (the largest of the forms, each on its own grid; each at most {worst:.2}x its published form's max abs there; per function below; forms in f64 with these f32 constants)",
+        fmt_err(largest)
+    );
+    let header = header_lines(&spec_rel_path(spec), &hash, &err_line);
+    let wgsl = render(&header, &name, &prefix, &e, &rows, Lang::Wgsl);
+    let rust = render(&header, &name, &prefix, &e, &rows, Lang::Rust);
+    let max = rows.iter().map(|r| r.refit[0]).fold(0.0f64, f64::max);
+    let points: usize = rows.iter().map(|r| r.points).sum();
+    let rms = (rows.iter().map(|r| r.refit[1] * r.refit[1] * r.points as f64).sum::<f64>() / points as f64).sqrt();
+    let json = json!({
+        "generator": GENERATOR,
+        "spec": spec_rel_path(spec),
+        "input_hash": hash,
+        "name": name,
+        "kind": KIND,
+        "quantity": spec.file.quantity,
+        "description": spec.file.description,
+        "function_prefix": prefix,
+        "source": "family::ggx::published::refit::COMMITTED",
+        "materialx_denominator_lower_bound": q_lower,
+        "forms": rows.iter().map(row_json).collect::<Vec<_>>(),
+    });
+    Ok(Built {
+        name: name.clone(),
+        artifacts: vec![
+            Artifact { path: format!("wgsl/{name}.wgsl").into(), contents: wgsl.into_bytes() },
+            Artifact { path: format!("src/{name}.rs").into(), contents: rust.into_bytes() },
+            Artifact { path: format!("json/{name}.json").into(), contents: (compact_json(&json) + "\n").into_bytes() },
+        ],
+        // The forms' errors pooled (each row is on its own grid and quantity; the per-form figures are in the JSON).
+        verification: Verification { points, max_abs_error: max, rms_error: rms, worst_point: vec![], max_abs_error_f32: max, rms_error_f32: rms, max_abs_error_in_parameter: None },
+        fit: None,
+    })
+}
+
+#[derive(Clone, Copy, PartialEq)]
+enum Lang {
+    Wgsl,
+    Rust,
+}
+
+impl Lang {
+    fn lit(self, v: f64) -> String {
+        let s = f32_literal(v as f32);
+        match self {
+            Lang::Wgsl => format!("{s}f"),
+            Lang::Rust => format!("{s}_f32"),
+        }
+    }
+
+    fn comment(self) -> &'static str {
+        match self {
+            Lang::Wgsl => "//",
+            Lang::Rust => "///",
+        }
+    }
+
+    /// `fn NAME(args) -> RET {` in the language (args: (name, doc)).
+    fn signature(self, name: &str, args: &[&str], vec2: bool) -> String {
+        match self {
+            Lang::Wgsl => {
+                let a: Vec<String> = args.iter().map(|a| format!("{a}: f32")).collect();
+                format!("fn {name}({}) -> {} {{\n", a.join(", "), if vec2 { "vec2<f32>" } else { "f32" })
+            }
+            Lang::Rust => {
+                let a: Vec<String> = args.iter().map(|a| format!("{a}: f32")).collect();
+                format!("pub fn {name}({}) -> {} {{\n", a.join(", "), if vec2 { "[f32; 2]" } else { "f32" })
+            }
+        }
+    }
+
+    fn clamp(self, module: &str, v: &str, lo: f64, hi: f64) -> String {
+        match self {
+            Lang::Wgsl => format!("{module}_input({v}, {}, {})", self.lit(lo), self.lit(hi)),
+            Lang::Rust => format!("input({v}, {}, {})", self.lit(lo), self.lit(hi)),
+        }
+    }
+}
+
+/// Doc lines of a function: what it is and its measured errors.
+fn doc(lang: Lang, what: &str, rows: &[&Row]) -> String {
+    let c = lang.comment();
+    let mut s = format!("{c} {what}\n");
+    for r in rows {
+        s += &format!(
+            "{c} {}: max abs {} (published {}, {:.2}x), rms {} (published {}) over {} values; {}.\n",
+            r.form,
+            fmt_err(r.refit[0]),
+            fmt_err(r.published[0]),
+            r.refit[0] / r.published[0],
+            fmt_err(r.refit[1]),
+            fmt_err(r.published[1]),
+            r.points,
+            r.grid
+        );
+    }
+    s
+}
+
+fn karis_body(lang: Lang, m: &str, k: &Karis) -> String {
+    let l = |v| lang.lit(v);
+    let (r, nv) = (lang.clamp(m, "roughness", 0.0, 1.0), lang.clamp(m, "n_dot_v", 0.0, 1.0));
+    match lang {
+        Lang::Wgsl => format!(
+            "    let c0 = vec4<f32>({}, {}, {}, {});\n    let c1 = vec4<f32>({}, {}, {}, {});\n    \
+             let r = {r} * c0 + c1;\n    let a004 = min(r.x * r.x, exp2({} * {nv})) * r.x + r.y;\n    \
+             return vec2<f32>({}, {}) * a004 + r.zw;\n}}\n",
+            l(k.c0[0]), l(k.c0[1]), l(k.c0[2]), l(k.c0[3]), l(k.c1[0]), l(k.c1[1]), l(k.c1[2]), l(k.c1[3]), l(k.k), l(-k.s), l(k.s)
+        ),
+        Lang::Rust => format!(
+            "    let c0 = [{}, {}, {}, {}];\n    let c1 = [{}, {}, {}, {}];\n    \
+             let (rough, nv) = ({r}, {nv});\n    let r: [f32; 4] = std::array::from_fn(|i| rough * c0[i] + c1[i]);\n    \
+             let a004 = (r[0] * r[0]).min(({} * nv).exp2()) * r[0] + r[1];\n    \
+             [{} * a004 + r[2], {} * a004 + r[3]]\n}}\n",
+            l(k.c0[0]), l(k.c0[1]), l(k.c0[2]), l(k.c0[3]), l(k.c1[0]), l(k.c1[1]), l(k.c1[2]), l(k.c1[3]), l(k.k), l(-k.s), l(k.s)
+        ),
+    }
+}
+
+fn lazarov_body(lang: Lang, m: &str, z: &Lazarov) -> String {
+    let l = |v| lang.lit(v);
+    let (g, nv) = (lang.clamp(m, "gloss", 0.0, 1.0), lang.clamp(m, "n_dot_v", 0.0, 1.0));
+    match lang {
+        Lang::Wgsl => format!(
+            "    let t = {g} * vec4<f32>({}, {}, {}, {}) + vec4<f32>(0f, 0f, {}, {});\n    \
+             let a0 = t.x * min(t.y, exp2({} * {nv})) + t.z;\n    return vec2<f32>(t.w - a0, a0);\n}}\n",
+            l(z.slope[0]), l(z.slope[1]), l(z.slope[2]), l(z.slope[3]), l(z.offset[0]), l(z.offset[1]), l(z.k)
+        ),
+        Lang::Rust => format!(
+            "    let (g, nv) = ({g}, {nv});\n    let t = [g * {}, g * {}, g * {} + {}, g * {} + {}];\n    \
+             let a0 = t[0] * t[1].min(({} * nv).exp2()) + t[2];\n    [t[3] - a0, a0]\n}}\n",
+            l(z.slope[0]), l(z.slope[1]), l(z.slope[2]), l(z.offset[0]), l(z.slope[3]), l(z.offset[1]), l(z.k)
+        ),
+    }
+}
+
+fn materialx_body(lang: Lang, m: &str, x: &MaterialX) -> String {
+    let (nv, a) = (lang.clamp(m, "n_dot_v", MATERIALX_N_DOT_V.0, MATERIALX_N_DOT_V.1), lang.clamp(m, "alpha", 0.0, 1.0));
+    let monomials = ["", " * x", " * y", " * x * y", " * x2", " * y2", " * x2 * y", " * x * y2", " * x2 * y2"];
+    match lang {
+        Lang::Wgsl => {
+            let v = |k: usize| format!("vec4<f32>({})", x.r[k].iter().map(|&c| lang.lit(c)).collect::<Vec<_>>().join(", "));
+            let sum: Vec<String> = (0..9).map(|k| format!("{}{}", v(k), monomials[k])).collect();
+            format!(
+                "    let x = {nv};\n    let y = {a};\n    let x2 = x * x;\n    let y2 = y * y;\n    \
+                 let r = {};\n    return clamp(r.xy / r.zw, vec2<f32>(0f), vec2<f32>(1f));\n}}\n",
+                sum.join("\n        + ")
+            )
+        }
+        Lang::Rust => {
+            let rows: Vec<String> = (0..9).map(|k| format!("        [{}],\n", x.r[k].iter().map(|&c| lang.lit(c)).collect::<Vec<_>>().join(", "))).collect();
+            format!(
+                "    const R: [[f32; 4]; 9] = [\n{}    ];\n    let (x, y) = ({nv}, {a});\n    let (x2, y2) = (x * x, y * y);\n    \
+                 let m = [1.0, x, y, x * y, x2, y2, x2 * y, x * y2, x2 * y2];\n    \
+                 let r: [f32; 4] = std::array::from_fn(|c| (0..9).fold(0.0, |s, k| s + R[k][c] * m[k]));\n    \
+                 [(r[0] / r[2]).clamp(0.0, 1.0), (r[1] / r[3]).clamp(0.0, 1.0)]\n}}\n",
+                rows.concat()
+            )
+        }
+    }
+}
+
+fn kc_body(lang: Lang, m: &str, k: &KullaConty) -> String {
+    let l = |v| lang.lit(v);
+    let eta = lang.clamp(m, "eta", ETA.0, ETA.1);
+    let (a, b) = (k.above, k.below);
+    match lang {
+        Lang::Wgsl => format!(
+            "    let e = {eta};\n    let below = {} + e * ({} + e * ({} + e * {}));\n    \
+             let above = (e - 1f) / ({} + {} * e);\n    return select(above, below, e < 1f);\n}}\n",
+            l(b[0]), l(b[1]), l(b[2]), l(b[3]), l(a[0]), l(a[1])
+        ),
+        Lang::Rust => format!(
+            "    let e = {eta};\n    if e < 1.0 {{\n        {} + e * ({} + e * ({} + e * {}))\n    }} else {{\n        \
+             (e - 1.0) / ({} + {} * e)\n    }}\n}}\n",
+            l(b[0]), l(b[1]), l(b[2]), l(b[3]), l(a[0]), l(a[1])
+        ),
+    }
+}
+
+fn render(header: &[String], module: &str, prefix: &str, e: &Refits, rows: &[Row], lang: Lang) -> String {
+    let mut s = String::new();
+    let by = |f: &str| rows.iter().filter(|r| r.function == f).collect::<Vec<_>>();
+    let top = match lang {
+        Lang::Wgsl => "//",
+        Lang::Rust => "//!",
+    };
+    for line in header {
+        s += &format!("{top} {line}\n");
+    }
+    match lang {
+        Lang::Wgsl => {
+            s += &format!("#define_import_path shadefit::{module}\n\n");
+            s += "// The published forms of the GGX split sum and the Fresnel average with shadefit's refitted\n\
+                  // constants (same form; minimax against the integrals each form approximates).\n\n";
+            s += &format!(
+                "// Clamp an input to [lo, hi]; NaN (any exponent-all-ones pattern with a non-zero\n\
+                 // mantissa) maps to lo.\nfn {module}_input(v: f32, lo: f32, hi: f32) -> f32 {{\n    \
+                 let nan = (bitcast<u32>(v) & 0x7fffffffu) > 0x7f800000u;\n    \
+                 return select(clamp(v, lo, hi), lo, nan);\n}}\n"
+            );
+        }
+        Lang::Rust => {
+            s += "//!\n//! The published forms of the GGX split sum and the Fresnel average with shadefit's refitted\n\
+                  //! constants (same form; minimax against the integrals each form approximates). CPU versions\n\
+                  //! of the WGSL functions of the same names.\n\n";
+            s += "#[inline]\nfn input(v: f32, lo: f32, hi: f32) -> f32 {\n    if v.is_nan() { lo } else { v.clamp(lo, hi) }\n}\n";
+        }
+    }
+    let f = |n: &str| format!("{prefix}_{n}");
+    let pair = "(scale, bias) of the split sum: specular = F0·scale + bias.";
+    let items: [(String, String, &[&str], bool, String); 5] = [
+        (f("karis"), format!("Karis's EnvBRDFApprox refitted to the height-correlated integral, roughness r (α = r²): {pair}"), &["roughness", "n_dot_v"], true, karis_body(lang, module, &e.karis_hc)),
+        (f("karis_ue4"), format!("Karis's EnvBRDFApprox refitted to UE4's separable Schlick–Smith G (k = α/2): {pair}"), &["roughness", "n_dot_v"], true, karis_body(lang, module, &e.karis_ue4)),
+        (f("lazarov"), format!("Lazarov's Black Ops II form refitted (gloss g: α = sqrt(2/(8192^g + 2))): {pair}"), &["gloss", "n_dot_v"], true, lazarov_body(lang, module, &e.lazarov)),
+        (f("materialx"), format!("MaterialX's rational pair refitted (n·v clamped to its fitted [1/128, 125/128]): {pair}"), &["n_dot_v", "alpha"], true, materialx_body(lang, module, &e.materialx)),
+        (f("fresnel_avg_dielectric"), "Kulla–Conty's dielectric Fresnel average F_avg(η) refitted (η clamped to [1/3, 3]).".to_string(), &["eta"], false, kc_body(lang, module, &e.kulla_conty)),
+    ];
+    for (name, what, args, vec2, body) in items {
+        s += "\n";
+        s += &doc(lang, &what, &by(&name));
+        s += &lang.signature(&name, args, vec2);
+        s += &body;
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use shadefit_runtime::ggx_published_refits as g;
+
+    /// A 33 × 33 grid of [0, 1]² and the special f32 values.
+    fn grid() -> Vec<(f32, f32)> {
+        (0..=32).flat_map(|i| (0..=32).map(move |j| (i as f32 / 32.0, j as f32 / 32.0))).collect()
+    }
+
+    const SPECIAL: [f32; 9] = [f32::NAN, -f32::NAN, f32::INFINITY, f32::NEG_INFINITY, f32::MAX, -1.0, -0.0, 1e-45, 2.0];
+
+    #[test]
+    fn emitted_rust_equals_the_committed_forms_in_f64() {
+        let e = emitted();
+        let (lo, hi) = MATERIALX_N_DOT_V;
+        let mut worst = [0.0f64; 4];
+        for (u, v) in grid() {
+            let (x, y) = (u as f64, v as f64);
+            let pairs = [
+                (g::ggx_refit_karis(u, v), e.karis_hc.eval(x, y)),
+                (g::ggx_refit_karis_ue4(u, v), e.karis_ue4.eval(x, y)),
+                (g::ggx_refit_lazarov(u, v), e.lazarov.eval(x, y)),
+                (g::ggx_refit_materialx(u, v), e.materialx.eval(x.clamp(lo, hi), y)),
+            ];
+            for (k, (a, b)) in pairs.iter().enumerate() {
+                worst[k] = worst[k].max((a[0] as f64 - b[0]).abs()).max((a[1] as f64 - b[1]).abs());
+            }
+        }
+        // Karis and Lazarov: a handful of f32 operations on values ≤ 2 and one exp2 (≤ 2 ulp):
+        // well under 1e-6. MaterialX: sums of nine terms up to ~300 in magnitude (|R|·monomial)
+        // in f32, so ~9 · 300 · 2⁻²⁴ ≈ 2e-4 in each of r.xy and r.zw, divided by r.zw ≥ 1 on
+        // the box (its proven lower bound is in the JSON): ≤ 5e-4.
+        assert!(worst[0] < 1e-6 && worst[1] < 1e-6 && worst[2] < 1e-6, "{worst:?}");
+        assert!(worst[3] < 5e-4, "{worst:?}");
+        for i in 0..=64 {
+            let eta = 1.0 / 3.0 + (3.0 - 1.0 / 3.0) * i as f64 / 64.0;
+            // A rational of degree 1 or a cubic on values ≤ 3: a few ulps of 1.
+            assert!((g::ggx_refit_fresnel_avg_dielectric(eta as f32) as f64 - e.kulla_conty.eval(eta as f32 as f64)).abs() < 1e-6);
+        }
+    }
+
+    #[test]
+    fn emitted_rust_is_finite_for_every_input_and_nan_is_the_lower_end() {
+        let all = grid().into_iter().chain(SPECIAL.iter().flat_map(|&s| [(s, 0.5), (0.5, s), (s, s)]));
+        for (u, v) in all {
+            for p in [g::ggx_refit_karis(u, v), g::ggx_refit_karis_ue4(u, v), g::ggx_refit_lazarov(u, v), g::ggx_refit_materialx(u, v)] {
+                assert!(p.iter().all(|c| c.is_finite()), "({u}, {v}): {p:?}");
+            }
+            assert!(g::ggx_refit_fresnel_avg_dielectric(u).is_finite());
+        }
+        assert_eq!(g::ggx_refit_karis(f32::NAN, 0.5), g::ggx_refit_karis(0.0, 0.5));
+        assert_eq!(g::ggx_refit_materialx(f32::NAN, 0.5), g::ggx_refit_materialx((MATERIALX_N_DOT_V.0) as f32, 0.5));
+        assert_eq!(g::ggx_refit_fresnel_avg_dielectric(f32::NAN), g::ggx_refit_fresnel_avg_dielectric((1.0f64 / 3.0) as f32));
+    }
+
+    #[test]
+    fn every_refit_beats_its_published_form_and_the_json_says_so() {
+        let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/generated/json/ggx_published_refits.json")).unwrap();
+        let v: Value = serde_json::from_str(&text).unwrap();
+        let rows = committed_rows(&v, "ggx_published_refits").unwrap();
+        assert_eq!(rows.len(), 6);
+        for r in &rows {
+            // The issue's aim: at most 0.8× the published max error, on the same grid.
+            assert!(r.refit[0] <= 0.8 * r.published[0], "{}: {:?} vs {:?}", r.form, r.refit, r.published);
+        }
+        // Re-measured here (the grids' integrals), they are what the JSON records.
+        let fresh = measure("ggx_refit", &emitted());
+        for (a, b) in fresh.iter().zip(&rows) {
+            assert_eq!((a.published, a.refit, a.points), (b.published, b.refit, b.points), "{}", a.form);
+        }
+    }
+}
