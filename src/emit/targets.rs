@@ -4,7 +4,7 @@
 //! The WGSL module (`wgsl/NAME.wgsl`, with its `#define_import_path`) is the source of every
 //! target. Without its directive line it is plain WGSL (`wgsl-plain/NAME.wgsl`). For the
 //! shading languages, naga parses the plain WGSL with an entry point appended,
-//! [`KEEP_ENTRY_POINT`]: a fragment stage (the one stage every language has, GLSL ES 3.00
+//! [`keep_entry_point_name`] (`NAME_keep_all`): a fragment stage (the one stage every language has, GLSL ES 3.00
 //! included) that calls every function of the module once with zero arguments (textures and
 //! samplers from globals of group 0), so that no backend drops a function as unreachable. naga
 //! validates that module, then its backends write HLSL (shader model 5.1), GLSL 450 core,
@@ -22,9 +22,12 @@ use naga::{ArraySize, ImageClass, ImageDimension, Literal, Scalar, ScalarKind, T
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-/// The entry point the shading-language targets gain: it calls every function of the module
-/// and computes nothing of use (in GLSL it is `main`).
-pub const KEEP_ENTRY_POINT: &str = "shadefit_keep_all";
+/// The entry point the shading-language targets of module `module` gain: it calls every
+/// function of the module and computes nothing of use (in GLSL it is `main`). Named after the
+/// module, as its globals are (`NAME_keep_binding_K`), so two modules' files do not clash.
+pub fn keep_entry_point_name(module: &str) -> String {
+    format!("{module}_keep_all")
+}
 
 /// The translator, as the headers name it (the major version is pinned in Cargo.toml).
 pub const TRANSLATOR: &str = "naga 30";
@@ -183,7 +186,7 @@ fn wgsl_type(m: &naga::Module, ty: naga::Handle<naga::Type>) -> Option<String> {
     })
 }
 
-/// The entry point [`KEEP_ENTRY_POINT`] calling every function of `m`, with the globals it
+/// The entry point [`keep_entry_point_name`] calling every function of `m`, with the globals it
 /// binds for texture and sampler arguments.
 fn keep_entry_point(module: &str, m: &naga::Module) -> Result<String, TargetError> {
     let mut globals: Vec<String> = Vec::new();
@@ -204,7 +207,7 @@ fn keep_entry_point(module: &str, m: &naga::Module) -> Result<String, TargetErro
                         globals.len() - 1
                     }
                 };
-                args.push(format!("shadefit_keep_binding_{k}"));
+                args.push(format!("{module}_keep_binding_{k}"));
             } else {
                 // Zero: a literal for a scalar (naga writes `T()` of a scalar as a helper call
                 // in HLSL), the zero-value constructor otherwise.
@@ -230,9 +233,9 @@ fn keep_entry_point(module: &str, m: &naga::Module) -> Result<String, TargetErro
          // it computes nothing of use.\n",
     );
     for (k, ty) in globals.iter().enumerate() {
-        writeln!(s, "@group(0) @binding({k}) var shadefit_keep_binding_{k}: {ty};").unwrap();
+        writeln!(s, "@group(0) @binding({k}) var {module}_keep_binding_{k}: {ty};").unwrap();
     }
-    write!(s, "@fragment\nfn {KEEP_ENTRY_POINT}() {{\n{calls}}}\n").unwrap();
+    write!(s, "@fragment\nfn {}() {{\n{calls}}}\n", keep_entry_point_name(module)).unwrap();
     Ok(s)
 }
 
@@ -268,8 +271,9 @@ pub fn translate(module: &str, wgsl: &str, targets: &[Target]) -> Result<Vec<Art
     };
     let note = |t: Target| {
         format!(
-            "{} translated from {from} by {TRANSLATOR}; the entry point {KEEP_ENTRY_POINT}{} calls every function once so that none is dropped",
+            "{} translated from {from} by {TRANSLATOR}; the entry point {}{} calls every function once so that none is dropped",
             t.name(),
+            keep_entry_point_name(module),
             if matches!(t, Target::Glsl | Target::GlslEs) { " (main)" } else { "" }
         )
     };
@@ -299,7 +303,7 @@ pub fn translate(module: &str, wgsl: &str, targets: &[Target]) -> Result<Vec<Art
                 };
                 let pipeline = naga::back::glsl::PipelineOptions {
                     shader_stage: naga::ShaderStage::Fragment,
-                    entry_point: KEEP_ENTRY_POINT.to_string(),
+                    entry_point: keep_entry_point_name(module),
                     multiview: None,
                 };
                 let mut code = String::new();
@@ -328,7 +332,7 @@ pub fn translate(module: &str, wgsl: &str, targets: &[Target]) -> Result<Vec<Art
                     debug_info: Some(spv::DebugInfo { source_code: &keep, file_name: &from, language: spv::SourceLanguage::Unknown }),
                     ..Default::default()
                 };
-                let pipeline = spv::PipelineOptions { shader_stage: naga::ShaderStage::Fragment, entry_point: KEEP_ENTRY_POINT.into() };
+                let pipeline = spv::PipelineOptions { shader_stage: naga::ShaderStage::Fragment, entry_point: keep_entry_point_name(module) };
                 let words = spv::write_vec(&ir, &info, &options, Some(&pipeline)).map_err(|e| backend(t)(&e))?;
                 words.iter().flat_map(|w| w.to_le_bytes()).collect()
             }
