@@ -7,7 +7,8 @@
 //! Family spec kinds and scene features come from the registry (`crate::family`); the stages
 //! below never name a family.
 
-use crate::emit::{self, Transaction, WriteError};
+use crate::emit::targets::{self, Target, TargetError};
+use crate::emit::{self, Artifact, Transaction, WriteError};
 use crate::family;
 use crate::pipeline::{self, BuildError, Built, CustomBuild, Mode};
 use crate::scene::{self, Scene, SceneReport};
@@ -36,6 +37,8 @@ pub enum Error {
     },
     #[error(transparent)]
     Write(#[from] WriteError),
+    #[error("translating an emitted WGSL module")]
+    Target(#[from] TargetError),
     #[error("{count} generated file(s) differ from what the specs and committed coefficients produce; run `shadefit build`")]
     Stale { count: usize },
     #[error("generated/ holds an interrupted build ({}); the next `shadefit build` restores the files it replaced first", journal.display())]
@@ -74,9 +77,13 @@ pub fn build_spec(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildEr
     pipeline::build_spec(spec, mode, root, &custom_builder)
 }
 
-/// Every spec in `paths.fits`, checking that each name in `only` is one of them.
+/// Every spec in `paths.fits`, checking that each name in `only` is one of them and that
+/// `[emit] targets` names targets.
 pub fn load_specs(paths: &Paths, only: &[String]) -> Result<Vec<Spec>, Error> {
     let specs = spec::load_dir(&paths.fits, family::catalog())?;
+    for s in &specs {
+        spec_targets(s)?;
+    }
     for name in only {
         if !specs.iter().any(|s| &s.file.name == name) {
             return Err(Error::UnknownSpec {
@@ -87,6 +94,35 @@ pub fn load_specs(paths: &Paths, only: &[String]) -> Result<Vec<Spec>, Error> {
         }
     }
     Ok(specs)
+}
+
+/// The targets a spec's `[emit] targets` asks for.
+pub fn spec_targets(s: &Spec) -> Result<Vec<Target>, SpecError> {
+    targets::parse_list(s.file.emit.targets.as_deref().unwrap_or_default())
+        .map_err(|why| SpecError::new(&s.path, spec::line_of(&s.text, "targets"), "targets", why))
+}
+
+/// The files of the other targets for every WGSL module among `artifacts` (`wgsl/NAME.wgsl`):
+/// those `module_targets(NAME)` names, translated in parallel and collected in module order.
+pub fn target_artifacts(artifacts: &[Artifact], module_targets: &(dyn Fn(&str) -> Vec<Target> + Sync)) -> Result<Vec<Artifact>, Error> {
+    let modules: Vec<(String, &Artifact, Vec<Target>)> = artifacts
+        .iter()
+        .filter_map(|a| {
+            let rel = a.path.strip_prefix("wgsl").ok()?;
+            let name = rel.to_str()?.strip_suffix(".wgsl")?.to_string();
+            let t = module_targets(&name);
+            (!t.iter().all(|t| *t == Target::Wgsl)).then_some((name, a, t))
+        })
+        .collect();
+    let files: Vec<Result<Vec<Artifact>, TargetError>> = modules
+        .par_iter()
+        .map(|(name, a, t)| targets::translate(name, &String::from_utf8_lossy(&a.contents), t))
+        .collect();
+    let mut out = Vec::new();
+    for f in files {
+        out.extend(f?);
+    }
+    Ok(out)
 }
 
 /// The scene manifests in `fits/scenes`.
@@ -107,8 +143,10 @@ pub struct Summary {
     pub specs: usize,
 }
 
-/// `shadefit build [--only A,B] [--check]`; `tick(total)` is called once per spec built.
-pub fn run(paths: &Paths, only: &[String], check: bool, tick: &(dyn Fn(usize) + Sync)) -> Result<Summary, Error> {
+/// `shadefit build [--only A,B] [--check] [--target T,..]`; `tick(total)` is called once per
+/// spec built. Every WGSL module is also written in `extra` targets and its spec's own
+/// (`[emit] targets`); with neither, the outputs are the WGSL modules and their siblings only.
+pub fn run(paths: &Paths, only: &[String], check: bool, extra: &[Target], tick: &(dyn Fn(usize) + Sync)) -> Result<Summary, Error> {
     let specs = load_specs(paths, only)?;
     let selected: Vec<&Spec> = specs.iter().filter(|s| only.is_empty() || only.contains(&s.file.name)).collect();
     let mode = if check { Mode::Committed } else { Mode::Fit };
@@ -158,11 +196,31 @@ pub fn run(paths: &Paths, only: &[String], check: bool, tick: &(dyn Fn(usize) + 
         }
     }
     artifacts.push(scene::runtime_index(&specs, &scenes));
+    // Other targets of every module (spec or scene), from the WGSL just rendered.
+    let module_targets = |module: &str| {
+        let mut t: Vec<Target> = extra.to_vec();
+        if let Some(s) = specs.iter().find(|s| s.file.name == module) {
+            t.extend(spec_targets(s).unwrap_or_default());
+        }
+        t.sort();
+        t.dedup();
+        t
+    };
+    let translated = target_artifacts(&artifacts, &module_targets)?;
+    let mut target_dirs: Vec<String> = translated.iter().filter_map(|a| Some(a.path.iter().next()?.to_str()?.to_string())).collect();
+    target_dirs.sort();
+    target_dirs.dedup();
+    artifacts.extend(translated);
     let mut stale = Vec::new();
     if check {
         stale.extend(pipeline::stale(&paths.generated, &artifacts));
         if only.is_empty() {
-            stale.extend(pipeline::orphans(&paths.generated, &artifacts).into_iter().map(|p| format!("{p} (no spec produces it)")));
+            // The target folders of this build too, but only those it writes: another build may
+            // have asked for other targets.
+            let dirs: Vec<&str> = pipeline::OUTPUT_DIRS.iter().copied().chain(target_dirs.iter().map(String::as_str)).collect();
+            stale.extend(
+                pipeline::orphans_in(&paths.generated, &artifacts, &dirs).into_iter().map(|p| format!("{p} (no spec produces it)")),
+            );
         }
     }
     if let Some(mut tx) = tx {

@@ -101,10 +101,10 @@ fn progress(len: usize, what: &str) -> ProgressBar {
     pb
 }
 
-pub fn build(paths: &Paths, only: &[String], check: bool) -> Result<()> {
+pub fn build(paths: &Paths, only: &[String], check: bool, targets: &[crate::emit::targets::Target]) -> Result<()> {
     let start = std::time::Instant::now();
     let pb = progress(0, if check { "check" } else { "build" });
-    let summary = build::run(paths, only, check, &|total| {
+    let summary = build::run(paths, only, check, targets, &|total| {
         pb.set_length(total as u64);
         pb.inc(1);
     });

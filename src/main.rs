@@ -59,6 +59,11 @@ enum Command {
         /// With --scene: rebuild every reached node.
         #[arg(long, requires = "scene")]
         force: bool,
+        /// Comma-separated outputs besides the WGSL modules, for every module: wgsl (the
+        /// modules, always written), wgsl-plain, hlsl, glsl (450 core), glsl-es (ES 300), msl,
+        /// spirv, c (a header of the constants). Specs may add their own ([emit] targets).
+        #[arg(long, value_delimiter = ',', value_parser = parse_target, conflicts_with = "scene")]
+        target: Vec<shadefit::emit::targets::Target>,
     },
     /// Fit a model to your own CSV data, from no start values.
     Fit {
@@ -120,6 +125,10 @@ enum Command {
     },
 }
 
+fn parse_target(s: &str) -> Result<shadefit::emit::targets::Target, String> {
+    Ok(shadefit::emit::targets::parse_list(&[s])?[0])
+}
+
 fn main() -> ExitCode {
     // A closed pipe ends the process quietly, as it does other command-line tools (Rust ignores
     // SIGPIPE by default, and printing to a closed pipe would then panic).
@@ -137,7 +146,7 @@ fn main() -> ExitCode {
             cli::eval_with_options(&quantity, &params, json, profile.as_deref(), kernel.as_deref())
         }
         Command::Build { scene: Some(file), force, .. } => cli::build_scene(&paths, &file, force),
-        Command::Build { only, check, .. } => cli::build(&paths, &only, check),
+        Command::Build { only, check, target, .. } => cli::build(&paths, &only, check, &target),
         Command::Fit { data, x, y, model, objective, json } => cli::fit_data(&data, &x, &y, &model, objective, json),
         Command::Samples { name, json } => cli::samples(&paths, &name, json),
         Command::Plot { out } => cli::plot(&paths, &out),

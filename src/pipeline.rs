@@ -895,11 +895,19 @@ pub fn stale(root: &Path, artifacts: &[Artifact]) -> Vec<String> {
 /// Hand-written files of the runtime crate under generated/src (never reported as orphans).
 pub const HAND_WRITTEN: &[&str] = &["src/lib.rs"];
 
+/// The folders under generated/ every build writes (other targets add theirs).
+pub const OUTPUT_DIRS: &[&str] = &["wgsl", "src", "json", "data"];
+
 /// Files under generated/{wgsl,src,json,data} that no spec produces (directories below
 /// generated/src, and the files in [`HAND_WRITTEN`], are the runtime crate's own code).
 pub fn orphans(root: &Path, artifacts: &[Artifact]) -> Vec<String> {
+    orphans_in(root, artifacts, OUTPUT_DIRS)
+}
+
+/// Files directly under the folders `dirs` of generated/ that no artifact is (see [`orphans`]).
+pub fn orphans_in(root: &Path, artifacts: &[Artifact], dirs: &[&str]) -> Vec<String> {
     let mut out = Vec::new();
-    for dir in ["wgsl", "src", "json", "data"] {
+    for &dir in dirs {
         let Ok(rd) = std::fs::read_dir(root.join(dir)) else { continue };
         let mut names: Vec<_> = rd.filter_map(|e| e.ok()).map(|e| e.path()).collect();
         names.sort();

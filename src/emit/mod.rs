@@ -7,6 +7,7 @@
 pub use crate::fit::expr;
 pub mod fields;
 pub mod rust;
+pub mod targets;
 pub mod texture;
 pub mod wgsl;
 

@@ -33,6 +33,7 @@
 //! [emit]
 //! function = "my_function"
 //! args = ["x"]                     # optional: argument names (default: the axis names)
+//! targets = ["hlsl", "spirv"]      # optional: more outputs than the WGSL module (emit::targets)
 //! ```
 
 pub mod data;
@@ -455,7 +456,11 @@ pub struct EmitSection {
     /// kind = "fields": name of the emitted evaluator of the inner basis (`function` then
     /// names the function returning the coefficients).
     pub evaluator: Option<String>,
+    /// Outputs besides the WGSL module (`emit::targets::Target` names: "wgsl-plain", "hlsl",
+    /// "glsl", "glsl-es", "msl", "spirv", "c"; `build` checks them); `build --target` adds to them.
+    pub targets: Option<Vec<String>>,
 }
+
 
 #[derive(Debug, Clone, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]

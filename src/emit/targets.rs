@@ -1,0 +1,489 @@
+//! Emit targets beyond the WGSL module: plain WGSL, HLSL, GLSL (450 core and ES 300), MSL,
+//! SPIR-V and a C/C++ header of the constants, all from the emitted WGSL module.
+//!
+//! The WGSL module (`wgsl/NAME.wgsl`, with its `#define_import_path`) is the source of every
+//! target. Without its directive line it is plain WGSL (`wgsl-plain/NAME.wgsl`). For the
+//! shading languages, naga parses the plain WGSL with an entry point appended,
+//! [`keep_entry_point_name`] (`NAME_keep_all`): a fragment stage (the one stage every language has, GLSL ES 3.00
+//! included) that calls every function of the module once with zero arguments (textures and
+//! samplers from globals of group 0), so that no backend drops a function as unreachable. naga
+//! validates that module, then its backends write HLSL (shader model 5.1), GLSL 450 core,
+//! GLSL ES 300, MSL 1.0 and SPIR-V 1.0. The C header holds the module's named constants (its
+//! coefficients and tables) as `static const` arrays, read from naga's IR of the plain WGSL.
+//!
+//! Every file carries the module's header (generator, spec, input hash, measured error) in its
+//! language's comments and one line naming what it was translated from; the SPIR-V module
+//! carries its WGSL source, header included, in `OpSource` (naga's debug information).
+//! Translation is a pure function of the WGSL text, so outputs are byte-identical whatever the
+//! thread count.
+
+use super::{f32_literal, Artifact};
+use naga::{ArraySize, ImageClass, ImageDimension, Literal, Scalar, ScalarKind, TypeInner};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// The entry point the shading-language targets of module `module` gain: it calls every
+/// function of the module and computes nothing of use (in GLSL it is `main`). Named after the
+/// module, as its globals are (`NAME_keep_binding_K`), so two modules' files do not clash.
+pub fn keep_entry_point_name(module: &str) -> String {
+    format!("{module}_keep_all")
+}
+
+/// The translator, as the headers name it (the major version is pinned in Cargo.toml).
+pub const TRANSLATOR: &str = "naga 30";
+
+/// One kind of output file per emitted WGSL module.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Target {
+    /// The WGSL module with `#define_import_path shadefit::NAME` (always written).
+    Wgsl,
+    /// The same WGSL without the directive: naga and tint take it as is.
+    WgslPlain,
+    /// HLSL, shader model 5.1.
+    Hlsl,
+    /// GLSL 450 core.
+    Glsl,
+    /// GLSL ES 3.00.
+    GlslEs,
+    /// Metal Shading Language 1.0.
+    Msl,
+    /// SPIR-V 1.0 (binary).
+    Spirv,
+    /// C/C++ header of the named constants.
+    C,
+}
+
+impl Target {
+    pub const ALL: [Target; 8] =
+        [Target::Wgsl, Target::WgslPlain, Target::Hlsl, Target::Glsl, Target::GlslEs, Target::Msl, Target::Spirv, Target::C];
+
+    /// The name `--target` and `[emit] targets` take; also the folder under generated/.
+    pub fn name(self) -> &'static str {
+        match self {
+            Target::Wgsl => "wgsl",
+            Target::WgslPlain => "wgsl-plain",
+            Target::Hlsl => "hlsl",
+            Target::Glsl => "glsl",
+            Target::GlslEs => "glsl-es",
+            Target::Msl => "msl",
+            Target::Spirv => "spirv",
+            Target::C => "c",
+        }
+    }
+
+    pub fn from_name(s: &str) -> Option<Target> {
+        Target::ALL.into_iter().find(|t| t.name() == s)
+    }
+
+    fn extension(self) -> &'static str {
+        match self {
+            Target::Wgsl | Target::WgslPlain => "wgsl",
+            Target::Hlsl => "hlsl",
+            Target::Glsl | Target::GlslEs => "glsl",
+            Target::Msl => "metal",
+            Target::Spirv => "spv",
+            Target::C => "h",
+        }
+    }
+
+    /// The file of module `module` under generated/.
+    pub fn path(self, module: &str) -> PathBuf {
+        Path::new(self.name()).join(format!("{module}.{}", self.extension()))
+    }
+}
+
+/// Parse a list of target names (`--target wgsl,hlsl`): sorted, without repeats.
+pub fn parse_list<S: AsRef<str>>(names: &[S]) -> Result<Vec<Target>, String> {
+    let mut out = Vec::new();
+    for n in names {
+        let n = n.as_ref().trim();
+        let t = Target::from_name(n).ok_or_else(|| {
+            let known: Vec<&str> = Target::ALL.iter().map(|t| t.name()).collect();
+            format!("unknown target '{n}' (known: {})", known.join(", "))
+        })?;
+        out.push(t);
+    }
+    out.sort();
+    out.dedup();
+    Ok(out)
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum TargetError {
+    #[error("{module}: {what} (targets other than wgsl need a self-contained module)")]
+    Unsupported { module: String, what: String },
+    #[error("{module}: naga rejects the module with its entry point appended: {message}")]
+    Invalid { module: String, message: String },
+    #[error("{module}: naga's {target} backend: {message}")]
+    Backend { module: String, target: &'static str, message: String },
+}
+
+/// The module's name and header lines (without `// `) and its code after the directive.
+struct Source<'a> {
+    header: Vec<&'a str>,
+    code: &'a str,
+}
+
+fn split_module<'a>(module: &str, text: &'a str) -> Result<Source<'a>, TargetError> {
+    let unsupported = |what: String| TargetError::Unsupported { module: module.to_string(), what };
+    let mut header = Vec::new();
+    let mut rest = text;
+    loop {
+        let (line, after) = rest.split_once('\n').unwrap_or((rest, ""));
+        if let Some(h) = line.strip_prefix("// ") {
+            header.push(h);
+            rest = after;
+        } else if line.starts_with("#define_import_path") {
+            rest = after;
+            break;
+        } else {
+            return Err(unsupported("no `#define_import_path` line after the header".into()));
+        }
+    }
+    if let Some(l) = rest.lines().find(|l| l.trim_start().starts_with('#')) {
+        return Err(unsupported(format!("it has a directive line `{}`", l.trim())));
+    }
+    Ok(Source { header, code: rest })
+}
+
+fn comment_header(header: &[&str], note: &str) -> String {
+    let mut s = String::new();
+    for h in header.iter().copied().chain(std::iter::once(note)) {
+        s.push_str("// ");
+        s.push_str(h);
+        s.push('\n');
+    }
+    s
+}
+
+/// The WGSL source of a type, for the types emitted functions take and return.
+fn wgsl_type(m: &naga::Module, ty: naga::Handle<naga::Type>) -> Option<String> {
+    fn scalar(s: Scalar) -> Option<&'static str> {
+        Some(match (s.kind, s.width) {
+            (ScalarKind::Float, 4) => "f32",
+            (ScalarKind::Uint, 4) => "u32",
+            (ScalarKind::Sint, 4) => "i32",
+            (ScalarKind::Bool, _) => "bool",
+            _ => return None,
+        })
+    }
+    Some(match &m.types[ty].inner {
+        TypeInner::Scalar(s) => scalar(*s)?.to_string(),
+        TypeInner::Vector { size, scalar: s } => format!("vec{}<{}>", *size as u8, scalar(*s)?),
+        TypeInner::Matrix { columns, rows, scalar: s } => format!("mat{}x{}<{}>", *columns as u8, *rows as u8, scalar(*s)?),
+        TypeInner::Array { base, size: ArraySize::Constant(n), .. } => format!("array<{}, {n}>", wgsl_type(m, *base)?),
+        TypeInner::Image { dim, arrayed, class: ImageClass::Sampled { kind: ScalarKind::Float, multi: false } } => {
+            let d = match dim {
+                ImageDimension::D1 => "1d",
+                ImageDimension::D2 => "2d",
+                ImageDimension::D3 => "3d",
+                ImageDimension::Cube => "cube",
+            };
+            format!("texture_{d}{}<f32>", if *arrayed { "_array" } else { "" })
+        }
+        TypeInner::Sampler { comparison } => (if *comparison { "sampler_comparison" } else { "sampler" }).to_string(),
+        _ => return None,
+    })
+}
+
+/// The entry point [`keep_entry_point_name`] calling every function of `m`, with the globals it
+/// binds for texture and sampler arguments.
+fn keep_entry_point(module: &str, m: &naga::Module) -> Result<String, TargetError> {
+    let mut globals: Vec<String> = Vec::new();
+    let mut calls = String::new();
+    for (_, f) in m.functions.iter() {
+        let name = f.name.as_deref().unwrap_or_default();
+        let mut args = Vec::new();
+        for a in &f.arguments {
+            let ty = wgsl_type(m, a.ty).ok_or_else(|| TargetError::Unsupported {
+                module: module.to_string(),
+                what: format!("function {name} takes an argument of a type the entry point cannot make"),
+            })?;
+            if matches!(m.types[a.ty].inner, TypeInner::Image { .. } | TypeInner::Sampler { .. }) {
+                let k = match globals.iter().position(|g| *g == ty) {
+                    Some(k) => k,
+                    None => {
+                        globals.push(ty);
+                        globals.len() - 1
+                    }
+                };
+                args.push(format!("{module}_keep_binding_{k}"));
+            } else {
+                // Zero: a literal for a scalar (naga writes `T()` of a scalar as a helper call
+                // in HLSL), the zero-value constructor otherwise.
+                let zero = match ty.as_str() {
+                    "f32" => "0f".to_string(),
+                    "u32" => "0u".to_string(),
+                    "i32" => "0i".to_string(),
+                    "bool" => "false".to_string(),
+                    _ => format!("{ty}()"),
+                };
+                args.push(zero);
+            }
+        }
+        let call = format!("{name}({})", args.join(", "));
+        if f.result.is_some() {
+            writeln!(calls, "    _ = {call};").unwrap();
+        } else {
+            writeln!(calls, "    {call};").unwrap();
+        }
+    }
+    let mut s = String::from(
+        "\n// Calls every function above once, so that no translation drops one as unreachable;\n\
+         // it computes nothing of use.\n",
+    );
+    for (k, ty) in globals.iter().enumerate() {
+        writeln!(s, "@group(0) @binding({k}) var {module}_keep_binding_{k}: {ty};").unwrap();
+    }
+    write!(s, "@fragment\nfn {}() {{\n{calls}}}\n", keep_entry_point_name(module)).unwrap();
+    Ok(s)
+}
+
+fn parse(module: &str, text: &str) -> Result<(naga::Module, naga::valid::ModuleInfo), TargetError> {
+    let invalid = |message: String| TargetError::Invalid { module: module.to_string(), message };
+    let m = naga::front::wgsl::parse_str(text).map_err(|e| invalid(e.emit_to_string(text)))?;
+    let info = naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::default())
+        .validate(&m)
+        .map_err(|e| invalid(e.emit_to_string(text)))?;
+    Ok((m, info))
+}
+
+/// The files of `targets` for the WGSL module `module` (the text of `wgsl/NAME.wgsl`); the
+/// module file itself ([`Target::Wgsl`]) is not among them.
+pub fn translate(module: &str, wgsl: &str, targets: &[Target]) -> Result<Vec<Artifact>, TargetError> {
+    let targets: Vec<Target> = targets.iter().copied().filter(|t| *t != Target::Wgsl).collect();
+    if targets.is_empty() {
+        return Ok(Vec::new());
+    }
+    let src = split_module(module, wgsl)?;
+    let from = format!("wgsl/{module}.wgsl");
+    let plain = format!(
+        "{}{}",
+        comment_header(&src.header, &format!("plain WGSL: {from} (the library shadefit::{module}) without its #define_import_path line")),
+        src.code
+    );
+    let (plain_ir, _) = parse(module, &plain)?;
+    let keep = format!("{plain}{}", keep_entry_point(module, &plain_ir)?);
+    let (ir, info) = parse(module, &keep)?;
+    let backend = |target: Target| {
+        let module = module.to_string();
+        move |e: &dyn std::fmt::Display| TargetError::Backend { module, target: target.name(), message: e.to_string() }
+    };
+    let note = |t: Target| {
+        format!(
+            "{} translated from {from} by {TRANSLATOR}; the entry point {}{} calls every function once so that none is dropped",
+            t.name(),
+            keep_entry_point_name(module),
+            if matches!(t, Target::Glsl | Target::GlslEs) { " (main)" } else { "" }
+        )
+    };
+    let mut out = Vec::new();
+    for t in targets {
+        let contents: Vec<u8> = match t {
+            Target::Wgsl => unreachable!("filtered above"),
+            Target::WgslPlain => plain.clone().into_bytes(),
+            Target::Hlsl => {
+                let options = naga::back::hlsl::Options::default();
+                let pipeline = naga::back::hlsl::PipelineOptions { entry_point: None };
+                let mut code = String::new();
+                naga::back::hlsl::Writer::new(&mut code, &options, &pipeline)
+                    .write(&ir, &info, None)
+                    .map_err(|e| backend(t)(&e))?;
+                format!("{}{code}", comment_header(&src.header, &note(t))).into_bytes()
+            }
+            Target::Glsl | Target::GlslEs => {
+                let version = match t {
+                    Target::Glsl => naga::back::glsl::Version::Desktop(450),
+                    _ => naga::back::glsl::Version::new_gles(300),
+                };
+                let options = naga::back::glsl::Options {
+                    version,
+                    writer_flags: naga::back::glsl::WriterFlags::empty(),
+                    ..Default::default()
+                };
+                let pipeline = naga::back::glsl::PipelineOptions {
+                    shader_stage: naga::ShaderStage::Fragment,
+                    entry_point: keep_entry_point_name(module),
+                    multiview: None,
+                };
+                let mut code = String::new();
+                naga::back::glsl::Writer::new(&mut code, &ir, &info, &options, &pipeline, Default::default())
+                    .and_then(|mut w| w.write().map(|_| ()))
+                    .map_err(|e| backend(t)(&e))?;
+                // `#version` comes first (GLSL ES allows nothing before it, not even comments).
+                let (version, rest) = code.split_once('\n').unwrap_or((&code, ""));
+                format!("{version}\n{}{rest}", comment_header(&src.header, &note(t))).into_bytes()
+            }
+            Target::Msl => {
+                let options = naga::back::msl::Options::default();
+                let pipeline = naga::back::msl::PipelineOptions::default();
+                let (code, _) = naga::back::msl::write_string(&ir, &info, &options, &pipeline).map_err(|e| backend(t)(&e))?;
+                format!("{}{code}", comment_header(&src.header, &note(t))).into_bytes()
+            }
+            Target::Spirv => {
+                use naga::back::spv;
+                // The source (header first) rides along in OpSource; names of constants and
+                // functions in OpName. Flags are explicit: naga's default depends on the build
+                // profile. The language operand says Unknown: WGSL (10) is recent enough that
+                // spirv-val releases still in distributions (SPIRV-Tools 2023.1) reject it.
+                let options = spv::Options {
+                    lang_version: (1, 0),
+                    flags: spv::WriterFlags::DEBUG | spv::WriterFlags::LABEL_VARYINGS,
+                    debug_info: Some(spv::DebugInfo { source_code: &keep, file_name: &from, language: spv::SourceLanguage::Unknown }),
+                    ..Default::default()
+                };
+                let pipeline = spv::PipelineOptions { shader_stage: naga::ShaderStage::Fragment, entry_point: keep_entry_point_name(module) };
+                let words = spv::write_vec(&ir, &info, &options, Some(&pipeline)).map_err(|e| backend(t)(&e))?;
+                words.iter().flat_map(|w| w.to_le_bytes()).collect()
+            }
+            Target::C => c_header(module, &src.header, &from, &plain_ir)?.into_bytes(),
+        };
+        out.push(Artifact { path: t.path(module), contents });
+    }
+    Ok(out)
+}
+
+/// A named constant flattened: its scalars in order, and its array shape (outermost first).
+pub struct Flat {
+    pub name: String,
+    pub scalar: Scalar,
+    pub dims: Vec<usize>,
+    pub values: Vec<Literal>,
+}
+
+/// The named constants of a module, flattened (`None` for one of a type with no C form).
+pub fn named_constants(m: &naga::Module) -> Vec<Option<Flat>> {
+    fn shape(m: &naga::Module, ty: naga::Handle<naga::Type>, dims: &mut Vec<usize>) -> Option<Scalar> {
+        match &m.types[ty].inner {
+            TypeInner::Scalar(s) => Some(*s),
+            TypeInner::Vector { size, scalar } => {
+                dims.push(*size as usize);
+                Some(*scalar)
+            }
+            TypeInner::Matrix { columns, rows, scalar } => {
+                dims.extend([*columns as usize, *rows as usize]);
+                Some(*scalar)
+            }
+            TypeInner::Array { base, size: ArraySize::Constant(n), .. } => {
+                dims.push(n.get() as usize);
+                shape(m, *base, dims)
+            }
+            _ => None,
+        }
+    }
+    fn flatten(m: &naga::Module, e: naga::Handle<naga::Expression>, count: usize, out: &mut Vec<Literal>) -> Option<()> {
+        match &m.global_expressions[e] {
+            naga::Expression::Literal(l) => out.push(*l),
+            naga::Expression::Compose { components, .. } => {
+                let each = count / components.len().max(1);
+                for c in components {
+                    flatten(m, *c, each, out)?;
+                }
+            }
+            naga::Expression::Splat { value, .. } => {
+                for _ in 0..count {
+                    flatten(m, *value, 1, out)?;
+                }
+            }
+            naga::Expression::Constant(c) => flatten(m, m.constants[*c].init, count, out)?,
+            _ => return None,
+        }
+        Some(())
+    }
+    m.constants
+        .iter()
+        .filter_map(|(_, c)| c.name.clone().map(|n| (n, c)))
+        .map(|(name, c)| {
+            let mut dims = Vec::new();
+            let scalar = shape(m, c.ty, &mut dims)?;
+            let count = dims.iter().product();
+            let mut values = Vec::new();
+            flatten(m, c.init, count, &mut values)?;
+            (values.len() == count).then_some(Flat { name, scalar, dims, values })
+        })
+        .collect()
+}
+
+fn c_literal(l: Literal) -> Option<String> {
+    Some(match l {
+        Literal::F32(v) if v.is_finite() => format!("{}f", f32_literal(v)),
+        Literal::U32(v) => format!("{v}u"),
+        Literal::I32(v) => format!("{v}"),
+        Literal::Bool(b) => (if b { "1" } else { "0" }).to_string(),
+        _ => return None,
+    })
+}
+
+/// The C/C++ header: every named constant as `static const` (arrays of vectors as 2-D arrays).
+fn c_header(module: &str, header: &[&str], from: &str, m: &naga::Module) -> Result<String, TargetError> {
+    let guard = format!("SHADEFIT_{}_H", module.to_uppercase());
+    let mut s = comment_header(
+        header,
+        &format!("c: the named constants of {from} (coefficients and tables), read from {TRANSLATOR}'s IR; src/{module}.rs evaluates them on the CPU"),
+    );
+    write!(s, "#ifndef {guard}\n#define {guard}\n\n#include <stdint.h>\n").unwrap();
+    for flat in named_constants(m) {
+        let unsupported = || TargetError::Unsupported { module: module.to_string(), what: "a constant with no C form".into() };
+        let f = flat.ok_or_else(unsupported)?;
+        let ty = match f.scalar.kind {
+            ScalarKind::Float if f.scalar.width == 4 => "float",
+            ScalarKind::Uint => "uint32_t",
+            ScalarKind::Sint => "int32_t",
+            ScalarKind::Bool => "int",
+            _ => return Err(unsupported()),
+        };
+        let lits: Vec<String> = f.values.iter().map(|l| c_literal(*l).ok_or_else(unsupported)).collect::<Result<_, _>>()?;
+        let dims: String = f.dims.iter().map(|d| format!("[{d}]")).collect();
+        write!(s, "\nstatic const {ty} {}{dims} = ", f.name).unwrap();
+        match f.dims.len() {
+            0 => s.push_str(&lits[0]),
+            1 => {
+                s.push('{');
+                for (i, l) in lits.iter().enumerate() {
+                    s.push_str(if i % 6 == 0 { "\n    " } else { " " });
+                    s.push_str(l);
+                    s.push(',');
+                }
+                s.push_str("\n}");
+            }
+            _ => {
+                // Rows of the innermost dimension, braces elided above it (C allows it).
+                let inner = *f.dims.last().expect("two or more dimensions");
+                s.push('{');
+                for row in lits.chunks(inner) {
+                    write!(s, "\n    {{{}}},", row.join(", ")).unwrap();
+                }
+                s.push_str("\n}");
+            }
+        }
+        s.push_str(";\n");
+    }
+    write!(s, "\n#endif /* {guard} */\n").unwrap();
+    Ok(s)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn target_names_round_trip_and_lists_are_sorted() {
+        for t in Target::ALL {
+            assert_eq!(Target::from_name(t.name()), Some(t));
+        }
+        assert_eq!(parse_list(&["spirv", "hlsl", "spirv"]).unwrap(), vec![Target::Hlsl, Target::Spirv]);
+        assert!(parse_list(&["hlsl", "vulkan"]).unwrap_err().contains("unknown target 'vulkan'"));
+    }
+
+    #[test]
+    fn the_module_target_alone_adds_nothing() {
+        assert!(translate("x", "not even WGSL", &[Target::Wgsl]).unwrap().is_empty());
+    }
+
+    #[test]
+    fn imports_are_refused() {
+        let src = "// h\n#define_import_path shadefit::x\n#import shadefit::y\nfn f() {}\n";
+        let e = translate("x", src, &[Target::Hlsl]).unwrap_err();
+        assert!(matches!(e, TargetError::Unsupported { .. }), "{e}");
+    }
+}
