@@ -5,7 +5,7 @@
 //! Each function keeps its source's form and argument order, with the refitted constants (f32,
 //! round-trip digits):
 //!
-//! - `F_karis(roughness, n_dot_v)` and `F_karis_ue4(roughness, n_dot_v)` → (scale, bias): Karis's
+//! - `F_karis(roughness, n_dot_v)` and `F_karis_separable(roughness, n_dot_v)` → (scale, bias): Karis's
 //!   EnvBRDFApprox refitted to the height-correlated integral and to UE4's separable G;
 //! - `F_lazarov(gloss, n_dot_v)` → (scale, bias): Lazarov's Black Ops II form;
 //! - `F_materialx(n_dot_v, alpha)` → (scale, bias): MaterialX's rational pair, clamped to
@@ -174,7 +174,7 @@ fn measure(prefix: &str, e: &Refits) -> Vec<Row> {
     };
     vec![
         pair_row(format!("{prefix}_karis"), "Karis 2014 EnvBRDFApprox", Target::Roughness, |m, r| KARIS.eval(r, m), |m, r| e.karis_hc.eval(r, m)),
-        pair_row(format!("{prefix}_karis_ue4"), "Karis 2014 EnvBRDFApprox", Target::RoughnessUe4, |m, r| KARIS.eval(r, m), |m, r| e.karis_ue4.eval(r, m)),
+        pair_row(format!("{prefix}_karis_separable"), "Karis 2014 EnvBRDFApprox", Target::RoughnessUe4, |m, r| KARIS.eval(r, m), |m, r| e.karis_ue4.eval(r, m)),
         pair_row(format!("{prefix}_lazarov"), "Lazarov 2013 (Black Ops II)", Target::Gloss, |m, g| LAZAROV.eval(g, m), |m, g| e.lazarov.eval(g, m)),
         pair_row(format!("{prefix}_materialx"), "MaterialX mx_ggx_dir_albedo_analytic", Target::Alpha, |m, a| MATERIALX.eval(m, a), |m, a| e.materialx.eval(mx_clamp(m), a)),
         eta_rows(true),
@@ -460,7 +460,7 @@ fn render(header: &[String], module: &str, prefix: &str, e: &Refits, rows: &[Row
     let pair = "(scale, bias) of the split sum: specular = F0·scale + bias.";
     let items: [(String, String, &[&str], bool, String); 5] = [
         (f("karis"), format!("Karis's EnvBRDFApprox refitted to the height-correlated integral, roughness r (α = r²): {pair}"), &["roughness", "n_dot_v"], true, karis_body(lang, module, &e.karis_hc)),
-        (f("karis_ue4"), format!("Karis's EnvBRDFApprox refitted to UE4's separable Schlick–Smith G (k = α/2): {pair}"), &["roughness", "n_dot_v"], true, karis_body(lang, module, &e.karis_ue4)),
+        (f("karis_separable"), format!("Karis's EnvBRDFApprox refitted to UE4's separable Schlick–Smith G (k = α/2): {pair}"), &["roughness", "n_dot_v"], true, karis_body(lang, module, &e.karis_ue4)),
         (f("lazarov"), format!("Lazarov's Black Ops II form refitted (gloss g: α = sqrt(2/(8192^g + 2))): {pair}"), &["gloss", "n_dot_v"], true, lazarov_body(lang, module, &e.lazarov)),
         (f("materialx"), format!("MaterialX's rational pair refitted (n·v clamped to its fitted [1/128, 125/128]): {pair}"), &["n_dot_v", "alpha"], true, materialx_body(lang, module, &e.materialx)),
         (f("fresnel_avg_dielectric"), "Kulla–Conty's dielectric Fresnel average F_avg(η) refitted (η clamped to [1/3, 3]).".to_string(), &["eta"], false, kc_body(lang, module, &e.kulla_conty)),
@@ -495,7 +495,7 @@ mod tests {
             let (x, y) = (u as f64, v as f64);
             let pairs = [
                 (g::ggx_refit_karis(u, v), e.karis_hc.eval(x, y)),
-                (g::ggx_refit_karis_ue4(u, v), e.karis_ue4.eval(x, y)),
+                (g::ggx_refit_karis_separable(u, v), e.karis_ue4.eval(x, y)),
                 (g::ggx_refit_lazarov(u, v), e.lazarov.eval(x, y)),
                 (g::ggx_refit_materialx(u, v), e.materialx.eval(x.clamp(lo, hi), y)),
             ];
@@ -520,7 +520,7 @@ mod tests {
     fn emitted_rust_is_finite_for_every_input_and_nan_is_the_lower_end() {
         let all = grid().into_iter().chain(SPECIAL.iter().flat_map(|&s| [(s, 0.5), (0.5, s), (s, s)]));
         for (u, v) in all {
-            for p in [g::ggx_refit_karis(u, v), g::ggx_refit_karis_ue4(u, v), g::ggx_refit_lazarov(u, v), g::ggx_refit_materialx(u, v)] {
+            for p in [g::ggx_refit_karis(u, v), g::ggx_refit_karis_separable(u, v), g::ggx_refit_lazarov(u, v), g::ggx_refit_materialx(u, v)] {
                 assert!(p.iter().all(|c| c.is_finite()), "({u}, {v}): {p:?}");
             }
             assert!(g::ggx_refit_fresnel_avg_dielectric(u).is_finite());
