@@ -15,11 +15,11 @@ fn input(v: f32, lo: f32, hi: f32) -> f32 {
 
 /// Numerator coefficients, one per numerator term.
 pub const GGX_ALBEDO_RATIONAL_NUM: [f32; 6] = [
-    2.8010073e12_f32, 2.701862e15_f32, 3.33724e15_f32, -4.1554394e15_f32, 1.2145985e15_f32, -1.5407441e15_f32,
+    2.2139555e12_f32, 2.1355977e15_f32, 2.637811e15_f32, -3.28453e15_f32, 9.600394e14_f32, -1.2178305e15_f32,
 ];
 /// Denominator coefficients (the constant term 1 is implicit).
 pub const GGX_ALBEDO_RATIONAL_DEN: [f32; 5] = [
-    2.9299325e15_f32, 3.5252512e15_f32, 6.8107918e13_f32, 1.9030326e14_f32, -1.729144e15_f32,
+    2.3158684e15_f32, 2.7864183e15_f32, 5.3833657e13_f32, 1.5041902e14_f32, -1.3667448e15_f32,
 ];
 
 /// CPU version of the WGSL function of the same name.

@@ -20,11 +20,11 @@ pub mod cobblestone_gloss_to_normal_length {
 
     /// Numerator coefficients, one per numerator term.
     pub const SCENE_COBBLESTONE_GLOSS_COBBLESTONE_GLOSS_TO_NORMAL_LENGTH_NUM: [f32; 4] = [
-        7.755161e-1_f32, -2.3869784e0_f32, 1.088344e1_f32, 3.1981975e-1_f32,
+        7.75525e-1_f32, -2.3871331e0_f32, 1.088343e1_f32, 3.1980693e-1_f32,
     ];
     /// Denominator coefficients (the constant term 1 is implicit).
     pub const SCENE_COBBLESTONE_GLOSS_COBBLESTONE_GLOSS_TO_NORMAL_LENGTH_DEN: [f32; 2] = [
-        -3.1273704e0_f32, 1.1717909e1_f32,
+        -3.1274946e0_f32, 1.1717864e1_f32,
     ];
 
     /// CPU version of the WGSL function of the same name.

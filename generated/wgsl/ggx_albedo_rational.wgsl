@@ -12,10 +12,10 @@ fn ggx_albedo_rational_input(v: f32, lo: f32, hi: f32) -> f32 {
 }
 
 const GGX_ALBEDO_RATIONAL_NUM: array<f32, 6> = array<f32, 6>(
-    2.8010073e12f, 2.701862e15f, 3.33724e15f, -4.1554394e15f, 1.2145985e15f, -1.5407441e15f,
+    2.2139555e12f, 2.1355977e15f, 2.637811e15f, -3.28453e15f, 9.600394e14f, -1.2178305e15f,
 );
 const GGX_ALBEDO_RATIONAL_DEN: array<f32, 5> = array<f32, 5>(
-    2.9299325e15f, 3.5252512e15f, 6.8107918e13f, 1.9030326e14f, -1.729144e15f,
+    2.3158684e15f, 2.7864183e15f, 5.3833657e13f, 1.5041902e14f, -1.3667448e15f,
 );
 
 fn ggx_albedo(alpha: f32, n_dot_v: f32) -> f32 {

@@ -13,10 +13,10 @@ fn scene_cobblestone_gloss_cobblestone_gloss_to_normal_length_input(v: f32, lo: 
 }
 
 const SCENE_COBBLESTONE_GLOSS_COBBLESTONE_GLOSS_TO_NORMAL_LENGTH_NUM: array<f32, 4> = array<f32, 4>(
-    7.755161e-1f, -2.3869784e0f, 1.088344e1f, 3.1981975e-1f,
+    7.75525e-1f, -2.3871331e0f, 1.088343e1f, 3.1980693e-1f,
 );
 const SCENE_COBBLESTONE_GLOSS_COBBLESTONE_GLOSS_TO_NORMAL_LENGTH_DEN: array<f32, 2> = array<f32, 2>(
-    -3.1273704e0f, 1.1717909e1f,
+    -3.1274946e0f, 1.1717864e1f,
 );
 
 fn cobblestone_gloss_to_normal_length(gloss: f32) -> f32 {

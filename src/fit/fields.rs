@@ -28,6 +28,7 @@ use super::positivity::{prove_denominator_positive, Positivity};
 use super::solve::{linearised_starts, FitError, Objective};
 use super::Data;
 use nalgebra::{DMatrix, DVector};
+use rayon::prelude::*;
 use serde::Serialize;
 
 /// Relative singular-value cut-off of the minimum-norm stage-1 coefficients.
@@ -55,6 +56,8 @@ pub struct Reduced {
     pub z: DVector<f64>,
     /// ‖y‖² − ‖z‖²: what no coefficient vector can fit (weighted when weights were given).
     pub floor: f64,
+    /// RᵀR, the k×k metric of the point's coefficients in the normal equations.
+    pub rtr: DMatrix<f64>,
 }
 
 /// Reduce B c ≈ y (rows weighted by `sqrt_w` when given) by a thin QR.
@@ -72,7 +75,9 @@ pub fn reduce(b: &DMatrix<f64>, y: &DVector<f64>, sqrt_w: Option<&[f64]>) -> Red
     qr.q_tr_mul(&mut qty);
     let z = qty.rows(0, k).into_owned();
     let floor = (y.norm_squared() - z.norm_squared()).max(0.0);
-    Reduced { r: qr.r(), z, floor }
+    let r = qr.r();
+    let rtr = r.tr_mul(&r);
+    Reduced { r, z, floor, rtr }
 }
 
 /// Stage-1 result of one grid point: the minimum-norm least-squares coefficients and the
@@ -104,6 +109,9 @@ pub struct Fields<'a> {
     pub systems: Vec<Reduced>,
     /// Offsets of θ_k in the concatenated parameter vector.
     starts: Vec<usize>,
+    /// Whether field k's parameter map θ_k → c_k is the identity (no fixed coefficient or pin):
+    /// then ∂c/∂θ_k is ∂c/∂c_k itself and the product with the map is skipped.
+    identity: Vec<bool>,
     pub theta: DVector<f64>,
 }
 
@@ -117,7 +125,8 @@ impl<'a> Fields<'a> {
             s += m.n_free();
         }
         starts.push(s);
-        Fields { models, basis, systems, starts, theta }
+        let identity = models.iter().map(|m| m.map().is_square() && m.map().is_identity(0.0)).collect();
+        Fields { models, basis, systems, starts, identity, theta }
     }
 
     pub fn n_params(&self) -> usize {
@@ -168,14 +177,24 @@ impl<'a> Fields<'a> {
     /// grid point g are R_g·D_g with D_g holding ∂c_k(x_g)/∂θ_k in row k, so
     /// (JᵀJ)[k, l] = Σ_g (R_gᵀR_g)[k, l] · d_k(g) d_l(g)ᵀ and (Jᵀr)[k] = Σ_g (R_gᵀ r_g)[k] d_k(g):
     /// k² small outer products per point instead of a dense product of J.
+    ///
+    /// A first pass over the points (in grid order) computes every d_k(g), the residuals, the
+    /// cost and Jᵀr; then each block (k, l ≥ k) of JᵀJ is summed on its own ([`block`], in
+    /// parallel), every entry over the points in grid order, so the result does not depend on
+    /// the number of threads.
     fn normal_equations(&self, theta: &DVector<f64>) -> (DMatrix<f64>, DVector<f64>, f64) {
         let nk = self.models.len();
         let full = self.full(theta);
         let np = self.n_params();
-        let mut a = DMatrix::zeros(np, np);
+        let ng = self.systems.len();
         let mut grad = DVector::zeros(np);
         let mut cost = 0.0;
-        let mut d: Vec<DVector<f64>> = self.models.iter().map(|m| DVector::zeros(m.n_free())).collect();
+        // d_k(g) at dall[g·np + starts[k]..], the weights (R_gᵀR_g)[k, l] at w[g·nk² + k·nk + l],
+        // and the barrier gradients of the fields whose denominator is below Q_MIN at g.
+        let mut dall = vec![0.0; ng * np];
+        let mut w = vec![0.0; ng * nk * nk];
+        let mut barrier: Vec<(usize, usize, DVector<f64>)> = Vec::new();
+        let mut dfull: Vec<DVector<f64>> = self.models.iter().map(|m| DVector::zeros(m.n_full())).collect();
         let mut c = DVector::zeros(nk);
         for (g, s) in self.systems.iter().enumerate() {
             for (k, m) in self.models.iter().enumerate() {
@@ -184,14 +203,20 @@ impl<'a> Fields<'a> {
                 let (p, q) = b.pq(&full[k]);
                 c[k] = m.offset + b.factor * p / q;
                 let f = b.factor / q;
-                let mut dfull = DVector::zeros(m.n_full());
+                let df = &mut dfull[k];
                 for (i, phi) in b.phi.iter().enumerate() {
-                    dfull[i] = f * phi;
+                    df[i] = f * phi;
                 }
                 for (i, psi) in b.psi.iter().enumerate() {
-                    dfull[nn + i] = -f * p / q * psi;
+                    df[nn + i] = -f * p / q * psi;
                 }
-                d[k] = m.map().tr_mul(&dfull);
+                let (sk, nkf) = (self.starts[k], m.n_free());
+                let dk = &mut dall[g * np + sk..g * np + sk + nkf];
+                if self.identity[k] {
+                    dk.copy_from_slice(df.as_slice());
+                } else {
+                    dk.copy_from_slice(m.map().tr_mul(df).as_slice());
+                }
                 if q < Q_MIN {
                     // Barrier residual Q_PENALTY·(Q_MIN − Q): ∂/∂den_i = −Q_PENALTY·ψ_i.
                     let mut dq = DVector::zeros(m.n_full());
@@ -201,36 +226,39 @@ impl<'a> Fields<'a> {
                     let dq = m.map().tr_mul(&dq);
                     let rq = Q_PENALTY * (Q_MIN - q);
                     cost += rq * rq;
-                    let (sk, nkf) = (self.starts[k], m.n_free());
                     grad.rows_mut(sk, nkf).axpy(rq, &dq, 1.0);
-                    a.view_mut((sk, sk), (nkf, nkf)).ger(1.0, &dq, &dq, 1.0);
+                    barrier.push((g, k, dq));
                 }
             }
             let r = &s.r * &c - &s.z;
             cost += r.norm_squared();
-            let mg = s.r.tr_mul(&s.r);
             let v = s.r.tr_mul(&r);
             for k in 0..nk {
                 let (sk, nkf) = (self.starts[k], self.models[k].n_free());
-                grad.rows_mut(sk, nkf).axpy(v[k], &d[k], 1.0);
-                for l in k..nk {
-                    let w = mg[(k, l)];
-                    if w == 0.0 {
-                        continue;
-                    }
-                    let (sl, nlf) = (self.starts[l], self.models[l].n_free());
-                    let mut blk = a.view_mut((sk, sl), (nkf, nlf));
-                    blk.ger(w, &d[k], &d[l], 1.0);
-                }
+                let dk = DVector::from_column_slice(&dall[g * np + sk..g * np + sk + nkf]);
+                grad.rows_mut(sk, nkf).axpy(v[k], &dk, 1.0);
             }
+            w[g * nk * nk..(g + 1) * nk * nk].copy_from_slice(s.rtr.transpose().as_slice());
         }
-        // Fill the lower triangle of blocks from the upper.
-        for k in 0..nk {
-            for l in 0..k {
-                let (sk, nkf) = (self.starts[k], self.models[k].n_free());
-                let (sl, nlf) = (self.starts[l], self.models[l].n_free());
-                let t = a.view((sl, sk), (nlf, nkf)).transpose();
-                a.view_mut((sk, sl), (nkf, nlf)).copy_from(&t);
+        let pairs: Vec<(usize, usize)> = (0..nk).flat_map(|k| (k..nk).map(move |l| (k, l))).collect();
+        let blocks: Vec<Vec<f64>> = pairs
+            .par_iter()
+            .map(|&(k, l)| {
+                let rows = (self.starts[k], self.models[k].n_free());
+                let cols = (self.starts[l], self.models[l].n_free());
+                let bar: Vec<(usize, &[f64])> =
+                    if k == l { barrier.iter().filter(|b| b.1 == k).map(|b| (b.0, b.2.as_slice())).collect() } else { Vec::new() };
+                block(&dall, np, &w, nk, (k, l), rows, cols, &bar)
+            })
+            .collect();
+        let mut a = DMatrix::zeros(np, np);
+        for (&(k, l), blk) in pairs.iter().zip(&blocks) {
+            let (sk, nkf) = (self.starts[k], self.models[k].n_free());
+            let (sl, nlf) = (self.starts[l], self.models[l].n_free());
+            let m = DMatrix::from_column_slice(nkf, nlf, blk);
+            a.view_mut((sk, sl), (nkf, nlf)).copy_from(&m);
+            if k != l {
+                a.view_mut((sl, sk), (nlf, nkf)).copy_from(&m.transpose());
             }
         }
         (a, grad, cost)
@@ -249,6 +277,52 @@ impl<'a> Fields<'a> {
         }
         self.residuals_at(theta).norm_squared() + pen
     }
+}
+
+/// Block (k, l) of JᵀJ (column-major, rows d_k, columns d_l): Σ_g w_g[k, l]·d_k(g) d_l(g)ᵀ
+/// plus, on a diagonal block, the barrier terms dq dqᵀ of the points in `barrier` (each before
+/// the point's own term). Every entry is accumulated over the points in grid order as
+/// (w·d_l[j])·d_k[i] + A[i, j], the operations of nalgebra's `ger` one point at a time, on a
+/// block small enough to stay in the first-level cache.
+#[allow(clippy::too_many_arguments)]
+fn block(
+    dall: &[f64],
+    np: usize,
+    w: &[f64],
+    nk: usize,
+    (k, l): (usize, usize),
+    (sk, nkf): (usize, usize),
+    (sl, nlf): (usize, usize),
+    barrier: &[(usize, &[f64])],
+) -> Vec<f64> {
+    let mut out = vec![0.0; nkf * nlf];
+    let mut next_barrier = 0;
+    for (g, dg) in dall.chunks_exact(np).enumerate() {
+        if let Some(&(gb, dq)) = barrier.get(next_barrier)
+            && gb == g
+        {
+            next_barrier += 1;
+            // ger(1.0, dq, dq): (1·dq[j])·dq[i], and 1·dq[j] is dq[j] exactly.
+            for (col, &t) in out.chunks_exact_mut(nkf).zip(dq) {
+                for (x, &dqi) in col.iter_mut().zip(dq) {
+                    *x += t * dqi;
+                }
+            }
+        }
+        let wg = w[g * nk * nk + k * nk + l];
+        if wg == 0.0 {
+            continue;
+        }
+        let dk = &dg[sk..sk + nkf];
+        let dl = &dg[sl..sl + nlf];
+        for (col, &dlj) in out.chunks_exact_mut(nkf).zip(dl) {
+            let t = wg * dlj;
+            for (x, &dki) in col.iter_mut().zip(dk) {
+                *x += t * dki;
+            }
+        }
+    }
+    out
 }
 
 /// The samples of one grid point: the stage-1 design matrix (inner samples × basis) and the
@@ -607,5 +681,38 @@ mod tests {
         let opts = FieldOptions { objective: Objective::Minimax, ..FieldOptions::default() };
         let m = fit_fields(&models, &x, &data, &opts, "synthetic").unwrap();
         assert!(m.max_abs_error < 1e-8, "minimax max {}", m.max_abs_error);
+    }
+
+    #[test]
+    fn normal_equations_are_the_dense_product_at_any_thread_count() {
+        let (x, data) = problem();
+        let models: Vec<RationalModel> = OFFSETS.iter().map(|&o| field(o)).collect();
+        let systems: Vec<Reduced> = data.iter().map(|d| reduce(&d.design, &d.y, None)).collect();
+        let theta = DVector::from_iterator(12, (0..12).map(|i| 0.3 * ((i as f64) * 1.7).sin()));
+        let f = Fields::new(&models, &x, systems, theta.clone());
+        // Dense J by central differences of the residuals R_g c(x_g; θ) − z_g.
+        let (np, h) = (f.n_params(), 1e-6);
+        let r0 = f.residuals_at(&theta);
+        let mut j = DMatrix::zeros(r0.len(), np);
+        for p in 0..np {
+            let (mut tp, mut tm) = (theta.clone(), theta.clone());
+            tp[p] += h;
+            tm[p] -= h;
+            j.set_column(p, &((f.residuals_at(&tp) - f.residuals_at(&tm)) / (2.0 * h)));
+        }
+        let (a, g, cost) = f.normal_equations(&theta);
+        let dense = j.tr_mul(&j);
+        let grad = j.tr_mul(&r0);
+        // Central differences of a smooth rational: error ~h²·f''' plus rounding ~1e-16/h, both
+        // far below 1e-7 of the entries' scale (Q stays ≥ 0.5 here, so no barrier term).
+        assert!((&a - &dense).amax() <= 1e-7 * dense.amax(), "JᵀJ off by {:e}", (&a - &dense).amax());
+        assert!((&g - &grad).amax() <= 1e-7 * grad.amax(), "Jᵀr off by {:e}", (&g - &grad).amax());
+        // The same squares summed per point then over points: rounding of a 63-term sum.
+        assert!((cost - r0.norm_squared()).abs() <= 1e-13 * cost, "cost {cost} vs {}", r0.norm_squared());
+        // The blocks are summed in grid order whatever the thread count: bit-identical.
+        let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap().install(|| f.normal_equations(&theta));
+        let two = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap().install(|| f.normal_equations(&theta));
+        assert_eq!(one.0.as_slice(), two.0.as_slice());
+        assert_eq!(one.0.as_slice(), a.as_slice());
     }
 }

@@ -53,25 +53,58 @@ fn working_set(r: &DVector<f64>, n_params: usize) -> Vec<usize> {
     idx
 }
 
-/// Solve the linearised LP on the samples `rows`; returns (δ, predicted max).
+/// Solve the linearised LP on the samples `rows`; returns δ and the linearised max at δ,
+/// max_i |r_i + J_i δ| over `rows` (evaluated here in f64, not taken from the LP, whose
+/// constraints hold only to its absolute feasibility tolerance).
+///
+/// The LP is posed in units where all its data are of order one, since the solver's
+/// tolerances are absolute (1e-7) and its pivoting assumes entries within ~1e6 of each other:
+/// - the step relative to its bound, u_j = δ_j / b_j ∈ [−1, 1] (columns a_ij = J_ij·b_j);
+/// - the max as t = m + S·σ, m = max |r_i| and S = max_i Σ_j |a_ij| the largest change of a
+///   row within the trust region; rows are divided by S. σ ≥ −m/S (t ≥ 0) and the objective
+///   is σ.
+///
+/// Exact reductions, which leave the LP's optimal set unchanged:
+/// - a side ±(r_i + a_i·u) ≤ t with ±r_i + Σ_j |a_ij| < m − S cannot bind: the sample with
+///   |r_k| = m keeps t ≥ m − S, so it is left out;
+/// - a term |a_ij| below the rounding error of evaluating its row (ε·(|r_i| + Σ_j |a_ij|))
+///   cannot move the row's value in f64 and is left out. Such terms are rounding residues of a
+///   feature that is exactly zero in the model (cos θ at θ = π/2 is 6e-17, its cube 2e-49):
+///   kept, they make rows span 1e49 and most LPs then fail (a stalled or cycling dual simplex
+///   after thousands of pivots), each failure shrinking the trust region.
 fn lp_step(r: &DVector<f64>, j: &DMatrix<f64>, bounds: &[f64], rows: &[usize]) -> Option<(DVector<f64>, f64)> {
+    let m = rows.iter().fold(0.0_f64, |a, &i| a.max(r[i].abs()));
+    let a: Vec<Vec<(usize, f64)>> = rows
+        .iter()
+        .map(|&i| {
+            let row: Vec<(usize, f64)> = bounds.iter().enumerate().map(|(k, &b)| (k, j[(i, k)] * b)).filter(|(_, v)| *v != 0.0).collect();
+            let size = r[i].abs() + row.iter().map(|(_, v)| v.abs()).sum::<f64>();
+            row.into_iter().filter(|(_, v)| v.abs() > f64::EPSILON * size).collect()
+        })
+        .collect();
+    let reach: Vec<f64> = a.iter().map(|row| row.iter().map(|(_, v)| v.abs()).sum()).collect();
+    let s = reach.iter().fold(0.0_f64, |x, &v| x.max(v));
+    if !(s > 0.0 && s.is_finite() && m.is_finite()) {
+        return None;
+    }
     let mut lp = Lp::new(OptimizationDirection::Minimize);
-    let deltas: Vec<_> = bounds.iter().map(|&b| lp.add_var(0.0, (-b, b))).collect();
-    let t = lp.add_var(1.0, (0.0, f64::INFINITY));
-    for &i in rows {
-        let row: Vec<(microlp::Variable, f64)> =
-            deltas.iter().enumerate().map(|(k, &d)| (d, j[(i, k)])).filter(|(_, v)| *v != 0.0).collect();
-        let mut upper = row.clone();
-        upper.push((t, -1.0));
-        lp.add_constraint(&upper, ComparisonOp::Le, -r[i]);
-        let mut lower: Vec<_> = row.iter().map(|&(d, v)| (d, -v)).collect();
-        lower.push((t, -1.0));
-        lp.add_constraint(&lower, ComparisonOp::Le, r[i]);
+    let units: Vec<_> = bounds.iter().map(|_| lp.add_var(0.0, (-1.0, 1.0))).collect();
+    let sigma = lp.add_var(1.0, (-m / s, f64::INFINITY));
+    for ((&i, row), &reach) in rows.iter().zip(&a).zip(&reach) {
+        for sign in [1.0, -1.0] {
+            if sign * r[i] + reach < m - s {
+                continue;
+            }
+            let mut c: Vec<(microlp::Variable, f64)> = row.iter().map(|&(k, v)| (units[k], sign * v / s)).collect();
+            c.push((sigma, -1.0));
+            lp.add_constraint(&c, ComparisonOp::Le, (m - sign * r[i]) / s);
+        }
     }
     let outcome = lp.solve().ok()?;
     let sol = outcome.solution()?;
-    let delta = DVector::from_iterator(deltas.len(), deltas.iter().map(|&d| sol[d]));
-    Some((delta, sol[t]))
+    let delta = DVector::from_iterator(units.len(), units.iter().zip(bounds).map(|(&u, &b)| sol[u].clamp(-1.0, 1.0) * b));
+    let linearised = rows.iter().fold(0.0_f64, |x, &i| x.max((r[i] + j.row(i).dot(&delta.transpose())).abs()));
+    Some((delta, linearised))
 }
 
 impl<O> Solver<O, St> for SlpMinimax
@@ -134,5 +167,65 @@ where
         } else {
             TerminationStatus::NotTerminated
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fit::model::{Derived, ModelParts, RationalModel, Term};
+    use crate::fit::{fit, Data, FitOptions, Objective};
+
+    /// R̃'s form (fits/fuzz_r.toml) over α ∈ [0.15, 1], θ ∈ [0, π/2]: γ = cos θ is 6e-17 at the
+    /// last grid column and γ³ is 2e-49 there, so the Jacobian's rows span ~1e49.
+    fn r_form() -> RationalModel {
+        let inputs = vec!["alpha".to_string(), "theta".to_string()];
+        let derived = vec![
+            Derived::parse("beta", "1 - alpha", &inputs).unwrap(),
+            Derived::parse("gamma", "cos(theta)", &inputs).unwrap(),
+            Derived::parse("delta", "sin(theta)", &inputs).unwrap(),
+        ];
+        let features: Vec<String> = inputs.iter().cloned().chain(derived.iter().map(|d| d.name.clone())).collect();
+        let terms = |ts: &[&str]| ts.iter().map(|t| Term::parse(t, &features).unwrap()).collect::<Vec<_>>();
+        RationalModel::new(ModelParts {
+            inputs,
+            derived,
+            numerator: terms(&["1", "beta", "gamma", "delta", "beta^2", "gamma^2", "beta*gamma", "gamma^3", "delta^3"]),
+            denominator: terms(&["beta", "gamma"]),
+            offset: 0.5,
+            factor: Some(Term::parse("beta", &features).unwrap()),
+            ..ModelParts::default()
+        })
+        .unwrap()
+    }
+
+    #[test]
+    fn polish_ends_where_the_linearised_problem_has_no_descent() {
+        let model = r_form();
+        let n = 17;
+        let x: Vec<Vec<f64>> = (0..n)
+            .flat_map(|i| (0..n).map(move |j| vec![0.15 + 0.85 * i as f64 / (n - 1) as f64, std::f64::consts::FRAC_PI_2 * j as f64 / (n - 1) as f64]))
+            .collect();
+        // Smooth, not in the model's span: the minimax error stays well above rounding.
+        let y: Vec<f64> = x.iter().map(|p| 0.5 + (1.0 - p[0]) * (0.3 * (-p[1]).exp() + 0.1 * (3.0 * p[0]).sin())).collect();
+        let data = Data { x, y };
+        let f = fit(&model, &data, &FitOptions { objective: Objective::Minimax, ..FitOptions::default() }, "R form").unwrap();
+        let problem = crate::fit::problem::Residuals::new(&model, &data, f.theta.clone());
+        let r = problem.raw(&f.theta);
+        let j = problem.jacobian_at(&f.theta);
+        let m = max_abs(&r);
+        let norm = f.theta.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
+        let bounds: Vec<f64> = f.theta.iter().map(|v| 1e-3 * v.abs().max(1e-3 * norm)).collect();
+        let rows: Vec<usize> = (0..r.len()).collect();
+        let (_, predicted) = lp_step(&r, &j, &bounds, &rows).expect("the LP at the optimum solves");
+        // At a minimax point the linearised max cannot fall at first order; what is left is the
+        // LP's own feasibility tolerance (1e-9 relative bounds it with room).
+        assert!(predicted >= m * (1.0 - 1e-9), "the LP still predicts {predicted:e} below {m:e}");
+        // And the polish moved past Lawson's iterate, which only approaches the optimum.
+        let lawson = {
+            let opts = FitOptions { objective: Objective::Minimax, polish_iters: 0, ..FitOptions::default() };
+            fit(&model, &data, &opts, "R form").unwrap().report.max_abs_error
+        };
+        assert!(m < lawson, "polished {m:e}, Lawson {lawson:e}");
     }
 }

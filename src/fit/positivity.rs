@@ -69,13 +69,15 @@ pub enum Positivity {
     NotProven { lower: f64, region: Vec<(f64, f64)>, sample: f64 },
 }
 
-fn term_range(t: &crate::fit::model::Term, feats: &[Iv]) -> Iv {
+/// The range of a term from the ranges of its features' powers (`pows[i][e]` = feats[i]ᵉ by
+/// [`Iv::powi`], computed once per box).
+fn term_range(t: &crate::fit::model::Term, pows: &[Vec<Iv>]) -> Iv {
     let mut term = Iv(0.0, 0.0);
     for m in &t.monomials {
         let mut v = Iv(1.0, 1.0);
-        for (e, r) in m.exps.iter().zip(feats) {
+        for (e, p) in m.exps.iter().zip(pows) {
             if *e > 0 {
-                v = v.mul(r.powi(*e));
+                v = v.mul(p[*e as usize]);
             }
         }
         term = term.add(v);
@@ -86,16 +88,17 @@ fn term_range(t: &crate::fit::model::Term, feats: &[Iv]) -> Iv {
 /// A lower bound of Q on `region`, rigorous in f64: interval arithmetic rounded outward, the
 /// derived features' ranges widened by two ulps each side (their cos, sin and affine maps are
 /// within an ulp or two of exact).
-fn bound(model: &RationalModel, c: &DVector<f64>, region: &[(f64, f64)]) -> f64 {
+fn bound(model: &RationalModel, c: &DVector<f64>, region: &[(f64, f64)], max_exp: &[u32]) -> f64 {
     let nn = model.numerator.len();
     let mut feats: Vec<Iv> = region.iter().map(|&(a, b)| Iv(a, b)).collect();
     feats.extend(model.derived.iter().map(|d| {
         let (a, b) = d.range(region);
         Iv(down(down(a)), up(up(b)))
     }));
-    let mut q = model.lead.as_ref().map_or(Iv(1.0, 1.0), |t| term_range(t, &feats));
+    let pows: Vec<Vec<Iv>> = feats.iter().zip(max_exp).map(|(f, &top)| (0..=top).map(|e| f.powi(e)).collect()).collect();
+    let mut q = model.lead.as_ref().map_or(Iv(1.0, 1.0), |t| term_range(t, &pows));
     for (j, t) in model.denominator.iter().enumerate() {
-        q = q.add(term_range(t, &feats).scale(c[nn + j]));
+        q = q.add(term_range(t, &pows).scale(c[nn + j]));
     }
     q.0
 }
@@ -108,12 +111,21 @@ pub fn prove_denominator_positive(
 ) -> Positivity {
     const MIN_BOUND: f64 = 1e-12;
     const BUDGET: usize = 200_000;
+    // The highest power of each feature in the denominator's terms (the powers a box needs).
+    let mut max_exp = vec![0u32; model.features.len()];
+    for t in model.lead.iter().chain(&model.denominator) {
+        for m in &t.monomials {
+            for (top, &e) in max_exp.iter_mut().zip(&m.exps) {
+                *top = (*top).max(e);
+            }
+        }
+    }
     let mut stack = vec![domain.to_vec()];
     let mut boxes = 0;
     let mut lowest = f64::INFINITY;
     while let Some(region) = stack.pop() {
         boxes += 1;
-        let lo = bound(model, c, &region);
+        let lo = bound(model, c, &region, &max_exp);
         if lo > MIN_BOUND {
             lowest = lowest.min(lo);
             continue;

@@ -21,6 +21,7 @@ use super::report::FitReport;
 use argmin::core::{Executor, State};
 use levenberg_marquardt::LevenbergMarquardt;
 use nalgebra::{DMatrix, DVector};
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -212,13 +213,17 @@ pub fn fit(model: &RationalModel, data: &Data, opts: &FitOptions, what: &str) ->
     let starts = linearised_starts(model, data, what)?;
     let domain = data.bounds();
     let lsq = FitOptions { objective: Objective::Lsq, ..*opts };
+    // The starts are independent: solved in parallel, then compared in their order.
+    let solved: Vec<(bool, Fit)> = starts
+        .into_par_iter()
+        .filter_map(|theta0| {
+            let f = fit_from(model, data, theta0, &lsq, what).ok()?;
+            let valid = matches!(prove_denominator_positive(model, &f.coefficients, &domain), Positivity::Proven { .. });
+            Some((valid, f))
+        })
+        .collect();
     let mut best: Option<(bool, Fit)> = None;
-    for theta0 in starts {
-        let Ok(f) = fit_from(model, data, theta0, &lsq, what) else { continue };
-        let valid = matches!(
-            prove_denominator_positive(model, &f.coefficients, &domain),
-            Positivity::Proven { .. }
-        );
+    for (valid, f) in solved {
         let better = match &best {
             None => true,
             Some((bv, b)) => (valid && !bv) || (valid == *bv && f.report.rss < b.report.rss),
