@@ -61,8 +61,11 @@ def _cuts(lo: float, hi: float, centre: float, widths: list[float]) -> list[floa
 
 def _tensor_gauss(alpha: float, mu_v: float, cos_cone: float, n: int) -> np.ndarray:
     x, w = roots_legendre(n)
-    widths = [0.25 * alpha, alpha, 4.0 * alpha]
-    mu_cuts = _cuts(cos_cone, 1.0, mu_v, [w_ * max(alpha, 1e-3) for w_ in (0.25, 1.0, 4.0)])
+    # Cuts at geometric distances from the mirror direction, from α/16 to 64α: the lobe's
+    # width is ~α, and its tails decay over decades of distance.
+    scales = (0.0625, 0.25, 1.0, 4.0, 16.0, 64.0)
+    widths = [s * alpha for s in scales]
+    mu_cuts = _cuts(cos_cone, 1.0, mu_v, [s * max(alpha, 1e-3) for s in scales])
     phi_cuts = _cuts(0.0, math.pi, math.pi, widths)
     total = np.zeros(2)
     for a, b in zip(mu_cuts, mu_cuts[1:]):
@@ -152,3 +155,26 @@ def test_schlick_fresnel_average_against_quad(f0):
     want, err = integrate.quad(lambda m: 2.0 * (f0 + (1.0 - f0) * (1.0 - m) ** 5) * m, 0.0, 1.0, epsabs=1e-15)
     out = sf_cli.eval_point("fresnel-avg-schlick", f0=f0)
     assert abs(out["value"] - want) <= out["error_estimate"] + err + ROUNDING
+
+
+# Random points with narrow lobes and narrow cones (seeded): α down to 0.003, cones up to
+# cos θc = 0.999, n·v over (0, 1]. The agreement is required to 1e-9 absolute: the sum of the
+# two quadratures' error estimates is below that at every point drawn (checked first).
+_rng = np.random.default_rng(20261124)
+CONE_POINTS = [
+    (float(a), float(m), float(c))
+    for a, m, c in zip(
+        np.concatenate([[0.003, 0.008, 0.01], 10.0 ** _rng.uniform(-2.5, 0.0, 9)]),
+        _rng.uniform(0.02, 1.0, 12),
+        np.concatenate([[0.9, 0.99, 0.999], _rng.uniform(0.0, 0.999, 9)]),
+    )
+]
+
+
+@pytest.mark.parametrize("alpha,mu_v,c", CONE_POINTS, ids=[f"{a:.4g},{m:.4g},{c:.4g}" for a, m, c in CONE_POINTS])
+def test_env_with_narrow_lobes_and_cones_to_1e_9(alpha, mu_v, c):
+    out = sf_cli.eval_point("ggx-env", alpha=alpha, n_dot_v=mu_v, cos_cone=c)
+    want, ref_err = reference_env(alpha, mu_v, c)
+    assert out["error_estimate"] + ref_err <= 1e-9, (out, ref_err)
+    got = np.array(out["value"])
+    assert np.all(np.abs(got - want) <= 1e-9), (out, want.tolist())

@@ -8,6 +8,7 @@ pub mod bench;
 pub mod compensation;
 pub mod integrals;
 pub mod lut;
+pub mod occlusion;
 pub mod published;
 
 use super::Family;
@@ -199,6 +200,7 @@ pub static QUANTITIES: &[QuantityDef] = &[
 fn items(generated: &Path) -> Vec<Item> {
     let mut items = published::items(generated);
     items.extend(compensation::items(generated));
+    items.extend(occlusion::items());
     items
 }
 
