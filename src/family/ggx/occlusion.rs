@@ -318,6 +318,27 @@ mod tests {
     }
 
     #[test]
+    fn scale_and_bias_fall_monotonically_as_the_cone_closes_and_vanish_at_its_end() {
+        // Nested cones keep nested sets of light directions and the integrand is ≥ 0, so each
+        // of scale and bias is non-increasing in cos θc; each value carries its error estimate
+        // (≤ 1e-10 each), so a rise beyond the sum of the two would be a real violation.
+        for &alpha in &[1e-3, 0.02, 0.3, 1.0] {
+            for &mu in &[0.01, 0.2, 0.6, 1.0] {
+                let mut last = integrals::env(alpha, mu, 0.0, Shadowing::HeightCorrelated, 1e-10);
+                for k in 1..=40 {
+                    let c = k as f64 / 40.0;
+                    let e = integrals::env(alpha, mu, c, Shadowing::HeightCorrelated, 1e-10);
+                    let slack = e.error + last.error;
+                    assert!(e.scale <= last.scale + slack && e.bias <= last.bias + slack, "α {alpha}, μ {mu}, c {c}: {e:?} after {last:?}");
+                    last = e;
+                }
+                // The closed cone keeps no direction: both exactly 0 (COD's last slice).
+                assert_eq!((last.scale, last.bias), (0.0, 0.0));
+            }
+        }
+    }
+
+    #[test]
     fn approximations_reach_their_limits() {
         // Lagarde: V = 1 gives 1; V = 0 and n·v < 1 give 0.
         assert_eq!(lagarde(0.5, 1.0, 0.3), 1.0);
