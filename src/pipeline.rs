@@ -168,6 +168,13 @@ pub fn sample(spec: &Spec, points: &[Vec<f64>]) -> Vec<f64> {
     points.par_iter().map(|p| sampler.eval(p).value).collect()
 }
 
+/// Records the channel a spec takes (`"channel"`) in its JSON, after `"quantity"`.
+pub fn with_channel(json: &mut Value, spec: &Spec) {
+    if let Some(c) = spec.channel_name() {
+        json["channel"] = c.into();
+    }
+}
+
 pub fn spec_rel_path(spec: &Spec) -> String {
     format!("fits/{}", spec.path.file_name().and_then(|s| s.to_str()).unwrap_or("?"))
 }
@@ -437,7 +444,7 @@ pub fn fit_from_coefficients(
         "input_hash": hash,
         "name": name,
         "kind": "fit",
-        "quantity": spec.quantity_label(),
+        "quantity": spec.file.quantity,
         "description": spec.file.description,
         "function": spec.file.emit.function,
         "axes": axes_json(spec),
@@ -464,6 +471,7 @@ pub fn fit_from_coefficients(
     if let (Some(o), Some(r)) = (json.as_object_mut(), f32_rounding) {
         o.insert("f32_rounding".into(), r);
     }
+    with_channel(&mut json, spec);
     let artifacts = vec![
         Artifact { path: format!("wgsl/{name}.wgsl").into(), contents: wgsl::render_module(&header, &func).into() },
         Artifact { path: format!("src/{name}.rs").into(), contents: rust::render_module(&header, &func, &doc).into() },
@@ -743,13 +751,13 @@ pub fn table_from_values(spec: &Spec, values: Vec<f64>, reference: &Reference) -
         counts.iter().map(|c| c.to_string()).collect::<Vec<_>>().join("×"),
         spec.quantity_label()
     );
-    let json = json!({
+    let mut json = json!({
         "generator": GENERATOR,
         "spec": spec_rel_path(spec),
         "input_hash": hash,
         "name": name,
         "kind": "table",
-        "quantity": spec.quantity_label(),
+        "quantity": spec.file.quantity,
         "description": spec.file.description,
         "function": spec.file.emit.function,
         "axes": axes_json(spec),
@@ -757,6 +765,7 @@ pub fn table_from_values(spec: &Spec, values: Vec<f64>, reference: &Reference) -
         "values": values,
         "verification": verification,
     });
+    with_channel(&mut json, spec);
     let mut csv = String::new();
     for h in &header {
         csv.push_str(&format!("# {h}\n"));

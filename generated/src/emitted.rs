@@ -38,6 +38,9 @@ pub mod ggx_env_bias_rational;
 #[path = "ggx_env_scale_rational.rs"]
 pub mod ggx_env_scale_rational;
 #[cfg(feature = "ggx")]
+#[path = "ggx_occlusion.rs"]
+pub mod ggx_occlusion;
+#[cfg(feature = "ggx")]
 #[path = "ggx_published_refits.rs"]
 pub mod ggx_published_refits;
 #[cfg(feature = "gloss")]
@@ -101,6 +104,8 @@ pub mod wgsl {
     #[cfg(feature = "ggx")]
     pub const GGX_ENV_SCALE_RATIONAL: &str = include_str!("../wgsl/ggx_env_scale_rational.wgsl");
     #[cfg(feature = "ggx")]
+    pub const GGX_OCCLUSION: &str = include_str!("../wgsl/ggx_occlusion.wgsl");
+    #[cfg(feature = "ggx")]
     pub const GGX_PUBLISHED_REFITS: &str = include_str!("../wgsl/ggx_published_refits.wgsl");
     #[cfg(feature = "gloss")]
     pub const GLOSS_COMBINE: &str = include_str!("../wgsl/gloss_combine.wgsl");
@@ -152,6 +157,8 @@ pub mod wgsl {
             "ggx_env_bias_rational" => Some(GGX_ENV_BIAS_RATIONAL),
             #[cfg(feature = "ggx")]
             "ggx_env_scale_rational" => Some(GGX_ENV_SCALE_RATIONAL),
+            #[cfg(feature = "ggx")]
+            "ggx_occlusion" => Some(GGX_OCCLUSION),
             #[cfg(feature = "ggx")]
             "ggx_published_refits" => Some(GGX_PUBLISHED_REFITS),
             #[cfg(feature = "gloss")]
@@ -206,6 +213,8 @@ pub mod wgsl {
         "ggx_env_bias_rational",
         #[cfg(feature = "ggx")]
         "ggx_env_scale_rational",
+        #[cfg(feature = "ggx")]
+        "ggx_occlusion",
         #[cfg(feature = "ggx")]
         "ggx_published_refits",
         #[cfg(feature = "gloss")]

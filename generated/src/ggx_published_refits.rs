@@ -4,8 +4,8 @@
 //! measured error: max abs 3.050e-1 (the largest of the forms, each on its own grid; each at most 0.73x its published form's max abs there; per function below; forms in f64 with these f32 constants)
 //!
 //! The published forms of the GGX split sum and the Fresnel average with shadefit's refitted
-//! constants (same form; minimax against the integrals each form approximates). CPU versions
-//! of the WGSL functions of the same names.
+//! constants (same form; minimax against the integrals each form approximates).
+//! CPU versions of the WGSL functions of the same names.
 
 #[inline]
 fn input(v: f32, lo: f32, hi: f32) -> f32 {

@@ -348,7 +348,7 @@ pub fn fields_from_coefficients(
         "input_hash": hash,
         "name": name,
         "kind": "fields",
-        "quantity": spec.quantity_label(),
+        "quantity": spec.file.quantity,
         "description": spec.file.description,
         "function": spec.file.emit.function,
         "evaluator": evaluator,

@@ -535,6 +535,11 @@ impl Spec {
         Sampler { quantity: self.quantity, channel: self.channel, tolerance: self.file.tolerance }
     }
 
+    /// The name of the channel the spec takes, if any.
+    pub fn channel_name(&self) -> Option<&'static str> {
+        self.channel.map(|c| self.quantity.channels[c])
+    }
+
     /// The quantity as reports name it: `QUANTITY[CHANNEL]` for a channel of a vector quantity,
     /// else the quantity's name.
     pub fn quantity_label(&self) -> String {

@@ -216,7 +216,7 @@ pub static FAMILY: Family = Family {
     name: "ggx",
     doc: "GGX split-sum: DFG scale/bias (with a visibility cone), E(mu), E_avg, Fresnel averages, energy compensation",
     quantities: QUANTITIES,
-    spec_kinds: &[lut::DFG_LUT, published::emit::REFITS],
+    spec_kinds: &[lut::DFG_LUT, published::emit::REFITS, occlusion::emit::OCCLUSION],
     eval_options: None,
     validate: items,
     figures,

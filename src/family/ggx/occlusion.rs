@@ -27,6 +27,8 @@
 //!   sqrt(1 − V)) and a specular cone about the mirror direction (cos α_s = 2^(−3.321928 r²),
 //!   r = perceptual roughness), over the specular cone's solid angle ([`cap_intersection`]).
 
+pub mod emit;
+
 use super::integrals::{self, Shadowing};
 use crate::validate::{Item, measure};
 use rayon::prelude::*;

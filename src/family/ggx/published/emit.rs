@@ -282,14 +282,15 @@ fn build(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> {
     })
 }
 
+/// The two languages a module is written in (shared with the family's other emitted modules).
 #[derive(Clone, Copy, PartialEq)]
-enum Lang {
+pub(crate) enum Lang {
     Wgsl,
     Rust,
 }
 
 impl Lang {
-    fn lit(self, v: f64) -> String {
+    pub(crate) fn lit(self, v: f64) -> String {
         let s = f32_literal(v as f32);
         match self {
             Lang::Wgsl => format!("{s}f"),
@@ -297,7 +298,7 @@ impl Lang {
         }
     }
 
-    fn comment(self) -> &'static str {
+    pub(crate) fn comment(self) -> &'static str {
         match self {
             Lang::Wgsl => "//",
             Lang::Rust => "///",
@@ -305,7 +306,7 @@ impl Lang {
     }
 
     /// `fn NAME(args) -> RET {` in the language (args: (name, doc)).
-    fn signature(self, name: &str, args: &[&str], vec2: bool) -> String {
+    pub(crate) fn signature(self, name: &str, args: &[&str], vec2: bool) -> String {
         match self {
             Lang::Wgsl => {
                 let a: Vec<String> = args.iter().map(|a| format!("{a}: f32")).collect();
@@ -318,7 +319,42 @@ impl Lang {
         }
     }
 
-    fn clamp(self, module: &str, v: &str, lo: f64, hi: f64) -> String {
+    /// The file's opening: header, module doc (`doc` lines), the import path (WGSL) and the
+    /// input clamp `MODULE_input` / `input` (NaN → the lower end).
+    pub(crate) fn preamble(self, header: &[String], module: &str, doc: &[&str]) -> String {
+        let mut s = String::new();
+        match self {
+            Lang::Wgsl => {
+                for line in header {
+                    s += &format!("// {line}\n");
+                }
+                s += &format!("#define_import_path shadefit::{module}\n\n");
+                for line in doc {
+                    s += &format!("// {line}\n");
+                }
+                s += &format!(
+                    "\n// Clamp an input to [lo, hi]; NaN (any exponent-all-ones pattern with a non-zero\n\
+                     // mantissa) maps to lo.\nfn {module}_input(v: f32, lo: f32, hi: f32) -> f32 {{\n    \
+                     let nan = (bitcast<u32>(v) & 0x7fffffffu) > 0x7f800000u;\n    \
+                     return select(clamp(v, lo, hi), lo, nan);\n}}\n"
+                );
+            }
+            Lang::Rust => {
+                for line in header {
+                    s += &format!("//! {line}\n");
+                }
+                s += "//!\n";
+                for line in doc {
+                    s += &format!("//! {line}\n");
+                }
+                s += "//! CPU versions of the WGSL functions of the same names.\n\n";
+                s += "#[inline]\nfn input(v: f32, lo: f32, hi: f32) -> f32 {\n    if v.is_nan() { lo } else { v.clamp(lo, hi) }\n}\n";
+            }
+        }
+        s
+    }
+
+    pub(crate) fn clamp(self, module: &str, v: &str, lo: f64, hi: f64) -> String {
         match self {
             Lang::Wgsl => format!("{module}_input({v}, {}, {})", self.lit(lo), self.lit(hi)),
             Lang::Rust => format!("input({v}, {}, {})", self.lit(lo), self.lit(hi)),
@@ -430,32 +466,11 @@ fn kc_body(lang: Lang, m: &str, k: &KullaConty) -> String {
 fn render(header: &[String], module: &str, prefix: &str, e: &Refits, rows: &[Row], lang: Lang) -> String {
     let mut s = String::new();
     let by = |f: &str| rows.iter().filter(|r| r.function == f).collect::<Vec<_>>();
-    let top = match lang {
-        Lang::Wgsl => "//",
-        Lang::Rust => "//!",
-    };
-    for line in header {
-        s += &format!("{top} {line}\n");
-    }
-    match lang {
-        Lang::Wgsl => {
-            s += &format!("#define_import_path shadefit::{module}\n\n");
-            s += "// The published forms of the GGX split sum and the Fresnel average with shadefit's refitted\n\
-                  // constants (same form; minimax against the integrals each form approximates).\n\n";
-            s += &format!(
-                "// Clamp an input to [lo, hi]; NaN (any exponent-all-ones pattern with a non-zero\n\
-                 // mantissa) maps to lo.\nfn {module}_input(v: f32, lo: f32, hi: f32) -> f32 {{\n    \
-                 let nan = (bitcast<u32>(v) & 0x7fffffffu) > 0x7f800000u;\n    \
-                 return select(clamp(v, lo, hi), lo, nan);\n}}\n"
-            );
-        }
-        Lang::Rust => {
-            s += "//!\n//! The published forms of the GGX split sum and the Fresnel average with shadefit's refitted\n\
-                  //! constants (same form; minimax against the integrals each form approximates). CPU versions\n\
-                  //! of the WGSL functions of the same names.\n\n";
-            s += "#[inline]\nfn input(v: f32, lo: f32, hi: f32) -> f32 {\n    if v.is_nan() { lo } else { v.clamp(lo, hi) }\n}\n";
-        }
-    }
+    s += &lang.preamble(
+        header,
+        module,
+        &["The published forms of the GGX split sum and the Fresnel average with shadefit's refitted", "constants (same form; minimax against the integrals each form approximates)."],
+    );
     let f = |n: &str| format!("{prefix}_{n}");
     let pair = "(scale, bias) of the split sum: specular = F0·scale + bias.";
     let items: [(String, String, &[&str], bool, String); 5] = [

@@ -1,0 +1,263 @@
+//! The cone model's helpers as shader code: the spec kind `ggx-occlusion`
+//! (`fits/ggx_occlusion.toml`), one WGSL library and one Rust module of exact formulas (no fit):
+//!
+//! - `F_interreflected_visibility(visibility, albedo)`: A / (1 − ρ + ρA) ([`super::interreflected`]);
+//! - `F_cone_of_visibility(visibility)`: cos θc = sqrt(1 − V) ([`super::cone_of_visibility`]);
+//! - `F_adjusted_cone_printed(cos_cone, gloss, n_dot_v)` and `F_adjusted_cone_corrected(…)`: the
+//!   talk's adjusted cone as printed and in its corrected reading ([`super::cod_adjust_printed`],
+//!   [`super::cod_adjust_corrected`]).
+//!
+//! Inputs are clamped to [0, 1] (NaN → 0). The interreflection denominator is 1 − ρ(1 − A) ≥ A,
+//! zero only at A = 0, ρ = 1, where the function returns 0 (its value along A = 0). The error
+//! recorded is the f32 code's (the Rust module, same operations as the WGSL) against the f64
+//! formulas on a grid of every argument; `Mode::Committed` reads it from the committed JSON.
+
+use super::super::published::emit::Lang;
+use crate::emit::{Artifact, GENERATOR, header_lines};
+use crate::family::SpecKind;
+use crate::pipeline::{BuildError, Built, Mode, Verification, compact_json, committed_json_with_hash, fmt_err, input_hash, spec_rel_path};
+use crate::spec::{CustomSpec, KindDef, Spec, SpecError, SpecFile, is_kind, line_of, parse_toml};
+use serde::Deserialize;
+use serde_json::json;
+use std::path::Path;
+
+pub const KIND: &str = "ggx-occlusion";
+
+/// The spec kind (registered in the family's descriptor).
+pub const OCCLUSION: SpecKind = SpecKind {
+    spec: KindDef {
+        name: KIND,
+        spec_file,
+        samples_note: "{name} emits exact formulas of the cone model: it has no samples",
+        input_hash,
+    },
+    build,
+};
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct OcclusionFile {
+    name: String,
+    #[allow(dead_code)]
+    kind: String,
+    quantity: String,
+    #[serde(default)]
+    description: String,
+    emit: Prefix,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Prefix {
+    /// Prefix of the emitted function names.
+    function: String,
+}
+
+/// For `Spec::parse`: the common spec of an occlusion-helpers spec, or `None`.
+pub fn spec_file(path: &Path, text: &str) -> Result<Option<SpecFile>, SpecError> {
+    if !is_kind(text, KIND) {
+        return Ok(None);
+    }
+    let f: OcclusionFile = parse_toml(path, text)?;
+    if f.quantity != "ggx-env" {
+        return Err(SpecError::new(path, line_of(text, "quantity"), "quantity", format!("kind = \"{KIND}\" serves ggx-env's cone, not '{}'", f.quantity)));
+    }
+    let axes = vec![
+        json!({"name": "alpha", "range": [0.0, 1.0], "count": 2}),
+        json!({"name": "n_dot_v", "range": [0.0, 1.0], "count": 2}),
+        json!({"name": "cos_cone", "range": [0.0, 1.0], "count": 2}),
+    ];
+    let common = CustomSpec { kind: KIND, name: &f.name, quantity: &f.quantity, description: &f.description, tolerance: 1e-12, axes, function: &f.emit.function };
+    common.spec_file(path, text).map(Some)
+}
+
+/// One helper: name suffix, arguments, its doc, the WGSL and Rust expressions of the clamped
+/// arguments `x0, x1, …`, and the f64 formula it is measured against.
+struct Helper {
+    suffix: &'static str,
+    args: &'static [&'static str],
+    doc: &'static str,
+    wgsl: &'static str,
+    rust: &'static str,
+    exact: fn(&[f64]) -> f64,
+}
+
+const HELPERS: [Helper; 4] = [
+    Helper {
+        suffix: "interreflected_visibility",
+        args: &["visibility", "albedo"],
+        doc: "Visibility after interreflections inside the cavity, A′ = A / (1 − ρ + ρA) (COD: WWII).",
+        wgsl: "x0 / max(1f - x1 + x1 * x0, 1e-30f)",
+        rust: "x0 / (1.0 - x1 + x1 * x0).max(1e-30)",
+        exact: |p| if p[0] == 0.0 { 0.0 } else { super::interreflected(p[0], p[1]) },
+    },
+    Helper {
+        suffix: "cone_of_visibility",
+        args: &["visibility"],
+        doc: "Cosine of the visibility cone's half-angle, cos θc = sqrt(1 − V) (the Nusselt analog).",
+        wgsl: "sqrt(1f - x0)",
+        rust: "(1.0 - x0).sqrt()",
+        exact: |p| super::cone_of_visibility(p[0]),
+    },
+    Helper {
+        suffix: "adjusted_cone_printed",
+        args: &["cos_cone", "gloss", "n_dot_v"],
+        doc: "The talk's adjusted cone as printed: cos θ (1 − g²)(1 − (1 − (n·v)⁴)) = cos θ (1 − g²)(n·v)⁴.",
+        wgsl: "x0 * (1f - x1 * x1) * (1f - (1f - x2 * x2 * x2 * x2))",
+        rust: "x0 * (1.0 - x1 * x1) * (1.0 - (1.0 - x2 * x2 * x2 * x2))",
+        exact: |p| super::cod_adjust_printed(p[0], p[1], p[2]),
+    },
+    Helper {
+        suffix: "adjusted_cone_corrected",
+        args: &["cos_cone", "gloss", "n_dot_v"],
+        doc: "The adjusted cone in the reading that opens it at grazing views: cos θ (1 − g²)(1 − (1 − n·v)⁴).",
+        wgsl: "x0 * (1f - x1 * x1) * (1f - (1f - x2) * (1f - x2) * (1f - x2) * (1f - x2))",
+        rust: "x0 * (1.0 - x1 * x1) * (1.0 - (1.0 - x2) * (1.0 - x2) * (1.0 - x2) * (1.0 - x2))",
+        exact: |p| super::cod_adjust_corrected(p[0], p[1], p[2]),
+    },
+];
+
+/// The Rust expression of a helper evaluated in f32 (what the emitted module computes).
+fn rust_f32(h: &Helper, p: &[f32]) -> f32 {
+    let x = |i: usize| p[i].clamp(0.0, 1.0);
+    match h.suffix {
+        "interreflected_visibility" => x(0) / (1.0 - x(1) + x(1) * x(0)).max(1e-30),
+        "cone_of_visibility" => (1.0 - x(0)).sqrt(),
+        "adjusted_cone_printed" => x(0) * (1.0 - x(1) * x(1)) * (1.0 - (1.0 - x(2) * x(2) * x(2) * x(2))),
+        _ => x(0) * (1.0 - x(1) * x(1)) * (1.0 - (1.0 - x(2)) * (1.0 - x(2)) * (1.0 - x(2)) * (1.0 - x(2))),
+    }
+}
+
+/// Max |f32 − f64| of each helper over 65 points per argument in [0, 1], and the point count.
+fn measure() -> (Vec<f64>, usize) {
+    let axis: Vec<f64> = (0..=64).map(|i| i as f64 / 64.0).collect();
+    let mut points = 0;
+    let errs = HELPERS
+        .iter()
+        .map(|h| {
+            let n = h.args.len();
+            let total = axis.len().pow(n as u32);
+            points += total;
+            (0..total)
+                .map(|mut k| {
+                    let p: Vec<f64> = (0..n).map(|_| {
+                        let v = axis[k % axis.len()];
+                        k /= axis.len();
+                        v
+                    }).collect();
+                    let p32: Vec<f32> = p.iter().map(|&v| v as f32).collect();
+                    let q: Vec<f64> = p32.iter().map(|&v| v as f64).collect();
+                    (rust_f32(h, &p32) as f64 - (h.exact)(&q)).abs()
+                })
+                .fold(0.0f64, f64::max)
+        })
+        .collect();
+    (errs, points)
+}
+
+fn build(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> {
+    let name = spec.file.name.clone();
+    let prefix = spec.file.emit.function.clone();
+    let hash = input_hash(spec);
+    let (errs, points) = match mode {
+        Mode::Fit => measure(),
+        Mode::Committed => {
+            let v = committed_json_with_hash(root, spec, &hash)?;
+            let bad = |why: &str| BuildError::NoCommitted { spec: name.clone(), why: why.into() };
+            let errs = v["functions"]
+                .as_array()
+                .ok_or_else(|| bad("no \"functions\""))?
+                .iter()
+                .map(|f| f["max_abs_error_f32"].as_f64().ok_or_else(|| bad("no max_abs_error_f32")))
+                .collect::<Result<Vec<f64>, _>>()?;
+            let points = v["points"].as_u64().ok_or_else(|| bad("no points"))? as usize;
+            if errs.len() != HELPERS.len() {
+                return Err(bad("one entry per helper expected"));
+            }
+            (errs, points)
+        }
+    };
+    let max = errs.iter().copied().fold(0.0f64, f64::max);
+    let err_line = format!("max abs {} (f32 code against the exact formulas in f64, {points} points over [0, 1] per argument)", fmt_err(max));
+    let header = header_lines(&spec_rel_path(spec), &hash, &err_line);
+    let doc = [
+        "Specular occlusion by a visibility cone (COD: WWII): visibility after interreflections, the",
+        "equivalent cone, and the talk's adjusted cone as printed and corrected. Exact formulas;",
+        "inputs clamped to [0, 1] (NaN -> 0).",
+    ];
+    let render = |lang: Lang| {
+        let mut s = lang.preamble(&header, &name, &doc);
+        for (h, e) in HELPERS.iter().zip(&errs) {
+            let c = lang.comment();
+            s += &format!("\n{c} {}\n{c} f32 code against the formula: max abs {}.\n", h.doc, fmt_err(*e));
+            s += &lang.signature(&format!("{prefix}_{}", h.suffix), h.args, false);
+            for (i, a) in h.args.iter().enumerate() {
+                s += &format!("    let x{i} = {};\n", lang.clamp(&name, a, 0.0, 1.0));
+            }
+            s += &match lang {
+                Lang::Wgsl => format!("    return {};\n}}\n", h.wgsl),
+                Lang::Rust => format!("    {}\n}}\n", h.rust),
+            };
+        }
+        s
+    };
+    let json = json!({
+        "generator": GENERATOR,
+        "spec": spec_rel_path(spec),
+        "input_hash": hash,
+        "name": name,
+        "kind": KIND,
+        "quantity": spec.file.quantity,
+        "description": spec.file.description,
+        "function_prefix": prefix,
+        "points": points,
+        "functions": HELPERS.iter().zip(&errs).map(|(h, e)| json!({"function": format!("{prefix}_{}", h.suffix), "args": h.args, "max_abs_error_f32": e})).collect::<Vec<_>>(),
+    });
+    Ok(Built {
+        name: name.clone(),
+        artifacts: vec![
+            Artifact { path: format!("wgsl/{name}.wgsl").into(), contents: render(Lang::Wgsl).into_bytes() },
+            Artifact { path: format!("src/{name}.rs").into(), contents: render(Lang::Rust).into_bytes() },
+            Artifact { path: format!("json/{name}.json").into(), contents: (compact_json(&json) + "\n").into_bytes() },
+        ],
+        // Exact formulas: the only error is the f32 code's (rms not measured).
+        verification: Verification { points, max_abs_error: max, rms_error: 0.0, worst_point: vec![], max_abs_error_f32: max, rms_error_f32: 0.0, max_abs_error_in_parameter: None },
+        fit: None,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use shadefit_runtime::ggx_occlusion as g;
+
+    #[test]
+    fn emitted_helpers_equal_the_formulas_and_are_finite_everywhere() {
+        // Each is a handful of f32 operations on values in [0, 1] (sqrt correctly rounded):
+        // within a few ulps of 1, 1e-6 absolute, of the f64 formula at the same f32 inputs;
+        // except the interreflection at A → 0, ρ → 1, where the denominator ~A and the value
+        // is an exact ratio to relative 2⁻²³ of a result ≤ 1.
+        let axis: Vec<f32> = (0..=32).map(|i| i as f32 / 32.0).collect();
+        for &a in &axis {
+            for &b in &axis {
+                let (x, y) = (a as f64, b as f64);
+                let want = if x == 0.0 { 0.0 } else { super::super::interreflected(x, y) };
+                assert!((g::ggx_cone_interreflected_visibility(a, b) as f64 - want).abs() < 1e-6, "({a}, {b})");
+                for &c in &axis {
+                    let z = c as f64;
+                    assert!((g::ggx_cone_adjusted_cone_printed(a, b, c) as f64 - super::super::cod_adjust_printed(x, y, z)).abs() < 1e-6);
+                    assert!((g::ggx_cone_adjusted_cone_corrected(a, b, c) as f64 - super::super::cod_adjust_corrected(x, y, z)).abs() < 1e-6);
+                }
+            }
+            assert!((g::ggx_cone_cone_of_visibility(a) as f64 - super::super::cone_of_visibility(a as f64)).abs() < 1e-6);
+        }
+        for s in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY, -1.0, 2.0, f32::MAX] {
+            assert!(g::ggx_cone_interreflected_visibility(s, s).is_finite());
+            assert!(g::ggx_cone_cone_of_visibility(s).is_finite());
+            assert!(g::ggx_cone_adjusted_cone_printed(s, 0.5, s).is_finite());
+            assert!(g::ggx_cone_adjusted_cone_corrected(s, s, s).is_finite());
+        }
+        // NaN is the lower end; A = 0 with white walls is 0, not 0/0.
+        assert_eq!(g::ggx_cone_cone_of_visibility(f32::NAN), 1.0);
+        assert_eq!(g::ggx_cone_interreflected_visibility(0.0, 1.0), 0.0);
+    }
+}
