@@ -233,7 +233,7 @@ fn materialx_item() -> Item {
         "MaterialX libraries/pbrlib/genglsl/lib/mx_microfacet_specular.glsl (v1.39.5)",
         g,
         |m, a| MATERIALX.eval(m, a),
-        |m, a| refit::COMMITTED.materialx.eval(m.clamp(emit::MATERIALX_N_DOT_V.0, emit::MATERIALX_N_DOT_V.1), a),
+        |m, a| emit::materialx_refit(&refit::COMMITTED.materialx, m, a),
         "same biquadratic/biquadratic pair with clamp; scale refitted minimax, bias kept as published (below); n·v clamped to the fitted [1/128, 125/128] as the emitted code does",
     );
     item.findings.push(
@@ -493,7 +493,7 @@ fn albedo_forms(ctx: &Ctx) -> Result<Vec<FormRow>, BenchError> {
         closed_row(name, &reference, PUBLISHED, &karis_wgsl(&KARIS, None), "karis_albedo", |x, a| { let [p, q] = KARIS.eval(a.sqrt(), x); p + q }, "Karis 2014 EnvBRDFApprox A + B = 1 − 0.55 r (input r = sqrt(α))")?,
         closed_row(name, &reference, "Karis refit", &karis_wgsl(&refits.karis_hc, None), "karis_albedo", |x, a| { let [p, q] = refits.karis_hc.eval(a.sqrt(), x); p + q }, "same form refitted to ggx-env (pair minimax)")?,
         closed_row(name, &reference, "MaterialX", &materialx_wgsl(&MATERIALX, None), "materialx_albedo", |x, a| { let [p, q] = MATERIALX.eval(x, a); p + q }, "mx_ggx_dir_albedo_analytic, A + B")?,
-        closed_row(name, &reference, "MaterialX refit", &materialx_wgsl(&refits.materialx, None), "materialx_albedo", |x, a| { let [p, q] = refits.materialx.eval(x, a); p + q }, "same pair refitted (per channel minimax)")?,
+        closed_row(name, &reference, "MaterialX refit", &materialx_wgsl(&refits.materialx, None), "materialx_albedo", |x, a| { let [p, q] = emit::materialx_refit(&refits.materialx, x, a); p + q }, "same pair refitted (scale minimax, bias as published; n·v clamped to its fitted [1/128, 125/128])")?,
         refit_row(&spec, ctx.generated, &reference, "fits/ggx_albedo_rational.toml, committed")?,
         fit_row(&cheaper, integral.fit(&cheaper, &[m, m])?, &reference, "rational bilinear", &fit_note)?,
         table_row(&small, table_values(&mut integral, &small), &reference, "table 16²", "")?,
@@ -531,7 +531,7 @@ fn env_forms(ctx: &Ctx, channel: usize) -> Result<Vec<FormRow>, BenchError> {
         closed_row(&spec, &reference, PUBLISHED, &karis_wgsl(&KARIS, c), "karis_albedo", |x, a| KARIS.eval(a.sqrt(), x)[channel], "Karis 2014 EnvBRDFApprox (fitted to UE4's separable G; input r = sqrt(α))")?,
         closed_row(&spec, &reference, "Karis refit", &karis_wgsl(&refits.karis_hc, c), "karis_albedo", |x, a| refits.karis_hc.eval(a.sqrt(), x)[channel], "same form refitted to ggx-env (pair minimax)")?,
         closed_row(&spec, &reference, "MaterialX", &materialx_wgsl(&MATERIALX, c), "materialx_albedo", |x, a| MATERIALX.eval(x, a)[channel], "mx_ggx_dir_albedo_analytic")?,
-        closed_row(&spec, &reference, "MaterialX refit", &materialx_wgsl(&refits.materialx, c), "materialx_albedo", |x, a| refits.materialx.eval(x, a)[channel], "same pair refitted (per channel minimax)")?,
+        closed_row(&spec, &reference, "MaterialX refit", &materialx_wgsl(&refits.materialx, c), "materialx_albedo", |x, a| emit::materialx_refit(&refits.materialx, x, a)[channel], "same pair refitted (scale minimax, bias as published; n·v clamped to its fitted [1/128, 125/128])")?,
         refit_row(&spec, ctx.generated, &reference, &format!("fits/ggx_env_{which}_rational.toml, committed"))?,
         fit_row(&cubic, integral.fit(&cubic, &[m, m])?, &reference, "rational cubic in n·v", &fit_note)?,
         table_row(&small, table_values(&mut integral, &small), &reference, "table 16²", "")?,
@@ -552,7 +552,7 @@ pub fn figures(out: &Path, _generated: &Path) -> Result<Vec<PathBuf>, PlotError>
         ("ggx_karis_errors", "Karis 2014 EnvBRDFApprox against ggx-env-ue4", Target::RoughnessUe4, Box::new(|m, r| KARIS.eval(r, m)), Box::new(|m, r| refits.karis_ue4.eval(r, m))),
         ("ggx_bevy_errors", "bevy F_AB (Karis) against ggx-env (height-correlated)", Target::Roughness, Box::new(|m, r| KARIS.eval(r, m)), Box::new(|m, r| refits.karis_hc.eval(r, m))),
         ("ggx_lazarov_errors", "Lazarov 2013 against ggx-env, α = sqrt(2/(8192^g + 2))", Target::Gloss, Box::new(|m, g| LAZAROV.eval(g, m)), Box::new(|m, g| refits.lazarov.eval(g, m))),
-        ("ggx_materialx_errors", "MaterialX mx_ggx_dir_albedo_analytic against ggx-env", Target::Alpha, Box::new(|m, a| MATERIALX.eval(m, a)), Box::new(|m, a| refits.materialx.eval(m, a))),
+        ("ggx_materialx_errors", "MaterialX mx_ggx_dir_albedo_analytic against ggx-env", Target::Alpha, Box::new(|m, a| MATERIALX.eval(m, a)), Box::new(|m, a| emit::materialx_refit(&refits.materialx, m, a))),
     ];
     for (stem, title, target, published, refit) in cases {
         let g = grid::standard(target);

@@ -49,6 +49,11 @@ pub const REFITS: SpecKind = SpecKind {
 
 /// n·v range of the MaterialX refit's fitting grid (every other texel centre of 64).
 pub const MATERIALX_N_DOT_V: (f64, f64) = (1.0 / 128.0, 125.0 / 128.0);
+/// The MaterialX refit as the emitted code evaluates it: n·v clamped to [`MATERIALX_N_DOT_V`].
+pub fn materialx_refit(m: &MaterialX, n_dot_v: f64, alpha: f64) -> [f64; 2] {
+    m.eval(n_dot_v.clamp(MATERIALX_N_DOT_V.0, MATERIALX_N_DOT_V.1), alpha)
+}
+
 /// η range of the Fresnel-average grids (both branches).
 pub const ETA: (f64, f64) = (1.0 / 3.0, 3.0);
 
@@ -153,8 +158,6 @@ fn pair_row(function: String, form: &'static str, target: Target, published: imp
 
 /// Every row, measured (the grids' integrals: a few seconds).
 fn measure(prefix: &str, e: &Refits) -> Vec<Row> {
-    // MaterialX's refit is clamped to its fitted n·v range, as the emitted code does.
-    let mx_clamp = |m: f64| m.clamp(MATERIALX_N_DOT_V.0, MATERIALX_N_DOT_V.1);
     let kc = |above: bool, k: &KullaConty| {
         let (eta, f) = grid::fresnel(above);
         let errs: Vec<f64> = eta.iter().zip(f).map(|(&x, &t)| k.eval(x) - t).collect();
@@ -176,7 +179,7 @@ fn measure(prefix: &str, e: &Refits) -> Vec<Row> {
         pair_row(format!("{prefix}_karis"), "Karis 2014 EnvBRDFApprox", Target::Roughness, |m, r| KARIS.eval(r, m), |m, r| e.karis_hc.eval(r, m)),
         pair_row(format!("{prefix}_karis_separable"), "Karis 2014 EnvBRDFApprox", Target::RoughnessUe4, |m, r| KARIS.eval(r, m), |m, r| e.karis_ue4.eval(r, m)),
         pair_row(format!("{prefix}_lazarov"), "Lazarov 2013 (Black Ops II)", Target::Gloss, |m, g| LAZAROV.eval(g, m), |m, g| e.lazarov.eval(g, m)),
-        pair_row(format!("{prefix}_materialx"), "MaterialX mx_ggx_dir_albedo_analytic", Target::Alpha, |m, a| MATERIALX.eval(m, a), |m, a| e.materialx.eval(mx_clamp(m), a)),
+        pair_row(format!("{prefix}_materialx"), "MaterialX mx_ggx_dir_albedo_analytic", Target::Alpha, |m, a| MATERIALX.eval(m, a), |m, a| materialx_refit(&e.materialx, m, a)),
         eta_rows(true),
         eta_rows(false),
     ]
@@ -504,7 +507,6 @@ mod tests {
     #[test]
     fn emitted_rust_equals_the_committed_forms_in_f64() {
         let e = emitted();
-        let (lo, hi) = MATERIALX_N_DOT_V;
         let mut worst = [0.0f64; 4];
         for (u, v) in grid() {
             let (x, y) = (u as f64, v as f64);
@@ -512,7 +514,7 @@ mod tests {
                 (g::ggx_refit_karis(u, v), e.karis_hc.eval(x, y)),
                 (g::ggx_refit_karis_separable(u, v), e.karis_ue4.eval(x, y)),
                 (g::ggx_refit_lazarov(u, v), e.lazarov.eval(x, y)),
-                (g::ggx_refit_materialx(u, v), e.materialx.eval(x.clamp(lo, hi), y)),
+                (g::ggx_refit_materialx(u, v), materialx_refit(&e.materialx, x, y)),
             ];
             for (k, (a, b)) in pairs.iter().enumerate() {
                 worst[k] = worst[k].max((a[0] as f64 - b[0]).abs()).max((a[1] as f64 - b[1]).abs());
