@@ -425,14 +425,17 @@ const LM_PATIENCE: usize = 400;
 
 /// When a watched LM run counts as stalled: at an accepted step, its rss fell by Δ over the
 /// last ≥ `WINDOW` evaluations, and at that rate the evaluations left before LM's cap would
-/// lower it by less than `SHARE` of itself. The run is then stopped with `lower` = rss·(1 −
-/// SHARE), taken as the least rss the full run could reach (progress slows, not speeds up, on
-/// such a crawl; [`fit`] runs a start again in full unless a finished start beats even that).
+/// lower it by less than `SHARE` of itself. The run is then stopped with `lower` = `REACH`·rss
+/// as the least rss the full run is taken to reach, and [`fit`] runs it again in full unless a
+/// finished valid start beats even that. A crawl can end (the bench's gloss_combine_3_2: a
+/// start stopped under a 1e-3 share at 50 evaluations with its lower bound at 0.999 rss went
+/// on to win), hence the strict share and the wide reach.
 struct Stall;
 
 impl Stall {
-    const WINDOW: usize = 50;
-    const SHARE: f64 = 1e-3;
+    const WINDOW: usize = 200;
+    const SHARE: f64 = 1e-6;
+    const REACH: f64 = 0.1;
 }
 
 /// A [`Residuals`] problem that counts LM's evaluations and stops the run (its Jacobian
@@ -475,7 +478,7 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Watched<'_> {
             let rate = (rss0 - rss) / (n - n0) as f64;
             let left = self.max_evals.saturating_sub(n) as f64;
             if rate * left < Stall::SHARE * rss {
-                self.stalled.set(Some(rss * (1.0 - Stall::SHARE)));
+                self.stalled.set(Some(rss * Stall::REACH));
                 return None;
             }
         }
@@ -641,17 +644,34 @@ mod tests {
     use super::*;
 
     /// Starts stopped for stalling change nothing: the chosen fit is bit for bit the one of
-    /// running every start in full. |x − 0.4| by a 3/3 rational: four of the seven linearised
-    /// starts crawl (poles near the kink), and some are left stopped.
+    /// running every start in full. A unit step at x = 0.3 by a 2/3 rational: three of the
+    /// linearised starts crawl far above the best and are left stopped.
+    /// Starts stopped for stalling change nothing: the chosen fit is bit for bit the one of
+    /// running every start in full. A unit step at x = 0.3 by a 2/3 rational: three of the
+    /// linearised starts crawl far above the best and are left stopped.
+    #[test]
+    fn explore_stall() {
+        let fs: Vec<(&str, fn(f64) -> f64)> = vec![("step", |x| (x - 0.4).abs()), ("kink2", |x| (x - 0.7).abs().sqrt()), ("step", |x| if x < 0.3 { 0.0 } else { 1.0 }), ("tanh", |x| (20.0 * (x - 0.5)).tanh()), ("sin", |x| (9.0 * x).sin())];
+        for (name, f) in fs { for (m, n) in [(2, 2), (3, 3), (4, 4), (3, 2), (2, 3), (5, 5)] {
+            let model = RationalModel::rational_1d("x", m, n);
+            let x: Vec<Vec<f64>> = (0..200).map(|i| vec![i as f64 / 199.0]).collect();
+            let data = Data { y: x.iter().map(|p| f(p[0])).collect(), x };
+            let lsq = FitOptions::default();
+            let Ok(starts) = linearised_starts(&model, &data, name) else { continue };
+            let (_, left) = multi_start(&model, &data, &lsq, name, &starts, true);
+            eprintln!("EXPLORE {name} {m} {n} left {left}");
+        }}
+    }
+
     #[test]
     fn stalled_starts_do_not_change_the_choice() {
-        let model = RationalModel::rational_1d("x", 3, 3);
+        let model = RationalModel::rational_1d("x", 2, 3);
         let x: Vec<Vec<f64>> = (0..200).map(|i| vec![i as f64 / 199.0]).collect();
-        let data = Data { y: x.iter().map(|p| (p[0] - 0.4).abs()).collect(), x };
+        let data = Data { y: x.iter().map(|p| if p[0] < 0.3 { 0.0 } else { 1.0 }).collect(), x };
         let lsq = FitOptions::default();
-        let starts = linearised_starts(&model, &data, "kink").unwrap();
-        let (watched, left) = multi_start(&model, &data, &lsq, "kink", &starts, true);
-        let (full, none) = multi_start(&model, &data, &lsq, "kink", &starts, false);
+        let starts = linearised_starts(&model, &data, "step").unwrap();
+        let (watched, left) = multi_start(&model, &data, &lsq, "step", &starts, true);
+        let (full, none) = multi_start(&model, &data, &lsq, "step", &starts, false);
         assert!(left >= 1, "no start was left stopped: the test does not exercise the stop");
         assert_eq!(none, 0);
         let ((wv, w), (fv, f)) = (watched.unwrap(), full.unwrap());
@@ -660,6 +680,6 @@ mod tests {
         assert_eq!(bits(&w.theta), bits(&f.theta));
         assert_eq!(w.report.rss.to_bits(), f.report.rss.to_bits());
         // The public entry point is the watched multi-start.
-        assert_eq!(bits(&fit(&model, &data, &lsq, "kink").unwrap().theta), bits(&f.theta));
+        assert_eq!(bits(&fit(&model, &data, &lsq, "step").unwrap().theta), bits(&f.theta));
     }
 }
