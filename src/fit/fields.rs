@@ -492,10 +492,11 @@ pub fn fit_fields(
     }
     let mut fields = Fields::new(models, x, systems, theta);
     let domain = Data { x: x.to_vec(), y: vec![] }.bounds();
+    // The fields' proofs are independent: in parallel (the answer is the same either way).
     let positive = |f: &Fields<'_>, theta: &DVector<f64>| {
         f.full(theta)
-            .iter()
-            .zip(models)
+            .par_iter()
+            .zip(models.par_iter())
             .all(|(c, m)| matches!(prove_denominator_positive(m, c, &domain), Positivity::Proven { .. }))
     };
     let mut evals = solve_joint(&mut fields, 500, what)?;
