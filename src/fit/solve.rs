@@ -499,16 +499,18 @@ fn least_squares_watched(problem: &mut Residuals<'_>, what: &str) -> Result<(DVe
         stalled: std::cell::Cell::new(None),
     };
     let (w, report) = lm_solver().minimize(watched);
-    let theta = w.inner.theta.clone();
-    if !theta.iter().all(|v| v.is_finite()) {
-        return Err(FitError::Diverged {
-            what: what.into(),
-            iters: report.number_of_evaluations,
-            residual: report.objective_function,
-        });
-    }
+    let theta = finite_lm_result(w.inner.theta.clone(), &report, what)?;
     problem.theta.copy_from(&theta);
     Ok((theta, report.number_of_evaluations, w.stalled.get()))
+}
+
+/// An LM run's parameters, or `Diverged` when any is not finite.
+fn finite_lm_result(theta: DVector<f64>, report: &levenberg_marquardt::MinimizationReport<f64>, what: &str) -> Result<DVector<f64>, FitError> {
+    if theta.iter().all(|v| v.is_finite()) {
+        Ok(theta)
+    } else {
+        Err(FitError::Diverged { what: what.into(), iters: report.number_of_evaluations, residual: report.objective_function })
+    }
 }
 
 fn least_squares(
@@ -519,14 +521,7 @@ fn least_squares(
     match solver {
         LsqSolver::Lm => {
             let (p, report) = lm_solver().minimize(problem.clone());
-            let theta = p.theta.clone();
-            if !theta.iter().all(|v| v.is_finite()) {
-                return Err(FitError::Diverged {
-                    what: what.into(),
-                    iters: report.number_of_evaluations,
-                    residual: report.objective_function,
-                });
-            }
+            let theta = finite_lm_result(p.theta.clone(), &report, what)?;
             problem.theta.copy_from(&theta);
             Ok((theta, report.number_of_evaluations, report.number_of_evaluations))
         }

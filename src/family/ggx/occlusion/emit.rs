@@ -12,12 +12,11 @@
 //! recorded is the f32 code's (the Rust module, same operations as the WGSL) against the f64
 //! formulas on a grid of every argument; `Mode::Committed` reads it from the committed JSON.
 
-use super::super::published::emit::Lang;
-use crate::emit::{Artifact, GENERATOR, header_lines};
+use super::super::published::emit::{Lang, module_built, module_json, module_spec_file};
+use crate::emit::header_lines;
 use crate::family::SpecKind;
-use crate::pipeline::{BuildError, Built, Mode, Verification, compact_json, committed_json_with_hash, fmt_err, input_hash, spec_rel_path};
-use crate::spec::{CustomSpec, KindDef, Spec, SpecError, SpecFile, is_kind, line_of, parse_toml};
-use serde::Deserialize;
+use crate::pipeline::{BuildError, Built, Mode, committed_json_with_hash, fmt_err, input_hash, spec_rel_path};
+use crate::spec::{KindDef, Spec, SpecError, SpecFile};
 use serde_json::json;
 use std::path::Path;
 
@@ -34,41 +33,10 @@ pub const OCCLUSION: SpecKind = SpecKind {
     build,
 };
 
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct OcclusionFile {
-    name: String,
-    #[allow(dead_code)]
-    kind: String,
-    quantity: String,
-    #[serde(default)]
-    description: String,
-    emit: Prefix,
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct Prefix {
-    /// Prefix of the emitted function names.
-    function: String,
-}
-
 /// For `Spec::parse`: the common spec of an occlusion-helpers spec, or `None`.
 pub fn spec_file(path: &Path, text: &str) -> Result<Option<SpecFile>, SpecError> {
-    if !is_kind(text, KIND) {
-        return Ok(None);
-    }
-    let f: OcclusionFile = parse_toml(path, text)?;
-    if f.quantity != "ggx-env" {
-        return Err(SpecError::new(path, line_of(text, "quantity"), "quantity", format!("kind = \"{KIND}\" serves ggx-env's cone, not '{}'", f.quantity)));
-    }
-    let axes = vec![
-        json!({"name": "alpha", "range": [0.0, 1.0], "count": 2}),
-        json!({"name": "n_dot_v", "range": [0.0, 1.0], "count": 2}),
-        json!({"name": "cos_cone", "range": [0.0, 1.0], "count": 2}),
-    ];
-    let common = CustomSpec { kind: KIND, name: &f.name, quantity: &f.quantity, description: &f.description, tolerance: 1e-12, axes, function: &f.emit.function };
-    common.spec_file(path, text).map(Some)
+    let axes = ["alpha", "n_dot_v", "cos_cone"].map(|a| json!({"name": a, "range": [0.0, 1.0], "count": 2})).to_vec();
+    module_spec_file(path, text, KIND, axes)
 }
 
 /// One helper: name suffix, arguments, its doc, the WGSL and Rust expressions of the clamped
@@ -201,29 +169,14 @@ fn build(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> {
         }
         s
     };
-    let json = json!({
-        "generator": GENERATOR,
-        "spec": spec_rel_path(spec),
-        "input_hash": hash,
-        "name": name,
-        "kind": KIND,
-        "quantity": spec.file.quantity,
-        "description": spec.file.description,
-        "function_prefix": prefix,
-        "points": points,
-        "functions": HELPERS.iter().zip(&errs).map(|(h, e)| json!({"function": format!("{prefix}_{}", h.suffix), "args": h.args, "max_abs_error_f32": e})).collect::<Vec<_>>(),
-    });
-    Ok(Built {
-        name: name.clone(),
-        artifacts: vec![
-            Artifact { path: format!("wgsl/{name}.wgsl").into(), contents: render(Lang::Wgsl).into_bytes() },
-            Artifact { path: format!("src/{name}.rs").into(), contents: render(Lang::Rust).into_bytes() },
-            Artifact { path: format!("json/{name}.json").into(), contents: (compact_json(&json) + "\n").into_bytes() },
-        ],
-        // Exact formulas: the only error is the f32 code's (rms not measured).
-        verification: Verification { points, max_abs_error: max, rms_error: 0.0, worst_point: vec![], max_abs_error_f32: max, rms_error_f32: 0.0, max_abs_error_in_parameter: None },
-        fit: None,
-    })
+    let mut json = module_json(spec, &hash, KIND);
+    json.insert("points".into(), points.into());
+    json.insert(
+        "functions".into(),
+        HELPERS.iter().zip(&errs).map(|(h, e)| json!({"function": format!("{prefix}_{}", h.suffix), "args": h.args, "max_abs_error_f32": e})).collect::<Vec<_>>().into(),
+    );
+    // Exact formulas: the only error is the f32 code's (rms not measured).
+    Ok(module_built(&name, render(Lang::Wgsl), render(Lang::Rust), json, points, max, 0.0))
 }
 
 #[cfg(test)]

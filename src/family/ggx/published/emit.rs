@@ -57,9 +57,11 @@ pub fn materialx_refit(m: &MaterialX, n_dot_v: f64, alpha: f64) -> [f64; 2] {
 /// η range of the Fresnel-average grids (both branches).
 pub const ETA: (f64, f64) = (1.0 / 3.0, 3.0);
 
+/// The spec file of a family kind that emits one module of functions: name, kind, quantity
+/// (`ggx-env`), description and `[emit] function` (the functions' name prefix).
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
-struct RefitsFile {
+struct ModuleFile {
     name: String,
     #[allow(dead_code)]
     kind: String,
@@ -76,22 +78,28 @@ struct EmitPrefix {
     function: String,
 }
 
-/// For `Spec::parse`: the common spec of a refits spec, or `None` when the text is not one.
-pub fn spec_file(path: &Path, text: &str) -> Result<Option<SpecFile>, SpecError> {
-    if !is_kind(text, KIND) {
+/// For `Spec::parse`: the common spec of a module spec of kind `kind` (see [`ModuleFile`]),
+/// with `axes` spelled out, or `None` when the text is not of that kind.
+pub(crate) fn module_spec_file(path: &Path, text: &str, kind: &'static str, axes: Vec<Value>) -> Result<Option<SpecFile>, SpecError> {
+    if !is_kind(text, kind) {
         return Ok(None);
     }
-    let f: RefitsFile = parse_toml(path, text)?;
+    let f: ModuleFile = parse_toml(path, text)?;
     if f.quantity != "ggx-env" {
-        return Err(SpecError::new(path, line_of(text, "quantity"), "quantity", format!("kind = \"{KIND}\" refits forms of ggx-env, not '{}'", f.quantity)));
+        return Err(SpecError::new(path, line_of(text, "quantity"), "quantity", format!("kind = \"{kind}\" serves ggx-env, not '{}'", f.quantity)));
     }
-    // Axes: the standard grid the pair forms are measured on (n·v texel centres of 64, α in [0, 1]).
+    let common = CustomSpec { kind, name: &f.name, quantity: &f.quantity, description: &f.description, tolerance: grid::TOL, axes, function: &f.emit.function };
+    common.spec_file(path, text).map(Some)
+}
+
+/// For `Spec::parse`: the common spec of a refits spec, or `None` when the text is not one.
+/// Axes: the standard grid the pair forms are measured on (n·v texel centres of 64, α in [0, 1]).
+pub fn spec_file(path: &Path, text: &str) -> Result<Option<SpecFile>, SpecError> {
     let axes = vec![
         json!({"name": "alpha", "range": [0.0, 1.0], "count": 65}),
         json!({"name": "n_dot_v", "range": [1.0 / 128.0, 127.0 / 128.0], "count": 64}),
     ];
-    let common = CustomSpec { kind: KIND, name: &f.name, quantity: &f.quantity, description: &f.description, tolerance: grid::TOL, axes, function: &f.emit.function };
-    common.spec_file(path, text).map(Some)
+    module_spec_file(path, text, KIND, axes)
 }
 
 /// The spec text and the committed constants (their shortest round-trip text).
@@ -259,30 +267,44 @@ fn build(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> {
     let max = rows.iter().map(|r| r.refit[0]).fold(0.0f64, f64::max);
     let points: usize = rows.iter().map(|r| r.points).sum();
     let rms = (rows.iter().map(|r| r.refit[1] * r.refit[1] * r.points as f64).sum::<f64>() / points as f64).sqrt();
-    let json = json!({
+    let mut json = module_json(spec, &hash, KIND);
+    json.insert("source".into(), "family::ggx::published::refit::COMMITTED".into());
+    json.insert("materialx_denominator_lower_bound".into(), q_lower.into());
+    json.insert("forms".into(), rows.iter().map(row_json).collect::<Vec<_>>().into());
+    // The forms' errors pooled (each row is on its own grid and quantity; the per-form figures are in the JSON).
+    Ok(module_built(&name, wgsl, rust, json, points, max, rms))
+}
+
+/// The provenance every module JSON of the family starts with; the caller adds its own keys.
+pub(crate) fn module_json(spec: &Spec, hash: &str, kind: &str) -> serde_json::Map<String, Value> {
+    let v = json!({
         "generator": GENERATOR,
         "spec": spec_rel_path(spec),
         "input_hash": hash,
-        "name": name,
-        "kind": KIND,
+        "name": spec.file.name,
+        "kind": kind,
         "quantity": spec.file.quantity,
         "description": spec.file.description,
-        "function_prefix": prefix,
-        "source": "family::ggx::published::refit::COMMITTED",
-        "materialx_denominator_lower_bound": q_lower,
-        "forms": rows.iter().map(row_json).collect::<Vec<_>>(),
+        "function_prefix": spec.file.emit.function,
     });
-    Ok(Built {
-        name: name.clone(),
+    match v {
+        Value::Object(m) => m,
+        _ => unreachable!("a JSON object literal"),
+    }
+}
+
+/// A module's three files (WGSL, Rust, JSON) with its pooled max and rms error over `points`.
+pub(crate) fn module_built(name: &str, wgsl: String, rust: String, json: serde_json::Map<String, Value>, points: usize, max: f64, rms: f64) -> Built {
+    Built {
+        name: name.to_string(),
         artifacts: vec![
             Artifact { path: format!("wgsl/{name}.wgsl").into(), contents: wgsl.into_bytes() },
             Artifact { path: format!("src/{name}.rs").into(), contents: rust.into_bytes() },
-            Artifact { path: format!("json/{name}.json").into(), contents: (compact_json(&json) + "\n").into_bytes() },
+            Artifact { path: format!("json/{name}.json").into(), contents: (compact_json(&Value::Object(json)) + "\n").into_bytes() },
         ],
-        // The forms' errors pooled (each row is on its own grid and quantity; the per-form figures are in the JSON).
         verification: Verification { points, max_abs_error: max, rms_error: rms, worst_point: vec![], max_abs_error_f32: max, rms_error_f32: rms, max_abs_error_in_parameter: None },
         fit: None,
-    })
+    }
 }
 
 /// The two languages a module is written in (shared with the family's other emitted modules).
