@@ -29,7 +29,7 @@
 
 pub mod emit;
 
-use super::integrals::{self, Shadowing};
+use super::integrals::{self, EnvEstimate, Shadowing};
 use crate::validate::{Item, measure};
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -98,8 +98,19 @@ pub fn jimenez(n_dot_v: f64, v: f64, r: f64) -> f64 {
 /// The cone model's specular occlusion for a Schlick F0 (see the module doc), with the
 /// integrals to `tol`.
 pub fn exact_so(alpha: f64, n_dot_v: f64, v: f64, f0: f64, tol: f64) -> f64 {
+    let (full, cone) = split_sums(alpha, n_dot_v, v, tol);
+    so_ratio(&full, &cone, f0)
+}
+
+/// The split sums over the hemisphere and over the cone of visibility V.
+fn split_sums(alpha: f64, n_dot_v: f64, v: f64, tol: f64) -> (EnvEstimate, EnvEstimate) {
     let full = integrals::env(alpha, n_dot_v, 0.0, Shadowing::HeightCorrelated, tol);
     let cone = integrals::env(alpha, n_dot_v, cone_of_visibility(v), Shadowing::HeightCorrelated, tol);
+    (full, cone)
+}
+
+/// (F0·scale_c + bias_c)/(F0·scale + bias), 0 where the unoccluded sum is 0.
+fn so_ratio(full: &EnvEstimate, cone: &EnvEstimate, f0: f64) -> f64 {
     let den = f0 * full.scale + full.bias;
     if den > 0.0 { (f0 * cone.scale + cone.bias) / den } else { 0.0 }
 }
@@ -129,18 +140,16 @@ fn grid() -> Vec<[f64; 3]> {
 fn reference(pts: &[[f64; 3]]) -> Vec<[f64; 2]> {
     pts.par_iter()
         .map(|&[r, mu, v]| {
-            let alpha = r * r;
-            let full = integrals::env(alpha, mu, 0.0, Shadowing::HeightCorrelated, TOL);
-            let cone = integrals::env(alpha, mu, cone_of_visibility(v), Shadowing::HeightCorrelated, TOL);
-            let so = |f0: f64| (f0 * cone.scale + cone.bias) / (f0 * full.scale + full.bias);
-            [so(F0), so(1.0)]
+            let (full, cone) = split_sums(r * r, mu, v, TOL);
+            [so_ratio(&full, &cone, F0), so_ratio(&full, &cone, 1.0)]
         })
         .collect()
 }
 
 const DOMAIN: &str = "perceptual roughness r ∈ [0.05, 1] (20) × n·v at 32 texel centres × visibility V ∈ [1/32, 1] (32): 20480 points";
 
-fn approximation_item(name: &str, source: &str, pts: &[[f64; 3]], refs: &[[f64; 2]], so: impl Fn(f64, f64, f64) -> f64 + Sync, convention: &str) -> Item {
+/// The item of one approximation `so(r, n·v, V)`, with its values at `pts` (for findings).
+fn approximation_item(name: &str, source: &str, pts: &[[f64; 3]], refs: &[[f64; 2]], so: impl Fn(f64, f64, f64) -> f64 + Sync, convention: &str) -> (Item, Vec<f64>) {
     let points: Vec<Vec<f64>> = pts.iter().map(|p| p.to_vec()).collect();
     let approx: Vec<f64> = pts.par_iter().map(|&[r, mu, v]| so(r, mu, v)).collect();
     let truth: Vec<f64> = refs.iter().map(|t| t[0]).collect();
@@ -158,7 +167,18 @@ fn approximation_item(name: &str, source: &str, pts: &[[f64; 3]], refs: &[[f64; 
         if bias < 0.0 { "over-occludes on average" } else { "under-occludes on average" }
     ));
     item.findings.push(convention.into());
-    item
+    (item, approx)
+}
+
+/// Max error (F0 = 4 %) where the mirror direction lies outside the cone (θv > θc: the cone
+/// model itself occludes glossy lobes there, the talk's halos) and inside it.
+fn outside_inside(pts: &[[f64; 3]], refs: &[[f64; 2]], approx: &[f64]) -> (f64, f64) {
+    let (mut outside, mut inside) = (0.0f64, 0.0f64);
+    for ((p, t), a) in pts.iter().zip(refs).zip(approx) {
+        let e = (a - t[0]).abs();
+        if p[1] < cone_of_visibility(p[2]) { outside = outside.max(e) } else { inside = inside.max(e) }
+    }
+    (outside, inside)
 }
 
 /// The finding on the printed adjustment (no integrals: the two readings compared).
@@ -210,10 +230,7 @@ pub fn typo_item() -> Item {
 pub fn items() -> Vec<Item> {
     let pts = grid();
     let refs = reference(&pts);
-    // Where the cone model itself is least trustworthy: views whose mirror direction lies
-    // outside the cone (θv > θc), which it occludes for glossy lobes (the talk's halos).
-    let outside = |p: &[f64; 3]| p[1] < cone_of_visibility(p[2]);
-    let mut lagarde_item = approximation_item(
+    let (mut lagarde_item, lagarde_so) = approximation_item(
         "specular occlusion: Lagarde & de Rousiers 2014",
         "Lagarde & de Rousiers 2014, 'Moving Frostbite to PBR' (course notes); Filament SPECULAR_AO_SIMPLE",
         &pts,
@@ -222,21 +239,13 @@ pub fn items() -> Vec<Item> {
         "Convention: SO = saturate((n·v + V)^(2^(−16α − 1)) − 1 + V) with α = r² (Filament passes its roughness = \
          perceptual²) and V the visibility (ambient occlusion) itself, compared with the cone of that V.",
     );
-    let split = |so: &dyn Fn(f64, f64, f64) -> f64| {
-        let (mut a, mut b) = (0.0f64, 0.0f64);
-        for (p, t) in pts.iter().zip(&refs) {
-            let e = (so(p[0], p[1], p[2]) - t[0]).abs();
-            if outside(p) { a = a.max(e) } else { b = b.max(e) }
-        }
-        (a, b)
-    };
-    let (out_l, in_l) = split(&|r, mu, v| lagarde(mu, v, r * r));
+    let (out_l, in_l) = outside_inside(&pts, &refs, &lagarde_so);
     lagarde_item.findings.push(format!(
         "Max error {out_l:.3e} where the mirror direction is outside the cone (n·v < cos θc, where the cone model itself \
          over-occludes glossy lobes: the talk's halos), {in_l:.3e} inside it{}.",
         if in_l > 0.5 * out_l { ": the disagreement is not confined to the cone model's weak region" } else { "" }
     ));
-    let mut jimenez_item = approximation_item(
+    let (mut jimenez_item, jimenez_so) = approximation_item(
         "specular occlusion: Jimenez et al. 2016 cone–cone intersection",
         "Jimenez, Wu, Pesce, Jarabo 2016, 'Practical Real-Time Strategies for Accurate Indirect Occlusion'",
         &pts,
@@ -246,8 +255,8 @@ pub fn items() -> Vec<Item> {
          mirror direction (θ from n equal to θv), cos α_s = 2^(−3.321928 r²) with r the perceptual roughness; SO = \
          their shared solid angle (exact spherical-lens area) over the specular cone's.",
     );
-    let (out_j, in_j) = split(&|r, mu, v| jimenez(mu, v, r));
-    let unoccluded = pts.iter().filter(|p| p[2] == 1.0).map(|p| jimenez(p[1], 1.0, p[0])).fold(1.0f64, f64::min);
+    let (out_j, in_j) = outside_inside(&pts, &refs, &jimenez_so);
+    let unoccluded = pts.iter().zip(&jimenez_so).filter(|(p, _)| p[2] == 1.0).map(|(_, &a)| a).fold(1.0f64, f64::min);
     jimenez_item.findings.push(format!(
         "Max error {out_j:.3e} outside the cone, {in_j:.3e} inside. With nothing occluded (V = 1) it still returns as little as \
          {unoccluded:.3}: the specular cone of a rough lobe at a grazing view reaches below the horizon, and the hemisphere \

@@ -40,13 +40,15 @@ pub fn spec_file(path: &Path, text: &str) -> Result<Option<SpecFile>, SpecError>
 }
 
 /// One helper: name suffix, arguments, its doc, the WGSL and Rust expressions of the clamped
-/// arguments `x0, x1, …`, and the f64 formula it is measured against.
+/// arguments `x0, x1, …`, the same expression in f32 here (what the emitted code computes, for
+/// the recorded error), and the f64 formula it is measured against.
 struct Helper {
     suffix: &'static str,
     args: &'static [&'static str],
     doc: &'static str,
     wgsl: &'static str,
     rust: &'static str,
+    f32: fn(&[f32]) -> f32,
     exact: fn(&[f64]) -> f64,
 }
 
@@ -57,6 +59,7 @@ const HELPERS: [Helper; 4] = [
         doc: "Visibility after interreflections inside the cavity, A′ = A / (1 − ρ + ρA) (COD: WWII).",
         wgsl: "x0 / max(1f - x1 + x1 * x0, 1e-30f)",
         rust: "x0 / (1.0 - x1 + x1 * x0).max(1e-30)",
+        f32: |x| x[0] / (1.0 - x[1] + x[1] * x[0]).max(1e-30),
         exact: |p| if p[0] == 0.0 { 0.0 } else { super::interreflected(p[0], p[1]) },
     },
     Helper {
@@ -65,6 +68,7 @@ const HELPERS: [Helper; 4] = [
         doc: "Cosine of the visibility cone's half-angle, cos θc = sqrt(1 − V) (the Nusselt analog).",
         wgsl: "sqrt(1f - x0)",
         rust: "(1.0 - x0).sqrt()",
+        f32: |x| (1.0 - x[0]).sqrt(),
         exact: |p| super::cone_of_visibility(p[0]),
     },
     Helper {
@@ -73,6 +77,7 @@ const HELPERS: [Helper; 4] = [
         doc: "The talk's adjusted cone as printed: cos θ (1 − g²)(1 − (1 − (n·v)⁴)) = cos θ (1 − g²)(n·v)⁴.",
         wgsl: "x0 * (1f - x1 * x1) * (1f - (1f - x2 * x2 * x2 * x2))",
         rust: "x0 * (1.0 - x1 * x1) * (1.0 - (1.0 - x2 * x2 * x2 * x2))",
+        f32: |x| x[0] * (1.0 - x[1] * x[1]) * (1.0 - (1.0 - x[2] * x[2] * x[2] * x[2])),
         exact: |p| super::cod_adjust_printed(p[0], p[1], p[2]),
     },
     Helper {
@@ -81,20 +86,10 @@ const HELPERS: [Helper; 4] = [
         doc: "The adjusted cone in the reading that opens it at grazing views: cos θ (1 − g²)(1 − (1 − n·v)⁴).",
         wgsl: "x0 * (1f - x1 * x1) * (1f - (1f - x2) * (1f - x2) * (1f - x2) * (1f - x2))",
         rust: "x0 * (1.0 - x1 * x1) * (1.0 - (1.0 - x2) * (1.0 - x2) * (1.0 - x2) * (1.0 - x2))",
+        f32: |x| x[0] * (1.0 - x[1] * x[1]) * (1.0 - (1.0 - x[2]) * (1.0 - x[2]) * (1.0 - x[2]) * (1.0 - x[2])),
         exact: |p| super::cod_adjust_corrected(p[0], p[1], p[2]),
     },
 ];
-
-/// The Rust expression of a helper evaluated in f32 (what the emitted module computes).
-fn rust_f32(h: &Helper, p: &[f32]) -> f32 {
-    let x = |i: usize| p[i].clamp(0.0, 1.0);
-    match h.suffix {
-        "interreflected_visibility" => x(0) / (1.0 - x(1) + x(1) * x(0)).max(1e-30),
-        "cone_of_visibility" => (1.0 - x(0)).sqrt(),
-        "adjusted_cone_printed" => x(0) * (1.0 - x(1) * x(1)) * (1.0 - (1.0 - x(2) * x(2) * x(2) * x(2))),
-        _ => x(0) * (1.0 - x(1) * x(1)) * (1.0 - (1.0 - x(2)) * (1.0 - x(2)) * (1.0 - x(2)) * (1.0 - x(2))),
-    }
-}
 
 /// Max |f32 − f64| of each helper over 65 points per argument in [0, 1], and the point count.
 fn measure() -> (Vec<f64>, usize) {
@@ -113,9 +108,10 @@ fn measure() -> (Vec<f64>, usize) {
                         k /= axis.len();
                         v
                     }).collect();
+                    // The grid is inside [0, 1], so the emitted clamps leave it as it is.
                     let p32: Vec<f32> = p.iter().map(|&v| v as f32).collect();
                     let q: Vec<f64> = p32.iter().map(|&v| v as f64).collect();
-                    (rust_f32(h, &p32) as f64 - (h.exact)(&q)).abs()
+                    ((h.f32)(&p32) as f64 - (h.exact)(&q)).abs()
                 })
                 .fold(0.0f64, f64::max)
         })
