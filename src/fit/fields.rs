@@ -156,6 +156,7 @@ impl<'a> Fields<'a> {
         let full = self.full(theta);
         let ng = self.systems.len();
         (0..ng)
+            .into_par_iter()
             .map(|g| {
                 self.models.iter().enumerate().map(|(k, m)| self.basis[k][g].value(&full[k], m.offset)).collect()
             })
@@ -165,10 +166,15 @@ impl<'a> Fields<'a> {
     fn residuals_at(&self, theta: &DVector<f64>) -> DVector<f64> {
         let nk = self.models.len();
         let vals = self.values(theta);
+        let rows: Vec<DVector<f64>> = self
+            .systems
+            .par_iter()
+            .zip(vals.par_iter())
+            .map(|(s, c)| &s.r * DVector::from_column_slice(c) - &s.z)
+            .collect();
         let mut out = DVector::zeros(self.systems.len() * nk);
-        for (g, (s, c)) in self.systems.iter().zip(&vals).enumerate() {
-            let c = DVector::from_column_slice(c);
-            out.rows_mut(g * nk, nk).copy_from(&(&s.r * c - &s.z));
+        for (g, r) in rows.iter().enumerate() {
+            out.rows_mut(g * nk, nk).copy_from(r);
         }
         out
     }
@@ -178,8 +184,8 @@ impl<'a> Fields<'a> {
     /// (JᵀJ)[k, l] = Σ_g (R_gᵀR_g)[k, l] · d_k(g) d_l(g)ᵀ and (Jᵀr)[k] = Σ_g (R_gᵀ r_g)[k] d_k(g):
     /// k² small outer products per point instead of a dense product of J.
     ///
-    /// A first pass over the points (in grid order) computes every d_k(g), the residuals, the
-    /// cost and Jᵀr; then each block (k, l ≥ k) of JᵀJ is summed on its own ([`block`], in
+    /// A first pass over the points (in parallel, each point on its own) computes every d_k(g)
+    /// and the residuals, the cost and Jᵀr are summed over them in grid order; then each block (k, l ≥ k) of JᵀJ is summed on its own ([`block`], in
     /// parallel), every entry over the points in grid order, so the result does not depend on
     /// the number of threads.
     fn normal_equations(&self, theta: &DVector<f64>) -> (DMatrix<f64>, DVector<f64>, f64) {
@@ -193,52 +199,67 @@ impl<'a> Fields<'a> {
         // and the barrier gradients of the fields whose denominator is below Q_MIN at g.
         let mut dall = vec![0.0; ng * np];
         let mut w = vec![0.0; ng * nk * nk];
-        let mut barrier: Vec<(usize, usize, DVector<f64>)> = Vec::new();
-        let mut dfull: Vec<DVector<f64>> = self.models.iter().map(|m| DVector::zeros(m.n_full())).collect();
-        let mut c = DVector::zeros(nk);
-        for (g, s) in self.systems.iter().enumerate() {
-            for (k, m) in self.models.iter().enumerate() {
-                let nn = m.numerator.len();
-                let b = &self.basis[k][g];
-                let (p, q) = b.pq(&full[k]);
-                c[k] = m.offset + b.factor * p / q;
-                let f = b.factor / q;
-                let df = &mut dfull[k];
-                for (i, phi) in b.phi.iter().enumerate() {
-                    df[i] = f * phi;
-                }
-                for (i, psi) in b.psi.iter().enumerate() {
-                    df[nn + i] = -f * p / q * psi;
-                }
-                let (sk, nkf) = (self.starts[k], m.n_free());
-                let dk = &mut dall[g * np + sk..g * np + sk + nkf];
-                if self.identity[k] {
-                    dk.copy_from_slice(df.as_slice());
-                } else {
-                    dk.copy_from_slice(m.map().tr_mul(df).as_slice());
-                }
-                if q < Q_MIN {
-                    // Barrier residual Q_PENALTY·(Q_MIN − Q): ∂/∂den_i = −Q_PENALTY·ψ_i.
-                    let mut dq = DVector::zeros(m.n_full());
-                    for (i, psi) in b.psi.iter().enumerate() {
-                        dq[nn + i] = -Q_PENALTY * psi;
+        // Per point (in parallel, each writing its own rows of dall and w): d_k(g), the barrier
+        // terms (k, residual, gradient) of the fields below Q_MIN, r_g and R_gᵀ r_g.
+        type Pass = (Vec<(usize, f64, DVector<f64>)>, DVector<f64>, DVector<f64>);
+        let per_point: Vec<Pass> = dall
+            .par_chunks_mut(np)
+            .zip(w.par_chunks_mut(nk * nk))
+            .zip(self.systems.par_iter())
+            .enumerate()
+            .map(|(g, ((dg, wg), s))| {
+                let mut bars = Vec::new();
+                let mut c = DVector::zeros(nk);
+                for (k, m) in self.models.iter().enumerate() {
+                    let nn = m.numerator.len();
+                    let b = &self.basis[k][g];
+                    let (p, q) = b.pq(&full[k]);
+                    c[k] = m.offset + b.factor * p / q;
+                    let f = b.factor / q;
+                    let mut df = DVector::zeros(m.n_full());
+                    for (i, phi) in b.phi.iter().enumerate() {
+                        df[i] = f * phi;
                     }
-                    let dq = m.map().tr_mul(&dq);
-                    let rq = Q_PENALTY * (Q_MIN - q);
-                    cost += rq * rq;
-                    grad.rows_mut(sk, nkf).axpy(rq, &dq, 1.0);
-                    barrier.push((g, k, dq));
+                    for (i, psi) in b.psi.iter().enumerate() {
+                        df[nn + i] = -f * p / q * psi;
+                    }
+                    let (sk, nkf) = (self.starts[k], m.n_free());
+                    let dk = &mut dg[sk..sk + nkf];
+                    if self.identity[k] {
+                        dk.copy_from_slice(df.as_slice());
+                    } else {
+                        dk.copy_from_slice(m.map().tr_mul(&df).as_slice());
+                    }
+                    if q < Q_MIN {
+                        // Barrier residual Q_PENALTY·(Q_MIN − Q): ∂/∂den_i = −Q_PENALTY·ψ_i.
+                        let mut dq = DVector::zeros(m.n_full());
+                        for (i, psi) in b.psi.iter().enumerate() {
+                            dq[nn + i] = -Q_PENALTY * psi;
+                        }
+                        bars.push((k, Q_PENALTY * (Q_MIN - q), m.map().tr_mul(&dq)));
+                    }
                 }
+                let r = &s.r * &c - &s.z;
+                let v = s.r.tr_mul(&r);
+                wg.copy_from_slice(s.rtr.transpose().as_slice());
+                (bars, r, v)
+            })
+            .collect();
+        // The cost and Jᵀr summed over the points in grid order.
+        let mut barrier: Vec<(usize, usize, DVector<f64>)> = Vec::new();
+        for (g, (bars, r, v)) in per_point.into_iter().enumerate() {
+            for (k, rq, dq) in bars {
+                let (sk, nkf) = (self.starts[k], self.models[k].n_free());
+                cost += rq * rq;
+                grad.rows_mut(sk, nkf).axpy(rq, &dq, 1.0);
+                barrier.push((g, k, dq));
             }
-            let r = &s.r * &c - &s.z;
             cost += r.norm_squared();
-            let v = s.r.tr_mul(&r);
             for k in 0..nk {
                 let (sk, nkf) = (self.starts[k], self.models[k].n_free());
                 let dk = DVector::from_column_slice(&dall[g * np + sk..g * np + sk + nkf]);
                 grad.rows_mut(sk, nkf).axpy(v[k], &dk, 1.0);
             }
-            w[g * nk * nk..(g + 1) * nk * nk].copy_from_slice(s.rtr.transpose().as_slice());
         }
         let pairs: Vec<(usize, usize)> = (0..nk).flat_map(|k| (k..nk).map(move |l| (k, l))).collect();
         let blocks: Vec<Vec<f64>> = pairs
@@ -268,8 +289,8 @@ impl<'a> Fields<'a> {
         let full = self.full(theta);
         let mut pen = 0.0;
         for (k, bk) in self.basis.iter().enumerate() {
-            for b in bk {
-                let q = b.pq(&full[k]).1;
+            let qs: Vec<f64> = bk.par_iter().map(|b| b.pq(&full[k]).1).collect();
+            for q in qs {
                 if q < Q_MIN {
                     pen += (Q_PENALTY * (Q_MIN - q)).powi(2);
                 }
@@ -284,8 +305,49 @@ impl<'a> Fields<'a> {
 /// the point's own term). Every entry is accumulated over the points in grid order as
 /// (w·d_l[j])·d_k[i] + A[i, j], the operations of nalgebra's `ger` one point at a time, on a
 /// block small enough to stay in the first-level cache.
+///
+/// The same loops are also compiled for AVX2 and taken where the processor has it: the
+/// operations per entry and their order are the same (Rust does not contract a·b + c into a
+/// fused multiply-add), only more entries go through one instruction, so the bits are the same.
 #[allow(clippy::too_many_arguments)]
 fn block(
+    dall: &[f64],
+    np: usize,
+    w: &[f64],
+    nk: usize,
+    kl: (usize, usize),
+    rows: (usize, usize),
+    cols: (usize, usize),
+    barrier: &[(usize, &[f64])],
+) -> Vec<f64> {
+    #[cfg(target_arch = "x86_64")]
+    if std::is_x86_feature_detected!("avx2") {
+        // SAFETY: AVX2 is present (checked just above), the one requirement of `block_avx2`.
+        return unsafe { block_avx2(dall, np, w, nk, kl, rows, cols, barrier) };
+    }
+    block_loops(dall, np, w, nk, kl, rows, cols, barrier)
+}
+
+/// [`block_loops`] compiled with AVX2 enabled.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[allow(clippy::too_many_arguments)]
+unsafe fn block_avx2(
+    dall: &[f64],
+    np: usize,
+    w: &[f64],
+    nk: usize,
+    kl: (usize, usize),
+    rows: (usize, usize),
+    cols: (usize, usize),
+    barrier: &[(usize, &[f64])],
+) -> Vec<f64> {
+    block_loops(dall, np, w, nk, kl, rows, cols, barrier)
+}
+
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn block_loops(
     dall: &[f64],
     np: usize,
     w: &[f64],
@@ -372,20 +434,16 @@ pub struct FieldsFit {
 /// Errors of the fields at θ over all samples: (max abs, rms, per-sample residuals).
 fn sample_errors(fields: &Fields<'_>, theta: &DVector<f64>, data: &[PointData]) -> (f64, f64, Vec<DVector<f64>>) {
     let vals = fields.values(theta);
+    let res: Vec<DVector<f64>> =
+        data.par_iter().zip(vals.par_iter()).map(|(d, c)| &d.design * DVector::from_column_slice(c) - &d.y).collect();
     let (mut max, mut ss, mut n) = (0.0f64, 0.0, 0usize);
-    let res: Vec<DVector<f64>> = data
-        .iter()
-        .zip(&vals)
-        .map(|(d, c)| {
-            let e = &d.design * DVector::from_column_slice(c) - &d.y;
-            for v in e.iter() {
-                max = if v.is_nan() { f64::INFINITY } else { max.max(v.abs()) };
-                ss += v * v;
-            }
-            n += e.len();
-            e
-        })
-        .collect();
+    for e in &res {
+        for v in e.iter() {
+            max = if v.is_nan() { f64::INFINITY } else { max.max(v.abs()) };
+            ss += v * v;
+        }
+        n += e.len();
+    }
     (max, (ss / n.max(1) as f64).sqrt(), res)
 }
 
@@ -452,7 +510,9 @@ pub fn fit_fields(
         return Err(FitError::NoData { what: what.into() });
     }
     // Stage 1.
-    let stage1: Vec<Stage1> = data.iter().map(|d| stage1(&d.design, &d.y)).collect();
+    // Per-point work (stage 1, the reduced systems, residuals) runs in parallel and is
+    // collected in grid order; every sum over points stays sequential in that order.
+    let stage1: Vec<Stage1> = data.par_iter().map(|d| stage1(&d.design, &d.y)).collect();
     let (mut s1max, mut s1ss, mut s1n) = (0.0f64, 0.0, 0usize);
     for (d, s) in data.iter().zip(&stage1) {
         let e = &d.design * DVector::from_column_slice(&s.coefficients) - &d.y;
@@ -462,7 +522,7 @@ pub fn fit_fields(
     }
     // Starting fields: each fitted alone to the well-conditioned ĉ_k.
     let good: Vec<usize> = (0..x.len()).filter(|&g| stage1[g].condition < START_COND).collect();
-    let systems: Vec<Reduced> = data.iter().map(|d| reduce(&d.design, &d.y, None)).collect();
+    let systems: Vec<Reduced> = data.par_iter().map(|d| reduce(&d.design, &d.y, None)).collect();
     // Candidate starts per field: the linearised ones (polynomial, Loeb, Sanathanan–Koerner)
     // of the field fitted alone; every field takes the candidate of the same index (or its
     // last one), and the joint cost picks the set.
@@ -534,8 +594,8 @@ pub fn fit_fields(
             }
             w.iter_mut().flatten().for_each(|wi| *wi = (*wi / top).max(WEIGHT_FLOOR));
             fields.systems = data
-                .iter()
-                .zip(&w)
+                .par_iter()
+                .zip(w.par_iter())
                 .map(|(d, wg)| {
                     let s: Vec<f64> = wg.iter().map(|v| v.sqrt()).collect();
                     reduce(&d.design, &d.y, Some(&s))

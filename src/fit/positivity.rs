@@ -46,7 +46,8 @@ impl Iv {
     }
 
     /// xᵉ by repeated outward-rounded products (`powi` is not correctly rounded); even powers
-    /// are ≥ 0 whatever the interval.
+    /// are ≥ 0 whatever the interval. (The proof takes all powers at once by [`powers`].)
+    #[cfg(test)]
     fn powi(self, e: u32) -> Iv {
         let mut r = Iv(1.0, 1.0);
         for _ in 0..e {
@@ -69,15 +70,50 @@ pub enum Positivity {
     NotProven { lower: f64, region: Vec<(f64, f64)>, sample: f64 },
 }
 
-/// The range of a term from the ranges of its features' powers (`pows[i][e]` = feats[i]ᵉ by
-/// [`Iv::powi`], computed once per box).
-fn term_range(t: &crate::fit::model::Term, pows: &[Vec<Iv>]) -> Iv {
+/// x⁰ … xⁿ into `out` (n + 1 entries), each equal to [`Iv::powi`]'s: the running product of
+/// e factors (the same operations), with the clamp of even powers applied to the copy kept.
+fn powers(x: Iv, out: &mut [Iv]) {
+    let mut run = Iv(1.0, 1.0);
+    for (e, slot) in out.iter_mut().enumerate() {
+        if e > 0 {
+            run = run.mul(x);
+        }
+        let mut v = run;
+        if e % 2 == 0 {
+            v.0 = v.0.max(0.0);
+        }
+        *slot = v;
+    }
+}
+
+/// Per-proof buffers of [`bound`] (a proof visits up to 200 000 boxes).
+struct Scratch {
+    feats: Vec<Iv>,
+    /// Every feature's powers, flattened: feature i's e-th at `offs[i] + e`.
+    pows: Vec<Iv>,
+    offs: Vec<usize>,
+}
+
+impl Scratch {
+    fn new(max_exp: &[u32]) -> Self {
+        let mut offs = Vec::with_capacity(max_exp.len());
+        let mut n = 0;
+        for &top in max_exp {
+            offs.push(n);
+            n += top as usize + 1;
+        }
+        Scratch { feats: Vec::with_capacity(max_exp.len()), pows: vec![Iv(0.0, 0.0); n], offs }
+    }
+}
+
+/// The range of a term from the ranges of its features' powers (see [`Scratch::pows`]).
+fn term_range(t: &crate::fit::model::Term, sc: &Scratch) -> Iv {
     let mut term = Iv(0.0, 0.0);
     for m in &t.monomials {
         let mut v = Iv(1.0, 1.0);
-        for (e, p) in m.exps.iter().zip(pows) {
+        for (e, off) in m.exps.iter().zip(&sc.offs) {
             if *e > 0 {
-                v = v.mul(p[*e as usize]);
+                v = v.mul(sc.pows[off + *e as usize]);
             }
         }
         term = term.add(v);
@@ -88,22 +124,28 @@ fn term_range(t: &crate::fit::model::Term, pows: &[Vec<Iv>]) -> Iv {
 /// A lower bound of Q on `region`, rigorous in f64: interval arithmetic rounded outward, the
 /// derived features' ranges widened by two ulps each side (their cos, sin and affine maps are
 /// within an ulp or two of exact).
-fn bound(model: &RationalModel, c: &DVector<f64>, region: &[(f64, f64)], max_exp: &[u32]) -> f64 {
+fn bound(model: &RationalModel, c: &DVector<f64>, region: &[(f64, f64)], max_exp: &[u32], sc: &mut Scratch) -> f64 {
     let nn = model.numerator.len();
-    let mut feats: Vec<Iv> = region.iter().map(|&(a, b)| Iv(a, b)).collect();
-    feats.extend(model.derived.iter().map(|d| {
+    sc.feats.clear();
+    sc.feats.extend(region.iter().map(|&(a, b)| Iv(a, b)));
+    sc.feats.extend(model.derived.iter().map(|d| {
         let (a, b) = d.range(region);
         Iv(down(down(a)), up(up(b)))
     }));
-    let pows: Vec<Vec<Iv>> = feats.iter().zip(max_exp).map(|(f, &top)| (0..=top).map(|e| f.powi(e)).collect()).collect();
-    let mut q = model.lead.as_ref().map_or(Iv(1.0, 1.0), |t| term_range(t, &pows));
+    for (i, (f, &top)) in sc.feats.iter().zip(max_exp).enumerate() {
+        powers(*f, &mut sc.pows[sc.offs[i]..=sc.offs[i] + top as usize]);
+    }
+    let mut q = model.lead.as_ref().map_or(Iv(1.0, 1.0), |t| term_range(t, sc));
     for (j, t) in model.denominator.iter().enumerate() {
-        q = q.add(term_range(t, &pows).scale(c[nn + j]));
+        q = q.add(term_range(t, sc).scale(c[nn + j]));
     }
     q.0
 }
 
 /// Prove Q > 0 on the box `domain` (one (min, max) per feature).
+///
+/// Depth first, the lower half of a bisected box before the upper; the boxes live on one flat
+/// stack (`dim` (min, max) pairs each).
 pub fn prove_denominator_positive(
     model: &RationalModel,
     c: &DVector<f64>,
@@ -120,17 +162,34 @@ pub fn prove_denominator_positive(
             }
         }
     }
-    let mut stack = vec![domain.to_vec()];
+    let mut sc = Scratch::new(&max_exp);
+    let dim = domain.len();
+    if dim == 0 {
+        // A constant: one box, nothing to bisect.
+        let lo = bound(model, c, domain, &max_exp, &mut sc);
+        if lo > MIN_BOUND {
+            return Positivity::Proven { lower: lo, boxes: 1 };
+        }
+        return Positivity::NotProven { lower: lo, region: vec![], sample: model.denominator_at(c, &[]) };
+    }
+    let mut stack: Vec<(f64, f64)> = domain.to_vec();
+    let mut region: Vec<(f64, f64)> = vec![(0.0, 0.0); dim];
+    let mut centre = vec![0.0; dim];
     let mut boxes = 0;
     let mut lowest = f64::INFINITY;
-    while let Some(region) = stack.pop() {
+    while stack.len() >= dim {
+        let top = stack.len() - dim;
+        region.copy_from_slice(&stack[top..]);
+        stack.truncate(top);
         boxes += 1;
-        let lo = bound(model, c, &region, &max_exp);
+        let lo = bound(model, c, &region, &max_exp, &mut sc);
         if lo > MIN_BOUND {
             lowest = lowest.min(lo);
             continue;
         }
-        let centre: Vec<f64> = region.iter().map(|r| 0.5 * (r.0 + r.1)).collect();
+        for (x, r) in centre.iter_mut().zip(&region) {
+            *x = 0.5 * (r.0 + r.1);
+        }
         let sample = model.denominator_at(c, &centre);
         let widest = region
             .iter()
@@ -139,16 +198,15 @@ pub fn prove_denominator_positive(
             .map(|(i, _)| i)
             .unwrap_or(0);
         let w = region[widest].1 - region[widest].0;
-        if sample <= MIN_BOUND || boxes + stack.len() >= BUDGET || w < 1e-9 {
+        if sample <= MIN_BOUND || boxes + stack.len() / dim >= BUDGET || w < 1e-9 {
             return Positivity::NotProven { lower: lo, region, sample };
         }
         let mid = 0.5 * (region[widest].0 + region[widest].1);
-        let mut a = region.clone();
-        let mut b = region;
-        a[widest].1 = mid;
-        b[widest].0 = mid;
-        stack.push(b);
-        stack.push(a);
+        // Upper half pushed first, so the lower half is taken next.
+        stack.extend_from_slice(&region);
+        stack[top + widest].0 = mid;
+        stack.extend_from_slice(&region);
+        stack[top + dim + widest].1 = mid;
     }
     Positivity::Proven { lower: lowest, boxes }
 }
@@ -168,6 +226,19 @@ mod tests {
         match p {
             Positivity::Proven { lower, .. } => Some(*lower),
             Positivity::NotProven { .. } => None,
+        }
+    }
+
+    #[test]
+    fn powers_equal_powi() {
+        // The same products in the same order: bit for bit, also across zero and with ∞ ends.
+        for x in [Iv(-0.3, 0.7), Iv(0.2, 1.9), Iv(-2.5, -0.1), Iv(-1.0, f64::INFINITY), Iv(0.0, 0.0)] {
+            let mut out = [Iv(0.0, 0.0); 8];
+            powers(x, &mut out);
+            for (e, v) in out.iter().enumerate() {
+                let r = x.powi(e as u32);
+                assert!(v.0.to_bits() == r.0.to_bits() && v.1.to_bits() == r.1.to_bits(), "{x:?}^{e}: {v:?} vs {r:?}");
+            }
         }
     }
 

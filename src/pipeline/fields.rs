@@ -214,18 +214,22 @@ pub fn committed(spec: &Spec, root: &std::path::Path) -> Result<(Vec<DVector<f64
 
 pub fn build(spec: &Spec, mode: Mode, root: &std::path::Path) -> Result<Built, BuildError> {
     // Fit mode keeps the fitting samples for the f32 rounding report; committed mode carries that
-    // report over from the committed JSON (it does not sample the fitting grid).
-    let (coefficients, report, rounding) = match mode {
+    // report over from the committed JSON (it does not sample the fitting grid). The verification
+    // grid is sampled beside the fit (independent work: idle threads of the fit's sequential
+    // steps take it up).
+    let (fitted, reference) = match mode {
         Mode::Fit => {
-            let (c, r, g) = fit_on_grid(spec)?;
-            (c, Some(r), Rounding::Measure(g))
+            let (f, r) = rayon::join(|| fit_on_grid(spec), || FieldsReference::of_spec(spec));
+            let (c, report, g) = f?;
+            ((c, Some(report), Rounding::Measure(g)), r)
         }
         Mode::Committed => {
             let (c, v) = committed(spec, root)?;
-            (c, v.get("fit").cloned(), Rounding::Committed(v["f32_rounding"].clone()))
+            ((c, v.get("fit").cloned(), Rounding::Committed(v["f32_rounding"].clone())), FieldsReference::of_spec(spec))
         }
     };
-    fields_from_coefficients(spec, &coefficients, report, Some(rounding), &FieldsReference::of_spec(spec), Denominators::Proven)
+    let (coefficients, report, rounding) = fitted;
+    fields_from_coefficients(spec, &coefficients, report, Some(rounding), &reference, Denominators::Proven)
 }
 
 /// The `f32_rounding` report of a fields build: measured on the fitting samples, or committed.
