@@ -1,0 +1,2 @@
+use crate::bench::FamilyBench;
+pub const BENCH: FamilyBench = FamilyBench::NONE;
