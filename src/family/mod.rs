@@ -8,6 +8,7 @@
 //! and the build orchestration (`src/build.rs`) and the CLI fill them from this registry. Adding
 //! a family is one folder and one line in [`FAMILIES`] (see ARCHITECTURE.md).
 
+pub mod fiber;
 pub mod fuzz;
 pub mod ggx;
 pub mod gloss;
@@ -72,7 +73,7 @@ pub struct Family {
 }
 
 /// Every family, in the order `eval --help`, `validate` and `plot` list them.
-pub static FAMILIES: &[&Family] = &[&gloss::FAMILY, &fuzz::FAMILY, &skin::FAMILY, &ggx::FAMILY];
+pub static FAMILIES: &[&Family] = &[&gloss::FAMILY, &fuzz::FAMILY, &skin::FAMILY, &ggx::FAMILY, &fiber::FAMILY];
 
 pub fn families() -> &'static [&'static Family] {
     FAMILIES

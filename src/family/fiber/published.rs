@@ -1,0 +1,108 @@
+//! The course's "approximate and conservative" r(k), measured. The seed text prints no formula
+//! for it (the slide names r(k) and says it loses energy), so the conservative r(k) here is the
+//! one the words define: the largest r(k) with r(k)·N(k, u·t) ≤ 1 for every light, r_c(k) =
+//! 1/N(k, 1) (N grows with |u·t|; `integrals` tests it), in closed form. Over (k, u·t) it loses
+//! 1 − N(k, u·t)/N(k, 1) of the energy; uniform u·t ∈ [0, 1] is the average over lights uniform
+//! on the sphere (u·t of a uniform direction is uniform on [−1, 1], and N is even).
+
+use super::integrals::{conservative_r, mean, mean_parallel, one_minus_k2};
+use crate::validate::Item;
+use std::path::Path;
+
+/// Integrator tolerance of the measurements (absolute on M ∈ [0.3, 1]).
+const TOL: f64 = 1e-12;
+/// The measuring grid: k uniform on [−0.99, 0], u·t uniform on [0, 1].
+const NK: usize = 100;
+const NC: usize = 65;
+
+fn grid() -> Vec<Vec<f64>> {
+    let ks = (0..NK).map(|i| -0.99 + 0.99 * i as f64 / (NK - 1) as f64);
+    ks.flat_map(|k| (0..NC).map(move |j| vec![k, j as f64 / (NC - 1) as f64])).collect()
+}
+
+pub fn items(generated: &Path) -> Vec<Item> {
+    let pts = grid();
+    let m: Vec<f64> = pts.iter().map(|p| mean(p[0], p[1], TOL).value).collect();
+    let domain = format!("k ∈ [−0.99, 0] ({NK} uniform), |u·t| ∈ [0, 1] ({NC} uniform)");
+    let source = "Ghost of Tsushima, 'Anisotropic Fuzz | Phase Function': r(k), 'approximate and conservative' (no formula printed)";
+
+    // (1) The energy r_c(k)·N(k, u·t), against 1.
+    let ones = vec![1.0; pts.len()];
+    let energy: Vec<f64> = pts.iter().zip(&m).map(|(p, m)| conservative_r(p[0]) * one_minus_k2(p[0]) * m).collect();
+    let mut item = Item::measured("fiber energy with the conservative r(k) = 1/N(k, 1)", source, &domain, &pts, &ones, &energy);
+    let loss: Vec<f64> = energy.iter().map(|e| 1.0 - e).collect();
+    let mean_loss = loss.iter().sum::<f64>() / loss.len() as f64;
+    let gain = energy.iter().fold(f64::NEG_INFINITY, |a, &e| a.max(e)) - 1.0;
+    let at = |k: f64| -> (f64, f64) {
+        let lo = 1.0 - mean(k, 0.0, TOL).value / mean_parallel(k);
+        // The average over u·t ∈ [0, 1] at this k, by the trapezoid rule on the 65 points.
+        let row: Vec<f64> = (0..NC).map(|j| 1.0 - mean(k, j as f64 / (NC - 1) as f64, TOL).value / mean_parallel(k)).collect();
+        let avg = (row.iter().sum::<f64>() - 0.5 * (row[0] + row[NC - 1])) / (NC - 1) as f64;
+        (lo, avg)
+    };
+    let (lo99, avg99) = at(-0.99);
+    let (lo50, avg50) = at(-0.5);
+    item.extra.push(("max_energy_loss".into(), item.max_abs_error));
+    item.extra.push(("mean_energy_loss".into(), mean_loss));
+    item.extra.push(("max_energy_gain".into(), gain));
+    item.findings = vec![
+        "No formula for r(k) is legible in the course text; r_c(k) = 1/N(k, 1) is the conservative one (never above 1), \
+         in closed form: r_c = m²/(2 (1 − k²) (ln(1 + m) − m/(1 + m))), m = −k."
+            .into(),
+        format!(
+            "r_c(k) runs from 1 (k = 0) to {:.2} (k = −0.99, spread 0); the exact r = 1/N there spans [{:.2}, {:.2}] over u·t.",
+            conservative_r(-0.99),
+            conservative_r(-0.99),
+            1.0 / (one_minus_k2(-0.99) * mean(-0.99, 0.0, TOL).value)
+        ),
+        format!(
+            "Energy lost: max {:.2}% (k = −0.99, u ⟂ t), mean {:.2}% over the grid; at k = −0.99 the average over lights is {:.2}% \
+             (u ⟂ t: {:.2}%), at k = −0.5 {:.2}% ({:.2}%); none gained (max r_c·N − 1 = {gain:.1e}).",
+            100.0 * item.max_abs_error,
+            100.0 * mean_loss,
+            100.0 * avg99,
+            100.0 * lo99,
+            100.0 * avg50,
+            100.0 * lo50
+        ),
+    ];
+    let out1 = item;
+
+    // (2) The shader factor W = (1 − k²) r: the conservative W_c(k) = 1/M(k, 1) and the refit.
+    let w: Vec<f64> = m.iter().map(|m| 1.0 / m).collect();
+    let wc: Vec<f64> = pts.iter().map(|p| 1.0 / mean_parallel(p[0])).collect();
+    let mut item = Item::measured(
+        "fiber_phase_scale (conservative (1 − k²) r_c(k))",
+        source,
+        &format!("{domain}; W = (1 − k²)/N ∈ [1, 3.28], its relative error is the energy error"),
+        &pts,
+        &w,
+        &wc,
+    );
+    if let Some(refit) = item.add_refit(generated, "fiber_phase_scale", crate::family::catalog(), &pts, &w) {
+        let rel = refit.iter().zip(&w).map(|(a, t)| (a / t - 1.0).abs()).fold(0.0, f64::max);
+        item.extra.push(("refit_max_energy_error".into(), rel));
+        item.findings.push(format!("The refit's energy error |W̃/W − 1|: max {rel:.2e} (a rational in k and |u·t|, one division)."));
+    }
+    vec![out1, item]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn conservative_r_never_gains_and_is_exact_at_parallel_light_and_k_zero() {
+        // r_c·N ≤ 1 everywhere (N(k, c) ≤ N(k, 1)); = 1 at c = 1 and at k = 0. Bound: the
+        // integrator's 1e-12 on M (≥ 0.3) relative, plus ulps.
+        let items = items(Path::new("/nonexistent"));
+        let gain = items[0].extra.iter().find(|e| e.0 == "max_energy_gain").unwrap().1;
+        assert!(gain <= 4e-12, "{gain:e}");
+        for p in grid().iter().filter(|p| p[1] == 1.0 || p[0] == 0.0) {
+            let e = conservative_r(p[0]) * one_minus_k2(p[0]) * mean(p[0], p[1], TOL).value;
+            assert!((e - 1.0).abs() <= 4e-12, "{p:?}: {e}");
+        }
+        // The largest loss is at spread 0 and u ⟂ t.
+        assert_eq!(items[0].worst_point, vec![-0.99, 0.0]);
+    }
+}
