@@ -583,15 +583,21 @@ impl Spec {
             _ => file.axis.len(),
         };
         if let Some(args) = &file.emit.args
-            && (args.len() != n_args || args.iter().any(|a| names::check_identifier(a).is_some()))
+            && (args.len() != n_args || args.iter().any(|a| names::check_argument(a).is_some()))
         {
-            let why = args.iter().find_map(|a| names::check_identifier(a)).unwrap_or_else(|| format!("{} given", args.len()));
+            let why = args.iter().find_map(|a| names::check_argument(a)).unwrap_or_else(|| format!("{} given", args.len()));
             return Err(at("args", format!("needs {n_args} distinct identifiers, one per (outer) axis ({why})")));
         }
         if let Some(args) = &file.emit.args
             && let Some(dup) = args.iter().enumerate().find(|(i, a)| args[..*i].contains(a)).map(|(_, a)| a)
         {
             return Err(at("args", format!("'{dup}' is given twice")));
+        }
+        // Without `args`, the axis names are the arguments.
+        if file.emit.args.is_none()
+            && let Some((a, why)) = file.axis.iter().take(n_args).find_map(|a| names::check_argument(&a.name).map(|w| (a, w)))
+        {
+            return Err(at("args", format!("the axis '{}' would name an argument: {why}; give [emit] args", a.name)));
         }
         if let Some(b) = file.max_error
             && !(b > 0.0 && b.is_finite())

@@ -66,6 +66,25 @@ pub fn check_identifier(s: &str) -> Option<String> {
     None
 }
 
+/// Locals of the emitted function bodies (clamped inputs x0…, table coordinates t0…, i0…,
+/// f0…, evaluator arguments a0…, the table index k, the bilinear rows a, b, the field values c):
+/// an argument of the same name would be shadowed or redeclared.
+fn emitted_local(s: &str) -> bool {
+    matches!(s, "k" | "a" | "b" | "c")
+        || (s.len() > 1 && matches!(&s[..1], "x" | "t" | "i" | "f" | "a") && s[1..].chars().all(|c| c.is_ascii_digit()))
+}
+
+/// Why `s` cannot name an argument of an emitted function (`None`: it can).
+pub fn check_argument(s: &str) -> Option<String> {
+    if let Some(why) = check_identifier(s) {
+        return Some(why);
+    }
+    if emitted_local(s) {
+        return Some(format!("'{s}' is a local of the emitted function bodies (reserved: k, a, b, c, x0…, t0…, i0…, f0…, a0…)"));
+    }
+    None
+}
+
 /// Why `s` cannot name a spec (its runtime module and files), `None` when it can.
 pub fn check_spec_name(s: &str) -> Option<String> {
     if let Some(why) = check_identifier(s) {
@@ -91,6 +110,12 @@ mod tests {
         }
         for bad in ["lib", "emitted", "runtime", "scene_velvet_horse", "fn"] {
             assert!(check_spec_name(bad).is_some(), "{bad}");
+        }
+        for bad in ["k", "a", "b", "c", "x0", "t1", "i12", "f0", "a3", "fn"] {
+            assert!(check_argument(bad).is_some(), "{bad}");
+        }
+        for good in ["x", "t", "f", "k2x", "x0a", "alpha", "n_dot_v", "schlick_k"] {
+            assert_eq!(check_argument(good), None, "{good}");
         }
         for good in ["gloss_length", "x", "_x", "n_dot_v", "alpha2", "scene"] {
             assert_eq!(check_identifier(good), None, "{good}");
