@@ -11,6 +11,7 @@
 pub mod fuzz;
 pub mod ggx;
 pub mod gloss;
+pub mod sggx;
 pub mod skin;
 
 use crate::bench::FamilyBench;
@@ -72,7 +73,7 @@ pub struct Family {
 }
 
 /// Every family, in the order `eval --help`, `validate` and `plot` list them.
-pub static FAMILIES: &[&Family] = &[&gloss::FAMILY, &fuzz::FAMILY, &skin::FAMILY, &ggx::FAMILY];
+pub static FAMILIES: &[&Family] = &[&gloss::FAMILY, &fuzz::FAMILY, &skin::FAMILY, &ggx::FAMILY, &sggx::FAMILY];
 
 pub fn families() -> &'static [&'static Family] {
     FAMILIES
