@@ -211,7 +211,7 @@ impl Decoded {
     }
 }
 
-/// `DecodeSggx` in f64, line for line: eigenvalues of the 2×2 matrix clamped to [α_min², 1]
+/// `DecodeSggx` in f64, line for line (`Sign` read as ±1, see the body): eigenvalues of the 2×2 matrix clamped to [α_min², 1]
 /// (guarding the indefinite matrices that filtering the encoded channels produces), the
 /// rotation from the half-angle identity cos²ψ = ½((Sxx − Syy)/discr + 1).
 pub fn decode_course(t: [f64; 3], alpha_min: f64) -> Decoded {
@@ -222,7 +222,10 @@ pub fn decode_course(t: [f64; 3], alpha_min: f64) -> Decoded {
     let alpha_t_sqr = (0.5 * (a.sxx + a.syy + discr)).clamp(0.0, 1.0).max(floor);
     let alpha_b_sqr = (0.5 * (a.sxx + a.syy - discr)).clamp(0.0, 1.0).max(floor);
     let c_sqr = (0.5 * ((a.sxx - a.syy) * discr_rcp + 1.0)).clamp(0.0, 1.0);
-    let sign = if a.sxy > 0.0 { 1.0 } else if a.sxy < 0.0 { -1.0 } else { 0.0 };
+    // The listing's `Sign` must not return 0: at Sxy = 0 with Sxx < Syy (an axis-aligned lobe
+    // rougher along b_n, or the texture unit's halfway mix of ±ρ) cos ψ = 0, and HLSL's sign(0) = 0
+    // would make the sine 0 too, collapsing the frame. Sign(x) = x < 0 ? −1 : 1 here.
+    let sign = if a.sxy < 0.0 { -1.0 } else { 1.0 };
     Decoded {
         alpha_t_sqr,
         alpha_b_sqr,
@@ -419,9 +422,11 @@ impl Ndf for Lean {
 /// mixture's second moment ∫ m mᵀ D(m) dm (numerically, on `rule`), and the eigenvalue on each
 /// axis ωₖ is the squared projected area σ(ωₖ)² of the mixture (exact: Σ wᵢ √(ωₖᵀSᵢωₖ)).
 pub fn estimate(mix: &Mixture, rule: &SphereRule) -> M3 {
+    use rayon::prelude::*;
+    let d: Vec<f64> = rule.points.par_iter().map(|(m, _)| mix.d(m)).collect();
     let mut c = M3::zeros();
-    for (m, w) in &rule.points {
-        c += m * m.transpose() * (w * mix.d(m));
+    for ((m, w), d) in rule.points.iter().zip(&d) {
+        c += m * m.transpose() * (w * d);
     }
     let eig = nalgebra::SymmetricEigen::new(c);
     let mut s = M3::zeros();
@@ -433,15 +438,51 @@ pub fn estimate(mix: &Mixture, rule: &SphereRule) -> M3 {
     s
 }
 
-/// Total-variation distance ½∫|p − q| between the NDFs normalised to unit mass on the sphere
-/// (0: same shape, 1: disjoint), and the masses ∫D of each.
-pub fn distance(a: &dyn Ndf, b: &dyn Ndf, rule: &SphereRule) -> (f64, f64, f64) {
-    let da: Vec<f64> = rule.points.iter().map(|(m, _)| a.d(m)).collect();
-    let db: Vec<f64> = rule.points.iter().map(|(m, _)| b.d(m)).collect();
+/// How far apart two NDFs are, as normalised distributions p = D/∫D on the sphere.
+#[derive(Debug, Clone, Copy)]
+pub struct Distance {
+    /// Total variation ½∫|p − q| (0: same shape, 1: disjoint).
+    pub tv: f64,
+    /// √∫(p − q)².
+    pub l2: f64,
+    /// max |p − q| on the rule's nodes, and where (θ, φ).
+    pub max: f64,
+    pub worst: (f64, f64),
+    /// ∫D of each.
+    pub mass: (f64, f64),
+}
+
+/// [`Distance`] of `a` and `b` on `rule` (values in parallel, sums in node order).
+pub fn distance(a: &dyn Ndf, b: &dyn Ndf, rule: &SphereRule) -> Distance {
+    use rayon::prelude::*;
+    let da: Vec<f64> = rule.points.par_iter().map(|(m, _)| a.d(m)).collect();
+    let db: Vec<f64> = rule.points.par_iter().map(|(m, _)| b.d(m)).collect();
     let ma: f64 = rule.points.iter().zip(&da).map(|((_, w), d)| w * d).sum();
     let mb: f64 = rule.points.iter().zip(&db).map(|((_, w), d)| w * d).sum();
-    let tv = 0.5 * rule.points.iter().zip(da.iter().zip(&db)).map(|((_, w), (x, y))| w * (x / ma - y / mb).abs()).sum::<f64>();
-    (tv, ma, mb)
+    let (mut tv, mut l2, mut max, mut worst) = (0.0, 0.0, 0.0, (0.0, 0.0));
+    for ((m, w), (x, y)) in rule.points.iter().zip(da.iter().zip(&db)) {
+        let e = (x / ma - y / mb).abs();
+        tv += w * e;
+        l2 += w * e * e;
+        if e > max {
+            max = e;
+            worst = (m.z.clamp(-1.0, 1.0).acos(), m.y.atan2(m.x));
+        }
+    }
+    Distance { tv: 0.5 * tv, l2: l2.sqrt(), max, worst, mass: (ma, mb) }
+}
+
+/// A deterministic stream in [0, 1) (xorshift64*), for seeded random cases.
+#[derive(Debug, Clone)]
+pub struct Rng(pub u64);
+
+impl Rng {
+    pub fn next(&mut self) -> f64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        (self.0.wrapping_mul(0x2545F4914F6CDD1D) >> 11) as f64 / (1u64 << 53) as f64
+    }
 }
 
 #[cfg(test)]
@@ -450,17 +491,6 @@ mod tests {
 
     fn texel(theta: f64, phi: f64, at: f64, ab: f64, psi: f64) -> (V3, Aniso) {
         (direction(theta, phi), Aniso::from_alphas(at, ab, psi))
-    }
-
-    /// A deterministic stream in [0, 1) (xorshift64*), for seeded random cases.
-    pub(crate) struct Rng(pub u64);
-    impl Rng {
-        pub fn next(&mut self) -> f64 {
-            self.0 ^= self.0 >> 12;
-            self.0 ^= self.0 << 25;
-            self.0 ^= self.0 >> 27;
-            (self.0.wrapping_mul(0x2545F4914F6CDD1D) >> 11) as f64 / (1u64 << 53) as f64
-        }
     }
 
     #[test]
@@ -633,6 +663,16 @@ mod tests {
         let d = decode_course(mix, ALPHA_MIN);
         assert_eq!(d.alpha_b_sqr, ALPHA_MIN * ALPHA_MIN);
         assert!((d.alpha_t_sqr - 0.5).abs() < 1e-15 && d.alpha_tb > 0.0);
+    }
+
+    #[test]
+    fn decoder_keeps_the_frame_of_axis_aligned_lobes_rougher_along_b() {
+        // Sxy = 0 exactly, Sxx < Syy (α 0.25 along t_n, 0.5 along b_n): cos ψ = 0, so sin ψ must
+        // be ±1 (HLSL's sign(0) = 0 would give a zero tangent). Exact: the channels 0.25, 0.5,
+        // 0.5 and every operation on them are exact in binary.
+        let d = decode_course(encode(Aniso { sxx: 0.0625, sxy: 0.0, syy: 0.25 }), ALPHA_MIN);
+        assert_eq!((d.cos, d.sin.abs()), (0.0, 1.0));
+        assert_eq!((d.alpha_t_sqr, d.alpha_b_sqr), (0.25, 0.0625));
     }
 
     #[test]
