@@ -5,6 +5,7 @@
 //! estimation and LEAN mapping to true mixtures (see `integrals.rs`).
 
 pub mod integrals;
+pub mod plot;
 pub mod published;
 
 use super::Family;
@@ -139,7 +140,7 @@ pub static FAMILY: Family = Family {
     spec_kinds: &[],
     eval_options: None,
     validate: published::items,
-    figures: |_, _| Ok(vec![]),
+    figures: plot::figures,
     bench: FamilyBench::NONE,
     scene_features: &[],
 };
