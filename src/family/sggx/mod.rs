@@ -4,6 +4,7 @@
 //! decoded by the course's `DecodeSggx`; the NDF distances of linear filtering, SGGX parameter
 //! estimation and LEAN mapping to true mixtures (see `integrals.rs`).
 
+pub mod emit;
 pub mod integrals;
 pub mod plot;
 pub mod published;
@@ -137,7 +138,7 @@ pub static FAMILY: Family = Family {
     name: "sggx",
     doc: "Ghost of Tsushima SGGX filtering and storage of anisotropic GGX roughness",
     quantities: QUANTITIES,
-    spec_kinds: &[],
+    spec_kinds: &[emit::DECODE],
     eval_options: None,
     validate: published::items,
     figures: plot::figures,
