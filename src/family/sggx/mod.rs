@@ -6,6 +6,7 @@
 
 pub mod emit;
 pub mod integrals;
+pub mod mip;
 pub mod plot;
 pub mod published;
 
@@ -144,4 +145,5 @@ pub static FAMILY: Family = Family {
     figures: plot::figures,
     bench: FamilyBench::NONE,
     scene_features: &[],
+    commands: &[mip::COMMAND],
 };
