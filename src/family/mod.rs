@@ -169,9 +169,16 @@ pub(crate) mod tests {
         ROWS.get_or_init(|| FAMILIES.iter().map(|f| (f.name, testing::quick(f.bench.forms, catalog()))).collect())[family].as_slice()
     }
 
+    /// Families that benchmark no shader form yet, with the reason (each must say why).
+    const NO_FORMS: &[(&str, &str)] = &[("sggx", "emits exact formulas (the course's decoder and D): no approximations to rank yet")];
+
     #[test]
     fn every_family_s_forms_are_sorted_by_cost_with_a_front_and_tables_converge() {
         for f in FAMILIES {
+            if NO_FORMS.iter().any(|(n, _)| *n == f.name) {
+                assert!(f.bench.forms.is_empty(), "{} has forms now: take it off NO_FORMS", f.name);
+                continue;
+            }
             let quantities: Vec<&str> = f.bench.forms.iter().map(|s| s.quantity).collect();
             assert!(!quantities.is_empty(), "{} benchmarks no shader form", f.name);
             let rows = quick_forms(f.name);
