@@ -4,6 +4,7 @@
 //! decoded by the course's `DecodeSggx`; the NDF distances of linear filtering, SGGX parameter
 //! estimation and LEAN mapping to true mixtures (see `integrals.rs`).
 
+pub mod bench;
 pub mod emit;
 pub mod integrals;
 pub mod mip;
@@ -11,7 +12,6 @@ pub mod plot;
 pub mod published;
 
 use super::Family;
-use crate::bench::FamilyBench;
 use crate::integrate::{Estimate, Tolerance, adaptive};
 use crate::quantity::{ParamSpec, QuantityDef};
 use integrals::{Aniso, Lobe, direction, extract, filter, rotation_to, sggx_from};
@@ -143,7 +143,7 @@ pub static FAMILY: Family = Family {
     eval_options: None,
     validate: published::items,
     figures: plot::figures,
-    bench: FamilyBench::NONE,
+    bench: bench::BENCH,
     scene_features: &[],
     commands: &[mip::COMMAND],
 };
