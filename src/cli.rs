@@ -362,6 +362,20 @@ pub fn validate(paths: &Paths, as_json: bool) -> Result<()> {
 }
 
 /// Figures (PNG and SVG) of every family with committed outputs.
+/// A family's own subcommand (`args[0]` is its name); its bad input is exit 2.
+pub fn family_command(args: &[String]) -> Result<()> {
+    let name = args.first().map(String::as_str).unwrap_or("");
+    let c = family::command(name).ok_or_else(|| input_err(format!("unknown command '{name}'\n{}", family::commands_help())))?;
+    match (c.run)(&args[1..]) {
+        Ok(out) => {
+            println!("{out}");
+            Ok(())
+        }
+        Err(family::CommandError::Input(m)) => Err(input_err(m)),
+        Err(family::CommandError::Failed(m)) => Err(anyhow::anyhow!(m)),
+    }
+}
+
 pub fn plot(paths: &Paths, out: &Path) -> Result<()> {
     let mut files = Vec::new();
     for f in family::families() {

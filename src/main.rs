@@ -8,7 +8,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 #[derive(Parser)]
-#[command(name = "shadefit", version, about = "Integrate, fit, verify and emit shading-model approximations")]
+#[command(name = "shadefit", version, about = "Integrate, fit, verify and emit shading-model approximations", after_help = shadefit::family::commands_help())]
 struct Cli {
     /// Folder of fit specs.
     #[arg(long, global = true, default_value = "fits")]
@@ -22,6 +22,9 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
+    /// A family's own command (listed below).
+    #[command(external_subcommand)]
+    Family(Vec<String>),
     /// Tables and fits known from the specs, with whether generated/ is up to date.
     List,
     /// Evaluate an integral (not a fit) at one point: QUANTITY name=value ...
@@ -141,6 +144,7 @@ fn main() -> ExitCode {
     let paths = Paths { fits: cli.fits, generated: cli.generated };
     let result = match cli.command {
         Command::List => cli::list(&paths),
+        Command::Family(args) => cli::family_command(&args),
         Command::Eval { quantity, params, json, profile: None, kernel: None } => cli::eval(&quantity, &params, json),
         Command::Eval { quantity, params, json, profile, kernel } => {
             cli::eval_with_options(&quantity, &params, json, profile.as_deref(), kernel.as_deref())

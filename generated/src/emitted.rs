@@ -61,6 +61,9 @@ pub mod gloss_length;
 #[cfg(feature = "gloss")]
 #[path = "gloss_table.rs"]
 pub mod gloss_table;
+#[cfg(feature = "sggx")]
+#[path = "sggx_decode.rs"]
+pub mod sggx_decode;
 #[cfg(feature = "skin")]
 #[path = "skin_punctual_lut.rs"]
 pub mod skin_punctual_lut;
@@ -122,6 +125,8 @@ pub mod wgsl {
     pub const GLOSS_LENGTH: &str = include_str!("../wgsl/gloss_length.wgsl");
     #[cfg(feature = "gloss")]
     pub const GLOSS_TABLE: &str = include_str!("../wgsl/gloss_table.wgsl");
+    #[cfg(feature = "sggx")]
+    pub const SGGX_DECODE: &str = include_str!("../wgsl/sggx_decode.wgsl");
     #[cfg(feature = "skin")]
     pub const SKIN_PUNCTUAL_LUT: &str = include_str!("../wgsl/skin_punctual_lut.wgsl");
     #[cfg(feature = "skin")]
@@ -178,6 +183,8 @@ pub mod wgsl {
             "gloss_length" => Some(GLOSS_LENGTH),
             #[cfg(feature = "gloss")]
             "gloss_table" => Some(GLOSS_TABLE),
+            #[cfg(feature = "sggx")]
+            "sggx_decode" => Some(SGGX_DECODE),
             #[cfg(feature = "skin")]
             "skin_punctual_lut" => Some(SKIN_PUNCTUAL_LUT),
             #[cfg(feature = "skin")]
@@ -236,6 +243,8 @@ pub mod wgsl {
         "gloss_length",
         #[cfg(feature = "gloss")]
         "gloss_table",
+        #[cfg(feature = "sggx")]
+        "sggx_decode",
         #[cfg(feature = "skin")]
         "skin_punctual_lut",
         #[cfg(feature = "skin")]

@@ -59,6 +59,9 @@ mod grid;
 #[cfg(feature = "fuzz")]
 #[path = "support/fuzz_ps.rs"]
 mod fuzz_ps;
+#[cfg(feature = "sggx")]
+#[path = "support/sggx.rs"]
+mod sggx;
 
 use shadefit_runtime::lut::{self, LutTexture};
 use shadefit_runtime::{EmittedFunction, FUNCTIONS, compose, gpu};
@@ -395,5 +398,30 @@ fn fuzz_ps_pair_equals_its_cpu_version_on_the_gpu() {
         let st = check_points(&program, h, case.arity, case.outputs, &case.points, &out, &cpu, &show, "const");
         let n = case.points.len() / case.arity;
         report(&format!("gpu {:<30} {n:>7} points x {}: {st} [{secs:.1} s]", case.name, case.outputs));
+    }
+}
+
+/// The SGGX decoder (one wrapper per decoded field) and D of a decoded texel, through the scalar
+/// wrappers of tests/support/sggx.rs, against the same bound.
+#[cfg(feature = "sggx")]
+#[test]
+fn sggx_decoder_and_ndf_equal_their_cpu_versions_on_the_gpu() {
+    let Some(gpu) = device("shadefit-runtime gpu test (sggx_decode)") else { return };
+    let runner = Runner { gpu };
+    let library = compose(&["sggx_decode"]).unwrap() + sggx::WRAPPERS;
+    let program = bound::Program::new(&library);
+    let mut cases: Vec<(&str, usize, Vec<u32>)> = sggx::FIELDS.iter().map(|f| (f.0, 3, sggx::decode_points())).collect();
+    cases.push(("t_d", 6, sggx::d_points()));
+    for (name, arity, points) in cases {
+        let shader = library.clone() + &entry_point(name, arity, 1);
+        let out = runner.run(name, &shader, arity, 1, &points, Extra::None);
+        let h = program.function(name);
+        let cpu = |p: &[u32]| {
+            let a: Vec<f32> = p.iter().map(|&b| f32::from_bits(b)).collect();
+            vec![if name == "t_d" { sggx::cpu_d(&a) } else { sggx::cpu_field(name, &a) }]
+        };
+        let show = |p: &[u32]| format!("{name}{:?}", p.iter().map(|&b| f32::from_bits(b)).collect::<Vec<_>>());
+        let st = check_points(&program, h, arity, 1, &points, &out, &cpu, &show, "const");
+        report(&format!("gpu {name:<30} {:>7} points: {st}", points.len() / arity));
     }
 }

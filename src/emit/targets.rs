@@ -182,6 +182,8 @@ fn wgsl_type(m: &naga::Module, ty: naga::Handle<naga::Type>) -> Option<String> {
             format!("texture_{d}{}<f32>", if *arrayed { "_array" } else { "" })
         }
         TypeInner::Sampler { comparison } => (if *comparison { "sampler_comparison" } else { "sampler" }).to_string(),
+        // A named struct of the module (its zero value `Name()` is a valid argument).
+        TypeInner::Struct { .. } => m.types[ty].name.clone()?,
         _ => return None,
     })
 }

@@ -228,6 +228,109 @@ pub fn ktx2_texels(
     out
 }
 
+/// `VkFormat` of a UNORM texture of `channels` (2: RG, 4: RGBA) and `bits` (8, 16) per channel:
+/// R8G8_UNORM (16), R8G8B8A8_UNORM (37), R16G16_UNORM (77), R16G16B16A16_UNORM (91).
+pub fn vk_format_unorm(channels: usize, bits: u32) -> u32 {
+    match (channels, bits) {
+        (2, 8) => 16,
+        (4, 8) => 37,
+        (2, 16) => 77,
+        (4, 16) => 91,
+        _ => panic!("UNORM KTX2 textures have 2 or 4 channels of 8 or 16 bits, not {channels} × {bits}"),
+    }
+}
+
+/// The data format descriptor of a UNORM texture: samples without qualifiers, sampleLower 0 and
+/// sampleUpper 2^bits − 1 (KDF 1.3 §5, integer samples).
+fn data_format_descriptor_unorm(channels: usize, bits: u32) -> Vec<u8> {
+    let ids = channel_ids(channels);
+    let samples = ids.len() as u32;
+    let block_size = 24 + 16 * samples;
+    let mut d = Vec::with_capacity(4 + block_size as usize);
+    put_u32(&mut d, 4 + block_size);
+    put_u32(&mut d, 0);
+    put_u32(&mut d, 2 | (block_size << 16));
+    d.extend_from_slice(&[1, 1, 1, 0]); // RGBSDA, BT709, LINEAR, straight alpha
+    d.extend_from_slice(&[0, 0, 0, 0]);
+    d.extend_from_slice(&[(samples * bits / 8) as u8, 0, 0, 0, 0, 0, 0, 0]);
+    for (k, &channel) in ids.iter().enumerate() {
+        put_u32(&mut d, (k as u32 * bits) | ((bits - 1) << 16) | (channel << 24));
+        put_u32(&mut d, 0);
+        put_u32(&mut d, 0);
+        put_u32(&mut d, ((1u64 << bits) - 1) as u32);
+    }
+    d
+}
+
+/// One mip level of [`ktx2_unorm_mips`]: its size and `width × height × channels` values in
+/// [0, 1] (row by row from the top), rounded to the nearest UNORM code.
+pub struct UnormLevel {
+    pub width: u32,
+    pub height: u32,
+    pub values: Vec<f64>,
+}
+
+/// A KTX2 file of a mip chain (level 0 first in `levels`, each half the previous, at least 1)
+/// of `channels` (2, 4) UNORM channels of `bits` (8, 16). The level data are stored smallest
+/// first, each at a multiple of lcm(texel size, 4) (KTX2 §3.9, mip padding).
+pub fn ktx2_unorm_mips(levels: &[UnormLevel], channels: usize, bits: u32, metadata: &[(&str, &str)]) -> Vec<u8> {
+    assert!(!levels.is_empty(), "a mip chain has at least one level");
+    let type_size = bits / 8;
+    let q = ((1u64 << bits) - 1) as f64;
+    let data: Vec<Vec<u8>> = levels
+        .iter()
+        .map(|l| {
+            assert_eq!(l.values.len(), (l.width * l.height) as usize * channels, "value count differs from width × height × channels");
+            let mut out = Vec::with_capacity(l.values.len() * type_size as usize);
+            for &v in &l.values {
+                let code = (v.clamp(0.0, 1.0) * q).round() as u32;
+                if bits == 8 { out.push(code as u8) } else { out.extend_from_slice(&(code as u16).to_le_bytes()) }
+            }
+            out
+        })
+        .collect();
+    let dfd = data_format_descriptor_unorm(channels, bits);
+    let mut kv = vec![("KTXorientation", "rd"), ("KTXwriter", super::GENERATOR)];
+    kv.extend_from_slice(metadata);
+    let kvd = key_value_data(&kv);
+    let index_end = 80 + 24 * levels.len();
+    let dfd_offset = index_end;
+    let kvd_offset = dfd_offset + dfd.len();
+    let align = (channels * type_size as usize).max(4);
+    // Offsets: smallest level first in the file.
+    let mut offsets = vec![0usize; levels.len()];
+    let mut at = kvd_offset + kvd.len();
+    for i in (0..levels.len()).rev() {
+        at = at.next_multiple_of(align);
+        offsets[i] = at;
+        at += data[i].len();
+    }
+    let mut out = Vec::with_capacity(at);
+    out.extend_from_slice(&KTX2_IDENTIFIER);
+    for v in [vk_format_unorm(channels, bits), type_size, levels[0].width, levels[0].height, 0, 0, 1, levels.len() as u32, 0] {
+        put_u32(&mut out, v);
+    }
+    put_u32(&mut out, dfd_offset as u32);
+    put_u32(&mut out, dfd.len() as u32);
+    put_u32(&mut out, kvd_offset as u32);
+    put_u32(&mut out, kvd.len() as u32);
+    put_u64(&mut out, 0);
+    put_u64(&mut out, 0);
+    for (o, d) in offsets.iter().zip(&data) {
+        put_u64(&mut out, *o as u64);
+        put_u64(&mut out, d.len() as u64);
+        put_u64(&mut out, d.len() as u64);
+    }
+    out.extend_from_slice(&dfd);
+    out.extend_from_slice(&kvd);
+    for i in (0..levels.len()).rev() {
+        pad_to(&mut out, align);
+        debug_assert_eq!(out.len(), offsets[i]);
+        out.extend_from_slice(&data[i]);
+    }
+    out
+}
+
 /// The sRGB transfer function (IEC 61966-2-1) of a linear value clamped to [0, 1], as 8 bits.
 pub fn srgb8(linear: f64) -> u8 {
     let v = linear.clamp(0.0, 1.0);
@@ -394,6 +497,35 @@ mod tests {
                 let t = rgb[(y / 3) * 3 + x / 2];
                 let p = &buf[(y * 6 + x) * 3..][..3];
                 assert_eq!(p, [srgb8(t[0]), srgb8(t[1]), srgb8(t[2])]);
+            }
+        }
+    }
+
+    #[test]
+    fn unorm_mip_chains_read_back_with_the_ktx2_crate() {
+        // 5×3 → 2×1 → 1×1; RG8 and RGBA16: the ktx2 crate's reader (independent) finds the
+        // format, the three levels in order and the codes (round(v · (2^bits − 1))).
+        for (channels, bits) in [(2usize, 8u32), (4, 16)] {
+            let sizes = [(5u32, 3u32), (2, 1), (1, 1)];
+            let levels: Vec<UnormLevel> = sizes
+                .iter()
+                .enumerate()
+                .map(|(k, &(w, h))| UnormLevel { width: w, height: h, values: (0..(w * h) as usize * channels).map(|i| ((i + k) % 7) as f64 / 6.0).collect() })
+                .collect();
+            let bytes = ktx2_unorm_mips(&levels, channels, bits, &[]);
+            let r = ktx2::Reader::new(&bytes[..]).expect("a valid KTX2 file");
+            let hd = r.header();
+            assert_eq!(hd.format.map(|f| f.value()), Some(vk_format_unorm(channels, bits)));
+            assert_eq!((hd.pixel_width, hd.pixel_height, hd.level_count), (5, 3, 3));
+            let q = ((1u64 << bits) - 1) as f64;
+            for (k, level) in r.levels().enumerate() {
+                let want: Vec<u32> = levels[k].values.iter().map(|v| (v * q).round() as u32).collect();
+                let got: Vec<u32> = if bits == 8 {
+                    level.data.iter().map(|&b| b as u32).collect()
+                } else {
+                    level.data.chunks(2).map(|c| u16::from_le_bytes([c[0], c[1]]) as u32).collect()
+                };
+                assert_eq!(got, want, "level {k}");
             }
         }
     }

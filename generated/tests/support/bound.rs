@@ -21,6 +21,7 @@
 //!   ε of 3 ulp of the quotient.
 //! - Subnormals may be flushed to zero: an argument or result below f32::MIN_POSITIVE in
 //!   magnitude gets a new ε of its own magnitude.
+//! - sqrt: 5 ulp of the result (1/inverseSqrt), plus min(Δ/(2√x), √Δ) for an input deviation Δ.
 //! - sin/cos: WGSL (and Vulkan's SPIR-V precision table) allow an absolute error of 2^-11
 //!   for arguments in [−π, π] (no bound outside: the evaluation panics if either side's
 //!   argument may leave that range). The CPU value is Rust's f32 `sin`/`cos` (the platform
@@ -468,6 +469,16 @@ impl Program {
                     let r = d.radius();
                     self.f(v.abs(), g.abs(), self.fresh(Dev::default(), r), None)
                 }
+            }
+            (M::Sqrt, V::F { v, g, d, .. }, None, None) => {
+                // WGSL: sqrt inherits 1/inverseSqrt's accuracy (2 ulp, then a 2.5-ulp division):
+                // a fresh 5 ulp of the result. An input deviation Δ moves √x by at most
+                // min(Δ/(2√x), √Δ) (the second near 0, where the slope is unbounded).
+                let r = v.sqrt();
+                let rx = d.radius();
+                let moved = if rx == 0.0 { 0.0 } else { (rx / (2.0 * (v as f64).max(0.0).sqrt())).min(rx.sqrt()) };
+                let d = self.fresh(Dev::default(), moved + 5.0 * ulp(r as f64));
+                self.f(r, g.max(0.0).sqrt(), d, None)
             }
             (fun, a, b, c) => panic!("unsupported {fun:?}({a:?}, {b:?}, {c:?})"),
         }

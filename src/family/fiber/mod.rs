@@ -66,4 +66,5 @@ pub static FAMILY: Family = Family {
     figures: plot::fiber_figures,
     bench: bench::BENCH,
     scene_features: &[],
+    commands: &[],
 };

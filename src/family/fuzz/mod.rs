@@ -136,4 +136,5 @@ pub static FAMILY: Family = Family {
     figures: plot::fuzz_figures,
     bench: bench::BENCH,
     scene_features: scene::FEATURES,
+    commands: &[],
 };

@@ -222,4 +222,5 @@ pub static FAMILY: Family = Family {
     figures,
     bench: bench::BENCH,
     scene_features: &[],
+    commands: &[],
 };

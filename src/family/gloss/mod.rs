@@ -85,4 +85,5 @@ pub static FAMILY: Family = Family {
     figures: plot::gloss_figures,
     bench: bench::BENCH,
     scene_features: scene::FEATURES,
+    commands: &[],
 };

@@ -139,4 +139,5 @@ pub static FAMILY: Family = Family {
     figures: plot::skin_figures,
     bench: bench::BENCH,
     scene_features: scene::FEATURES,
+    commands: &[],
 };

@@ -1,0 +1,288 @@
+//! `shadefit aniso-mip`: the mip chain of a normal map and an aniso map by SGGX filtering.
+//!
+//! Inputs: a tangent-space normal map (PNG, RGB or RGBA, 8 or 16 bits; n = normalize(2c − 1),
+//! z clamped to ≥ 1e-3) and an aniso map in the course's encoding (PNG, RGB or RGBA, 8 or 16
+//! bits: [√Sxx, ½ Sxy/√(Sxx Syy) + ½, √Syy], decoded as `DecodeSggx` does, so α ≥ α_min), of the
+//! same size. Every texel becomes S = M_n [[B, 0], [0, 1]] M_nᵀ; each level's S is the mean of
+//! a `footprint` × `footprint` box of the previous level's (2: the 2×2 children; 4: those and
+//! a ring around them, edges clamped); n′ by power iteration, the block normalised, encoded.
+//!
+//! Outputs: `OUT.normal.ktx2` (RG, n′.xy as ½n + ½) and `OUT.aniso.ktx2` (RGBA, the encoding
+//! and A = 1), both UNORM of `bits` (8 or 16), the full chain down to 1×1. Nothing is written
+//! unless both files are complete (temporary files, then renames). Per-texel work runs in
+//! parallel and is collected in texel order: the files are the same at any thread count.
+
+use super::integrals::{ALPHA_MIN, M3, V3, decode_course, encode, extract, sggx_from};
+use crate::emit::texture::{UnormLevel, ktx2_unorm_mips};
+use crate::family::{CommandError, FamilyCommand};
+use rayon::prelude::*;
+use std::path::{Path, PathBuf};
+
+pub const COMMAND: FamilyCommand = FamilyCommand {
+    name: "aniso-mip",
+    about: "SGGX-filtered mip chain of a normal map + aniso map (PNG in, KTX2 out)",
+    run,
+};
+
+const USAGE: &str = "usage: shadefit aniso-mip --normal NORMAL.png --aniso ANISO.png --out PREFIX [--bits 8|16] [--footprint 2|4]
+  writes PREFIX.normal.ktx2 (RG UNORM) and PREFIX.aniso.ktx2 (RGBA UNORM), every mip level";
+
+/// Options of one run.
+#[derive(Debug, Clone)]
+pub struct Options {
+    pub normal: PathBuf,
+    pub aniso: PathBuf,
+    pub out: PathBuf,
+    pub bits: u32,
+    pub footprint: usize,
+}
+
+fn input(msg: impl Into<String>) -> CommandError {
+    CommandError::Input(msg.into())
+}
+
+pub fn parse(args: &[String]) -> Result<Options, CommandError> {
+    let (mut normal, mut aniso, mut out, mut bits, mut footprint) = (None, None, None, 8, 2);
+    let mut it = args.iter();
+    while let Some(a) = it.next() {
+        let mut value = |flag: &str| it.next().cloned().ok_or_else(|| input(format!("aniso-mip: {flag} needs a value\n{USAGE}")));
+        match a.as_str() {
+            "--normal" => normal = Some(PathBuf::from(value(a)?)),
+            "--aniso" => aniso = Some(PathBuf::from(value(a)?)),
+            "--out" => out = Some(PathBuf::from(value(a)?)),
+            "--bits" => {
+                bits = match value(a)?.as_str() {
+                    "8" => 8,
+                    "16" => 16,
+                    v => return Err(input(format!("aniso-mip: --bits: '{v}' is not 8 or 16"))),
+                }
+            }
+            "--footprint" => {
+                footprint = match value(a)?.as_str() {
+                    "2" => 2,
+                    "4" => 4,
+                    v => return Err(input(format!("aniso-mip: --footprint: '{v}' is not 2 or 4"))),
+                }
+            }
+            other => return Err(input(format!("aniso-mip: unknown argument '{other}'\n{USAGE}"))),
+        }
+    }
+    let need = |v: Option<PathBuf>, flag: &str| v.ok_or_else(|| input(format!("aniso-mip: {flag} is required\n{USAGE}")));
+    Ok(Options { normal: need(normal, "--normal")?, aniso: need(aniso, "--aniso")?, out: need(out, "--out")?, bits, footprint })
+}
+
+/// A PNG's channels as values in [0, 1]: (width, height, channels, values).
+fn read_png(path: &Path, what: &str) -> Result<(u32, u32, usize, Vec<f64>), CommandError> {
+    let bad = |field: &str, why: String| input(format!("{}: {field}: {why} ({what})", path.display()));
+    let file = std::fs::File::open(path).map_err(|e| bad("file", e.to_string()))?;
+    let decoder = png::Decoder::new(std::io::BufReader::new(file));
+    let mut reader = decoder.read_info().map_err(|e| bad("png", e.to_string()))?;
+    let info = reader.info().clone();
+    let channels = match info.color_type {
+        png::ColorType::Rgb => 3,
+        png::ColorType::Rgba => 4,
+        c => return Err(bad("color type", format!("{c:?}; RGB or RGBA expected"))),
+    };
+    let depth = match info.bit_depth {
+        png::BitDepth::Eight => 8,
+        png::BitDepth::Sixteen => 16,
+        d => return Err(bad("bit depth", format!("{d:?}; 8 or 16 expected"))),
+    };
+    let mut buf = vec![0; reader.output_buffer_size().ok_or_else(|| bad("size", "too large".into()))?];
+    let frame = reader.next_frame(&mut buf).map_err(|e| bad("png", e.to_string()))?;
+    let bytes = &buf[..frame.buffer_size()];
+    let values: Vec<f64> = if depth == 8 {
+        bytes.iter().map(|&b| b as f64 / 255.0).collect()
+    } else {
+        bytes.chunks(2).map(|c| u16::from_be_bytes([c[0], c[1]]) as f64 / 65535.0).collect()
+    };
+    Ok((info.width, info.height, channels, values))
+}
+
+/// Statistics of a run.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Report {
+    pub levels: usize,
+    pub texels: usize,
+    pub max_iterations: usize,
+    pub not_converged: usize,
+    /// Filtered blocks with an eigenvalue > 1 (clamped by the encoding).
+    pub clamped: usize,
+}
+
+/// The two KTX2 files' bytes and the run's statistics.
+pub fn mip_chain(width: u32, height: u32, s0: Vec<M3>, bits: u32, footprint: usize, progress: &dyn Fn(u64)) -> (Vec<u8>, Vec<u8>, Report) {
+    let mut report = Report::default();
+    let mut normals: Vec<UnormLevel> = Vec::new();
+    let mut anisos: Vec<UnormLevel> = Vec::new();
+    let (mut w, mut h, mut s) = (width as usize, height as usize, s0);
+    loop {
+        let texels: Vec<super::integrals::Extracted> = s.par_iter().map(extract).collect();
+        let mut nv = Vec::with_capacity(w * h * 2);
+        let mut av = Vec::with_capacity(w * h * 4);
+        for e in &texels {
+            report.max_iterations = report.max_iterations.max(e.power.iterations);
+            report.not_converged += !e.power.converged as usize;
+            report.clamped += (e.aniso.alphas().0 > 1.0 + 1e-12) as usize;
+            nv.extend([0.5 * e.n.x + 0.5, 0.5 * e.n.y + 0.5]);
+            let t = encode(e.aniso);
+            av.extend([t[0], t[1], t[2], 1.0]);
+        }
+        report.texels += texels.len();
+        progress(texels.len() as u64);
+        normals.push(UnormLevel { width: w as u32, height: h as u32, values: nv });
+        anisos.push(UnormLevel { width: w as u32, height: h as u32, values: av });
+        if w == 1 && h == 1 {
+            break;
+        }
+        let (nw, nh) = ((w / 2).max(1), (h / 2).max(1));
+        let prev = &s;
+        let next: Vec<M3> = (0..nw * nh)
+            .into_par_iter()
+            .map(|k| {
+                let (x, y) = (k % nw, k / nw);
+                // The children (2x, 2y)…(2x+1, 2y+1) and, for footprint 4, one texel around them.
+                let r = (footprint as isize - 2) / 2;
+                let mut acc = M3::zeros();
+                let mut count = 0.0;
+                for dy in -r..2 + r {
+                    for dx in -r..2 + r {
+                        let sx = (2 * x as isize + dx).clamp(0, w as isize - 1) as usize;
+                        let sy = (2 * y as isize + dy).clamp(0, h as isize - 1) as usize;
+                        acc += prev[sy * w + sx];
+                        count += 1.0;
+                    }
+                }
+                acc / count
+            })
+            .collect();
+        (w, h, s) = (nw, nh, next);
+    }
+    report.levels = normals.len();
+    let meta = [("shadefit", "aniso-mip: SGGX-filtered normal map (n.xy as n/2 + 1/2)")];
+    let normal = ktx2_unorm_mips(&normals, 2, bits, &meta);
+    let meta = [("shadefit", "aniso-mip: SGGX aniso map [sqrt(Sxx), Sxy/sqrt(Sxx Syy)/2 + 1/2, sqrt(Syy), 1]")];
+    let aniso = ktx2_unorm_mips(&anisos, 4, bits, &meta);
+    (normal, aniso, report)
+}
+
+/// The texels' SGGX matrices from the two maps' values.
+pub fn texels(normal: &[f64], nc: usize, aniso: &[f64], ac: usize, count: usize) -> Vec<M3> {
+    (0..count)
+        .into_par_iter()
+        .map(|i| {
+            let c = &normal[i * nc..i * nc + 3];
+            let mut n = V3::new(2.0 * c[0] - 1.0, 2.0 * c[1] - 1.0, (2.0 * c[2] - 1.0).max(1e-3));
+            n /= n.norm();
+            let t = &aniso[i * ac..i * ac + 3];
+            sggx_from(n, decode_course([t[0], t[1], t[2]], ALPHA_MIN).aniso())
+        })
+        .collect()
+}
+
+fn write_atomically(files: &[(PathBuf, Vec<u8>)]) -> Result<(), CommandError> {
+    let mut temps = Vec::new();
+    for (path, bytes) in files {
+        let tmp = path.with_extension("ktx2.tmp");
+        if let Err(e) = std::fs::write(&tmp, bytes) {
+            for t in &temps {
+                let _ = std::fs::remove_file(t);
+            }
+            let _ = std::fs::remove_file(&tmp);
+            return Err(CommandError::Failed(format!("{}: {e}", tmp.display())));
+        }
+        temps.push(tmp);
+    }
+    for ((path, _), tmp) in files.iter().zip(&temps) {
+        std::fs::rename(tmp, path).map_err(|e| CommandError::Failed(format!("{}: {e}", path.display())))?;
+    }
+    Ok(())
+}
+
+pub fn run(args: &[String]) -> Result<String, CommandError> {
+    if args.iter().any(|a| a == "-h" || a == "--help") {
+        return Ok(USAGE.into());
+    }
+    let o = parse(args)?;
+    let (w, h, nc, nv) = read_png(&o.normal, "normal map")?;
+    let (aw, ah, ac, avals) = read_png(&o.aniso, "aniso map")?;
+    if (aw, ah) != (w, h) {
+        return Err(input(format!("{}: size: {aw}×{ah} differs from the normal map's {w}×{h} ({})", o.aniso.display(), o.normal.display())));
+    }
+    let total: u64 = {
+        let (mut w, mut h, mut t) = (w as u64, h as u64, 0);
+        loop {
+            t += w * h;
+            if w == 1 && h == 1 {
+                break t;
+            }
+            (w, h) = ((w / 2).max(1), (h / 2).max(1));
+        }
+    };
+    let bar = if total >= 1 << 20 { indicatif::ProgressBar::new(total) } else { indicatif::ProgressBar::hidden() };
+    let s0 = texels(&nv, nc, &avals, ac, (w * h) as usize);
+    let (normal, aniso, r) = mip_chain(w, h, s0, o.bits, o.footprint, &|n| bar.inc(n));
+    bar.finish_and_clear();
+    let stem = o.out.to_string_lossy().to_string();
+    let files = [(PathBuf::from(format!("{stem}.normal.ktx2")), normal), (PathBuf::from(format!("{stem}.aniso.ktx2")), aniso)];
+    write_atomically(&files)?;
+    Ok(format!(
+        "{}\n{}\n{} levels, {} texels; power iteration: at most {} iterations, {} not converged; {} blocks clamped by the encoding",
+        files[0].0.display(),
+        files[1].0.display(),
+        r.levels,
+        r.texels,
+        r.max_iterations,
+        r.not_converged,
+        r.clamped
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::family::sggx::integrals::{Aniso, direction, sggx_from};
+
+    #[test]
+    fn a_uniform_texture_keeps_its_texel_at_every_level() {
+        // Every level's S is the mean of equal matrices, so every texel is the input's to the
+        // power iteration's residual (1e-12 after encoding, far below an 8-bit step); 5×3 → 2×1 →
+        // 1×1, footprint 4 (edges clamped) alike.
+        let n = direction(0.5, 1.0);
+        let a = Aniso::from_alphas(0.6, 0.1, 0.4);
+        let s = sggx_from(n, a);
+        for footprint in [2, 4] {
+            let (normal, aniso, r) = mip_chain(5, 3, vec![s; 15], 8, footprint, &|_| {});
+            assert_eq!((r.levels, r.texels, r.not_converged, r.clamped), (3, 15 + 2 + 1, 0, 0));
+            let want_n = [0.5 * n.x + 0.5, 0.5 * n.y + 0.5].map(|v| (v * 255.0).round() as u8);
+            let t = encode(a);
+            let want_a = [t[0], t[1], t[2], 1.0].map(|v| (v * 255.0).round() as u8);
+            let rn = ktx2::Reader::new(&normal[..]).unwrap();
+            let ra = ktx2::Reader::new(&aniso[..]).unwrap();
+            for (ln, la) in rn.levels().zip(ra.levels()) {
+                assert!(ln.data.chunks(2).all(|c| c == want_n), "{:?} vs {want_n:?}", &ln.data[..2]);
+                assert!(la.data.chunks(4).all(|c| c == want_a));
+            }
+        }
+    }
+
+    #[test]
+    fn two_tilted_texels_filter_to_the_mixture_s_normal() {
+        // A 2×1 texture of normals at ±30° about z (isotropic α = 0.3): its 1×1 level has the
+        // normal z (the mean of S is symmetric under the mirror x → −x) and a block wider along
+        // x than y; 16-bit codes.
+        let a = Aniso::isotropic(0.3);
+        let s = vec![sggx_from(direction(0.5236, 0.0), a), sggx_from(direction(0.5236, std::f64::consts::PI), a)];
+        let (normal, aniso, r) = mip_chain(2, 1, s, 16, 2, &|_| {});
+        assert_eq!(r.levels, 2);
+        let rn = ktx2::Reader::new(&normal[..]).unwrap();
+        let top = rn.levels().nth(1).unwrap().data;
+        let n: Vec<u16> = top.chunks(2).map(|c| u16::from_le_bytes([c[0], c[1]])).collect();
+        // n′ = z: both codes ½·65535 = 32767.5, rounded either way by the residual's 1e-16.
+        assert!(n.iter().all(|&c| c == 32767 || c == 32768), "{n:?}");
+        let ra = ktx2::Reader::new(&aniso[..]).unwrap();
+        let top = ra.levels().nth(1).unwrap().data;
+        let v: Vec<u16> = top.chunks(2).map(|c| u16::from_le_bytes([c[0], c[1]])).collect();
+        assert!(v[0] > v[2], "√Sxx {} > √Syy {}", v[0], v[2]);
+    }
+}
