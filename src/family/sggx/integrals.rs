@@ -9,7 +9,9 @@
 //!
 //! The SGGX matrix is S = M_n [[B, 0], [0, 1]] M_nᵀ; its NDF is
 //!
-//!     D(m) = 1 / (π √|S| (mᵀ S⁻¹ m)²),
+//! ```text
+//! D(m) = 1 / (π √|S| (mᵀ S⁻¹ m)²),
+//! ```
 //!
 //! which is the anisotropic GGX NDF on the upper half (S = diag(α_t², α_b², 1) gives
 //! 1/(π α_t α_b (x²/α_t² + y²/α_b² + z²)²)). The projected area of the microflakes along ω is
@@ -17,7 +19,9 @@
 //! normalisation ∫ D(h)(h·n) dh = 1. The course's rearranged form multiplies numerator and
 //! denominator of Burley's form by (α_t α_b)⁴:
 //!
-//!     D(h) = (α_t α_b)³ / (π ((t·h)² α_b² + (b·h)² α_t² + (n·h)² (α_t α_b)²)²).
+//! ```text
+//! D(h) = (α_t α_b)³ / (π ((t·h)² α_b² + (b·h)² α_t² + (n·h)² (α_t α_b)²)²).
+//! ```
 //!
 //! Filtering: S′ = Σ wᵢ Sᵢ / Σ wᵢ (linear, so S′ stays symmetric positive definite: a convex
 //! combination of SPD matrices); n′ is its dominant eigenvector, found by power iteration from
