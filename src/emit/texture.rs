@@ -119,8 +119,9 @@ pub fn vk_format(format: TextureFormat, channels: usize) -> u32 {
     }
 }
 
-/// The data format descriptor: total size, then one basic descriptor block (KDF 1.3 §5).
-fn data_format_descriptor(format: TextureFormat, channels: usize) -> Vec<u8> {
+/// A data format descriptor: total size, then one basic descriptor block (KDF 1.3 §5) of
+/// `channels` samples of `bits` each; `sample(offset, channel id)` gives a sample's four words.
+fn basic_dfd(channels: usize, bits: u32, sample: impl Fn(u32, u32) -> [u32; 4]) -> Vec<u8> {
     let ids = channel_ids(channels);
     let samples = ids.len() as u32;
     let block_size = 24 + 16 * samples;
@@ -131,19 +132,24 @@ fn data_format_descriptor(format: TextureFormat, channels: usize) -> Vec<u8> {
     // colorModel RGBSDA (1), primaries BT709 (1), transfer LINEAR (1), flags ALPHA_STRAIGHT (0).
     d.extend_from_slice(&[1, 1, 1, 0]);
     d.extend_from_slice(&[0, 0, 0, 0]); // texelBlockDimension 1×1×1×1 (stored minus one)
-    d.extend_from_slice(&[(samples * format.type_size()) as u8, 0, 0, 0, 0, 0, 0, 0]); // bytesPlane0..7
-    let bits = 8 * format.type_size();
-    // Channel ids R = 0, G = 1, B = 2, A = 15, with the FLOAT (0x80) and SIGNED (0x40)
-    // qualifiers; sampleLower/Upper are −1.0 and 1.0 as f32 bit patterns (the convention for
-    // float samples of any width).
+    d.extend_from_slice(&[(samples * bits / 8) as u8, 0, 0, 0, 0, 0, 0, 0]); // bytesPlane0..7
     for (k, &channel) in ids.iter().enumerate() {
-        let offset = k as u32 * bits;
-        put_u32(&mut d, offset | ((bits - 1) << 16) | ((channel | 0xC0) << 24));
-        put_u32(&mut d, 0); // samplePosition0..3
-        put_u32(&mut d, 0xBF80_0000);
-        put_u32(&mut d, 0x3F80_0000);
+        for word in sample(k as u32 * bits, channel) {
+            put_u32(&mut d, word);
+        }
     }
     d
+}
+
+/// The data format descriptor of a float texture. Channel ids R = 0, G = 1, B = 2, A = 15, with
+/// the FLOAT (0x80) and SIGNED (0x40) qualifiers; sampleLower/Upper are −1.0 and 1.0 as f32 bit
+/// patterns (the convention for float samples of any width).
+fn data_format_descriptor(format: TextureFormat, channels: usize) -> Vec<u8> {
+    let bits = 8 * format.type_size();
+    basic_dfd(channels, bits, |offset, channel| {
+        // bitOffset, bitLength − 1, channel and qualifiers; samplePosition0..3; lower; upper.
+        [offset | ((bits - 1) << 16) | ((channel | 0xC0) << 24), 0, 0xBF80_0000, 0x3F80_0000]
+    })
 }
 
 /// Key/value data: entries sorted by key, each `length, key NUL value, padding to 4`.
@@ -243,23 +249,7 @@ pub fn vk_format_unorm(channels: usize, bits: u32) -> u32 {
 /// The data format descriptor of a UNORM texture: samples without qualifiers, sampleLower 0 and
 /// sampleUpper 2^bits − 1 (KDF 1.3 §5, integer samples).
 fn data_format_descriptor_unorm(channels: usize, bits: u32) -> Vec<u8> {
-    let ids = channel_ids(channels);
-    let samples = ids.len() as u32;
-    let block_size = 24 + 16 * samples;
-    let mut d = Vec::with_capacity(4 + block_size as usize);
-    put_u32(&mut d, 4 + block_size);
-    put_u32(&mut d, 0);
-    put_u32(&mut d, 2 | (block_size << 16));
-    d.extend_from_slice(&[1, 1, 1, 0]); // RGBSDA, BT709, LINEAR, straight alpha
-    d.extend_from_slice(&[0, 0, 0, 0]);
-    d.extend_from_slice(&[(samples * bits / 8) as u8, 0, 0, 0, 0, 0, 0, 0]);
-    for (k, &channel) in ids.iter().enumerate() {
-        put_u32(&mut d, (k as u32 * bits) | ((bits - 1) << 16) | (channel << 24));
-        put_u32(&mut d, 0);
-        put_u32(&mut d, 0);
-        put_u32(&mut d, ((1u64 << bits) - 1) as u32);
-    }
-    d
+    basic_dfd(channels, bits, |offset, channel| [offset | ((bits - 1) << 16) | (channel << 24), 0, 0, ((1u64 << bits) - 1) as u32])
 }
 
 /// One mip level of [`ktx2_unorm_mips`]: its size and `width × height × channels` values in

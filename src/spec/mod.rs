@@ -370,6 +370,49 @@ impl CustomSpec<'_> {
     }
 }
 
+/// The spec file of a family kind that emits one module of functions: name, kind, quantity,
+/// description and `[emit] function` (the functions' name prefix).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ModuleFile {
+    name: String,
+    #[allow(dead_code)]
+    kind: String,
+    quantity: String,
+    #[serde(default)]
+    description: String,
+    emit: ModulePrefix,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ModulePrefix {
+    /// Prefix of the emitted function names.
+    function: String,
+}
+
+/// For family kinds that emit one module of functions: the common spec of a module spec of kind
+/// `kind` (see [`ModuleFile`]) serving `quantity`, with `tolerance` and `axes` spelled out, or
+/// `None` when the text is not of that kind.
+pub fn module_spec_file(
+    path: &Path,
+    text: &str,
+    kind: &'static str,
+    quantity: &str,
+    tolerance: f64,
+    axes: Vec<serde_json::Value>,
+) -> Result<Option<SpecFile>, SpecError> {
+    if !is_kind(text, kind) {
+        return Ok(None);
+    }
+    let f: ModuleFile = parse_toml(path, text)?;
+    if f.quantity != quantity {
+        return Err(SpecError::new(path, line_of(text, "quantity"), "quantity", format!("kind = \"{kind}\" serves {quantity}, not '{}'", f.quantity)));
+    }
+    let common = CustomSpec { kind, name: &f.name, quantity: &f.quantity, description: &f.description, tolerance, axes, function: &f.emit.function };
+    common.spec_file(path, text).map(Some)
+}
+
 /// For family LUT kinds: every side of a texture `resolution` is in [2, max] (the message
 /// names the first that is not).
 pub fn check_resolution(resolution: &[usize], max: usize) -> Result<(), String> {

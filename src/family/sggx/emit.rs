@@ -23,8 +23,7 @@ use crate::emit::{f32_literal, header_lines};
 use crate::family::SpecKind;
 use crate::family::ggx::published::emit::{module_built, module_json};
 use crate::pipeline::{BuildError, Built, Mode, committed_json_with_hash, fmt_err, input_hash, spec_rel_path};
-use crate::spec::{CustomSpec, KindDef, Spec, SpecError, SpecFile, is_kind, line_of, parse_toml};
-use serde::Deserialize;
+use crate::spec::{KindDef, Spec, SpecError, SpecFile, module_spec_file};
 use serde_json::json;
 use std::path::Path;
 
@@ -36,37 +35,11 @@ pub const DECODE: SpecKind = SpecKind {
     build,
 };
 
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct DecodeFile {
-    name: String,
-    #[allow(dead_code)]
-    kind: String,
-    quantity: String,
-    #[serde(default)]
-    description: String,
-    emit: EmitPrefix,
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct EmitPrefix {
-    function: String,
-}
-
 /// For `Spec::parse`: the common spec of a decoder spec, or `None`.
 pub fn spec_file(path: &Path, text: &str) -> Result<Option<SpecFile>, SpecError> {
-    if !is_kind(text, KIND) {
-        return Ok(None);
-    }
-    let f: DecodeFile = parse_toml(path, text)?;
-    if f.quantity != "sggx-filter" {
-        return Err(SpecError::new(path, line_of(text, "quantity"), "quantity", format!("kind = \"{KIND}\" serves sggx-filter, not '{}'", f.quantity)));
-    }
     // No samples: the quantity's parameters at their ends, as the common schema wants them.
     let axes = super::QUANTITIES[0].params.iter().map(|p| json!({"name": p.name, "range": [p.min, p.max], "count": 2, "verify": 2})).collect();
-    let common = CustomSpec { kind: KIND, name: &f.name, quantity: &f.quantity, description: &f.description, tolerance: 1e-6, axes, function: &f.emit.function };
-    common.spec_file(path, text).map(Some)
+    module_spec_file(path, text, KIND, "sggx-filter", 1e-6, axes)
 }
 
 /// What `PREFIX_decode` returns.

@@ -28,9 +28,8 @@ use crate::family::SpecKind;
 use crate::fit::positivity::{Positivity, prove_denominator_positive};
 use crate::pipeline::{BuildError, Built, Mode, Verification, compact_json, committed_json_with_hash, fmt_err, hex, spec_rel_path};
 use crate::validate;
-use crate::spec::{CustomSpec, KindDef, Spec, SpecError, SpecFile, is_kind, line_of, parse_toml};
+use crate::spec::{KindDef, Spec, SpecError, SpecFile};
 use nalgebra::DVector;
-use serde::Deserialize;
 use serde_json::{Value, json};
 use sha2::{Digest, Sha256};
 use std::path::Path;
@@ -58,39 +57,10 @@ pub fn materialx_refit(m: &MaterialX, n_dot_v: f64, alpha: f64) -> [f64; 2] {
 /// η range of the Fresnel-average grids (both branches).
 pub const ETA: (f64, f64) = (1.0 / 3.0, 3.0);
 
-/// The spec file of a family kind that emits one module of functions: name, kind, quantity
-/// (`ggx-env`), description and `[emit] function` (the functions' name prefix).
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct ModuleFile {
-    name: String,
-    #[allow(dead_code)]
-    kind: String,
-    quantity: String,
-    #[serde(default)]
-    description: String,
-    emit: EmitPrefix,
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct EmitPrefix {
-    /// Prefix of the emitted function names.
-    function: String,
-}
-
-/// For `Spec::parse`: the common spec of a module spec of kind `kind` (see [`ModuleFile`]),
-/// with `axes` spelled out, or `None` when the text is not of that kind.
+/// For `Spec::parse`: the common spec of a module spec of this family (`ggx-env`, the grid
+/// tolerance) of kind `kind`, or `None` when the text is not of that kind.
 pub(crate) fn module_spec_file(path: &Path, text: &str, kind: &'static str, axes: Vec<Value>) -> Result<Option<SpecFile>, SpecError> {
-    if !is_kind(text, kind) {
-        return Ok(None);
-    }
-    let f: ModuleFile = parse_toml(path, text)?;
-    if f.quantity != "ggx-env" {
-        return Err(SpecError::new(path, line_of(text, "quantity"), "quantity", format!("kind = \"{kind}\" serves ggx-env, not '{}'", f.quantity)));
-    }
-    let common = CustomSpec { kind, name: &f.name, quantity: &f.quantity, description: &f.description, tolerance: grid::TOL, axes, function: &f.emit.function };
-    common.spec_file(path, text).map(Some)
+    crate::spec::module_spec_file(path, text, kind, "ggx-env", grid::TOL, axes)
 }
 
 /// For `Spec::parse`: the common spec of a refits spec, or `None` when the text is not one.
