@@ -447,6 +447,45 @@ fn sample_errors(fields: &Fields<'_>, theta: &DVector<f64>, data: &[PointData]) 
     (max, (ss / n.max(1) as f64).sqrt(), res)
 }
 
+/// One reweighting step of [`fit_fields`]'s outer loop from the residuals `res` of the current
+/// θ: Lawson's weights (L4: e²), the weighted systems, a warm-started joint solve. `None` when
+/// the weights degenerate or the solve fails (the loop stops); otherwise (residual
+/// evaluations, max error, rms error, residuals) at the new θ.
+fn outer_step(
+    fields: &mut Fields<'_>,
+    w: &mut [Vec<f64>],
+    res: &[DVector<f64>],
+    data: &[PointData],
+    opts: &FieldOptions,
+    what: &str,
+) -> Option<(usize, f64, f64, Vec<DVector<f64>>)> {
+    // Lawson: w ← w·|e| (L4: w = e²), scaled to max 1 and floored.
+    for (wg, eg) in w.iter_mut().zip(res) {
+        for (wi, ei) in wg.iter_mut().zip(eg.iter()) {
+            *wi = match opts.objective {
+                Objective::L4 => ei * ei,
+                _ => *wi * ei.abs(),
+            };
+        }
+    }
+    let top = w.iter().flatten().fold(0.0f64, |m, v| m.max(*v));
+    if !(top > 0.0) || !top.is_finite() {
+        return None;
+    }
+    w.iter_mut().flatten().for_each(|wi| *wi = (*wi / top).max(WEIGHT_FLOOR));
+    fields.systems = data
+        .par_iter()
+        .zip(w.par_iter())
+        .map(|(d, wg)| {
+            let s: Vec<f64> = wg.iter().map(|v| v.sqrt()).collect();
+            reduce(&d.design, &d.y, Some(&s))
+        })
+        .collect();
+    let evals = solve_joint(fields, opts.inner_iters, what).ok()?;
+    let (m, rr, r) = sample_errors(fields, &fields.theta, data);
+    Some((evals, m, rr, r))
+}
+
 /// Levenberg–Marquardt on the normal equations (JᵀJ + λ·diag(JᵀJ)) δ = −Jᵀr, solved by
 /// Cholesky. The joint system is small in parameters (a few hundred) and tall in residuals;
 /// forming JᵀJ with a blocked product is far cheaper than a column-pivoted QR of J each
@@ -553,62 +592,63 @@ pub fn fit_fields(
     let mut fields = Fields::new(models, x, systems, theta);
     let domain = Data { x: x.to_vec(), y: vec![] }.bounds();
     // The fields' proofs are independent: in parallel (the answer is the same either way).
-    let positive = |f: &Fields<'_>, theta: &DVector<f64>| {
-        f.full(theta)
-            .par_iter()
+    let positive = |full: &[DVector<f64>]| {
+        full.par_iter()
             .zip(models.par_iter())
             .all(|(c, m)| matches!(prove_denominator_positive(m, c, &domain), Positivity::Proven { .. }))
     };
     let mut evals = solve_joint(&mut fields, 500, what)?;
     let mut outer = 0;
+    // Whether fields.theta is known to have every denominator proven positive (the outer loop
+    // keeps only proven iterates).
+    let mut proven = false;
     if opts.objective != Objective::Lsq {
         // IRLS for Σ|e|^p: weights |e|^(p−2) at the previous optimum. Minimax continues p
         // upward (the L_p optimum tends to the minimax one as p → ∞); jumping straight to
         // Lawson's multiplicative weights concentrates them on a few grid points and lets
         // the fields run away elsewhere. The iterate with the lowest max error (or, for L4,
         // the last one) is kept; with an rms cap, only iterates under it qualify.
+        //
+        // An iterate that qualifies by its errors still needs its denominators proven; that
+        // proof runs beside the next iteration, which does not depend on it. When the proof's
+        // answer ends the loop, the next iteration is dropped uncounted, so the iterates,
+        // counts and result are those of doing each step after the previous proof.
         let n_outer = match opts.objective {
             Objective::L4 => opts.outer_iters.min(4),
             _ => opts.outer_iters,
         };
-        let (m0, r0, _) = sample_errors(&fields, &fields.theta, data);
-        let admissible = |f: &Fields<'_>, rms: f64| opts.max_rms.is_none_or(|cap| rms <= cap) && positive(f, &f.theta);
-        let mut best = (if admissible(&fields, r0) { m0 } else { f64::INFINITY }, fields.theta.clone());
+        let rms_ok = |rms: f64| opts.max_rms.is_none_or(|cap| rms <= cap);
+        let (m0, r0, mut res) = sample_errors(&fields, &fields.theta, data);
+        let ok0 = rms_ok(r0) && positive(&fields.full(&fields.theta));
+        let mut best = (if ok0 { m0 } else { f64::INFINITY }, fields.theta.clone());
         let mut w: Vec<Vec<f64>> = data.iter().map(|d| vec![1.0; d.y.len()]).collect();
         let mut since_best = 0;
-        for _ in 0..n_outer {
-            outer += 1;
-            let (_, _, res) = sample_errors(&fields, &fields.theta, data);
-            // Lawson: w ← w·|e| (L4: w = e²), scaled to max 1 and floored.
-            for (wg, eg) in w.iter_mut().zip(&res) {
-                for (wi, ei) in wg.iter_mut().zip(eg.iter()) {
-                    *wi = match opts.objective {
-                        Objective::L4 => ei * ei,
-                        _ => *wi * ei.abs(),
-                    };
+        // (max error, θ, full coefficients) of an iterate awaiting its proof.
+        let mut pending: Option<(f64, DVector<f64>, Vec<DVector<f64>>)> = None;
+        loop {
+            let more = outer < n_outer;
+            let (answer, step) = rayon::join(
+                || pending.as_ref().map(|(_, _, full)| positive(full)),
+                || more.then(|| outer_step(&mut fields, &mut w, &res, data, opts, what)),
+            );
+            if let (Some((m, theta, _)), Some(ok)) = (pending.take(), answer) {
+                if ok {
+                    best = (m, theta);
+                    since_best = 0;
+                } else {
+                    since_best += 1;
+                    if since_best >= 6 {
+                        break;
+                    }
                 }
             }
-            let top = w.iter().flatten().fold(0.0f64, |m, v| m.max(*v));
-            if !(top > 0.0) || !top.is_finite() {
-                break;
-            }
-            w.iter_mut().flatten().for_each(|wi| *wi = (*wi / top).max(WEIGHT_FLOOR));
-            fields.systems = data
-                .par_iter()
-                .zip(w.par_iter())
-                .map(|(d, wg)| {
-                    let s: Vec<f64> = wg.iter().map(|v| v.sqrt()).collect();
-                    reduce(&d.design, &d.y, Some(&s))
-                })
-                .collect();
-            evals += match solve_joint(&mut fields, opts.inner_iters, what) {
-                Ok(e) => e,
-                Err(_) => break,
-            };
-            let (m, rr, _) = sample_errors(&fields, &fields.theta, data);
-            if (opts.objective == Objective::L4 || m < best.0) && admissible(&fields, rr) {
-                best = (m, fields.theta.clone());
-                since_best = 0;
+            let Some(step) = step else { break };
+            outer += 1;
+            let Some((e, m, rr, r)) = step else { break };
+            evals += e;
+            res = r;
+            if (opts.objective == Objective::L4 || m < best.0) && rms_ok(rr) {
+                pending = Some((m, fields.theta.clone(), fields.full(&fields.theta)));
             } else {
                 since_best += 1;
                 if since_best >= 6 {
@@ -626,9 +666,10 @@ pub fn fit_fields(
             });
         }
         fields.theta = best.1;
+        proven = true;
     }
     let (max, rms, _) = sample_errors(&fields, &fields.theta, data);
-    if !positive(&fields, &fields.theta) {
+    if !proven && !positive(&fields.full(&fields.theta)) {
         let full = fields.full(&fields.theta);
         let (k, lower, region) = models
             .iter()
