@@ -316,3 +316,53 @@ fn skin_luts_and_curvature_on_the_gpu() {
     assert!(worst[0] <= 8.0 * 2f32.powi(-24), "{}", worst[0]);
     assert!(worst[1] <= 50.0 * 8.0 * 2f32.powi(-24) + 3.0 * 2f32.powi(-24) * 50.0, "{}", worst[1]);
 }
+
+/// A 1×1 RGBA32F KTX2 file as the skin LUT reader expects it (KTX 2.0 header, one level).
+fn rgba32f_ktx2(texel: [f32; 4]) -> Vec<u8> {
+    let mut b = vec![0xAB, 0x4B, 0x54, 0x58, 0x20, 0x32, 0x30, 0xBB, 0x0D, 0x0A, 0x1A, 0x0A];
+    // vkFormat R32G32B32A32_SFLOAT, typeSize, 1×1, depth 0, layers 0, faces 1, levels 1, scheme 0.
+    for v in [109u32, 4, 1, 1, 0, 0, 1, 1, 0] {
+        b.extend_from_slice(&v.to_le_bytes());
+    }
+    b.resize(80, 0); // index: no DFD, key/value or supercompression data
+    for v in [104u64, 16, 16] {
+        b.extend_from_slice(&v.to_le_bytes()); // level 0: offset, length, uncompressed length
+    }
+    for v in texel {
+        b.extend_from_slice(&v.to_le_bytes());
+    }
+    b
+}
+
+#[test]
+fn an_rgba32f_lut_needs_float32_filterable() {
+    let g = match pollster::block_on(gpu::headless("shadefit skin format test")) {
+        Ok(g) => g,
+        Err(e) if in_ci() => panic!("CI is set, so the GPU test must run, but: {e}"),
+        Err(e) => {
+            report(&format!("skin format test SKIPPED: {e}"));
+            return;
+        }
+    };
+    let bytes = rgba32f_ktx2([0.25, 0.5, 0.75, 1.0]);
+    assert_eq!(skin::Ktx2Image::parse(&bytes).expect("well-formed").format, skin::LutFormat::Rgba32Float);
+    // `headless` requests no optional features: the linear sampler cannot filter this texture.
+    assert!(!g.device.features().contains(wgpu::Features::FLOAT32_FILTERABLE));
+    let e = skin::create_lut_texture(&g.device, &g.queue, "rgba32f", &bytes).expect_err("refused without the feature");
+    assert_eq!(e, skin::Ktx2Error::NeedsFloat32Filterable);
+    // The half-float LUTs need nothing.
+    skin::create_lut_texture(&g.device, &g.queue, "rgba16f", punctual::SKIN_PUNCTUAL_LUT_KTX2).expect("rgba16f");
+    // With the feature requested (where the adapter offers it) the texture is accepted.
+    if g.adapter.features().contains(wgpu::Features::FLOAT32_FILTERABLE) {
+        let (device, queue) = pollster::block_on(g.adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("shadefit float32-filterable"),
+            required_features: wgpu::Features::FLOAT32_FILTERABLE,
+            ..Default::default()
+        }))
+        .expect("device with FLOAT32_FILTERABLE");
+        skin::create_lut_texture(&device, &queue, "rgba32f", &bytes).expect("accepted with the feature");
+        report("skin format test: RGBA32F accepted with FLOAT32_FILTERABLE");
+    } else {
+        report("skin format test: the adapter does not offer FLOAT32_FILTERABLE");
+    }
+}

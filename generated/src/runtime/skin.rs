@@ -28,7 +28,9 @@
 //! writes (no supercompression, one 2-D level); with the `gpu` feature [`create_lut_texture`]
 //! uploads it and [`lut_sampler`] makes the linear, clamp-to-edge sampler the emitted
 //! `NAME_sample` functions expect. RGBA16F is filterable in core WebGPU; RGBA32F needs the
-//! `FLOAT32_FILTERABLE` feature for a linear sampler (or use the const-array lookup `NAME`).
+//! `FLOAT32_FILTERABLE` feature for a linear sampler, so [`create_lut_texture`] refuses an
+//! RGBA32F texture on a device created without it ([`Ktx2Error::NeedsFloat32Filterable`];
+//! request the feature, or use the const-array lookup `NAME`).
 
 /// The WGSL library `shadefit::skin_curvature` (hand-written, see the module docs).
 pub const CURVATURE_WGSL: &str = include_str!("skin_curvature.wgsl");
@@ -71,6 +73,8 @@ pub enum Ktx2Error {
     Format(u32),
     /// Supercompressed, layered, cube, 3-D or mipmapped: not what shadefit writes.
     Unsupported(&'static str),
+    /// An RGBA32F texture for a linear sampler on a device without `FLOAT32_FILTERABLE`.
+    NeedsFloat32Filterable,
 }
 
 impl std::fmt::Display for Ktx2Error {
@@ -79,6 +83,10 @@ impl std::fmt::Display for Ktx2Error {
             Ktx2Error::Malformed(why) => write!(f, "malformed KTX2: {why}"),
             Ktx2Error::Format(v) => write!(f, "KTX2 VkFormat {v} is not RGBA16F (97) or RGBA32F (109)"),
             Ktx2Error::Unsupported(what) => write!(f, "unsupported KTX2: {what}"),
+            Ktx2Error::NeedsFloat32Filterable => write!(
+                f,
+                "an RGBA32F LUT is sampled linearly: create the device with wgpu::Features::FLOAT32_FILTERABLE"
+            ),
         }
     }
 }
@@ -90,6 +98,14 @@ impl std::error::Error for Ktx2Error {}
 pub enum LutFormat {
     Rgba16Float,
     Rgba32Float,
+}
+
+impl LutFormat {
+    /// Whether a linear sampler on this format needs the optional `float32-filterable`
+    /// feature (WebGPU: 32-bit float formats are unfilterable in core).
+    pub fn needs_float32_filterable(self) -> bool {
+        self == LutFormat::Rgba32Float
+    }
 }
 
 /// One 2-D level of a KTX2 file: size, format and the texels (little-endian, row 0 first).
@@ -170,7 +186,8 @@ mod gpu {
     use wgpu::util::DeviceExt;
 
     /// Upload a skin LUT's KTX2 bytes (`NAME_KTX2`) as a 2-D texture (`Rgba16Float` or
-    /// `Rgba32Float`, one level, `TEXTURE_BINDING | COPY_DST`).
+    /// `Rgba32Float`, one level, `TEXTURE_BINDING | COPY_DST`). An `Rgba32Float` texture is
+    /// refused unless the device has `FLOAT32_FILTERABLE`: [`lut_sampler`] filters linearly.
     pub fn create_lut_texture(
         device: &wgpu::Device,
         queue: &wgpu::Queue,
@@ -178,6 +195,9 @@ mod gpu {
         ktx2: &[u8],
     ) -> Result<wgpu::Texture, Ktx2Error> {
         let img = Ktx2Image::parse(ktx2)?;
+        if img.format.needs_float32_filterable() && !device.features().contains(wgpu::Features::FLOAT32_FILTERABLE) {
+            return Err(Ktx2Error::NeedsFloat32Filterable);
+        }
         let format = match img.format {
             LutFormat::Rgba16Float => wgpu::TextureFormat::Rgba16Float,
             LutFormat::Rgba32Float => wgpu::TextureFormat::Rgba32Float,

@@ -174,9 +174,16 @@ impl SkinLutCode<'_> {
             s.push_str(&format!("// {line}\n"));
         }
         s.push_str(&format!(
-            "// The texture generated/data/{m}.ktx2 ({}, linear, alpha 1) holds the same texels, for {f}_sample.\n\n",
+            "// The texture generated/data/{m}.ktx2 ({}, linear, alpha 1) holds the same texels, for {f}_sample.\n",
             self.format.name()
         ));
+        if self.format == TextureFormat::Rgba32float {
+            // The spec promised the feature (`float32_filterable = true`): say so where it binds.
+            s.push_str(&format!(
+                "// {f}_sample filters a 32-bit float texture: the device needs FLOAT32_FILTERABLE (float32-filterable).\n"
+            ));
+        }
+        s.push('\n');
         s.push_str(&format!("const {up}_SIZE: vec2<u32> = vec2<u32>({w}u, {h}u);\n"));
         s.push_str(&format!("const {up}_CURVATURE_MAX: f32 = {};\n", lit(c.kmax)));
         s.push_str(&format!("const {up}_RGB: array<vec3f, {n}> = array<vec3f, {n}>(\n", n = self.values.len()));

@@ -12,6 +12,7 @@
 //! kernel = "linear"                # optional, skin-punctual only: "linear" (default) or "radial"
 //! tolerance = 1e-10                # optional: quadrature tolerance per texel and channel
 //! texture_format = "rgba16float"   # optional: KTX2 texels, "rgba16float" or "rgba32float"
+//! float32_filterable = false       # required true with "rgba32float" (see below)
 //!
 //! [profile]                        # optional (see super::profile): preset, gaussians or csv
 //! preset = "deon-luebke"
@@ -23,6 +24,14 @@
 //! Texel (i, j) of a skin-punctual LUT holds D at n·l = −1 + 2i/(n_u − 1) and at
 //! κ = κ_max·mapping⁻¹(j/(n_v − 1)); a skin-sh LUT has one row per band (1 and 2; band 0 is 1)
 //! and column i at κ = κ_max·mapping⁻¹(i/(n − 1)). See `super::build` for the outputs.
+//!
+//! `NAME_sample` reads the texture through a linear sampler. Core WebGPU filters RGBA16F but
+//! not RGBA32F (linear filtering of 32-bit floats is the optional `float32-filterable`
+//! feature, `wgpu::Features::FLOAT32_FILTERABLE`), so an "rgba32float" LUT must say
+//! `float32_filterable = true`: the engine promises to request that feature (the runtime's
+//! `create_lut_texture` refuses the texture on a device without it). Without that line the
+//! spec is rejected rather than emitting a sampler pairing that fails validation on most
+//! devices.
 //!
 //! The spec is checked here with errors that name the file, the line and the field; it then
 //! enters the common [`SpecFile`] with its axes (curvature, n_dot_l or band) spelled out, so
@@ -88,6 +97,8 @@ struct SkinLutFile {
     kernel: Option<KernelName>,
     #[serde(default)]
     texture_format: TextureFormat,
+    #[serde(default)]
+    float32_filterable: bool,
     profile: Option<ProfileSection>,
     emit: SkinEmit,
 }
@@ -139,6 +150,20 @@ impl SkinLut {
         let k = f.curvature_max;
         if !(k.is_finite() && k > 0.0 && k <= MAX_CURVATURE) {
             return Err(at("curvature_max", format!("{k}/mm must be finite and in (0, {MAX_CURVATURE}]")));
+        }
+        match (f.texture_format, f.float32_filterable) {
+            (TextureFormat::Rgba32float, false) => {
+                return Err(at(
+                    "texture_format",
+                    "rgba32float is not filterable in core WebGPU and NAME_sample uses a linear sampler: \
+                     set float32_filterable = true (the device must enable FLOAT32_FILTERABLE) or use rgba16float"
+                        .into(),
+                ));
+            }
+            (TextureFormat::Rgba16float, true) => {
+                return Err(at("float32_filterable", "applies to texture_format = \"rgba32float\" only".into()));
+            }
+            _ => {}
         }
         let tolerance = f.tolerance.unwrap_or(DEFAULT_TOLERANCE);
         check_tolerance(tolerance, TOLERANCE_RANGE, "the LUT promises 1e-6 per channel; below 1e-14 the quadrature cannot converge").map_err(|m| at("tolerance", m))?;
@@ -282,6 +307,12 @@ mod tests {
         bad(("curvature_max = 2.0", "curvature_max = 2.0\ncurvature_mapping = \"log\""), 6, "curvature_mapping", "unknown variant");
         bad(("curvature_max = 2.0", "curvature_max = 2.0\nn_dot_l_mapping = \"angle\""), 6, "n_dot_l_mapping", "unknown variant");
         bad(("skin-punctual", "skin-diffuse"), 3, "quantity", "skin-punctual' or 'skin-sh'");
+        // A 32-bit float texture behind a linear sampler only with the feature requested.
+        let f32_tex = "curvature_max = 2.0\ntexture_format = \"rgba32float\"";
+        bad(("curvature_max = 2.0", f32_tex), 6, "texture_format", "set float32_filterable = true");
+        bad(("curvature_max = 2.0", "curvature_max = 2.0\nfloat32_filterable = true"), 6, "float32_filterable", "rgba32float");
+        let ok = parse(&PUNCTUAL.replace("curvature_max = 2.0", &format!("{f32_tex}\nfloat32_filterable = true"))).unwrap();
+        assert_eq!(ok.format, TextureFormat::Rgba32float);
         bad(("name = \"skin_x\"", "name = \"skin_y\""), 1, "name", "must match the file name");
         bad(("function = \"skin_x\"", "function = \"Skin-X\""), 8, "function", "not a valid function name");
         let sh = PUNCTUAL.replace("skin-punctual", "skin-sh").replace("[8, 5]", "[5]") ;
