@@ -158,3 +158,114 @@ def test_ktx2_holds_the_texels(name):
     want = values.astype(np.float32).astype(dtype)
     assert np.array_equal(texels[:, :3], want)
     assert np.all(texels[:, 3] == 1.0)
+
+
+# --- The LUT files' verification claims, re-measured -------------------------------------------
+#
+# `verification` claims the error of bilinear interpolation of the texels (f64, and the emitted f32
+# lookup) against the integral, on the grid with every midpoint added (2n − 1 points per axis of
+# the mapped coordinate). Here the interpolation is this file's own and the integral is the scipy
+# reference above. The SH LUT's grid (2 × 127 points) is re-measured whole; the punctual LUT's
+# (129 × 127 points) at the claimed worst point and a seeded subset (a point costs 6 quads here).
+#
+# Tolerance: the build's truth (the LUT's `tolerance` per point), quad's estimate and 1e-9 for it
+# being an estimate (as above); for the f32 claims 1e-5 more: the emitted lookup computes its
+# texel coordinates in f32 (a few ulps of coordinates below 64: 3e-5 of a texel, times texel steps
+# below 0.05) and interpolates in f32 (three roundings of values <= 1), while this file
+# interpolates the f32 texels in f64.
+
+F32_LOOKUP_TOL = 1e-5
+CLAIM_POINTS = 8
+
+
+def unit_coordinate(kappa, axis):
+    """The mapped coordinate t in [0, 1] of curvature kappa on a LUT axis (`mapping`)."""
+    t = kappa / axis["range"][1]
+    return {"linear": t, "sqrt": math.sqrt(t)}[axis["mapping"]]
+
+
+def lerp_row(row, x):
+    i = min(int(math.floor(x)), len(row) - 2)
+    f = x - i
+    return row[i] * (1.0 - f) + row[i + 1] * f
+
+
+def punctual_lookup(values, w, h, g, kappa, nl):
+    """Bilinear interpolation of the texels (rows: curvature, columns: n·l) at (κ, n·l)."""
+    x = (nl + 1.0) / 2.0 * (w - 1)
+    y = unit_coordinate(kappa, g["axes"][1]) * (h - 1)
+    j = min(int(math.floor(y)), h - 2)
+    a = lerp_row(values[j * w:(j + 1) * w], x)
+    b = lerp_row(values[(j + 1) * w:(j + 2) * w], x)
+    return a * (1.0 - (y - j)) + b * (y - j)
+
+
+def sh_reference(kappa, band, ch):
+    if kappa == 0.0:
+        return 1.0, 0.0
+    r = 1.0 / kappa
+    kern = lambda gam: radial_profile(2 * r * math.sin(gam / 2), ch) * math.sin(gam)
+    num, e1 = integrate.quad(lambda gam: kern(gam) * special.eval_legendre(band, math.cos(gam)), 0, math.pi,
+                             limit=400, epsabs=1e-13, epsrel=1e-13)
+    den, e2 = integrate.quad(kern, 0, math.pi, limit=400, epsabs=1e-13, epsrel=1e-13)
+    return num / den, (e1 + e2) / den
+
+
+def test_punctual_lut_verification_claims():
+    g, w, h, values = lut("skin_punctual_lut")
+    ver = g["verification"]
+    assert ver["points"] == (2 * w - 1) * (2 * h - 1)
+    kappa_max = g["axes"][1]["range"][1]
+    fine_t = np.arange(2 * h - 1) / (2 * h - 2)
+    fine_kappa = kappa_max * {"linear": fine_t, "sqrt": fine_t**2}[g["axes"][1]["mapping"]]
+    fine_kappa[-1] = kappa_max
+    fine_nl = -1.0 + 2.0 * np.arange(2 * w - 1) / (2 * w - 2)
+    worst = tuple(ver["worst_point"])
+    assert np.any(np.abs(fine_kappa - worst[0]) <= 1e-15) and np.any(np.abs(fine_nl - worst[1]) <= 1e-15), worst
+    rng = np.random.default_rng(20260413)
+    pts = [(float(fine_kappa[rng.integers(1, 2 * h - 1)]), float(fine_nl[rng.integers(0, 2 * w - 1)]))
+           for _ in range(CLAIM_POINTS)] + [worst]
+    values32 = values.astype(np.float32).astype(float)
+    for k, (kappa, nl) in enumerate(pts):
+        errs, errs32, tol = [], [], 0.0
+        for ch in range(3):
+            ref, err = ring(kappa, nl, ch)
+            tol = max(tol, g["tolerance"] + err + 1e-9)
+            errs.append(abs(punctual_lookup(values[:, ch], w, h, g, kappa, nl) - ref))
+            errs32.append(abs(punctual_lookup(values32[:, ch], w, h, g, kappa, nl) - ref))
+        e, e32 = max(errs), max(errs32)
+        assert e <= ver["max_abs_error"] + tol, ((kappa, nl), e, ver["max_abs_error"])
+        assert e32 <= ver["max_abs_error_f32"] + tol + F32_LOOKUP_TOL, ((kappa, nl), e32, ver["max_abs_error_f32"])
+        if k == len(pts) - 1:
+            # The claimed worst point: its error is the claimed maximum.
+            assert abs(e - ver["max_abs_error"]) <= tol, (worst, e, ver["max_abs_error"])
+            assert abs(e32 - ver["max_abs_error_f32"]) <= tol + F32_LOOKUP_TOL, (worst, e32, ver["max_abs_error_f32"])
+
+
+def test_sh_lut_verification_claims():
+    g, w, h, values = lut("skin_sh_lut")
+    ver = g["verification"]
+    assert ver["points"] == 2 * (2 * w - 1)
+    kappa_max = g["axes"][0]["range"][1]
+    fine_t = np.arange(2 * w - 1) / (2 * w - 2)
+    fine_kappa = kappa_max * {"linear": fine_t, "sqrt": fine_t**2}[g["axes"][0]["mapping"]]
+    fine_kappa[-1] = kappa_max
+    values32 = values.astype(np.float32).astype(float)
+    e, e32, where, tol = [], [], [], 0.0
+    for band in (1, 2):
+        rows = slice((band - 1) * w, band * w)
+        for a, kappa in enumerate(fine_kappa):
+            for ch in range(3):
+                ref, err = sh_reference(float(kappa), band, ch)
+                tol = max(tol, g["tolerance"] + err + 1e-9)
+                e.append(abs(lerp_row(values[rows, ch], a / 2.0) - ref))
+                e32.append(abs(lerp_row(values32[rows, ch], a / 2.0) - ref))
+                where.append((float(kappa), float(band)))
+    e, e32 = np.array(e), np.array(e32)
+    assert abs(ver["max_abs_error"] - e.max()) <= tol, (ver["max_abs_error"], e.max())
+    assert abs(ver["rms_error"] - math.sqrt(np.mean(e * e))) <= tol, (ver["rms_error"], math.sqrt(np.mean(e * e)))
+    assert abs(ver["max_abs_error_f32"] - e32.max()) <= tol + F32_LOOKUP_TOL
+    assert abs(ver["rms_error_f32"] - math.sqrt(np.mean(e32 * e32))) <= tol + F32_LOOKUP_TOL
+    # The claimed worst point is where our error is largest (ties within the tolerance).
+    at = [i for i, p in enumerate(where) if abs(p[0] - ver["worst_point"][0]) <= 1e-15 and p[1] == ver["worst_point"][1]]
+    assert at and max(e[i] for i in at) >= e.max() - tol, ver["worst_point"]
