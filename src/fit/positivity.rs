@@ -329,4 +329,60 @@ mod tests {
         // Both outcomes occur, so the property was exercised both ways.
         assert!(yes > 300 && no > 300, "{yes} proven, {no} not");
     }
+
+    #[test]
+    fn two_dimensional_proofs_with_a_derived_feature_hold_under_dense_sampling() {
+        // Q = 1 + b₁x + b₂y + b₃xy + b₄x² + b₅c² with c = cos(y) a derived feature, on random
+        // boxes inside [−1.5, 1.5]²: whenever the proof holds, Q at the 161 × 161 points of the
+        // box (f64, to ~1e-15) stays above the bound; a NotProven region with a negative sample
+        // at its centre really has Q < 0 there (checked independently).
+        use crate::fit::model::{Derived, ModelParts, Term};
+        let inputs = vec!["x".to_string(), "y".to_string()];
+        let derived = vec![Derived::parse("c", "cos(y)", &inputs).unwrap()];
+        let features = vec!["x".to_string(), "y".to_string(), "c".to_string()];
+        let term = |t: &str| Term::parse(t, &features).unwrap();
+        let model = RationalModel::new(ModelParts {
+            inputs: inputs.clone(),
+            derived,
+            numerator: vec![term("1")],
+            denominator: ["x", "y", "x*y", "x^2", "c^2"].into_iter().map(term).collect(),
+            ..ModelParts::default()
+        })
+        .unwrap();
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut uniform = |lo: f64, hi: f64| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            lo + (hi - lo) * (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let (mut yes, mut no) = (0, 0);
+        for _ in 0..300 {
+            let b: Vec<f64> = (0..5).map(|_| uniform(-1.2, 1.2)).collect();
+            let q = |x: f64, y: f64| 1.0 + b[0] * x + b[1] * y + b[2] * x * y + b[3] * x * x + b[4] * y.cos() * y.cos();
+            let (x0, y0) = (uniform(-1.5, 1.0), uniform(-1.5, 1.0));
+            let dom = [(x0, (x0 + uniform(0.05, 1.5)).min(1.5)), (y0, (y0 + uniform(0.05, 1.5)).min(1.5))];
+            let mut c = vec![1.0];
+            c.extend_from_slice(&b);
+            let n = 160;
+            let at = |k: usize, (a, b): (f64, f64)| a + (b - a) * k as f64 / n as f64;
+            let min = (0..=n)
+                .flat_map(|i| (0..=n).map(move |j| (i, j)))
+                .map(|(i, j)| q(at(i, dom[0]), at(j, dom[1])))
+                .fold(f64::INFINITY, f64::min);
+            match prove_denominator_positive(&model, &DVector::from_vec(c), &dom) {
+                Positivity::Proven { lower, .. } => {
+                    yes += 1;
+                    assert!(lower > 1e-12 && min >= lower - 1e-14, "b = {b:?} on {dom:?}: bound {lower}, sampled min {min}");
+                }
+                Positivity::NotProven { region, sample, .. } => {
+                    no += 1;
+                    let centre = [0.5 * (region[0].0 + region[0].1), 0.5 * (region[1].0 + region[1].1)];
+                    // The reported sample is Q at the region's centre.
+                    assert!((sample - q(centre[0], centre[1])).abs() <= 1e-14, "{sample} vs {}", q(centre[0], centre[1]));
+                }
+            }
+        }
+        assert!(yes > 30 && no > 30, "{yes} proven, {no} not");
+    }
 }
