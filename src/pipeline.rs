@@ -977,6 +977,28 @@ mod tests {
                 }
             }
         }
+        // A fixed coefficient (here c1 = −1.7, emitted as its rounded value) may not move at all,
+        // while the others still may: an unmoved fixed one is accepted beside a moved free one.
+        let fixed = fit::RationalModel::new(fit::model::ModelParts {
+            inputs: vec!["x".into()],
+            numerator: ["1", "x", "x^2"].iter().map(|t| fit::model::Term::parse(t, &["x".to_string()]).unwrap()).collect(),
+            denominator: vec![fit::model::Term::parse("x", &["x".to_string()]).unwrap()],
+            fixed: vec![(1, -1.7)],
+            ..fit::model::ModelParts::default()
+        })
+        .unwrap();
+        let with = |moves: [i32; 4]| {
+            let v: Vec<f64> = r.iter().zip(moves).map(|(&x, k)| away_from_zero(x, k) as f64).collect();
+            committed_f32(&fixed, &c, &json!({"numerator_f32": v[..3].to_vec(), "denominator_f32": v[3..].to_vec()}), "t")
+        };
+        assert!(with([0, 0, 0, 0]).is_ok());
+        assert!(with([3, 0, -5, 64]).is_ok(), "free coefficients moved, the fixed one not");
+        for k in [1, -1] {
+            match with([0, k, 0, 0]) {
+                Err(BuildError::F32Coefficients { why, .. }) => assert!(why.contains("fixed"), "{why}"),
+                other => panic!("fixed coefficient moved {k} ulp accepted: {other:?}"),
+            }
+        }
         // A value that is not an f32 at all, and a wrong count, are refused too.
         let m = json!({"numerator_f32": [0.3, r[1] as f64, r[2] as f64], "denominator_f32": [r[3] as f64]});
         assert!(matches!(committed_f32(&model, &c, &m, "t"), Err(BuildError::F32Coefficients { .. })));

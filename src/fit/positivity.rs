@@ -385,4 +385,67 @@ mod tests {
         }
         assert!(yes > 30 && no > 30, "{yes} proven, {no} not");
     }
+
+    /// Q = 1 + b₁x + b₂x² + 0·y on `domain` (x, y): the 2-D model of the bisection tests.
+    fn prove_xy(b: [f64; 2], domain: [(f64, f64); 2]) -> Positivity {
+        use crate::fit::model::{ModelParts, Term};
+        let features = vec!["x".to_string(), "y".to_string()];
+        let term = |t: &str| Term::parse(t, &features).unwrap();
+        let model = RationalModel::new(ModelParts {
+            inputs: features.clone(),
+            numerator: vec![term("1")],
+            denominator: vec![term("x"), term("x^2"), term("y")],
+            ..ModelParts::default()
+        })
+        .unwrap();
+        prove_denominator_positive(&model, &DVector::from_vec(vec![1.0, b[0], b[1], 0.0]), &domain)
+    }
+
+    #[test]
+    fn a_constant_denominator_is_one_box() {
+        // No feature in the box (dim 0): Q = 1, proven at once with the bound 1.
+        let m = RationalModel::rational_1d("x", 0, 0);
+        assert_eq!(prove_denominator_positive(&m, &DVector::from_vec(vec![1.0]), &[]), Positivity::Proven { lower: 1.0, boxes: 1 });
+        // A linear Q is bounded exactly on one box (monotone: no overestimation), so no
+        // bisection: Q = 1 − 0.9x on [0, 1] in one box.
+        assert!(matches!(prove(1, &[-0.9], (0.0, 1.0)), Positivity::Proven { boxes: 1, .. }));
+        // The near-tangent quadratic needs bisection: more than one box.
+        let q = prove(2, &[-4.0 / (1.0 + 1e-6), 4.0 / (1.0 + 1e-6)], (0.0, 1.0));
+        assert!(matches!(q, Positivity::Proven { boxes, .. } if boxes > 1), "{q:?}");
+    }
+
+    #[test]
+    fn a_sign_change_is_reported_where_first_seen() {
+        // Q = 1 − 2x on [0, 1]: the first box's bound is −1 and its centre is the root itself,
+        // so the proof stops there: the whole box, Q(½) = 0, the bound of the box.
+        match prove(1, &[-2.0], (0.0, 1.0)) {
+            Positivity::NotProven { lower, region, sample } => {
+                assert_eq!(region, vec![(0.0, 1.0)]);
+                assert_eq!(sample, 0.0);
+                // A rigorous bound of the exact minimum −1, within a few ulps of it.
+                assert!((-1.0 - 1e-14..=-1.0).contains(&lower), "{lower}");
+            }
+            p => panic!("{p:?}"),
+        }
+    }
+
+    #[test]
+    fn bisection_takes_the_widest_side() {
+        // Q = 4(x ∓ ½)² + ε (scaled to Q(0) = 1, ε = 1e-3) needs x bisected; y has a zero
+        // coefficient and a narrower side: far from zero, or starting at zero (end ratio ∞),
+        // or beside an x side of negative ends. The proof holds only if the side bisected is
+        // the widest, not the one with the largest ends, sum or ratio (bisecting y alone runs
+        // into the 1e-9 width limit).
+        let eps = 1e-3;
+        let right = [-4.0 / (1.0 + eps), 4.0 / (1.0 + eps)]; // minimum at x = ½
+        let left = [4.0 / (1.0 + eps), 4.0 / (1.0 + eps)]; // minimum at x = −½
+        for (b, dom) in [
+            (right, [(0.0, 1.0), (10.0, 10.001)]),
+            (right, [(0.25, 1.25), (0.0, 0.001)]),
+            (left, [(-1.0, 0.0), (0.0, 0.001)]),
+        ] {
+            let p = prove_xy(b, dom);
+            assert!(matches!(p, Positivity::Proven { lower, .. } if lower > 1e-12 && lower <= eps / (1.0 + eps)), "{dom:?}: {p:?}");
+        }
+    }
 }
