@@ -932,3 +932,77 @@ pub fn orphans_in(root: &Path, artifacts: &[Artifact], dirs: &[&str]) -> Vec<Str
 }
 
 pub use emit::write_all;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `x` moved `k` f32 steps away from zero (k < 0: towards it), by its bit pattern: for a
+    /// finite non-zero f32 of either sign, consecutive bit patterns are consecutive floats.
+    fn away_from_zero(x: f32, k: i32) -> f32 {
+        assert!(x != 0.0 && x.is_finite());
+        f32::from_bits((x.to_bits() as i64 + k as i64) as u32)
+    }
+
+    /// `committed_f32` against the contract in the module docs and ARCHITECTURE.md: a committed
+    /// f32 coefficient may lie at most 64 ulps (the re-optimisation's move cap) from the f64
+    /// coefficient rounded to nearest; one more is a coefficient the fit cannot have produced.
+    #[test]
+    fn committed_f32_coefficients_are_held_to_the_move_cap_exactly() {
+        assert_eq!(f32round::MAX_ULPS, 64, "the documented cap");
+        // P = c0 + c1 x + c2 x², Q = 1 + d1 x: positive and negative coefficients, one below 1.
+        let model = fit::RationalModel::rational_1d("x", 2, 1);
+        let c = DVector::from_vec(vec![0.3, -1.7, 12.5, -0.25]);
+        // Rounded to nearest by the `as` cast (IEEE round-to-nearest-even), not by the code
+        // under test.
+        let r: Vec<f32> = c.iter().map(|&v| v as f32).collect();
+        let check = |i: usize, k: i32| {
+            let mut v = r.clone();
+            v[i] = away_from_zero(v[i], k);
+            let m = json!({
+                "numerator_f32": v[..3].iter().map(|&x| x as f64).collect::<Vec<_>>(),
+                "denominator_f32": v[3..].iter().map(|&x| x as f64).collect::<Vec<_>>(),
+            });
+            committed_f32(&model, &c, &m, "t")
+        };
+        for i in 0..4 {
+            for k in [0, 1, -1, 64, -64] {
+                let (num, den) = check(i, k).unwrap_or_else(|e| panic!("coefficient {i} moved {k} ulps rejected: {e}"));
+                assert_eq!(num.len() + den.len(), 4);
+            }
+            for k in [65, -65, 512, -512] {
+                match check(i, k) {
+                    Err(BuildError::F32Coefficients { why, .. }) => assert!(why.contains("ulps"), "{why}"),
+                    other => panic!("coefficient {i} moved {k} ulps accepted: {other:?}"),
+                }
+            }
+        }
+        // A fixed coefficient (here c1 = −1.7, emitted as its rounded value) may not move at all,
+        // while the others still may: an unmoved fixed one is accepted beside a moved free one.
+        let fixed = fit::RationalModel::new(fit::model::ModelParts {
+            inputs: vec!["x".into()],
+            numerator: ["1", "x", "x^2"].iter().map(|t| fit::model::Term::parse(t, &["x".to_string()]).unwrap()).collect(),
+            denominator: vec![fit::model::Term::parse("x", &["x".to_string()]).unwrap()],
+            fixed: vec![(1, -1.7)],
+            ..fit::model::ModelParts::default()
+        })
+        .unwrap();
+        let with = |moves: [i32; 4]| {
+            let v: Vec<f64> = r.iter().zip(moves).map(|(&x, k)| away_from_zero(x, k) as f64).collect();
+            committed_f32(&fixed, &c, &json!({"numerator_f32": v[..3].to_vec(), "denominator_f32": v[3..].to_vec()}), "t")
+        };
+        assert!(with([0, 0, 0, 0]).is_ok());
+        assert!(with([3, 0, -5, 64]).is_ok(), "free coefficients moved, the fixed one not");
+        for k in [1, -1] {
+            match with([0, k, 0, 0]) {
+                Err(BuildError::F32Coefficients { why, .. }) => assert!(why.contains("fixed"), "{why}"),
+                other => panic!("fixed coefficient moved {k} ulp accepted: {other:?}"),
+            }
+        }
+        // A value that is not an f32 at all, and a wrong count, are refused too.
+        let m = json!({"numerator_f32": [0.3, r[1] as f64, r[2] as f64], "denominator_f32": [r[3] as f64]});
+        assert!(matches!(committed_f32(&model, &c, &m, "t"), Err(BuildError::F32Coefficients { .. })));
+        let m = json!({"numerator_f32": [r[0] as f64, r[1] as f64], "denominator_f32": [r[3] as f64]});
+        assert!(matches!(committed_f32(&model, &c, &m, "t"), Err(BuildError::F32Coefficients { .. })));
+    }
+}

@@ -417,4 +417,123 @@ mod tests {
         // Both outcomes occur, so the property was exercised both ways.
         assert!(yes > 300 && no > 300, "{yes} proven, {no} not");
     }
+
+    #[test]
+    fn two_dimensional_proofs_with_a_derived_feature_hold_under_dense_sampling() {
+        // Q = 1 + b₁x + b₂y + b₃xy + b₄x² + b₅c² with c = cos(y) a derived feature, on random
+        // boxes inside [−1.5, 1.5]²: whenever the proof holds, Q at the 161 × 161 points of the
+        // box (f64, to ~1e-15) stays above the bound; a NotProven region with a negative sample
+        // at its centre really has Q < 0 there (checked independently).
+        use crate::fit::model::{Derived, ModelParts, Term};
+        let inputs = vec!["x".to_string(), "y".to_string()];
+        let derived = vec![Derived::parse("c", "cos(y)", &inputs).unwrap()];
+        let features = vec!["x".to_string(), "y".to_string(), "c".to_string()];
+        let term = |t: &str| Term::parse(t, &features).unwrap();
+        let model = RationalModel::new(ModelParts {
+            inputs: inputs.clone(),
+            derived,
+            numerator: vec![term("1")],
+            denominator: ["x", "y", "x*y", "x^2", "c^2"].into_iter().map(term).collect(),
+            ..ModelParts::default()
+        })
+        .unwrap();
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut uniform = |lo: f64, hi: f64| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            lo + (hi - lo) * (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let (mut yes, mut no) = (0, 0);
+        for _ in 0..300 {
+            let b: Vec<f64> = (0..5).map(|_| uniform(-1.2, 1.2)).collect();
+            let q = |x: f64, y: f64| 1.0 + b[0] * x + b[1] * y + b[2] * x * y + b[3] * x * x + b[4] * y.cos() * y.cos();
+            let (x0, y0) = (uniform(-1.5, 1.0), uniform(-1.5, 1.0));
+            let dom = [(x0, (x0 + uniform(0.05, 1.5)).min(1.5)), (y0, (y0 + uniform(0.05, 1.5)).min(1.5))];
+            let mut c = vec![1.0];
+            c.extend_from_slice(&b);
+            let n = 160;
+            let at = |k: usize, (a, b): (f64, f64)| a + (b - a) * k as f64 / n as f64;
+            let min = (0..=n)
+                .flat_map(|i| (0..=n).map(move |j| (i, j)))
+                .map(|(i, j)| q(at(i, dom[0]), at(j, dom[1])))
+                .fold(f64::INFINITY, f64::min);
+            match prove_denominator_positive(&model, &DVector::from_vec(c), &dom) {
+                Positivity::Proven { lower, .. } => {
+                    yes += 1;
+                    assert!(lower > 1e-12 && min >= lower - 1e-14, "b = {b:?} on {dom:?}: bound {lower}, sampled min {min}");
+                }
+                Positivity::NotProven { region, sample, .. } => {
+                    no += 1;
+                    let centre = [0.5 * (region[0].0 + region[0].1), 0.5 * (region[1].0 + region[1].1)];
+                    // The reported sample is Q at the region's centre.
+                    assert!((sample - q(centre[0], centre[1])).abs() <= 1e-14, "{sample} vs {}", q(centre[0], centre[1]));
+                }
+            }
+        }
+        assert!(yes > 30 && no > 30, "{yes} proven, {no} not");
+    }
+
+    /// Q = 1 + b₁x + b₂x² + 0·y on `domain` (x, y): the 2-D model of the bisection tests.
+    fn prove_xy(b: [f64; 2], domain: [(f64, f64); 2]) -> Positivity {
+        use crate::fit::model::{ModelParts, Term};
+        let features = vec!["x".to_string(), "y".to_string()];
+        let term = |t: &str| Term::parse(t, &features).unwrap();
+        let model = RationalModel::new(ModelParts {
+            inputs: features.clone(),
+            numerator: vec![term("1")],
+            denominator: vec![term("x"), term("x^2"), term("y")],
+            ..ModelParts::default()
+        })
+        .unwrap();
+        prove_denominator_positive(&model, &DVector::from_vec(vec![1.0, b[0], b[1], 0.0]), &domain)
+    }
+
+    #[test]
+    fn a_constant_denominator_is_one_box() {
+        // No feature in the box (dim 0): Q = 1, proven at once with the bound 1.
+        let m = RationalModel::rational_1d("x", 0, 0);
+        assert_eq!(prove_denominator_positive(&m, &DVector::from_vec(vec![1.0]), &[]), Positivity::Proven { lower: 1.0, boxes: 1 });
+        // A linear Q is bounded exactly on one box (monotone: no overestimation), so no
+        // bisection: Q = 1 − 0.9x on [0, 1] in one box.
+        assert!(matches!(prove(1, &[-0.9], (0.0, 1.0)), Positivity::Proven { boxes: 1, .. }));
+        // The near-tangent quadratic needs bisection: more than one box.
+        let q = prove(2, &[-4.0 / (1.0 + 1e-6), 4.0 / (1.0 + 1e-6)], (0.0, 1.0));
+        assert!(matches!(q, Positivity::Proven { boxes, .. } if boxes > 1), "{q:?}");
+    }
+
+    #[test]
+    fn a_sign_change_is_reported_where_first_seen() {
+        // Q = 1 − 2x on [0, 1]: the first box's bound is −1 and its centre is the root itself,
+        // so the proof stops there: the whole box, Q(½) = 0, the bound of the box.
+        match prove(1, &[-2.0], (0.0, 1.0)) {
+            Positivity::NotProven { lower, region, sample } => {
+                assert_eq!(region, vec![(0.0, 1.0)]);
+                assert_eq!(sample, 0.0);
+                // A rigorous bound of the exact minimum −1, within a few ulps of it.
+                assert!((-1.0 - 1e-14..=-1.0).contains(&lower), "{lower}");
+            }
+            p => panic!("{p:?}"),
+        }
+    }
+
+    #[test]
+    fn bisection_takes_the_widest_side() {
+        // Q = 4(x ∓ ½)² + ε (scaled to Q(0) = 1, ε = 1e-3) needs x bisected; y has a zero
+        // coefficient and a narrower side: far from zero, or starting at zero (end ratio ∞),
+        // or beside an x side of negative ends. The proof holds only if the side bisected is
+        // the widest, not the one with the largest ends, sum or ratio (bisecting y alone runs
+        // into the 1e-9 width limit).
+        let eps = 1e-3;
+        let right = [-4.0 / (1.0 + eps), 4.0 / (1.0 + eps)]; // minimum at x = ½
+        let left = [4.0 / (1.0 + eps), 4.0 / (1.0 + eps)]; // minimum at x = −½
+        for (b, dom) in [
+            (right, [(0.0, 1.0), (10.0, 10.001)]),
+            (right, [(0.25, 1.25), (0.0, 0.001)]),
+            (left, [(-1.0, 0.0), (0.0, 0.001)]),
+        ] {
+            let p = prove_xy(b, dom);
+            assert!(matches!(p, Positivity::Proven { lower, .. } if lower > 1e-12 && lower <= eps / (1.0 + eps)), "{dom:?}: {p:?}");
+        }
+    }
 }

@@ -4,7 +4,7 @@ Checks the release binary (target/release/shadefit, or $SHADEFIT_BIN) and the co
 generated/json files against independent scipy/nlopt computations:
 
 * test_integrals.py  -- `shadefit eval` against quad/brentq of the defining integrals;
-* test_fits.py       -- the committed fits against scipy least_squares and nlopt on the same
+* test_fits.py       -- every fit spec, fresh (`build --only` in a scratch folder) and committed, against scipy least_squares and nlopt on the same
                         samples and model form (objective and wall time of every method go to
                         out/fit_comparison.json);
 * test_nist.py       -- `shadefit fit` on NIST StRD MGH09 and Kirby2 (certified RSS), beside scipy;

@@ -408,6 +408,122 @@ mod tests {
         assert_eq!(back, v);
     }
 
+    /// A small spec of each kind, built from scratch; its JSON's verification claims are then
+    /// re-measured here from the JSON alone (texels, axes) against the integral evaluated point
+    /// by point (`skin::punctual`, `skin::sh_band`), with this test's own interpolation.
+    fn remeasure(text: &str) {
+        let spec = crate::spec::Spec::parse(Path::new("fits/skin_t.toml"), text.to_string(), crate::family::catalog())
+            .expect("a valid skin spec");
+        let lut = SkinLut::from_spec(&spec).unwrap();
+        let built = build(&spec, Mode::Fit, Path::new("")).unwrap();
+        let json = built.artifacts.iter().find(|a| a.path.to_str().unwrap().ends_with(".json")).unwrap();
+        let v: Value = serde_json::from_slice(&json.contents).unwrap();
+        let texels: Vec<[f64; 3]> = v["values"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|t| std::array::from_fn(|c| t[c].as_f64().unwrap()))
+            .collect();
+        let (w, h) = (v["texture"]["width"].as_u64().unwrap() as usize, v["texture"]["height"].as_u64().unwrap() as usize);
+        let tol = tolerance(&lut);
+        let p = &lut.profile.profile;
+        // Fine grid: every texel and every midpoint, 2n − 1 points per axis of the mapped
+        // coordinate (the grid the claims are stated on); at each point the texel coordinate
+        // (x, y), the integral, and the interpolation in f64 and over the f32 texels.
+        let n = lut.curvature_count;
+        let kappa_at = |t: f64| skin::mapped_curvature(t, lut.curvature_max, lut.curvature_mapping);
+        let lerp = |a: f64, b: f64, f: f64| a + (b - a) * f;
+        let interp = |row: &[[f64; 3]], x: f64, c: usize| {
+            let i = (x.floor() as usize).min(row.len() - 2);
+            lerp(row[i][c], row[i + 1][c], x - i as f64)
+        };
+        let texel32 = |t: &[f64; 3]| t.map(|x| x as f32 as f64);
+        let (mut max64, mut max32, mut ss64, mut ss32, mut count) = (0.0f64, 0.0f64, 0.0, 0.0, 0usize);
+        let mut see = |approx: f64, approx32: f64, want: f64| {
+            let (e, e32) = ((approx - want).abs(), (approx32 - want).abs());
+            max64 = max64.max(e);
+            max32 = max32.max(e32);
+            ss64 += e * e;
+            ss32 += e32 * e32;
+            count += 1;
+        };
+        match lut.kind {
+            SkinLutKind::Punctual { kernel, n_dot_l, .. } => {
+                assert_eq!((w, h), (n_dot_l, n));
+                let rows: Vec<Vec<[f64; 3]>> = texels.chunks(w).map(<[_]>::to_vec).collect();
+                let rows32: Vec<Vec<[f64; 3]>> = rows.iter().map(|r| r.iter().map(texel32).collect()).collect();
+                for b in 0..2 * n - 1 {
+                    let kappa = kappa_at(b as f64 / (2 * n - 2) as f64);
+                    let y = b as f64 / 2.0;
+                    let j = (y.floor() as usize).min(n - 2);
+                    for a in 0..2 * n_dot_l - 1 {
+                        let nl = -1.0 + 2.0 * a as f64 / (2 * n_dot_l - 2) as f64;
+                        let x = a as f64 / 2.0;
+                        let want = skin::punctual(p, kernel, kappa, nl, tol).unwrap();
+                        for c in 0..3 {
+                            let two = |rs: &[Vec<[f64; 3]>]| lerp(interp(&rs[j], x, c), interp(&rs[j + 1], x, c), y - j as f64);
+                            see(two(&rows), two(&rows32), want[c].value);
+                        }
+                    }
+                }
+            }
+            SkinLutKind::Sh => {
+                assert_eq!((w, h), (n, 2));
+                for band in 1..=2u32 {
+                    let row = &texels[(band as usize - 1) * n..band as usize * n];
+                    let row32: Vec<[f64; 3]> = row.iter().map(texel32).collect();
+                    for a in 0..2 * n - 1 {
+                        let kappa = kappa_at(a as f64 / (2 * n - 2) as f64);
+                        let want = skin::sh_band(p, kappa, band, tol).unwrap();
+                        for c in 0..3 {
+                            see(interp(row, a as f64 / 2.0, c), interp(&row32, a as f64 / 2.0, c), want[c].value);
+                        }
+                    }
+                }
+            }
+        }
+        let ver = &v["verification"];
+        let claim = |k: &str| ver[k].as_f64().unwrap();
+        assert_eq!(ver["points"].as_u64().unwrap() as usize * 3, count);
+        // Both sides take the integral to the spec's tolerance (1e-9 per texel and point), and
+        // the texels enter the interpolation with weights summing to 1: the f64 claims agree
+        // with ours to 2·tol; interpolation order differs only by f64 rounding (1e-16).
+        let bound64 = 2.0 * lut.tolerance + 1e-15;
+        // The f32 lookup computes its coordinates in f32 (a few ulps of coordinates below 2n:
+        // 1e-5 of a texel at most here) and interpolates in f32 (three roundings of values
+        // ≤ 1: 2e-7): with texel steps ≤ 0.3 here, 1e-5 bounds the difference.
+        let bound32 = bound64 + 1e-5;
+        let rms = |ss: f64| (ss / count as f64).sqrt();
+        for (k, ours, bound) in [
+            ("max_abs_error", max64, bound64),
+            ("rms_error", rms(ss64), bound64),
+            ("max_abs_error_f32", max32, bound32),
+            ("rms_error_f32", rms(ss32), bound32),
+        ] {
+            assert!((claim(k) - ours).abs() <= bound, "{k}: claimed {:e}, re-measured {ours:e}", claim(k));
+        }
+        // Not a vacuous comparison: interpolation on these coarse grids errs by far more than
+        // the bounds above, and halving the claim would be visible.
+        assert!(max64 > 100.0 * bound32, "{max64:e}");
+    }
+
+    #[test]
+    fn verification_claims_are_re_measured_punctual() {
+        remeasure(
+            "name = \"skin_t\"\nkind = \"skin-lut\"\nquantity = \"skin-punctual\"\nresolution = [9, 5]\n\
+             curvature_max = 1.0\ncurvature_mapping = \"sqrt\"\nkernel = \"linear\"\ntolerance = 1e-9\n\n\
+             [emit]\nfunction = \"skin_t\"\n",
+        );
+    }
+
+    #[test]
+    fn verification_claims_are_re_measured_sh() {
+        remeasure(
+            "name = \"skin_t\"\nkind = \"skin-lut\"\nquantity = \"skin-sh\"\nresolution = [6]\n\
+             curvature_max = 2.0\ntolerance = 1e-9\n\n[emit]\nfunction = \"skin_t\"\n",
+        );
+    }
+
     #[test]
     fn bilinear_reproduces_planes() {
         let (w, h) = (4, 3);

@@ -957,6 +957,32 @@ mod tests {
     }
 
     #[test]
+    fn deon_luebke_constants_are_the_published_table() {
+        // GPU Gems 3, chapter 14 (d'Eon & Luebke 2007), Table 14-1: "the sum-of-Gaussians
+        // parameters for a three-layer skin model", variance (mm²) then red, green, blue weights,
+        // as printed (three decimals), typed here from the table rather than from the constant.
+        let table: [(f64, [f64; 3]); 6] = [
+            (0.0064, [0.233, 0.455, 0.649]),
+            (0.0484, [0.100, 0.336, 0.344]),
+            (0.187, [0.118, 0.198, 0.0]),
+            (0.567, [0.113, 0.007, 0.007]),
+            (1.99, [0.358, 0.004, 0.0]),
+            (7.41, [0.078, 0.0, 0.0]),
+        ];
+        assert_eq!(DEON_LUEBKE_SKIN.len(), table.len());
+        for (g, (v, w)) in DEON_LUEBKE_SKIN.iter().zip(table) {
+            // The same decimal literals parse to the same f64: exact equality.
+            assert_eq!(g.variance_mm2, v);
+            assert_eq!(g.weight, w);
+        }
+        // The chapter's own consistency: the variances grow, each channel's weights sum to 1
+        // (a normalised profile, white total diffuse reflectance), and the profile the default
+        // preset loads is this table.
+        assert!(DEON_LUEBKE_SKIN.windows(2).all(|p| p[0].variance_mm2 < p[1].variance_mm2));
+        assert_eq!(default_skin_profile(), Profile::Gaussians(table.iter().map(|&(v, w)| Gaussian { variance_mm2: v, weight: w }).collect()));
+    }
+
+    #[test]
     fn default_weights_sum_to_one() {
         // The published weights are given to 3 decimals and sum to 1.000 exactly in decimal;
         // in f64 the sum is within a few ulps.
