@@ -29,6 +29,9 @@ pub mod ggx_albedo_rational;
 #[path = "ggx_albedo_table.rs"]
 pub mod ggx_albedo_table;
 #[cfg(feature = "ggx")]
+#[path = "ggx_cone_lut.rs"]
+pub mod ggx_cone_lut;
+#[cfg(feature = "ggx")]
 #[path = "ggx_dfg_lut.rs"]
 pub mod ggx_dfg_lut;
 #[cfg(feature = "ggx")]
@@ -104,6 +107,8 @@ pub mod wgsl {
     #[cfg(feature = "ggx")]
     pub const GGX_ALBEDO_TABLE: &str = include_str!("../wgsl/ggx_albedo_table.wgsl");
     #[cfg(feature = "ggx")]
+    pub const GGX_CONE_LUT: &str = include_str!("../wgsl/ggx_cone_lut.wgsl");
+    #[cfg(feature = "ggx")]
     pub const GGX_DFG_LUT: &str = include_str!("../wgsl/ggx_dfg_lut.wgsl");
     #[cfg(feature = "ggx")]
     pub const GGX_DFG_LUT_FILAMENT: &str = include_str!("../wgsl/ggx_dfg_lut_filament.wgsl");
@@ -161,6 +166,8 @@ pub mod wgsl {
             "ggx_albedo_rational" => Some(GGX_ALBEDO_RATIONAL),
             #[cfg(feature = "ggx")]
             "ggx_albedo_table" => Some(GGX_ALBEDO_TABLE),
+            #[cfg(feature = "ggx")]
+            "ggx_cone_lut" => Some(GGX_CONE_LUT),
             #[cfg(feature = "ggx")]
             "ggx_dfg_lut" => Some(GGX_DFG_LUT),
             #[cfg(feature = "ggx")]
@@ -221,6 +228,8 @@ pub mod wgsl {
         "ggx_albedo_rational",
         #[cfg(feature = "ggx")]
         "ggx_albedo_table",
+        #[cfg(feature = "ggx")]
+        "ggx_cone_lut",
         #[cfg(feature = "ggx")]
         "ggx_dfg_lut",
         #[cfg(feature = "ggx")]

@@ -206,6 +206,7 @@ fn items(generated: &Path) -> Vec<Item> {
 
 fn figures(out: &Path, generated: &Path) -> Result<Vec<PathBuf>, PlotError> {
     let mut files = lut::figures(out, generated)?;
+    files.extend(occlusion::lut::plot::figures(out, generated)?);
     files.extend(published::figures(out, generated)?);
     files.extend(compensation::figures(out, generated)?);
     Ok(files)
@@ -216,7 +217,7 @@ pub static FAMILY: Family = Family {
     name: "ggx",
     doc: "GGX split-sum: DFG scale/bias (with a visibility cone), E(mu), E_avg, Fresnel averages, energy compensation",
     quantities: QUANTITIES,
-    spec_kinds: &[lut::DFG_LUT, published::emit::REFITS, occlusion::emit::OCCLUSION],
+    spec_kinds: &[lut::DFG_LUT, published::emit::REFITS, occlusion::emit::OCCLUSION, occlusion::lut::CONE_LUT],
     eval_options: None,
     validate: items,
     figures,

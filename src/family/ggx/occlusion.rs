@@ -28,6 +28,7 @@
 //!   r = perceptual roughness), over the specular cone's solid angle ([`cap_intersection`]).
 
 pub mod emit;
+pub mod lut;
 
 use super::integrals::{self, EnvEstimate, Shadowing};
 use crate::validate::{Item, measure};
