@@ -200,13 +200,14 @@ pub static QUANTITIES: &[QuantityDef] = &[
 fn items(generated: &Path) -> Vec<Item> {
     let mut items = published::items(generated);
     items.extend(compensation::items(generated));
-    items.extend(occlusion::items());
+    items.extend(occlusion::items(generated));
     items
 }
 
 fn figures(out: &Path, generated: &Path) -> Result<Vec<PathBuf>, PlotError> {
     let mut files = lut::figures(out, generated)?;
     files.extend(occlusion::lut::plot::figures(out, generated)?);
+    files.extend(occlusion::plot::figures(out, generated)?);
     files.extend(published::figures(out, generated)?);
     files.extend(compensation::figures(out, generated)?);
     Ok(files)

@@ -17,6 +17,9 @@ pub struct Committed {
     pub depth: usize,
     /// The row parameter: "gloss", "roughness" or "alpha".
     pub row: String,
+    /// The layout's name: "scale-bias" (stored R, G = scale, bias) or "filament" (bias, scale + bias).
+    pub layout: String,
+    /// [scale, bias] in f64 (whatever the layout stores).
     pub values: Vec<[f64; 2]>,
     pub error_map: Vec<f64>,
 }
@@ -43,8 +46,9 @@ pub fn read(path: &Path) -> Result<Option<Committed>, PlotError> {
         return Err(err(&format!("{} values, {} error map cells for a {width}×{height}×{depth} texture", values.len(), error_map.len())));
     }
     let row = v["axes"][1]["name"].as_str().unwrap_or("gloss").to_string();
+    let layout = v["layout"]["name"].as_str().unwrap_or("scale-bias").to_string();
     let name = v["name"].as_str().ok_or_else(|| err("no name"))?.to_string();
-    Ok(Some(Committed { name, width, height, depth, row, values, error_map }))
+    Ok(Some(Committed { name, width, height, depth, row, layout, values, error_map }))
 }
 
 /// The committed cone LUTs in `generated/json`, in file-name order.
