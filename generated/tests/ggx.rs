@@ -81,4 +81,33 @@ mod cone {
             assert!((m[ch] - 0.5 * (a[ch] + b[ch])).abs() <= 4e-7, "{m:?} vs {a:?}, {b:?}");
         }
     }
+
+    /// Special f32 inputs (signed zeros, denormals, infinities, NaN, out of the domain) and a
+    /// coarse grid, for every argument of the 3-argument cone functions.
+    fn specials() -> Vec<f32> {
+        let mut v = vec![0.0, -0.0, 1e-45, -1e-45, f32::MIN_POSITIVE, f32::INFINITY, f32::NEG_INFINITY, f32::NAN, f32::MAX, f32::MIN, 1.0, 1.0 + f32::EPSILON, -1.0, 0.05];
+        v.extend((0..=20).map(|i| i as f32 / 20.0));
+        v
+    }
+
+    #[test]
+    fn cone_functions_are_finite_and_in_range_for_every_input() {
+        use shadefit_runtime::{ggx_cone_bias_rational as br, ggx_cone_scale_rational as sr};
+        // Scale and bias lie in [0, 1] (clamped fits; f16 texels of values in [0, 1], convex
+        // combinations of them): no allowance needed.
+        let s = specials();
+        for &a in &s {
+            for &b in &s {
+                for &c in &s {
+                    let t = cone::ggx_cone_dfg_scale_bias(a, b, c);
+                    let f = [sr::ggx_cone_scale(a, b, c), br::ggx_cone_bias(a, b, c)];
+                    for v in t.into_iter().chain(f) {
+                        assert!(v.is_finite() && (0.0..=1.0).contains(&v), "({a:e}, {b:e}, {c:e}): {t:?} {f:?}");
+                    }
+                }
+            }
+        }
+        // The (1 − cos θc) factor: the closed cone is exactly 0, as the table's last slice.
+        assert_eq!((sr::ggx_cone_scale(0.3, 0.5, 1.0), br::ggx_cone_bias(0.3, 0.5, 1.0)), (0.0, 0.0));
+    }
 }

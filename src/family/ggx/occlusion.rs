@@ -26,6 +26,11 @@
 //!   cone–cone intersection): the solid angle shared by the visibility cone (axis n, cos α_v =
 //!   sqrt(1 − V)) and a specular cone about the mirror direction (cos α_s = 2^(−3.321928 r²),
 //!   r = perceptual roughness), over the specular cone's solid angle ([`cap_intersection`]).
+//! - Both refitted in their own shape to the cone model ([`refits`]), and COD: WWII's 3-D table
+//!   ([`lut`]) read trilinearly as a shader would ([`LutReader`]).
+//! - Jimenez et al. 2016's multi-bounce AO, max(V, ((aV + b)V + c)V) with a, b, c linear in ρ
+//!   ([`jimenez_multibounce`]), against the interreflection model above (not the data it was
+//!   fitted to, which has no closed form), with the same cubic refitted to the model.
 
 pub mod emit;
 pub mod lut;
@@ -278,7 +283,8 @@ pub fn typo_item() -> Item {
 }
 
 /// Every occlusion item: the typo finding, the published approximations and their refits
-/// against the cone model, then the committed 3-D tables in `generated` read as a shader would.
+/// against the cone model, the committed 3-D tables in `generated` read as a shader would, and
+/// Jimenez's multi-bounce fit against the interreflection model.
 pub fn items(generated: &Path) -> Vec<Item> {
     let pts = grid();
     let refs = reference(&pts);
@@ -346,7 +352,59 @@ pub fn items(generated: &Path) -> Vec<Item> {
     );
     let mut out = vec![typo_item(), lagarde_item, lagarde_refit_item, jimenez_item, jimenez_refit_item];
     out.extend(lut_items(generated, &pts, &refs));
+    out.push(multibounce_item());
     out
+}
+
+/// Jimenez et al. 2016's multi-bounce fit: a, b, c of ((aV + b)V + c)V, each linear in the
+/// albedo ρ: [a₁, a₀, b₁, b₀, c₁, c₀] with a = a₁ρ + a₀ (their Eq. 10).
+pub const JIMENEZ_MULTIBOUNCE: [f64; 6] = [2.0404, -0.3324, -4.7951, 0.6417, 2.7552, 0.6903];
+
+/// max(V, ((aV + b)V + c)V) with a, b, c linear in ρ (`p` as [`JIMENEZ_MULTIBOUNCE`]).
+pub fn jimenez_multibounce(p: &[f64], v: f64, albedo: f64) -> f64 {
+    let a = p[0] * albedo + p[1];
+    let b = p[2] * albedo + p[3];
+    let c = p[4] * albedo + p[5];
+    v.max(((a * v + b) * v + c) * v)
+}
+
+/// The multi-bounce item: Jimenez's fit against COD: WWII's interreflection model, and the
+/// same cubic refitted (minimax) to that model.
+fn multibounce_item() -> Item {
+    use super::published::refit::nelder_mead;
+    // V and ρ at 65 uniform points each, [0, 1]² (the model is smooth: a uniform grid suffices).
+    let pts: Vec<Vec<f64>> = (0..=64).flat_map(|i| (0..=64).map(move |j| vec![i as f64 / 64.0, j as f64 / 64.0])).collect();
+    let truth: Vec<f64> = pts.iter().map(|p| if p[0] == 0.0 { 0.0 } else { interreflected(p[0], p[1]) }).collect();
+    let max_err = |q: &[f64]| pts.iter().zip(&truth).map(|(p, t)| (jimenez_multibounce(q, p[0], p[1]) - t).abs()).fold(0.0, f64::max);
+    let approx: Vec<f64> = pts.iter().map(|p| jimenez_multibounce(&JIMENEZ_MULTIBOUNCE, p[0], p[1])).collect();
+    let mut item = Item::measured(
+        "multi-bounce AO: Jimenez et al. 2016 against COD: WWII's interreflection model",
+        "Jimenez, Wu, Pesce, Jarabo 2016 (multi-bounce fit, Eq. 10); COD: WWII A′ = A/(1 − ρ + ρA)",
+        "visibility V × albedo ρ on [0, 1]² (65 × 65 uniform points)",
+        &pts,
+        &truth,
+        &approx,
+    );
+    let (refit, refit_max) = nelder_mead(max_err, &JIMENEZ_MULTIBOUNCE);
+    let refit_vals: Vec<f64> = pts.iter().map(|p| jimenez_multibounce(&refit, p[0], p[1])).collect();
+    let (_, refit_rms, refit_worst) = measure(&pts, &truth, &refit_vals);
+    item.extra.push(("refit_max_abs_error".into(), refit_max));
+    item.extra.push(("refit_rms_error".into(), refit_rms));
+    item.findings.push(
+        "Jimenez et al. fitted their cubic to multi-bounce ambient occlusion simulated in their test scenes, a target with \
+         no closed form to restate; it is measured here against the one closed-form interreflection model at hand, COD: \
+         WWII's A′ = A/(1 − ρ + ρA) (a cavity whose walls fill the fraction 1 − A of the view, every bounce seeing the same \
+         visibility A: A Σ ((1 − A)ρ)^k), which is a different model: the error is the two models' disagreement, not \
+         the fit's error against its own data."
+            .into(),
+    );
+    item.findings.push(format!(
+        "The same shape refitted minimax to the COD model: a, b, c = ({:.4}ρ {:+.4}, {:.4}ρ {:+.4}, {:.4}ρ {:+.4}); max {refit_max:.3e}, \
+         rms {refit_rms:.3e}, worst at [V, ρ] = {refit_worst:.3?} (published constants: max {:.3e}, rms {:.3e}). The cubic cannot \
+         follow the model's pole-like rise at ρ → 1, V → 0 (A′ = 1 for ρ = 1 and any A > 0).",
+        refit[0], refit[1], refit[2], refit[3], refit[4], refit[5], item.max_abs_error, item.rms_error
+    ));
+    item
 }
 
 /// The row coordinate of a committed cone LUT at α (its mapping inverted; gloss clamped to
@@ -546,6 +604,18 @@ mod tests {
         let (l, j) = refits();
         println!("LAGARDE_REFIT = [{:?}, {:?}]; JIMENEZ_REFIT = {:?}", l[0], l[1], j);
         assert_eq!((l, j), (LAGARDE_REFIT, JIMENEZ_REFIT));
+    }
+
+    #[test]
+    fn multibounce_fit_and_model_limits() {
+        // The COD model: A′ = A at ρ = 0, 1 at ρ = 1; Jimenez's cubic at ρ = 0 is
+        // max(V, ((−0.3324V + 0.6417)V + 0.6903)V), 0.9996 at V = 1 (the sum of its constants).
+        assert_eq!(jimenez_multibounce(&JIMENEZ_MULTIBOUNCE, 0.0, 0.7), 0.0);
+        assert!((jimenez_multibounce(&JIMENEZ_MULTIBOUNCE, 1.0, 0.0) - 0.9996).abs() < 1e-12);
+        // Never below V (the max).
+        for &(v, r) in &[(0.2, 0.0), (0.5, 0.5), (0.9, 1.0)] {
+            assert!(jimenez_multibounce(&JIMENEZ_MULTIBOUNCE, v, r) >= v);
+        }
     }
 
     #[test]
