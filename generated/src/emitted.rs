@@ -29,6 +29,15 @@ pub mod ggx_albedo_rational;
 #[path = "ggx_albedo_table.rs"]
 pub mod ggx_albedo_table;
 #[cfg(feature = "ggx")]
+#[path = "ggx_cone_bias_rational.rs"]
+pub mod ggx_cone_bias_rational;
+#[cfg(feature = "ggx")]
+#[path = "ggx_cone_lut.rs"]
+pub mod ggx_cone_lut;
+#[cfg(feature = "ggx")]
+#[path = "ggx_cone_scale_rational.rs"]
+pub mod ggx_cone_scale_rational;
+#[cfg(feature = "ggx")]
 #[path = "ggx_dfg_lut.rs"]
 pub mod ggx_dfg_lut;
 #[cfg(feature = "ggx")]
@@ -104,6 +113,12 @@ pub mod wgsl {
     #[cfg(feature = "ggx")]
     pub const GGX_ALBEDO_TABLE: &str = include_str!("../wgsl/ggx_albedo_table.wgsl");
     #[cfg(feature = "ggx")]
+    pub const GGX_CONE_BIAS_RATIONAL: &str = include_str!("../wgsl/ggx_cone_bias_rational.wgsl");
+    #[cfg(feature = "ggx")]
+    pub const GGX_CONE_LUT: &str = include_str!("../wgsl/ggx_cone_lut.wgsl");
+    #[cfg(feature = "ggx")]
+    pub const GGX_CONE_SCALE_RATIONAL: &str = include_str!("../wgsl/ggx_cone_scale_rational.wgsl");
+    #[cfg(feature = "ggx")]
     pub const GGX_DFG_LUT: &str = include_str!("../wgsl/ggx_dfg_lut.wgsl");
     #[cfg(feature = "ggx")]
     pub const GGX_DFG_LUT_FILAMENT: &str = include_str!("../wgsl/ggx_dfg_lut_filament.wgsl");
@@ -161,6 +176,12 @@ pub mod wgsl {
             "ggx_albedo_rational" => Some(GGX_ALBEDO_RATIONAL),
             #[cfg(feature = "ggx")]
             "ggx_albedo_table" => Some(GGX_ALBEDO_TABLE),
+            #[cfg(feature = "ggx")]
+            "ggx_cone_bias_rational" => Some(GGX_CONE_BIAS_RATIONAL),
+            #[cfg(feature = "ggx")]
+            "ggx_cone_lut" => Some(GGX_CONE_LUT),
+            #[cfg(feature = "ggx")]
+            "ggx_cone_scale_rational" => Some(GGX_CONE_SCALE_RATIONAL),
             #[cfg(feature = "ggx")]
             "ggx_dfg_lut" => Some(GGX_DFG_LUT),
             #[cfg(feature = "ggx")]
@@ -222,6 +243,12 @@ pub mod wgsl {
         #[cfg(feature = "ggx")]
         "ggx_albedo_table",
         #[cfg(feature = "ggx")]
+        "ggx_cone_bias_rational",
+        #[cfg(feature = "ggx")]
+        "ggx_cone_lut",
+        #[cfg(feature = "ggx")]
+        "ggx_cone_scale_rational",
+        #[cfg(feature = "ggx")]
         "ggx_dfg_lut",
         #[cfg(feature = "ggx")]
         "ggx_dfg_lut_filament",
@@ -278,6 +305,10 @@ pub const FUNCTIONS: &[EmittedFunction] = &[
     EmittedFunction { module: "ggx_albedo_rational", name: "ggx_albedo", domain: &[[1e-4, 1e0], [7.8125e-3, 1e0]], cpu: Cpu::Two(ggx_albedo_rational::ggx_albedo) },
     #[cfg(feature = "ggx")]
     EmittedFunction { module: "ggx_albedo_table", name: "ggx_albedo_lut", domain: &[[1e-4, 1e0], [0e0, 1e0]], cpu: Cpu::Two(ggx_albedo_table::ggx_albedo_lut) },
+    #[cfg(feature = "ggx")]
+    EmittedFunction { module: "ggx_cone_bias_rational", name: "ggx_cone_bias", domain: &[[1e-1, 1e0], [7.8125e-3, 1e0], [0e0, 1e0]], cpu: Cpu::Three(ggx_cone_bias_rational::ggx_cone_bias) },
+    #[cfg(feature = "ggx")]
+    EmittedFunction { module: "ggx_cone_scale_rational", name: "ggx_cone_scale", domain: &[[1e-1, 1e0], [7.8125e-3, 1e0], [0e0, 1e0]], cpu: Cpu::Three(ggx_cone_scale_rational::ggx_cone_scale) },
     #[cfg(feature = "ggx")]
     EmittedFunction { module: "ggx_env_bias_rational", name: "ggx_env_bias", domain: &[[1e-6, 1e0], [7.8125e-3, 1e0]], cpu: Cpu::Two(ggx_env_bias_rational::ggx_env_bias) },
     #[cfg(feature = "ggx")]

@@ -41,3 +41,73 @@ fn both_layouts_decode_to_the_same_scale_and_bias() {
         }
     }
 }
+
+mod cone {
+    //! The cone LUT (COD: WWII's 3-D table): a 3-D RG16F texture whose lookups hit the texels
+    //! at the centres and on the slices, interpolate linearly in cos θc between slices, and whose
+    //! first slice holds what the 2-D table holds where the two share a sample.
+    use shadefit_runtime::ggx_cone_lut as cone;
+
+    #[test]
+    fn ktx2_header_is_a_3d_rg16f_texture_of_the_size() {
+        let bytes = cone::GGX_CONE_LUT_KTX2;
+        let u32_at = |k: usize| u32::from_le_bytes(bytes[k..k + 4].try_into().unwrap());
+        assert_eq!(&bytes[1..4], b"KTX");
+        assert_eq!(u32_at(12), 83, "VK_FORMAT_R16G16_SFLOAT");
+        // pixelWidth, pixelHeight, pixelDepth, layerCount (0: not an array).
+        assert_eq!([u32_at(20), u32_at(24), u32_at(28)], cone::GGX_CONE_LUT_SIZE);
+        assert_eq!(u32_at(32), 0);
+    }
+
+    #[test]
+    fn lookups_hit_texels_on_slices_and_are_linear_between_them() {
+        let [w, h, d] = cone::GGX_CONE_LUT_SIZE;
+        for (i, j, k) in [(0, 0, 0), (5, 17, 3), (w - 1, h - 1, d - 1), (16, 3, 6)] {
+            // (i + 0.5)/n is dyadic and k/(d − 1)·(d − 1) rounds back to k: exact weights of 0.
+            let (u, g, c) = ((i as f32 + 0.5) / w as f32, (j as f32 + 0.5) / h as f32, k as f32 / (d - 1) as f32);
+            assert_eq!(cone::ggx_cone_dfg(u, g, c), cone::ggx_cone_dfg_texel(i, j, k));
+        }
+        // The closed cone is zero; NaN and out-of-range arguments clamp.
+        assert_eq!(cone::ggx_cone_dfg(0.5, 0.5, 1.0), [0.0, 0.0]);
+        assert_eq!(cone::ggx_cone_dfg(f32::NAN, 2.0, -1.0), cone::ggx_cone_dfg_texel(0, h - 1, 0));
+        // Half way between slices 2 and 3 at a texel centre: the mean of the two texels. f32(2.5/7)·7
+        // lands within 2 ulps of 2.5 (weight error ≤ 2.4e-7 on |a − b| ≤ 1), plus the lerp's two
+        // roundings of values ≤ 1 (≤ 1.2e-7): 4e-7 bounds both.
+        let (u, g) = (10.5 / w as f32, 20.5 / h as f32);
+        let c = 2.5 / (d - 1) as f32;
+        let (a, b) = (cone::ggx_cone_dfg_texel(10, 20, 2), cone::ggx_cone_dfg_texel(10, 20, 3));
+        let m = cone::ggx_cone_dfg(u, g, c);
+        for ch in 0..2 {
+            assert!((m[ch] - 0.5 * (a[ch] + b[ch])).abs() <= 4e-7, "{m:?} vs {a:?}, {b:?}");
+        }
+    }
+
+    /// Special f32 inputs (signed zeros, denormals, infinities, NaN, out of the domain) and a
+    /// coarse grid, for every argument of the 3-argument cone functions.
+    fn specials() -> Vec<f32> {
+        let mut v = vec![0.0, -0.0, 1e-45, -1e-45, f32::MIN_POSITIVE, f32::INFINITY, f32::NEG_INFINITY, f32::NAN, f32::MAX, f32::MIN, 1.0, 1.0 + f32::EPSILON, -1.0, 0.05];
+        v.extend((0..=20).map(|i| i as f32 / 20.0));
+        v
+    }
+
+    #[test]
+    fn cone_functions_are_finite_and_in_range_for_every_input() {
+        use shadefit_runtime::{ggx_cone_bias_rational as br, ggx_cone_scale_rational as sr};
+        // Scale and bias lie in [0, 1] (clamped fits; f16 texels of values in [0, 1], convex
+        // combinations of them): no allowance needed.
+        let s = specials();
+        for &a in &s {
+            for &b in &s {
+                for &c in &s {
+                    let t = cone::ggx_cone_dfg_scale_bias(a, b, c);
+                    let f = [sr::ggx_cone_scale(a, b, c), br::ggx_cone_bias(a, b, c)];
+                    for v in t.into_iter().chain(f) {
+                        assert!(v.is_finite() && (0.0..=1.0).contains(&v), "({a:e}, {b:e}, {c:e}): {t:?} {f:?}");
+                    }
+                }
+            }
+        }
+        // The (1 − cos θc) factor: the closed cone is exactly 0, as the table's last slice.
+        assert_eq!((sr::ggx_cone_scale(0.3, 0.5, 1.0), br::ggx_cone_bias(0.3, 0.5, 1.0)), (0.0, 0.0));
+    }
+}

@@ -3,17 +3,17 @@
 //! randomness, fixed compression settings), so a build is byte-identical on every run.
 //!
 //! # KTX2 (Khronos KTX 2.0 specification, with the Khronos Data Format 1.3 descriptor)
-//! One 2-D image, one mip level, one layer, one face, no supercompression:
+//! One 2-D image (or one 3-D image: [`ktx2_volume`]), one mip level, one layer, one face, no supercompression:
 //!
 //! | bytes      | contents |
 //! |------------|----------|
 //! | 0..12      | identifier «KTX 20»\r\n\x1A\n |
-//! | 12..48     | vkFormat, typeSize, width, height, depth 0, layers 0, faces 1, levels 1, supercompression 0 |
+//! | 12..48     | vkFormat, typeSize, width, height, depth (0 for 2-D), layers 0, faces 1, levels 1, supercompression 0 |
 //! | 48..80     | index: DFD offset/length, key/value offset/length, no supercompression global data |
 //! | 80..104    | level 0: byte offset, byte length, uncompressed byte length |
 //! | 104..196   | DFD: total size, basic block (RGBSDA model, BT.709 primaries, *linear* transfer, straight alpha), 4 samples (R, G, B, A: float, signed) |
-//! | 196..      | key/value data (sorted by key): `KTXorientation` = `rd`, `KTXwriter`, `shadefit` (the generated-file header lines) |
-//! | aligned    | level 0 texels, row by row from the top (row 0 first), little-endian |
+//! | 196..      | key/value data (sorted by key): `KTXorientation` = `rd` (`rdi` for 3-D), `KTXwriter`, `shadefit` (the generated-file header lines) |
+//! | aligned    | level 0 texels, row by row from the top (row 0 first), slice after slice for 3-D, little-endian |
 //!
 //! The level data starts at a multiple of the texel size (8 bytes for RGBA16F, 16 for RGBA32F,
 //! both multiples of 4 as the specification requires). Two-channel textures (RG16F, RG32F:
@@ -195,9 +195,27 @@ pub fn ktx2_texels(
     format: TextureFormat,
     metadata: &[(&str, &str)],
 ) -> Vec<u8> {
-    assert_eq!(values.len(), (width * height) as usize * channels, "value count differs from width × height × channels");
+    ktx2_volume(width, height, 0, channels, values, format, metadata)
+}
+
+/// A KTX2 file of one `width`×`height`×`depth` 3-D image (pixelDepth = `depth`; 0 is a 2-D
+/// image, as [`ktx2_texels`]), `values[((z * height + y) * width + x) * channels + c]`: the
+/// slices one after the other (z = 0 first), each row by row from the top, as the KTX 2.0
+/// specification orders a level's image. `KTXorientation` is `rd` for 2-D and `rdi` for 3-D
+/// (x right, y down, z into the screen with the slice index).
+pub fn ktx2_volume(
+    width: u32,
+    height: u32,
+    depth: u32,
+    channels: usize,
+    values: &[f32],
+    format: TextureFormat,
+    metadata: &[(&str, &str)],
+) -> Vec<u8> {
+    assert_eq!(values.len(), (width * height * depth.max(1)) as usize * channels, "value count differs from width × height × depth × channels");
     let dfd = data_format_descriptor(format, channels);
-    let mut kv = vec![("KTXorientation", "rd"), ("KTXwriter", super::GENERATOR)];
+    let orientation = if depth == 0 { "rd" } else { "rdi" };
+    let mut kv = vec![("KTXorientation", orientation), ("KTXwriter", super::GENERATOR)];
     kv.extend_from_slice(metadata);
     let kvd = key_value_data(&kv);
     let dfd_offset = LEVEL_INDEX_END;
@@ -213,7 +231,7 @@ pub fn ktx2_texels(
 
     let mut out = Vec::with_capacity(level_offset + level.len());
     out.extend_from_slice(&KTX2_IDENTIFIER);
-    for v in [vk_format(format, channels), format.type_size(), width, height, 0, 0, 1, 1, 0] {
+    for v in [vk_format(format, channels), format.type_size(), width, height, depth, 0, 1, 1, 0] {
         put_u32(&mut out, v);
     }
     put_u32(&mut out, dfd_offset as u32);

@@ -178,3 +178,45 @@ def test_env_with_narrow_lobes_and_cones_to_1e_9(alpha, mu_v, c):
     assert out["error_estimate"] + ref_err <= 1e-9, (out, ref_err)
     got = np.array(out["value"])
     assert np.all(np.abs(got - want) <= 1e-9), (out, want.tolist())
+
+
+# The committed cone LUT (fits/ggx_cone_lut.toml, COD: WWII's 3-D table): seeded texels against
+# the light-space quadrature above, at the texel's own (n·v, gloss → α, cos θc). Each texel is
+# shadefit's integral to the spec's tolerance (per texel, each channel); the bound adds the
+# reference's estimate and the rounding allowance. The KTX2 file holds each texel rounded to f16
+# (numpy's float16 conversion is round-to-nearest-even, as the writer's).
+def _cone_lut_texels():
+    g = sf_cli.generated("ggx_cone_lut")
+    t = g["texture"]
+    w, h, d = t["width"], t["height"], t["depth"]
+    rng = np.random.default_rng(20261125)
+    picks = [(0, 0, 0), (w - 1, h - 1, d - 2), (w // 2, 0, d - 1)]
+    picks += [tuple(int(v) for v in (rng.integers(w), rng.integers(h), rng.integers(d - 1))) for _ in range(9)]
+    return g, picks
+
+
+_CONE_G, _CONE_PICKS = _cone_lut_texels()
+
+
+@pytest.mark.parametrize("i,j,k", _CONE_PICKS, ids=[f"{i},{j},{k}" for i, j, k in _CONE_PICKS])
+def test_cone_lut_texels_against_light_space_quadrature(i, j, k):
+    g = _CONE_G
+    t = g["texture"]
+    w, h, d = t["width"], t["height"], t["depth"]
+    assert g["axes"][1]["mapping"] == "gloss"
+    mu = (i + 0.5) / w
+    gloss = (j + 0.5) / h
+    alpha = math.sqrt(2.0 / (1.0 + 2.0 ** (18.0 * gloss)))
+    c = k / (d - 1)
+    got = np.array(g["values"][(k * h + j) * w + i])
+    if k == d - 1:
+        assert np.all(got == 0.0)
+        return
+    want, ref_err = reference_env(alpha, mu, c)
+    tol = g["quadrature"]["tolerance"] + ref_err + ROUNDING
+    assert np.all(np.abs(got - want) <= tol), (got.tolist(), want.tolist(), tol)
+    ktx = (sf_cli.ROOT / "generated" / t["ktx2"]).read_bytes()
+    assert int.from_bytes(ktx[28:32], "little") == d  # pixelDepth: a 3-D texture
+    offset = int.from_bytes(ktx[80:88], "little")
+    texels = np.frombuffer(ktx, dtype="<f2", offset=offset, count=w * h * d * 2).reshape(d, h, w, 2)
+    assert np.array_equal(texels[k, j, i], got.astype(np.float32).astype(np.float16))

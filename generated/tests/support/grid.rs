@@ -73,9 +73,15 @@ pub fn axis(lo: f32, hi: f32, dense: usize, nodes: usize) -> Vec<u32> {
 }
 
 /// All points of a function, flattened (arity words per point): the Cartesian product of its
-/// axes. One-argument functions get 2^16 dense values, two-argument ones 256 per axis.
+/// axes. One-argument functions get 2^16 dense values, two-argument ones 256 per axis and
+/// three-argument ones 48 per axis (about 10^6 points with the specials and nodes: 256 per axis
+/// would be 825 MB of inputs, over a device's 256 MiB buffer limit).
 pub fn points(f: &EmittedFunction, nodes: &[u32]) -> Vec<u32> {
-    let dense = if f.domain.len() == 1 { 1 << 16 } else { 256 };
+    let dense = match f.domain.len() {
+        1 => 1 << 16,
+        2 => 256,
+        _ => 48,
+    };
     let axes: Vec<Vec<u32>> = f
         .domain
         .iter()

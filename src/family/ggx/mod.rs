@@ -200,12 +200,14 @@ pub static QUANTITIES: &[QuantityDef] = &[
 fn items(generated: &Path) -> Vec<Item> {
     let mut items = published::items(generated);
     items.extend(compensation::items(generated));
-    items.extend(occlusion::items());
+    items.extend(occlusion::items(generated));
     items
 }
 
 fn figures(out: &Path, generated: &Path) -> Result<Vec<PathBuf>, PlotError> {
     let mut files = lut::figures(out, generated)?;
+    files.extend(occlusion::lut::plot::figures(out, generated)?);
+    files.extend(occlusion::plot::figures(out, generated)?);
     files.extend(published::figures(out, generated)?);
     files.extend(compensation::figures(out, generated)?);
     Ok(files)
@@ -216,7 +218,7 @@ pub static FAMILY: Family = Family {
     name: "ggx",
     doc: "GGX split-sum: DFG scale/bias (with a visibility cone), E(mu), E_avg, Fresnel averages, energy compensation",
     quantities: QUANTITIES,
-    spec_kinds: &[lut::DFG_LUT, published::emit::REFITS, occlusion::emit::OCCLUSION],
+    spec_kinds: &[lut::DFG_LUT, published::emit::REFITS, occlusion::emit::OCCLUSION, occlusion::lut::CONE_LUT],
     eval_options: None,
     validate: items,
     figures,

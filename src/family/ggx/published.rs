@@ -414,7 +414,12 @@ pub fn items(_generated: &Path) -> Vec<Item> {
 // Bench: shader forms of E
 
 /// Fit specs timed with every solver (the bench's fits section).
-pub static FITS: &[FitBench] = &[FitBench { spec: "ggx_albedo_rational", order: 20, quick: false }];
+pub static FITS: &[FitBench] = &[
+    FitBench { spec: "ggx_albedo_rational", order: 20, quick: false },
+    // The LUT-less forms of the split sum over a visibility cone (3-D grids, full runs only).
+    FitBench { spec: "ggx_cone_scale_rational", order: 21, quick: false },
+    FitBench { spec: "ggx_cone_bias_rational", order: 22, quick: false },
+];
 
 /// Shader forms per quantity (the bench's forms section).
 pub static FORMS: &[FormSet] = &[

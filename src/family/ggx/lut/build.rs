@@ -77,8 +77,8 @@ pub struct Quadrature {
 pub struct Measure {
     pub max_abs_error: f64,
     pub rms_error: f64,
-    /// (n·v, roughness or α) of the largest error.
-    pub worst_point: [f64; 2],
+    /// (n·v, roughness or α[, cos θc]) of the largest error.
+    pub worst_point: Vec<f64>,
     /// Largest error per stored channel (R, G).
     pub max_abs_error_per_channel: [f64; 2],
 }
@@ -104,14 +104,14 @@ pub struct Measured {
     pub error_map: Vec<f64>,
 }
 
-fn f16_texture(format: DfgFormat) -> TextureFormat {
+pub fn f16_texture(format: DfgFormat) -> TextureFormat {
     match format {
         DfgFormat::Rg16float | DfgFormat::Rgba16float => TextureFormat::Rgba16float,
     }
 }
 
 /// The stored channels in f32, as the texture holds them (f64 → f32 → f16).
-fn stored(lut: &DfgLut, values: &[[f64; 2]]) -> Vec<[f32; 2]> {
+pub fn stored(lut: &DfgLut, values: &[[f64; 2]]) -> Vec<[f32; 2]> {
     let f = f16_texture(lut.format);
     values.iter().map(|v| lut.layout.encode(*v).map(|x| f.stored(x as f32))).collect()
 }
@@ -135,19 +135,27 @@ fn bilinear(texels: &[[f64; 2]], (w, h): (usize, usize), u: f64, t: f64) -> [f64
     })
 }
 
-struct Accumulator {
+/// Max, sum of squares, worst point and per-channel max of (got − want) over points.
+pub struct Accumulator {
     max: f64,
     ss: f64,
-    worst: [f64; 2],
+    worst: Vec<f64>,
     per_channel: [f64; 2],
 }
 
+impl Default for Accumulator {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
 impl Accumulator {
-    fn new() -> Self {
-        Accumulator { max: -1.0, ss: 0.0, worst: [0.0; 2], per_channel: [0.0; 2] }
+    pub fn new() -> Self {
+        Accumulator { max: -1.0, ss: 0.0, worst: Vec::new(), per_channel: [0.0; 2] }
     }
 
-    fn add(&mut self, got: [f64; 2], want: [f64; 2], at: [f64; 2]) -> f64 {
+    /// Add one point; returns its larger channel error.
+    pub fn add(&mut self, got: [f64; 2], want: [f64; 2], at: &[f64]) -> f64 {
         let mut m = 0.0f64;
         for c in 0..2 {
             let e = (got[c] - want[c]).abs();
@@ -157,12 +165,13 @@ impl Accumulator {
         }
         if m > self.max {
             self.max = m;
-            self.worst = at;
+            self.worst = at.to_vec();
         }
         m
     }
 
-    fn finish(self, count: usize) -> Measure {
+    /// The measure over `count` points (2 channels each).
+    pub fn finish(self, count: usize) -> Measure {
         Measure {
             max_abs_error: self.max.max(0.0),
             rms_error: (self.ss / (2 * count) as f64).sqrt(),
@@ -173,7 +182,7 @@ impl Accumulator {
 }
 
 /// Three significant digits (the error map is a picture, not a claim).
-fn digits3(x: f64) -> f64 {
+pub fn digits3(x: f64) -> f64 {
     format!("{x:.2e}").parse().expect("a formatted float parses")
 }
 
@@ -199,15 +208,15 @@ pub fn verify(lut: &DfgLut, values: &[[f64; 2]]) -> Result<Measured, BuildError>
             }
             let want = lut.layout.encode([e.scale, e.bias]);
             let got = bilinear(&stored64, (w, h), u, t);
-            let m = tex.add(got, want, [u, t]);
+            let m = tex.add(got, want, &[u, t]);
             if inside(u, w) && inside(t, h) {
-                inner.add(got, want, [u, t]);
+                inner.add(got, want, &[u, t]);
                 inner_count += 1;
             }
             let cell = &mut map[(l / d) * w + k / d];
             *cell = cell.max(m);
-            l32.add(lookup_f32(&stored32, (w, h), u as f32, t as f32).map(f64::from), want, [u, t]);
-            interp.add(bilinear(&encoded, (w, h), u, t), want, [u, t]);
+            l32.add(lookup_f32(&stored32, (w, h), u as f32, t as f32).map(f64::from), want, &[u, t]);
+            interp.add(bilinear(&encoded, (w, h), u, t), want, &[u, t]);
         }
     }
     let n = truth.len();
@@ -255,10 +264,21 @@ fn describe(lut: &DfgLut) -> String {
     )
 }
 
-fn mapping_doc(lut: &DfgLut) -> String {
+/// The row mapping in words, for the emitted files' docs.
+pub fn mapping_doc(lut: &DfgLut) -> String {
     match lut.mapping {
         RoughnessMapping::Perceptual => format!("roughness r = (j + 0.5)/{}, α = r²", lut.height),
         RoughnessMapping::Alpha => format!("α = (j + 0.5)/{}", lut.height),
+        RoughnessMapping::Gloss => format!("gloss g = (j + 0.5)/{}, α = sqrt(2/(1 + 2^(18 g)))", lut.height),
+    }
+}
+
+/// α of the row coordinate t in the JSON's words.
+pub fn alpha_of_t(mapping: RoughnessMapping) -> &'static str {
+    match mapping {
+        RoughnessMapping::Perceptual => "alpha = t^2",
+        RoughnessMapping::Alpha => "alpha = t",
+        RoughnessMapping::Gloss => "alpha = sqrt(2/(1 + 2^(18 t))) (gloss)",
     }
 }
 
@@ -338,7 +358,7 @@ pub fn build(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> 
         "axes": [
             {"name": "n_dot_v", "texture_axis": "x", "count": w, "mapping": "linear", "texel_centres": "n_dot_v = (i + 0.5)/width"},
             {"name": lut.mapping.argument(), "texture_axis": "y", "count": h, "mapping": lut.mapping.name(),
-             "texel_centres": format!("t = (j + 0.5)/height, {}", if lut.mapping == RoughnessMapping::Perceptual { "alpha = t^2" } else { "alpha = t" })},
+             "texel_centres": format!("t = (j + 0.5)/height, {}", alpha_of_t(lut.mapping))},
         ],
         "texture": {
             "width": w,
@@ -359,7 +379,7 @@ pub fn build(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> 
         points: measured.points,
         max_abs_error: t.max_abs_error,
         rms_error: t.rms_error,
-        worst_point: t.worst_point.to_vec(),
+        worst_point: t.worst_point.clone(),
         max_abs_error_f32: measured.lookup_f32.max_abs_error,
         rms_error_f32: measured.lookup_f32.rms_error,
         max_abs_error_in_parameter: None,

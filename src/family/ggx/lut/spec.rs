@@ -7,8 +7,9 @@
 //! quantity = "ggx-env"             # or "ggx-env-ue4" (UE4's separable G, no cone)
 //! description = "..."
 //! resolution = [128, 128]          # [n·v columns, roughness rows]
-//! roughness_mapping = "perceptual" # optional: rows at perceptual roughness r (α = r²), or
-//!                                  # "alpha" (rows at α)
+//! roughness_mapping = "perceptual" # optional: rows at perceptual roughness r (α = r²),
+//!                                  # "alpha" (rows at α) or "gloss" (rows at COD: WWII gloss g,
+//!                                  # α = sqrt(2/(1 + 2^(18 g))))
 //! n_dot_v_mapping = "linear"       # optional: columns at n·v (the only mapping)
 //! layout = "scale-bias"            # optional: R = scale, G = bias (UE), or "filament":
 //!                                  # R = bias, G = scale + bias
@@ -21,7 +22,8 @@
 //! ```
 //!
 //! Texel (i, j) holds the integrals at n·v = (i + 0.5)/width and at row coordinate
-//! t = (j + 0.5)/height, α = t² (perceptual) or α = t (alpha): texel centres, as engines sample
+//! t = (j + 0.5)/height, α = t² (perceptual), α = t (alpha) or α = sqrt(2/(1 + 2^(18 t)))
+//! (gloss): texel centres, as engines sample
 //! the table at uv = (n·v, roughness) with no half-texel remap (UE's PreIntegratedGF,
 //! Filament's n·v axis, MaterialX, bevy). Row 0 is the first row of the texture (v = 0).
 //!
@@ -57,6 +59,9 @@ pub enum RoughnessMapping {
     Perceptual,
     /// Rows at α (MaterialX).
     Alpha,
+    /// Rows at COD: WWII gloss g, α = sqrt(2/(1 + 2^(18 g))) (the gloss family's mapping; gloss
+    /// 0 is α = 1, gloss 1 is α ≈ 0.00276).
+    Gloss,
 }
 
 impl RoughnessMapping {
@@ -64,6 +69,7 @@ impl RoughnessMapping {
         match self {
             RoughnessMapping::Perceptual => "perceptual",
             RoughnessMapping::Alpha => "alpha",
+            RoughnessMapping::Gloss => "gloss",
         }
     }
 
@@ -72,6 +78,7 @@ impl RoughnessMapping {
         match self {
             RoughnessMapping::Perceptual => "roughness",
             RoughnessMapping::Alpha => "alpha",
+            RoughnessMapping::Gloss => "gloss",
         }
     }
 
@@ -80,6 +87,7 @@ impl RoughnessMapping {
         match self {
             RoughnessMapping::Perceptual => t * t,
             RoughnessMapping::Alpha => t,
+            RoughnessMapping::Gloss => crate::family::gloss::integrals::alpha_from_gloss(t),
         }
     }
 }
@@ -264,6 +272,12 @@ impl DfgLut {
         self.mapping.alpha(self.row_coordinate(j))
     }
 
+    /// [lowest, highest] α of the rows' centres (gloss rows run from rough to smooth).
+    pub fn alpha_range(&self) -> [f64; 2] {
+        let (a, b) = (self.alpha(0), self.alpha(self.height - 1));
+        [a.min(b), a.max(b)]
+    }
+
     /// The shadowing at α (UE4's separable G takes k = α/2).
     pub fn shadowing_at(&self, alpha: f64) -> Shadowing {
         if self.ue4 { Shadowing::Separable { k: 0.5 * alpha } } else { Shadowing::HeightCorrelated }
@@ -273,7 +287,7 @@ impl DfgLut {
     fn spec_file(&self, path: &Path, text: &str) -> Result<SpecFile, SpecError> {
         let (w, h) = (self.width, self.height);
         let mut axes = vec![
-            json!({"name": "alpha", "range": [self.alpha(0), self.alpha(h - 1)], "count": h, "verify": 4 * h}),
+            json!({"name": "alpha", "range": self.alpha_range(), "count": h, "verify": 4 * h}),
             json!({"name": "n_dot_v", "range": [self.n_dot_v(0), self.n_dot_v(w - 1)], "count": w, "verify": 4 * w}),
         ];
         if self.quantity == "ggx-env" {

@@ -1,0 +1,276 @@
+//! The build of a cone LUT spec (`kind = "ggx-cone-lut"`, see `super::spec`): tabulate, verify,
+//! emit.
+//!
+//! - tabulate: slice k is the 2-D DFG table of the spec's resolution and mapping at
+//!   cos θc = k/(slices − 1), by the 2-D table's own [`tabulate`] (so slice 0 is that table);
+//! - verify: the integral at the centres of a grid [`VERIFY_DENSITY`] times denser on every axis
+//!   (off the texel grid everywhere: n·v and the row parameter between the texel centres and past
+//!   the outer ones, cos θc between the slices) to [`VERIFY_TOLERANCE`], against the texture as a
+//!   linear sampler reads it: the f16 texels interpolated trilinearly with exact weights (the
+//!   hardware-filtering error of the stored table). Recorded as for the 2-D table: max, rms,
+//!   worst point [n·v, row, cos θc] of the texture, of the emitted f32 lookup and of the f64
+//!   texels (interpolation alone), the same between the outer texel centres, the f16 rounding,
+//!   and the map of the largest texture error per texel footprint and slice interval;
+//! - emit: `wgsl/NAME.wgsl`, `src/NAME.rs` (`super::emit`), `data/NAME.ktx2` (3-D, RG16F or
+//!   RGBA16F), `data/NAME.png` (sRGB preview: the slices left to right, cos θc = 0 first; R, G
+//!   as stored, B = 0; row 0 at the top) and `json/NAME.json`.
+//!
+//! `Mode::Committed` (build --check) takes the texels and the measured errors from the
+//! committed JSON and re-renders every file without integrating.
+
+use super::emit::{ConeLutCode, lookup_f32};
+use super::spec::ConeLut;
+use crate::emit::texture::{ktx2_volume, png_srgb_preview};
+use crate::emit::{Artifact, GENERATOR, header_lines};
+use crate::family::ggx::lut::build::{Accumulator, Measure, Quadrature, alpha_of_t, digits3, f16_texture, integrate, mapping_doc, stored, tabulate as tabulate_2d};
+use crate::pipeline::{BuildError, Built, Mode, Verification, committed_texels, compact_json, fmt_err, spec_rel_path};
+use crate::spec::Spec;
+use serde::{Deserialize, Serialize};
+use serde_json::{Value, json};
+use std::path::Path;
+
+/// Verification points per texel footprint (n·v, row) and per slice interval.
+pub const VERIFY_DENSITY: usize = 2;
+/// Quadrature tolerance of the verification integrals (as the 2-D table's): far below the
+/// interpolation errors measured (≳ 1e-3 at the worst points).
+pub const VERIFY_TOLERANCE: f64 = 1e-6;
+
+/// The texels (scale, bias), slice after slice (each row-major, n·v fastest), with the
+/// quadrature work of all slices.
+pub fn tabulate(lut: &ConeLut) -> (Vec<[f64; 2]>, Quadrature) {
+    let mut values = Vec::with_capacity(lut.base.width * lut.base.height * lut.depth);
+    let (mut max_err, mut evals) = (0.0f64, 0.0);
+    for k in 0..lut.depth {
+        let (v, q) = tabulate_2d(&lut.slice(k));
+        values.extend(v);
+        max_err = max_err.max(q.max_error_estimate);
+        evals += q.evals_per_texel;
+    }
+    let q = Quadrature { tolerance: lut.base.tolerance, max_error_estimate: max_err, evals_per_texel: (evals / lut.depth as f64).round() };
+    (values, q)
+}
+
+/// Trilinear interpolation in f64 of `texels` at (u, t) (texel centres, clamp to edge) and
+/// cone cosine c (slices at k/(d − 1)), exact weights.
+pub fn trilinear(texels: &[[f64; 2]], (w, h, d): (usize, usize, usize), u: f64, t: f64, c: f64) -> [f64; 2] {
+    let axis = |p: f64, n: usize| {
+        let x = p * n as f64 - 0.5;
+        let x0 = x.floor();
+        ((x0.max(0.0) as usize).min(n - 1), ((x0 + 1.0).max(0.0) as usize).min(n - 1), x - x0)
+    };
+    let (i0, i1, fx) = axis(u.clamp(0.0, 1.0), w);
+    let (j0, j1, fy) = axis(t.clamp(0.0, 1.0), h);
+    let z = c.clamp(0.0, 1.0) * (d - 1) as f64;
+    let k0 = (z.floor() as usize).min(d - 1);
+    let (k1, fz) = ((k0 + 1).min(d - 1), z - z.floor());
+    let at = |i: usize, j: usize, k: usize| texels[(k * h + j) * w + i];
+    std::array::from_fn(|ch| {
+        let plane = |k: usize| {
+            let a = at(i0, j0, k)[ch] * (1.0 - fx) + at(i1, j0, k)[ch] * fx;
+            let b = at(i0, j1, k)[ch] * (1.0 - fx) + at(i1, j1, k)[ch] * fx;
+            a * (1.0 - fy) + b * fy
+        };
+        plane(k0) * (1.0 - fz) + plane(k1) * fz
+    })
+}
+
+/// What the verification measured (see the module docs).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Measured {
+    pub density: usize,
+    pub points: usize,
+    pub reference_tolerance: f64,
+    pub reference_max_error_estimate: f64,
+    /// The f16 texture, trilinear with exact weights (the storage error under filtering).
+    pub texture: Measure,
+    /// The same between the outer texel centres of n·v and the rows only.
+    pub texture_interior: Measure,
+    /// The emitted f32 lookup over the f16 texels.
+    pub lookup_f32: Measure,
+    /// The f64 texels, trilinear (interpolation alone).
+    pub interpolation: Measure,
+    /// Largest |f16(texel) − texel| over texels and channels (rounding alone).
+    pub max_abs_storage_error: f64,
+    /// Largest texture error per texel footprint and slice interval: index
+    /// (k·height + j)·width + i for slice interval k (between slices k and k + 1), 3 digits.
+    pub error_map: Vec<f64>,
+}
+
+/// The verification of the texels `values` (see the module docs).
+pub fn verify(lut: &ConeLut, values: &[[f64; 2]]) -> Result<Measured, BuildError> {
+    let b = &lut.base;
+    let (w, h, d) = (b.width, b.height, lut.depth);
+    let n = VERIFY_DENSITY;
+    let us: Vec<f64> = (0..n * w).map(|k| (k as f64 + 0.5) / (n * w) as f64).collect();
+    let ts: Vec<f64> = (0..n * h).map(|k| (k as f64 + 0.5) / (n * h) as f64).collect();
+    let cs: Vec<f64> = (0..n * (d - 1)).map(|k| (k as f64 + 0.5) / (n * (d - 1)) as f64).collect();
+    let stored32 = stored(b, values);
+    let stored64: Vec<[f64; 2]> = stored32.iter().map(|v| v.map(f64::from)).collect();
+    let encoded: Vec<[f64; 2]> = values.iter().map(|v| b.layout.encode(*v)).collect();
+    let (mut tex, mut inner, mut l32, mut interp) = (Accumulator::new(), Accumulator::new(), Accumulator::new(), Accumulator::new());
+    let (mut inner_count, mut ref_err) = (0, 0.0f64);
+    let inside = |p: f64, n: usize| p >= 0.5 / n as f64 && p <= 1.0 - 0.5 / n as f64;
+    let mut map = vec![0.0f64; w * h * (d - 1)];
+    for (m, &c) in cs.iter().enumerate() {
+        let truth = integrate(&lut.table(c), &us, &ts, VERIFY_TOLERANCE);
+        for (l, &t) in ts.iter().enumerate() {
+            for (k, &u) in us.iter().enumerate() {
+                let e = &truth[l * us.len() + k];
+                if !(e.scale.is_finite() && e.bias.is_finite()) {
+                    return Err(BuildError::NonFinite { spec: b.name.clone(), at: vec![u, t, c] });
+                }
+                ref_err = ref_err.max(e.error);
+                let want = b.layout.encode([e.scale, e.bias]);
+                let at = [u, t, c];
+                let got = trilinear(&stored64, (w, h, d), u, t, c);
+                let err = tex.add(got, want, &at);
+                if inside(u, w) && inside(t, h) {
+                    inner.add(got, want, &at);
+                    inner_count += 1;
+                }
+                let cell = &mut map[((m / n) * h + l / n) * w + k / n];
+                *cell = cell.max(err);
+                l32.add(lookup_f32(&stored32, (w, h, d), u as f32, t as f32, c as f32).map(f64::from), want, &at);
+                interp.add(trilinear(&encoded, (w, h, d), u, t, c), want, &at);
+            }
+        }
+    }
+    let points = us.len() * ts.len() * cs.len();
+    let storage = encoded.iter().zip(&stored64).flat_map(|(a, s)| (0..2).map(move |c| (a[c] - s[c]).abs())).fold(0.0, f64::max);
+    Ok(Measured {
+        density: n,
+        points,
+        reference_tolerance: VERIFY_TOLERANCE,
+        reference_max_error_estimate: ref_err,
+        texture: tex.finish(points),
+        texture_interior: inner.finish(inner_count.max(1)),
+        lookup_f32: l32.finish(points),
+        interpolation: interp.finish(points),
+        max_abs_storage_error: storage,
+        error_map: map.into_iter().map(digits3).collect(),
+    })
+}
+
+fn committed_parts(v: &Value, lut: &ConeLut) -> Result<(Vec<[f64; 2]>, Quadrature, Measured), BuildError> {
+    let b = &lut.base;
+    let bad = |why: String| BuildError::NoCommitted { spec: b.name.clone(), why };
+    let values = committed_texels::<2>(v, &b.name, b.width * b.height * lut.depth, "[scale, bias]")?;
+    let quadrature: Quadrature = serde_json::from_value(v["quadrature"].clone()).map_err(|e| bad(format!("quadrature: {e}")))?;
+    let measured: Measured = serde_json::from_value(v["verification"].clone()).map_err(|e| bad(format!("verification: {e}")))?;
+    if measured.error_map.len() != b.width * b.height * (lut.depth - 1) {
+        return Err(bad("error_map size differs from texel footprints × slice intervals".into()));
+    }
+    Ok((values, quadrature, measured))
+}
+
+/// Build one cone LUT spec (see the module docs).
+pub fn build(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> {
+    let lut = ConeLut::from_spec(spec)?;
+    let b = &lut.base;
+    let name = spec.file.name.clone();
+    let hash = crate::pipeline::input_hash(spec);
+    let (w, h, d) = (b.width, b.height, lut.depth);
+    let (values, quadrature, measured) = match mode {
+        Mode::Fit => {
+            let (values, q) = tabulate(&lut);
+            if let Some(k) = values.iter().position(|v| !(v[0].is_finite() && v[1].is_finite())) {
+                return Err(BuildError::NonFinite { spec: name, at: vec![b.n_dot_v(k % w), b.row_coordinate((k / w) % h), lut.cos_cone(k / (w * h))] });
+            }
+            let m = verify(&lut, &values)?;
+            (values, q, m)
+        }
+        Mode::Committed => committed_parts(&crate::pipeline::committed_json_with_hash(root, spec, &hash)?, &lut)?,
+    };
+    let stored32 = stored(b, &values);
+    let t = &measured.texture;
+    let err_line = format!(
+        "{} 3-D texture, trilinear (texel centres in n·v and {}, slices at cos_cone = k/{}, clamp to edge) against the integral at {}x denser points: max abs {}, rms {} over {} points x 2 channels (between the outer texel centres: max abs {}); f64 texels trilinear: max abs {}; f16 storage <= {}; quadrature estimate <= {}",
+        b.format.name(),
+        b.mapping.argument(),
+        d - 1,
+        measured.density,
+        fmt_err(t.max_abs_error),
+        fmt_err(t.rms_error),
+        measured.points,
+        fmt_err(measured.texture_interior.max_abs_error),
+        fmt_err(measured.interpolation.max_abs_error),
+        fmt_err(measured.max_abs_storage_error),
+        fmt_err(quadrature.max_error_estimate),
+    );
+    let header = header_lines(&spec_rel_path(spec), &hash, &err_line);
+    let provenance = header.join("\n");
+    let channels = b.format.channels();
+    let flat: Vec<f32> = stored32.iter().flat_map(|v| if channels == 2 { vec![v[0], v[1]] } else { vec![v[0], v[1], 0.0, 1.0] }).collect();
+    let ktx2 = ktx2_volume(w as u32, h as u32, d as u32, channels, &flat, f16_texture(b.format), &[("shadefit", &provenance)]);
+    let level_offset = u64::from_le_bytes(ktx2[80..88].try_into().expect("eight bytes")) as usize;
+    let code = ConeLutCode { module: &name, function: &b.function, width: w, height: h, depth: d, layout: b.layout, format: b.format, row: b.mapping.argument(), level_offset };
+    let desc = if b.description.is_empty() { String::new() } else { format!("{}: ", b.description) };
+    let doc = format!(
+        "{desc}`{}` looks up the GGX split-sum environment BRDF (scale, bias) of quantity `{}` over the light directions in a visibility cone (height-correlated Smith G2, Schlick Fc), COD: WWII's 3-D table for cone-based specular occlusion.",
+        b.function, b.quantity
+    );
+    let mdoc = mapping_doc(b);
+    let wgsl = code.render_wgsl(&header, &doc, &mdoc);
+    let rust = code.render_rust(&header, &doc, &mdoc);
+    // Preview: the slices side by side (slice k in columns k·w .. (k + 1)·w).
+    let preview: Vec<[f64; 3]> = (0..h)
+        .flat_map(|j| (0..d).flat_map(move |k| (0..w).map(move |i| (k * h + j) * w + i)))
+        .map(|idx| {
+            let [r, g] = b.layout.encode(values[idx]);
+            [r, g, 0.0]
+        })
+        .collect();
+    let s = (1024 / (w * d).max(h)).max(1);
+    let png = png_srgb_preview(w * d, h, &preview, s, s, &[("Software", GENERATOR.to_string()), ("Comment", provenance.clone())]);
+    let (lo, hi) = values.iter().flat_map(|v| b.layout.encode(*v)).fold((f64::INFINITY, f64::NEG_INFINITY), |(a, c), x| (a.min(x), c.max(x)));
+    let json = json!({
+        "generator": GENERATOR,
+        "spec": spec_rel_path(spec),
+        "input_hash": hash,
+        "name": name,
+        "kind": super::spec::KIND,
+        "quantity": b.quantity,
+        "description": b.description,
+        "function": b.function,
+        "shadowing": "height-correlated Smith G2",
+        "layout": {"name": b.layout.name(), "channels": b.layout.channels()},
+        "axes": [
+            {"name": "n_dot_v", "texture_axis": "x", "count": w, "mapping": "linear", "texel_centres": "n_dot_v = (i + 0.5)/width"},
+            {"name": b.mapping.argument(), "texture_axis": "y", "count": h, "mapping": b.mapping.name(),
+             "texel_centres": format!("t = (j + 0.5)/height, {}", alpha_of_t(b.mapping))},
+            {"name": "cos_cone", "texture_axis": "z", "count": d, "mapping": "linear", "slices": "cos_cone = k/(depth - 1): slice 0 the hemisphere, the last a closed cone"},
+        ],
+        "texture": {
+            "width": w,
+            "height": h,
+            "depth": d,
+            "format": b.format.name(),
+            "ktx2": format!("data/{name}.ktx2"),
+            "preview": format!("data/{name}.png"),
+            "encoding": "linear 3-D texture, R and G as the layout says (RGBA: B = 0, A = 1); the PNG preview is sRGB-encoded with the slices left to right (cos_cone = 0 first), B = 0, row 0 at the top",
+            "sampling": format!("uvw = (n_dot_v, t, (cos_cone * {} + 0.5) / {d}) with the parameters clamped to [0, 1], linear filter, clamp to edge", d - 1),
+        },
+        "range": [lo, hi],
+        "quadrature": quadrature,
+        "verification": measured,
+        "values_layout": "slice-major, then row-major, n_dot_v fastest: values[(k * height + j) * width + i] = [scale, bias] in f64 (the texture stores the layout's channels of these, rounded to f32 then f16)",
+        "values": values,
+    });
+    let verification = Verification {
+        points: measured.points,
+        max_abs_error: t.max_abs_error,
+        rms_error: t.rms_error,
+        worst_point: t.worst_point.clone(),
+        max_abs_error_f32: measured.lookup_f32.max_abs_error,
+        rms_error_f32: measured.lookup_f32.rms_error,
+        max_abs_error_in_parameter: None,
+    };
+    let artifacts = vec![
+        Artifact { path: format!("wgsl/{name}.wgsl").into(), contents: wgsl.into() },
+        Artifact { path: format!("src/{name}.rs").into(), contents: rust.into() },
+        Artifact { path: format!("json/{name}.json").into(), contents: compact_json(&json).into() },
+        Artifact { path: format!("data/{name}.ktx2").into(), contents: ktx2 },
+        Artifact { path: format!("data/{name}.png").into(), contents: png },
+    ];
+    Ok(Built { name, artifacts, verification, fit: None })
+}
