@@ -12,6 +12,7 @@ pub mod fiber;
 pub mod fuzz;
 pub mod ggx;
 pub mod gloss;
+pub mod msdiffuse;
 pub mod sggx;
 pub mod skin;
 
@@ -108,7 +109,7 @@ pub struct Family {
 
 /// Every family, in the order `eval --help`, `validate` and `plot` list them.
 pub static FAMILIES: &[&Family] =
-    &[&gloss::FAMILY, &fuzz::FAMILY, &skin::FAMILY, &ggx::FAMILY, &fiber::FAMILY, &sggx::FAMILY];
+    &[&gloss::FAMILY, &fuzz::FAMILY, &skin::FAMILY, &ggx::FAMILY, &fiber::FAMILY, &sggx::FAMILY, &msdiffuse::FAMILY];
 
 pub fn families() -> &'static [&'static Family] {
     FAMILIES
