@@ -4,6 +4,7 @@
 //! standard errors, and the talk's published approximations measured against them.
 
 pub mod integrals;
+pub mod table;
 pub mod walk;
 
 use super::Family;
@@ -91,7 +92,7 @@ pub static FAMILY: Family = Family {
     name: "msdiffuse",
     doc: "Call of Duty: WWII multiple-scattering diffuse BRDF: Lambertian microfacets on GGX, Heitz 2016's walk",
     quantities: QUANTITIES,
-    spec_kinds: &[],
+    spec_kinds: &[table::TABLE],
     eval_options: None,
     validate: |_| Vec::new(),
     figures: no_figures,
