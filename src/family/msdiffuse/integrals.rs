@@ -134,11 +134,11 @@ impl Sums {
     }
 }
 
-/// The sums of `paths` paths (rounded up to whole chunks), each chunk by `chunk`, chunks in
-/// parallel when `parallel`, combined in order.
+/// The sums of `paths` paths, by chunks of [`CHUNK`] (the last one shorter), each chunk by
+/// `chunk`, chunks in parallel when `parallel`, combined in order.
 pub fn chunked(paths: u64, parallel: bool, chunk: impl Fn(u64, u64) -> Sums + Sync) -> Sums {
     let chunks = paths.div_ceil(CHUNK).max(1);
-    let run = |c: u64| chunk(c * CHUNK, (c + 1) * CHUNK);
+    let run = |c: u64| chunk(c * CHUNK, ((c + 1) * CHUNK).min(paths));
     let parts: Vec<Sums> = if parallel { (0..chunks).into_par_iter().map(run).collect() } else { (0..chunks).map(run).collect() };
     let mut total = Sums::default();
     for p in &parts {

@@ -4,6 +4,7 @@
 //! standard errors, and the talk's published approximations measured against them.
 
 pub mod integrals;
+pub mod merl;
 pub mod table;
 pub mod walk;
 

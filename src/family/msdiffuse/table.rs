@@ -13,6 +13,9 @@
 //! paths = 4096                      # random-walk paths per slice cell
 //! albedo_resolution = 32            # optional: n·v columns of the albedo table per gloss
 //! albedo_paths = 4096               # optional: paths per albedo cell
+//! merl_paths = 64                   # optional: also the full isotropic BRDF of every gloss
+//!                                   # layer in MERL's binary layout (90·90·180 cells each,
+//!                                   # these paths a cell; 35 MB a layer: for jobs, not fits/)
 //!
 //! [emit]
 //! function = "ms_diffuse_slice"     # WGSL and Rust function prefix
@@ -20,17 +23,20 @@
 //!
 //! Cell (i, j) of layer k: θh = (i + 0.5)/W · π/2, θd = (j + 0.5)/H · π/2 (centres), gloss
 //! g_k = k/(G − 1) (ends included); albedo cell (a, k): n·v = (a + 0.5)/A. Cells are numbered
-//! slices first (k, j, i, i fastest), then the albedo cells (k, a); the RNG key is the spec
-//! name, so any cell's bits depend only on (name, cell, path).
+//! slices first (k, j, i, i fastest), then the albedo cells (k, a), then the MERL cells (k, then
+//! the file's order); the RNG key is the spec name, so any cell's bits depend only on (name,
+//! cell, path).
 //!
 //! Outputs: `json/NAME.json` (settings, every cell's value and standard error in f64, the albedo
 //! table, statistics), `data/NAME.ktx2` (RG32F atlas: layer k at rows kH…kH + H − 1, R = π f/ρ,
 //! G = its standard error), `data/NAME.png` (sRGB preview of R), and a small runtime module
-//! (`wgsl/NAME.wgsl`, `src/NAME.rs`) mapping (n·h, l·h, gloss) to atlas coordinates.
-//! `Mode::Committed` (build --check) reads the values from the committed JSON and re-renders
-//! every file without simulating.
+//! (`wgsl/NAME.wgsl`, `src/NAME.rs`) mapping (n·h, l·h, gloss) to atlas coordinates; with
+//! `merl_paths`, `data/NAME_merl_K.binary` per layer K (`super::merl`).
+//! `Mode::Committed` (build --check) reads the values from the committed JSON (and MERL files)
+//! and re-renders every file without simulating.
 
 use super::integrals::{TALK_F0, albedo, at_cosine, brdf, directions, surface, Order};
+use super::merl;
 use super::walk::{Specular, key_of};
 use crate::emit::texture::{TextureFormat, ktx2_texels, png_srgb_preview};
 use crate::emit::{Artifact, GENERATOR, f32_literal, header_lines};
@@ -92,6 +98,7 @@ struct TableFile {
     paths: u64,
     albedo_resolution: Option<usize>,
     albedo_paths: Option<u64>,
+    merl_paths: Option<u64>,
     emit: TableEmit,
 }
 
@@ -110,6 +117,7 @@ pub struct Table {
     pub paths: u64,
     pub albedo_width: usize,
     pub albedo_paths: u64,
+    pub merl_paths: Option<u64>,
 }
 
 impl Table {
@@ -142,6 +150,11 @@ impl Table {
         if !paths_ok(albedo_paths) {
             return Err(at("albedo_paths", format!("{albedo_paths} must be in [{}, {}]", PATHS_RANGE[0], PATHS_RANGE[1])));
         }
+        if let Some(p) = f.merl_paths
+            && !(2..=PATHS_RANGE[1]).contains(&p)
+        {
+            return Err(at("merl_paths", format!("{p} must be in [2, {}] (two paths give a standard error)", PATHS_RANGE[1])));
+        }
         let albedo_width = f.albedo_resolution.unwrap_or(32);
         if !(2..=MAX_SIDE).contains(&albedo_width) {
             return Err(at("albedo_resolution", format!("{albedo_width} must be in [2, {MAX_SIDE}]")));
@@ -162,6 +175,7 @@ impl Table {
             paths: f.paths,
             albedo_width,
             albedo_paths,
+            merl_paths: f.merl_paths,
         })
     }
 
@@ -189,9 +203,17 @@ impl Table {
         (self.width * self.height * self.layers) as u64
     }
 
-    /// Every cell: slices, then albedo.
+    pub fn albedo_cells(&self) -> u64 {
+        (self.albedo_width * self.layers) as u64
+    }
+
+    pub fn merl_cells(&self) -> u64 {
+        if self.merl_paths.is_some() { (merl::CELLS * self.layers) as u64 } else { 0 }
+    }
+
+    /// Every cell: slices, then albedo, then MERL.
     pub fn cells(&self) -> u64 {
-        self.slice_cells() + (self.albedo_width * self.layers) as u64
+        self.slice_cells() + self.albedo_cells() + self.merl_cells()
     }
 
     pub fn key(&self) -> u64 {
@@ -208,6 +230,19 @@ impl Table {
             let s = surface(self.gloss(k), self.f0, self.specular);
             let (l, v) = directions(self.theta_h(i), self.theta_d(j), self.phi_d).expect("slice cells lie above the horizon");
             Cell::of(brdf(&s, l, v, Order::All, key, c, self.paths, false))
+        } else if c >= n + self.albedo_cells() {
+            let m = (c - n - self.albedo_cells()) as usize;
+            let (k, cell) = (m / merl::CELLS, m % merl::CELLS);
+            let (th, td, pd) = merl::cell_angles(cell);
+            let s = surface(self.gloss(k), self.f0, self.specular);
+            // The MERL cell stores the red value of f = (π f/ρ)/π at ρ = 1; se of the same.
+            match directions(th, td, pd) {
+                Some((l, v)) => {
+                    let e = brdf(&s, l, v, Order::All, key, c, self.merl_paths.unwrap_or(1), false);
+                    Cell { value: merl::red_of(Some(e.value / PI)), se: e.error / PI / merl::SCALES[0] }
+                }
+                None => Cell { value: merl::red_of(None), se: 0.0 },
+            }
         } else {
             let a = ((c - n) % self.albedo_width as u64) as usize;
             let k = ((c - n) / self.albedo_width as u64) as usize;
@@ -305,7 +340,8 @@ pub fn render(spec: &Spec, t: &Table, cells: &[Cell]) -> Result<Built, BuildErro
     let name = spec.file.name.clone();
     let hash = crate::pipeline::input_hash(spec);
     let n = t.slice_cells() as usize;
-    let (slices, albedo_cells) = cells.split_at(n);
+    let (slices, rest) = cells.split_at(n);
+    let (albedo_cells, merl_cells) = rest.split_at(t.albedo_cells() as usize);
     if let Some(k) = cells.iter().position(|c| !(c.value.is_finite() && c.se.is_finite())) {
         return Err(BuildError::NonFinite { spec: name, at: vec![k as f64] });
     }
@@ -387,14 +423,23 @@ pub fn render(spec: &Spec, t: &Table, cells: &[Cell]) -> Result<Built, BuildErro
         max_abs_error_in_parameter: None,
     };
     let (wgsl, rust) = module(&name, t, &header);
-    let artifacts = vec![
+    let mut artifacts = vec![
         Artifact { path: format!("wgsl/{name}.wgsl").into(), contents: wgsl.into() },
         Artifact { path: format!("src/{name}.rs").into(), contents: rust.into() },
         Artifact { path: format!("json/{name}.json").into(), contents: compact_json(&json).into() },
         Artifact { path: format!("data/{name}.ktx2").into(), contents: ktx2 },
         Artifact { path: format!("data/{name}.png").into(), contents: png },
     ];
+    for (k, layer) in merl_cells.chunks(merl::CELLS).enumerate() {
+        let red: Vec<f64> = layer.iter().map(|c| c.value).collect();
+        artifacts.push(Artifact { path: merl_path(&name, k).into(), contents: merl::encode(&red) });
+    }
     Ok(Built { name, artifacts, verification, fit: None })
+}
+
+/// The MERL file of layer k.
+pub fn merl_path(name: &str, k: usize) -> String {
+    format!("data/{name}_merl_{k}.binary")
 }
 
 /// The runtime module: atlas size and coordinates of (n·h, l·h, gloss).
@@ -459,6 +504,16 @@ pub fn build(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> 
             let v = crate::pipeline::committed_json_with_hash(root, spec, &crate::pipeline::input_hash(spec))?;
             let mut c = committed_cells(&v, &t, "slices", t.slice_cells() as usize)?;
             c.extend(committed_cells(&v, &t, "albedo", t.albedo_width * t.layers)?);
+            if t.merl_paths.is_some() {
+                // The MERL values are the committed files themselves (the red block; the
+                // standard errors are not stored there and are not rendered anywhere).
+                for k in 0..t.layers {
+                    let bad = |why: String| BuildError::NoCommitted { spec: t.name.clone(), why };
+                    let bytes = std::fs::read(root.join(merl_path(&t.name, k))).map_err(|e| bad(format!("{}: {e}", merl_path(&t.name, k))))?;
+                    let red = merl::decode_red(&bytes).ok_or_else(|| bad(format!("{} is not a 90x90x180 MERL file", merl_path(&t.name, k))))?;
+                    c.extend(red.into_iter().map(|value| Cell { value, se: 0.0 }));
+                }
+            }
             c
         }
     };
@@ -491,6 +546,37 @@ pub(super) mod tests {
         bad(("paths = 1024", "paths = 1024\nphi_d = 4.0"), 6, "phi_d", "[0, π]");
         bad(("paths = 1024", "paths = 1024\nspecular = \"kept\""), 6, "specular", "unknown variant");
         bad(("quantity = \"ms-diffuse\"", "quantity = \"ms-diffuse-albedo\""), 3, "quantity", "tabulates 'ms-diffuse'");
+    }
+
+    #[test]
+    fn merl_files_hold_the_walk_at_the_cell_centres() {
+        // merl_paths = 2 (1.46M cells a layer, the smallest run): a cell of the file is the
+        // estimate at its centre (same key, cell number and paths), and check mode re-renders
+        // the file byte for byte from the committed one.
+        let text = SPEC.replace("[4, 3, 2]", "[2, 2, 1]").replace("albedo_resolution = 3", "albedo_resolution = 2\nmerl_paths = 2");
+        let s = spec(&text);
+        let t = Table::from_spec(&s).unwrap();
+        let built = build(&s, Mode::Fit, Path::new("")).unwrap();
+        let file = &built.artifacts.iter().find(|a| a.path.ends_with("data/msd_t_merl_0.binary")).unwrap().contents;
+        let red = merl::decode_red(file).unwrap();
+        let base = t.slice_cells() + t.albedo_cells();
+        for cell in [0usize, 1234, 90 * 180 * 45 + 180 * 30 + 90, merl::CELLS - 1] {
+            let (th, td, pd) = merl::cell_angles(cell);
+            let want = match directions(th, td, pd) {
+                Some((l, v)) => brdf(&surface(0.0, TALK_F0, Specular::Gone), l, v, Order::All, t.key(), base + cell as u64, 2, true).value / PI / merl::SCALES[0],
+                None => -1.0,
+            };
+            assert_eq!(red[cell], want, "cell {cell}");
+        }
+        let dir = tempfile::tempdir().unwrap();
+        for a in &built.artifacts {
+            std::fs::create_dir_all(dir.path().join(&a.path).parent().unwrap()).unwrap();
+            std::fs::write(dir.path().join(&a.path), &a.contents).unwrap();
+        }
+        let again = build(&s, Mode::Committed, dir.path()).unwrap();
+        for (a, b) in built.artifacts.iter().zip(&again.artifacts) {
+            assert!(a.path == b.path && a.contents == b.contents, "{} differs when re-rendered", a.path.display());
+        }
     }
 
     #[test]
