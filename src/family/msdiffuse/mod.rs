@@ -5,6 +5,7 @@
 
 pub mod integrals;
 pub mod merl;
+pub mod published;
 pub mod table;
 pub mod walk;
 
@@ -95,7 +96,7 @@ pub static FAMILY: Family = Family {
     quantities: QUANTITIES,
     spec_kinds: &[table::TABLE],
     eval_options: None,
-    validate: |_| Vec::new(),
+    validate: published::items,
     figures: no_figures,
     bench: FamilyBench { integrators: &[], fits: &[], tables: &[], forms: &[] },
     scene_features: &[],
