@@ -31,6 +31,18 @@ use std::sync::OnceLock;
 pub struct SpecKind {
     pub spec: KindDef,
     pub build: fn(&Spec, Mode, &Path) -> Result<Built, BuildError>,
+    /// Kinds whose work splits into independent cells (`build --shard K/N`, `merge`).
+    pub shard: Option<Sharding>,
+}
+
+/// How a spec kind's work splits into cells: their count, and the payload of a range of them
+/// (bytes that depend on the spec and the cells only). Concatenated in cell order, the payloads
+/// of every range are what the kind's builder takes from `pipeline::take_merged` in
+/// `Mode::Fit` instead of computing.
+#[derive(Debug)]
+pub struct Sharding {
+    pub cells: fn(&Spec) -> Result<u64, BuildError>,
+    pub compute: fn(&Spec, std::ops::Range<u64>) -> Result<Vec<u8>, BuildError>,
 }
 
 /// `shadefit eval` options a family may take (`--profile`, `--kernel`).

@@ -65,7 +65,28 @@ pub const TABLE: SpecKind = SpecKind {
         input_hash: crate::pipeline::input_hash,
     },
     build,
+    shard: Some(crate::family::Sharding { cells: shard_cells, compute: shard_compute }),
 };
+
+fn shard_cells(spec: &Spec) -> Result<u64, BuildError> {
+    Ok(Table::from_spec(spec)?.cells())
+}
+
+/// The payload of a range of cells: each cell's value and standard error, f64 little-endian.
+fn shard_compute(spec: &Spec, range: std::ops::Range<u64>) -> Result<Vec<u8>, BuildError> {
+    let t = Table::from_spec(spec)?;
+    Ok(t.simulate(range).iter().flat_map(|c| [c.value.to_le_bytes(), c.se.to_le_bytes()]).flatten().collect())
+}
+
+fn cells_of_payload(t: &Table, bytes: &[u8]) -> Result<Vec<Cell>, BuildError> {
+    if bytes.len() as u64 != 16 * t.cells() {
+        return Err(BuildError::NoCommitted { spec: t.name.clone(), why: format!("merged shards hold {} bytes, {} cells need {}", bytes.len(), t.cells(), 16 * t.cells()) });
+    }
+    Ok(bytes
+        .chunks(16)
+        .map(|c| Cell { value: f64::from_le_bytes(c[..8].try_into().unwrap()), se: f64::from_le_bytes(c[8..].try_into().unwrap()) })
+        .collect())
+}
 
 #[derive(Debug, Clone, Copy, Default, Deserialize, PartialEq, Eq)]
 #[serde(rename_all = "lowercase")]
@@ -499,7 +520,10 @@ fn module(name: &str, t: &Table, header: &[String]) -> (String, String) {
 pub fn build(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> {
     let t = Table::from_spec(spec)?;
     let cells = match mode {
-        Mode::Fit => t.simulate(0..t.cells()),
+        Mode::Fit => match crate::pipeline::take_merged(&t.name) {
+            Some(bytes) => cells_of_payload(&t, &bytes)?,
+            None => t.simulate(0..t.cells()),
+        },
         Mode::Committed => {
             let v = crate::pipeline::committed_json_with_hash(root, spec, &crate::pipeline::input_hash(spec))?;
             let mut c = committed_cells(&v, &t, "slices", t.slice_cells() as usize)?;
