@@ -3,19 +3,19 @@
 //! (F0 = 0.04) taking the specular share away; its BRDF and directional albedo by Monte Carlo with
 //! standard errors, and the talk's published approximations measured against them.
 
+pub mod bench;
 pub mod integrals;
 pub mod merl;
+pub mod plot;
 pub mod published;
 pub mod table;
 pub mod walk;
 
 use super::Family;
-use crate::bench::FamilyBench;
 use crate::integrate::Estimate;
 use crate::quantity::{ParamSpec, QuantityDef};
 use integrals::{Order, at_cosine, brdf, cell_of, directions, eval_paths, specular_of, surface};
 use std::f64::consts::{FRAC_PI_2, PI};
-use std::path::{Path, PathBuf};
 
 /// The RNG key of `eval` points (tables key theirs by their spec name).
 fn eval_key(quantity: &str) -> u64 {
@@ -85,10 +85,6 @@ pub static QUANTITIES: &[QuantityDef] = &[
     },
 ];
 
-fn no_figures(_out: &Path, _generated: &Path) -> Result<Vec<PathBuf>, crate::plot::PlotError> {
-    Ok(Vec::new())
-}
-
 /// The msdiffuse family's descriptor (registered in `crate::family::FAMILIES`).
 pub static FAMILY: Family = Family {
     name: "msdiffuse",
@@ -97,8 +93,8 @@ pub static FAMILY: Family = Family {
     spec_kinds: &[table::TABLE],
     eval_options: None,
     validate: published::items,
-    figures: no_figures,
-    bench: FamilyBench { integrators: &[], fits: &[], tables: &[], forms: &[] },
+    figures: plot::figures,
+    bench: bench::BENCH,
     scene_features: &[],
     commands: &[],
 };
