@@ -58,7 +58,7 @@ pub fn figures(out: &Path, generated: &Path) -> Result<Vec<PathBuf>, PlotError> 
         files.extend(crate::plot::line_plot(
             &out.join(stem),
             &format!("π f/ρ in the plane of incidence, gloss {g}, light at {:.0}° (polar: radius = value)", theta_l.to_degrees()),
-            "x (toward the light's side: negative)",
+            "x (the light's side: positive)",
             "z",
             &series,
             false,
