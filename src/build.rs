@@ -43,6 +43,8 @@ pub enum Error {
     Stale { count: usize },
     #[error("generated/ holds an interrupted build ({}); the next `shadefit build` restores the files it replaced first", journal.display())]
     Interrupted { journal: PathBuf },
+    #[error("{0}")]
+    Shard(String),
 }
 
 impl Error {
@@ -51,7 +53,7 @@ impl Error {
         use crate::fit::FitError;
         use crate::pipeline::SceneError;
         match self {
-            Error::Spec(_) | Error::UnknownSpec { .. } => true,
+            Error::Spec(_) | Error::UnknownSpec { .. } | Error::Shard(_) => true,
             // A spec whose model cannot avoid a pole on its domain or whose basis is degenerate on
             // its samples (e.g. fixed denominator coefficients forcing a pole), or a scene naming a spec that fits/ lacks: the spec or
             // the manifest is what must change.
@@ -278,4 +280,161 @@ pub fn status(paths: &Paths) -> Result<Vec<(Spec, Status)>, Error> {
             (s, st)
         })
         .collect())
+}
+
+/// First line of a shard file; a JSON header line and the payload follow.
+pub const SHARD_MAGIC: &str = "shadefit-shard 1";
+
+/// `K/N` (0 ≤ K < N) of `build --shard`.
+pub fn parse_shard(text: &str) -> Result<(u64, u64), Error> {
+    let bad = || Error::Shard(format!("--shard '{text}': expected K/N with 0 <= K < N (e.g. 0/8)"));
+    let (k, n) = text.split_once('/').ok_or_else(bad)?;
+    let (k, n): (u64, u64) = (k.trim().parse().map_err(|_| bad())?, n.trim().parse().map_err(|_| bad())?);
+    if n == 0 || k >= n {
+        return Err(bad());
+    }
+    Ok((k, n))
+}
+
+/// The cells [lo, hi) of shard k of n over `total` cells (contiguous, in order, sizes within one).
+pub fn shard_range(total: u64, k: u64, n: u64) -> std::ops::Range<u64> {
+    let at = |i: u64| ((total as u128 * i as u128) / n as u128) as u64;
+    at(k)..at(k + 1)
+}
+
+/// The input hash a spec's outputs record (its kind's).
+fn hash_of(spec: &Spec) -> String {
+    match spec.file.kind {
+        spec::Kind::Custom(kind) => family::spec_kind(kind).map_or_else(|| pipeline::input_hash(spec), |k| (k.spec.input_hash)(spec)),
+        _ => pipeline::input_hash(spec),
+    }
+}
+
+fn sharding_of(spec: &Spec) -> Option<&'static family::Sharding> {
+    match spec.file.kind {
+        spec::Kind::Custom(kind) => family::spec_kind(kind)?.shard.as_ref(),
+        _ => None,
+    }
+}
+
+/// `build --shard K/N`: the cells of shard K of N of each named spec (every spec whose kind
+/// shards, when none is named) into `out/NAME.K-of-N.shard`. Writes nothing under generated/.
+pub fn shard(paths: &Paths, only: &[String], (k, n): (u64, u64), out: &Path) -> Result<Vec<PathBuf>, Error> {
+    let specs = load_specs(paths, only)?;
+    let selected: Vec<&Spec> = specs.iter().filter(|s| if only.is_empty() { sharding_of(s).is_some() } else { only.contains(&s.file.name) }).collect();
+    let mut jobs = Vec::new();
+    for s in &selected {
+        let sh = sharding_of(s).ok_or_else(|| Error::Shard(format!("{}: kind {:?} does not shard (only family table kinds with independent cells do)", s.file.name, s.file.kind)))?;
+        jobs.push((*s, sh));
+    }
+    let mut files = Vec::new();
+    for (s, sh) in jobs {
+        let name = s.file.name.clone();
+        let total = (sh.cells)(s).map_err(|source| Error::Build { spec: name.clone(), source })?;
+        let range = shard_range(total, k, n);
+        let payload = (sh.compute)(s, range.clone()).map_err(|source| Error::Build { spec: name.clone(), source })?;
+        let header = serde_json::json!({
+            "generator": emit::GENERATOR,
+            "spec": name,
+            "input_hash": hash_of(s),
+            "shard": k,
+            "of": n,
+            "cells": [range.start, range.end],
+            "total_cells": total,
+            "payload_bytes": payload.len(),
+        });
+        let mut bytes = format!("{SHARD_MAGIC}\n{header}\n").into_bytes();
+        bytes.extend_from_slice(&payload);
+        std::fs::create_dir_all(out).map_err(|e| Error::Shard(format!("cannot create {}: {e}", out.display())))?;
+        let path = out.join(format!("{name}.{k}-of-{n}.shard"));
+        std::fs::write(&path, &bytes).map_err(|e| Error::Shard(format!("cannot write {}: {e}", path.display())))?;
+        files.push(path);
+    }
+    Ok(files)
+}
+
+struct ShardFile {
+    spec: String,
+    hash: String,
+    k: u64,
+    n: u64,
+    cells: [u64; 2],
+    total: u64,
+    payload: Vec<u8>,
+}
+
+fn read_shard(path: &Path) -> Result<ShardFile, Error> {
+    let bad = |why: String| Error::Shard(format!("{}: {why}", path.display()));
+    let bytes = std::fs::read(path).map_err(|e| bad(e.to_string()))?;
+    let mut lines = bytes.splitn(3, |&b| b == b'\n');
+    if lines.next() != Some(SHARD_MAGIC.as_bytes()) {
+        return Err(bad(format!("not a shard file (line 1 is not '{SHARD_MAGIC}')")));
+    }
+    let header: serde_json::Value = lines.next().and_then(|h| serde_json::from_slice(h).ok()).ok_or_else(|| bad("line 2 is not a JSON header".into()))?;
+    let payload = lines.next().unwrap_or_default().to_vec();
+    let field = |f: &str| header[f].as_u64().ok_or_else(|| bad(format!("header field '{f}' is missing")));
+    let cells = [header["cells"][0].as_u64(), header["cells"][1].as_u64()];
+    let sf = ShardFile {
+        spec: header["spec"].as_str().ok_or_else(|| bad("header field 'spec' is missing".into()))?.to_string(),
+        hash: header["input_hash"].as_str().ok_or_else(|| bad("header field 'input_hash' is missing".into()))?.to_string(),
+        k: field("shard")?,
+        n: field("of")?,
+        cells: match cells {
+            [Some(a), Some(b)] => [a, b],
+            _ => return Err(bad("header field 'cells' is not [lo, hi]".into())),
+        },
+        total: field("total_cells")?,
+        payload,
+    };
+    if sf.payload.len() as u64 != field("payload_bytes")? {
+        return Err(bad(format!("payload holds {} bytes, the header says {}", sf.payload.len(), field("payload_bytes")?)));
+    }
+    Ok(sf)
+}
+
+/// `merge FILES…`: the shard files of one or more specs combined (every shard of each present
+/// once, made from the current spec) and built exactly as a single-machine `build --only` of
+/// those specs would, into generated/.
+pub fn merge(paths: &Paths, files: &[PathBuf], tick: &(dyn Fn(usize) + Sync)) -> Result<Summary, Error> {
+    if files.is_empty() {
+        return Err(Error::Shard("merge: no shard files given".into()));
+    }
+    let mut by_spec: std::collections::BTreeMap<String, Vec<(ShardFile, PathBuf)>> = Default::default();
+    for f in files {
+        let sf = read_shard(f)?;
+        by_spec.entry(sf.spec.clone()).or_default().push((sf, f.clone()));
+    }
+    let names: Vec<String> = by_spec.keys().cloned().collect();
+    let specs = load_specs(paths, &names)?;
+    for (name, mut parts) in by_spec {
+        let spec = specs.iter().find(|s| s.file.name == name).expect("load_specs checked the names");
+        let sh = sharding_of(spec).ok_or_else(|| Error::Shard(format!("{name}: its kind does not shard")))?;
+        let hash = hash_of(spec);
+        parts.sort_by_key(|(p, _)| p.k);
+        let n = parts[0].0.n;
+        let total = (sh.cells)(spec).map_err(|source| Error::Build { spec: name.clone(), source })?;
+        let mut payload = Vec::new();
+        for (i, (p, path)) in parts.iter().enumerate() {
+            let at = |why: String| Error::Shard(format!("{}: {why}", path.display()));
+            if p.hash != hash {
+                return Err(at(format!("made from another version of fits/{name}.toml (input hash {}, the spec's is {hash}); run its shards again", p.hash)));
+            }
+            if p.n != n || p.total != total {
+                return Err(at(format!("shard {}/{} of {} cells does not belong with {}-way shards of {total} cells", p.k, p.n, p.total, n)));
+            }
+            if p.k != i as u64 {
+                return Err(at(format!("shard {} is {}; each of 0..{n} must be given once", i, if p.k < i as u64 { "given twice" } else { "missing" })));
+            }
+            let r = shard_range(total, p.k, n);
+            if p.cells != [r.start, r.end] {
+                return Err(at(format!("cells {:?} are not shard {}/{n}'s {:?}", p.cells, p.k, r)));
+            }
+            payload.extend_from_slice(&p.payload);
+        }
+        if parts.len() as u64 != n {
+            return Err(Error::Shard(format!("{name}: {} of {n} shards given", parts.len())));
+        }
+        pipeline::set_merged(&name, payload);
+    }
+    run(paths, &names, false, &[], tick)
 }

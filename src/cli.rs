@@ -101,6 +101,29 @@ fn progress(len: usize, what: &str) -> ProgressBar {
     pb
 }
 
+/// `build --shard K/N`: the shard files of the named specs.
+pub fn build_shard(paths: &Paths, only: &[String], shard: &str, out: &Path) -> Result<()> {
+    let start = std::time::Instant::now();
+    let ks = build::parse_shard(shard).map_err(build_err)?;
+    let files = build::shard(paths, only, ks, out).map_err(build_err)?;
+    for f in &files {
+        println!("{}", f.display());
+    }
+    println!("{} shard file(s); {:.1} s wall on {} thread(s)", files.len(), start.elapsed().as_secs_f64(), rayon::current_num_threads());
+    Ok(())
+}
+
+/// `merge FILES…`: the merged build of the shards' specs.
+pub fn merge(paths: &Paths, files: &[PathBuf]) -> Result<()> {
+    let start = std::time::Instant::now();
+    let summary = build::merge(paths, files, &|_| {}).map_err(build_err)?;
+    for (b, _) in &summary.built {
+        println!("{:<22} merged from shards ({} points)", b.name, b.verification.points);
+    }
+    println!("{} file(s) written, {} unchanged; {:.1} s wall", summary.written, summary.files - summary.written, start.elapsed().as_secs_f64());
+    Ok(())
+}
+
 pub fn build(paths: &Paths, only: &[String], check: bool, targets: &[crate::emit::targets::Target]) -> Result<()> {
     let start = std::time::Instant::now();
     let pb = progress(0, if check { "check" } else { "build" });

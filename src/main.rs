@@ -67,6 +67,19 @@ enum Command {
         /// spirv, c (a header of the constants). Specs may add their own ([emit] targets).
         #[arg(long, value_delimiter = ',', value_parser = parse_target, conflicts_with = "scene")]
         target: Vec<shadefit::emit::targets::Target>,
+        /// K/N: compute shard K (0-based) of N of the cells of the named specs (default: every
+        /// spec whose kind shards) into --shard-dir, writing nothing under generated/;
+        /// `shadefit merge` combines the N shard files into what one build writes.
+        #[arg(long, conflicts_with_all = ["scene", "check", "target"])]
+        shard: Option<String>,
+        /// Folder of the shard files.
+        #[arg(long, default_value = "shards", requires = "shard")]
+        shard_dir: PathBuf,
+    },
+    /// Combine shard files (`build --shard K/N`) into exactly the files one build writes.
+    Merge {
+        /// Shard files: every shard of each spec once.
+        files: Vec<PathBuf>,
     },
     /// Fit a model to your own CSV data, from no start values.
     Fit {
@@ -150,7 +163,9 @@ fn main() -> ExitCode {
             cli::eval_with_options(&quantity, &params, json, profile.as_deref(), kernel.as_deref())
         }
         Command::Build { scene: Some(file), force, .. } => cli::build_scene(&paths, &file, force),
+        Command::Build { only, shard: Some(shard), shard_dir, .. } => cli::build_shard(&paths, &only, &shard, &shard_dir),
         Command::Build { only, check, target, .. } => cli::build(&paths, &only, check, &target),
+        Command::Merge { files } => cli::merge(&paths, &files),
         Command::Fit { data, x, y, model, objective, json } => cli::fit_data(&data, &x, &y, &model, objective, json),
         Command::Samples { name, json } => cli::samples(&paths, &name, json),
         Command::Plot { out } => cli::plot(&paths, &out),

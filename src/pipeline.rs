@@ -933,6 +933,20 @@ pub fn orphans_in(root: &Path, artifacts: &[Artifact], dirs: &[&str]) -> Vec<Str
 
 pub use emit::write_all;
 
+/// Cell payloads merged from shard files (`shadefit merge`), by spec name: a spec kind that
+/// shards takes its payload here in `Mode::Fit` instead of computing its cells.
+static MERGED: std::sync::Mutex<std::collections::BTreeMap<String, Vec<u8>>> = std::sync::Mutex::new(std::collections::BTreeMap::new());
+
+/// Hand the merged payload of spec `name` to its next build.
+pub fn set_merged(name: &str, payload: Vec<u8>) {
+    MERGED.lock().unwrap_or_else(|e| e.into_inner()).insert(name.to_string(), payload);
+}
+
+/// The merged payload of spec `name`, if `merge` gave one (taken: a later build computes).
+pub fn take_merged(name: &str) -> Option<Vec<u8>> {
+    MERGED.lock().unwrap_or_else(|e| e.into_inner()).remove(name)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -70,6 +70,12 @@ pub mod gloss_length;
 #[cfg(feature = "gloss")]
 #[path = "gloss_table.rs"]
 pub mod gloss_table;
+#[cfg(feature = "ms")]
+#[path = "ms_diffuse_slices.rs"]
+pub mod ms_diffuse_slices;
+#[cfg(feature = "ms")]
+#[path = "ms_diffuse_slices_lambert.rs"]
+pub mod ms_diffuse_slices_lambert;
 #[cfg(feature = "sggx")]
 #[path = "sggx_decode.rs"]
 pub mod sggx_decode;
@@ -140,6 +146,10 @@ pub mod wgsl {
     pub const GLOSS_LENGTH: &str = include_str!("../wgsl/gloss_length.wgsl");
     #[cfg(feature = "gloss")]
     pub const GLOSS_TABLE: &str = include_str!("../wgsl/gloss_table.wgsl");
+    #[cfg(feature = "ms")]
+    pub const MS_DIFFUSE_SLICES: &str = include_str!("../wgsl/ms_diffuse_slices.wgsl");
+    #[cfg(feature = "ms")]
+    pub const MS_DIFFUSE_SLICES_LAMBERT: &str = include_str!("../wgsl/ms_diffuse_slices_lambert.wgsl");
     #[cfg(feature = "sggx")]
     pub const SGGX_DECODE: &str = include_str!("../wgsl/sggx_decode.wgsl");
     #[cfg(feature = "skin")]
@@ -204,6 +214,10 @@ pub mod wgsl {
             "gloss_length" => Some(GLOSS_LENGTH),
             #[cfg(feature = "gloss")]
             "gloss_table" => Some(GLOSS_TABLE),
+            #[cfg(feature = "ms")]
+            "ms_diffuse_slices" => Some(MS_DIFFUSE_SLICES),
+            #[cfg(feature = "ms")]
+            "ms_diffuse_slices_lambert" => Some(MS_DIFFUSE_SLICES_LAMBERT),
             #[cfg(feature = "sggx")]
             "sggx_decode" => Some(SGGX_DECODE),
             #[cfg(feature = "skin")]
@@ -270,6 +284,10 @@ pub mod wgsl {
         "gloss_length",
         #[cfg(feature = "gloss")]
         "gloss_table",
+        #[cfg(feature = "ms")]
+        "ms_diffuse_slices",
+        #[cfg(feature = "ms")]
+        "ms_diffuse_slices_lambert",
         #[cfg(feature = "sggx")]
         "sggx_decode",
         #[cfg(feature = "skin")]

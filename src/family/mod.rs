@@ -12,6 +12,7 @@ pub mod fiber;
 pub mod fuzz;
 pub mod ggx;
 pub mod gloss;
+pub mod msdiffuse;
 pub mod sggx;
 pub mod skin;
 
@@ -30,6 +31,18 @@ use std::sync::OnceLock;
 pub struct SpecKind {
     pub spec: KindDef,
     pub build: fn(&Spec, Mode, &Path) -> Result<Built, BuildError>,
+    /// Kinds whose work splits into independent cells (`build --shard K/N`, `merge`).
+    pub shard: Option<Sharding>,
+}
+
+/// How a spec kind's work splits into cells: their count, and the payload of a range of them
+/// (bytes that depend on the spec and the cells only). Concatenated in cell order, the payloads
+/// of every range are what the kind's builder takes from `pipeline::take_merged` in
+/// `Mode::Fit` instead of computing.
+#[derive(Debug)]
+pub struct Sharding {
+    pub cells: fn(&Spec) -> Result<u64, BuildError>,
+    pub compute: fn(&Spec, std::ops::Range<u64>) -> Result<Vec<u8>, BuildError>,
 }
 
 /// `shadefit eval` options a family may take (`--profile`, `--kernel`).
@@ -108,7 +121,7 @@ pub struct Family {
 
 /// Every family, in the order `eval --help`, `validate` and `plot` list them.
 pub static FAMILIES: &[&Family] =
-    &[&gloss::FAMILY, &fuzz::FAMILY, &skin::FAMILY, &ggx::FAMILY, &fiber::FAMILY, &sggx::FAMILY];
+    &[&gloss::FAMILY, &fuzz::FAMILY, &skin::FAMILY, &ggx::FAMILY, &fiber::FAMILY, &sggx::FAMILY, &msdiffuse::FAMILY];
 
 pub fn families() -> &'static [&'static Family] {
     FAMILIES
@@ -172,7 +185,10 @@ pub(crate) mod tests {
     }
 
     /// Families that benchmark no shader form yet, with the reason (each must say why).
-    const NO_FORMS: &[(&str, &str)] = &[("sggx", "emits exact formulas (the course's decoder and D): no approximations to rank yet")];
+    const NO_FORMS: &[(&str, &str)] = &[
+        ("sggx", "emits exact formulas (the course's decoder and D): no approximations to rank yet"),
+        ("msdiffuse", "emits simulated tables; the published forms are measured by validate, no shader form of its own yet"),
+    ];
 
     #[test]
     fn every_family_s_forms_are_sorted_by_cost_with_a_front_and_tables_converge() {

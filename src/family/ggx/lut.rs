@@ -21,6 +21,7 @@ pub const DFG_LUT: SpecKind = SpecKind {
         input_hash: crate::pipeline::input_hash,
     },
     build: build::build,
+    shard: None,
 };
 
 /// Table benchmark rows: the default DFG LUT against numpy (Filament's Hammersley estimator,

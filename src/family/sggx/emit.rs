@@ -33,6 +33,7 @@ pub const KIND: &str = "sggx-decode";
 pub const DECODE: SpecKind = SpecKind {
     spec: KindDef { name: KIND, spec_file, samples_note: "{name} emits the course's decoder and NDF (exact formulas): it has no samples", input_hash },
     build,
+    shard: None,
 };
 
 /// For `Spec::parse`: the common spec of a decoder spec, or `None`.

@@ -88,6 +88,7 @@ static SKIN_LUT: SpecKind = SpecKind {
         },
     },
     build: build::build,
+    shard: None,
 };
 
 /// `eval skin-punctual|skin-sh --profile FILE --kernel linear|radial`: a diffusion profile of

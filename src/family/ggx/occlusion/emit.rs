@@ -31,6 +31,7 @@ pub const OCCLUSION: SpecKind = SpecKind {
         input_hash,
     },
     build,
+    shard: None,
 };
 
 /// For `Spec::parse`: the common spec of an occlusion-helpers spec, or `None`.

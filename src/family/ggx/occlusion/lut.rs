@@ -20,6 +20,7 @@ pub const CONE_LUT: SpecKind = SpecKind {
         input_hash: crate::pipeline::input_hash,
     },
     build: build::build,
+    shard: None,
 };
 
 #[cfg(test)]

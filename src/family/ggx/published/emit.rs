@@ -45,6 +45,7 @@ pub const REFITS: SpecKind = SpecKind {
         input_hash,
     },
     build,
+    shard: None,
 };
 
 /// n·v range of the MaterialX refit's fitting grid (every other texel centre of 64).

@@ -1,0 +1,108 @@
+//! `build --shard K/N` and `merge`: N shard processes run side by side, merged, give exactly the
+//! bytes of one build; bad shard sets are the user's input (exit 2) and write nothing.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+const SPEC: &str = "name = \"msd_s\"\nkind = \"ms-diffuse-table\"\nquantity = \"ms-diffuse\"\n\
+    resolution = [6, 5, 2]\npaths = 512\nalbedo_resolution = 3\nalbedo_paths = 300\n\n[emit]\nfunction = \"msd_s\"\n";
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_shadefit"))
+}
+
+fn project(spec: &str) -> tempfile::TempDir {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir_all(dir.path().join("fits")).unwrap();
+    std::fs::write(dir.path().join("fits/msd_s.toml"), spec).unwrap();
+    dir
+}
+
+fn run(dir: &Path, args: &[&str]) -> std::process::Output {
+    bin().current_dir(dir).args(args).output().unwrap()
+}
+
+/// Every file under `root`, relative, with its bytes.
+fn files(root: &Path) -> Vec<(PathBuf, Vec<u8>)> {
+    let mut out = Vec::new();
+    let mut stack = vec![root.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                stack.push(p);
+            } else {
+                out.push((p.strip_prefix(root).unwrap().to_path_buf(), std::fs::read(&p).unwrap()));
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+#[test]
+fn shards_merged_are_the_single_build_byte_for_byte() {
+    let one = project(SPEC);
+    let r = run(one.path(), &["build"]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let want = files(&one.path().join("generated"));
+    assert!(want.iter().any(|(p, _)| p.ends_with("json/msd_s.json")));
+
+    for n in [1u64, 3, 7] {
+        let many = project(SPEC);
+        // N processes at once, as an array job runs them (one thread each).
+        let children: Vec<_> = (0..n)
+            .map(|k| {
+                bin()
+                    .current_dir(many.path())
+                    .env("RAYON_NUM_THREADS", "1")
+                    .args(["build", "--shard", &format!("{k}/{n}"), "--shard-dir", "shards"])
+                    .spawn()
+                    .unwrap()
+            })
+            .collect();
+        for mut c in children {
+            assert!(c.wait().unwrap().success());
+        }
+        assert!(!many.path().join("generated/json").exists(), "--shard writes nothing under generated/");
+        let mut shards: Vec<String> = std::fs::read_dir(many.path().join("shards")).unwrap().map(|e| e.unwrap().path().display().to_string()).collect();
+        shards.sort();
+        shards.reverse(); // merge sorts them itself
+        assert_eq!(shards.len() as u64, n);
+        let mut args = vec!["merge".to_string()];
+        args.extend(shards);
+        let r = bin().current_dir(many.path()).args(&args).output().unwrap();
+        assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+        let got = files(&many.path().join("generated"));
+        assert_eq!(got.len(), want.len());
+        for ((pa, a), (pb, b)) in want.iter().zip(&got) {
+            assert!(pa == pb && a == b, "{} differs after merging {n} shards", pa.display());
+        }
+    }
+}
+
+#[test]
+fn bad_shard_sets_are_input_errors_and_write_nothing() {
+    let p = project(SPEC);
+    for k in 0..3 {
+        assert!(run(p.path(), &["build", "--shard", &format!("{k}/3")]).status.success());
+    }
+    let shard = |k: u64| format!("shards/msd_s.{k}-of-3.shard");
+    let expect_2 = |args: &[&str], fragment: &str| {
+        let r = run(p.path(), args);
+        let err = String::from_utf8_lossy(&r.stderr).to_string();
+        assert_eq!(r.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(fragment), "{args:?}: {err}");
+        assert!(!p.path().join("generated/json").exists(), "{args:?} wrote files");
+    };
+    expect_2(&["merge", &shard(0), &shard(2)], "shard 1 is missing");
+    expect_2(&["merge", &shard(0), &shard(1)], "2 of 3 shards given");
+    expect_2(&["merge", &shard(0), &shard(1), &shard(1)], "given twice");
+    expect_2(&["build", "--shard", "3/3"], "0 <= K < N");
+    expect_2(&["build", "--shard", "x"], "K/N");
+    std::fs::write(p.path().join("shards/junk.shard"), "not a shard\n").unwrap();
+    expect_2(&["merge", "shards/junk.shard"], "not a shard file");
+    // A shard of an edited spec is stale.
+    std::fs::write(p.path().join("fits/msd_s.toml"), SPEC.replace("paths = 512", "paths = 600")).unwrap();
+    expect_2(&["merge", &shard(0), &shard(1), &shard(2)], "another version");
+}
