@@ -7,8 +7,8 @@
 //! writes the result's bits. Inputs per argument (tests/support/grid.rs): the domain edges and
 //! their f32 neighbours, values outside, ±0, subnormals, ±MIN_POSITIVE, ±1, ±MAX, ±inf, five
 //! NaN patterns, a dense grid over the domain (2^16 points for one argument, 256 per axis for
-//! two, 48 for three) and, for tables, every node and cell centre; all combinations for two
-//! and three arguments.
+//! two, 16 for three) and, for tables, every node and cell centre (at most 8 intervals per axis
+//! for three arguments); all combinations for two and three arguments.
 //!
 //! # Bound
 //! Per point, |GPU − CPU| ≤ d, with d computed by interpreting the same WGSL (naga IR) in f32

@@ -73,20 +73,25 @@ pub fn axis(lo: f32, hi: f32, dense: usize, nodes: usize) -> Vec<u32> {
 }
 
 /// All points of a function, flattened (arity words per point): the Cartesian product of its
-/// axes. One-argument functions get 2^16 dense values, two-argument ones 256 per axis and
-/// three-argument ones 48 per axis (about 10^6 points with the specials and nodes: 256 per axis
-/// would be 825 MB of inputs, over a device's 256 MiB buffer limit).
+/// axes. One-argument functions get 2^16 dense values, two-argument ones 256 per axis, and
+/// three-argument ones 16 per axis with at most 8 node intervals (~60 values per axis with the
+/// specials, ~2e5 points: 256 per axis would be 825 MB of inputs, over a device's 256 MiB
+/// buffer limit, and more workgroups than one dispatch dimension allows).
 pub fn points(f: &EmittedFunction, nodes: &[u32]) -> Vec<u32> {
+    let three = f.domain.len() >= 3;
     let dense = match f.domain.len() {
         1 => 1 << 16,
         2 => 256,
-        _ => 48,
+        _ => 16,
     };
     let axes: Vec<Vec<u32>> = f
         .domain
         .iter()
         .enumerate()
-        .map(|(k, [lo, hi])| axis(*lo, *hi, dense, nodes.get(k).map_or(64, |&n| n as usize - 1)))
+        .map(|(k, [lo, hi])| {
+            let n = nodes.get(k).map_or(64, |&n| n as usize - 1);
+            axis(*lo, *hi, dense, if three { n.min(8) } else { n })
+        })
         .collect();
     let mut out = Vec::new();
     match axes.as_slice() {
