@@ -225,6 +225,8 @@ impl Source {
                     M::Sqrt => transc("sqrt", w),
                     M::InverseSqrt => transc("inverseSqrt", w),
                     M::Atan => transc("atan", w),
+                    M::Acos => transc("acos", w),
+                    M::Asin => transc("asin", w),
                     M::Atan2 => transc("atan2", w),
                     M::Length => {
                         transc("sqrt", 1);

@@ -371,7 +371,7 @@ pub fn render(spec: &Spec, t: &Table, cells: &[Cell]) -> Result<Built, BuildErro
     let (w, h) = (t.width, t.height);
     let worst_point = vec![t.gloss(worst / (w * h)), t.theta_h(worst % w), t.theta_d((worst / w) % h)];
     let err_line = format!(
-        "Monte Carlo standard error of the slice cells (pi f/rho): max {}, rms {} over {} cells of {} paths; albedo cells: max {}, rms {}",
+        "Monte Carlo standard error of the slice cells (pi f/rho): max abs {}, rms {} over {} cells of {} paths; albedo cells: max abs {}, rms {}",
         fmt_err(max_se),
         fmt_err(rms_se),
         n,
