@@ -2,7 +2,8 @@
 //!
 //! Q(x) = 1 + Σ b_j ψ_j(x) is evaluated over a box with interval arithmetic (each monomial
 //! an interval product of interval powers). If the lower bound is positive the box is done;
-//! otherwise it is bisected along its widest side, down to a budget of boxes. Interval
+//! otherwise it is bisected along its widest side, down to a budget of boxes (200 000) or a
+//! widest side below 1e-9, and stops at the first box whose centre is itself ≤ 1e-12. Interval
 //! evaluation over-estimates the range, never under-estimates it, and every interval end is
 //! rounded outward (`next_down`/`next_up`), so a lower bound on every leaf is a proof in f64.
 //! Where the plain interval bound is not enough, the box also gets the mean-value form in the
@@ -536,4 +537,47 @@ mod tests {
             assert!(matches!(p, Positivity::Proven { lower, .. } if lower > 1e-12 && lower <= eps / (1.0 + eps)), "{dom:?}: {p:?}");
         }
     }
+
+    #[test]
+    fn a_root_on_the_box_edge_stops_at_the_width_limit() {
+        // Q = 1 − x on [0, 1]: zero at the edge x = 1, which no centre reaches (Q at a centre is
+        // half the box width). Lower halves are proven, upper halves [1 − 2⁻ᵏ, 1] bisected until
+        // the widest side is below 1e-9: k = 30 (2⁻³⁰ ≈ 9.3e-10, 2⁻²⁹ ≈ 1.9e-9). The region
+        // reported is that box, its centre's Q 2⁻³¹, its bound at most the exact minimum 0.
+        let k30 = (2.0f64).powi(-30);
+        match prove(1, &[-1.0], (0.0, 1.0)) {
+            Positivity::NotProven { lower, region, sample } => {
+                assert_eq!(region, vec![(1.0 - k30, 1.0)]);
+                assert_eq!(sample, k30 / 2.0);
+                assert!(lower <= 0.0 && lower > -1e-15, "{lower}");
+            }
+            p => panic!("{p:?}"),
+        }
+    }
+
+    #[test]
+    fn the_width_limit_is_strict() {
+        // Q = 1 − u with the derived feature u = 1 − x, i.e. Q = x, on [0, W], W = 1024·1e-9
+        // (1e-9 scaled by a power of two: exact): zero at the edge x = 0, so the boxes
+        // [0, W/2ᵏ] are bisected, their widths exact. [0, W/1024] is exactly 1e-9 wide, not
+        // below it, so it is bisected once more and the proof stops at [0, W/2048].
+        use crate::fit::model::{Derived, ModelParts, Term};
+        let inputs = vec!["x".to_string()];
+        let features = vec!["x".to_string(), "u".to_string()];
+        let model = RationalModel::new(ModelParts {
+            inputs: inputs.clone(),
+            derived: vec![Derived::parse("u", "1 - x", &inputs).unwrap()],
+            numerator: vec![Term::parse("1", &features).unwrap()],
+            denominator: vec![Term::parse("u", &features).unwrap()],
+            ..ModelParts::default()
+        })
+        .unwrap();
+        let w = 1024.0 * 1e-9;
+        assert_eq!(w / 1024.0, 1e-9);
+        match prove_denominator_positive(&model, &DVector::from_vec(vec![1.0, -1.0]), &[(0.0, w)]) {
+            Positivity::NotProven { region, .. } => assert_eq!(region, vec![(0.0, w / 2048.0)]),
+            p => panic!("{p:?}"),
+        }
+    }
+
 }
