@@ -375,21 +375,35 @@ pub fn build(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> 
         "values_layout": "row-major, n_dot_v fastest: values[j * width + i] = [scale, bias] in f64 (the texture stores the layout's channels of these, rounded to f32 then f16)",
         "values": values,
     });
+    Ok(lut_built(name, [wgsl, rust, compact_json(&json)], ktx2, png, measured.points, t, &measured.lookup_f32))
+}
+
+/// A LUT build's outputs: the WGSL, Rust and JSON texts, the KTX2 texture and the PNG preview,
+/// with the verification of the filtered texture (`texture`) and the emitted f32 lookup.
+pub fn lut_built(
+    name: String,
+    [wgsl, rust, json]: [String; 3],
+    ktx2: Vec<u8>,
+    png: Vec<u8>,
+    points: usize,
+    texture: &Measure,
+    lookup_f32: &Measure,
+) -> Built {
     let verification = Verification {
-        points: measured.points,
-        max_abs_error: t.max_abs_error,
-        rms_error: t.rms_error,
-        worst_point: t.worst_point.clone(),
-        max_abs_error_f32: measured.lookup_f32.max_abs_error,
-        rms_error_f32: measured.lookup_f32.rms_error,
+        points,
+        max_abs_error: texture.max_abs_error,
+        rms_error: texture.rms_error,
+        worst_point: texture.worst_point.clone(),
+        max_abs_error_f32: lookup_f32.max_abs_error,
+        rms_error_f32: lookup_f32.rms_error,
         max_abs_error_in_parameter: None,
     };
     let artifacts = vec![
         Artifact { path: format!("wgsl/{name}.wgsl").into(), contents: wgsl.into() },
         Artifact { path: format!("src/{name}.rs").into(), contents: rust.into() },
-        Artifact { path: format!("json/{name}.json").into(), contents: compact_json(&json).into() },
+        Artifact { path: format!("json/{name}.json").into(), contents: json.into() },
         Artifact { path: format!("data/{name}.ktx2").into(), contents: ktx2 },
         Artifact { path: format!("data/{name}.png").into(), contents: png },
     ];
-    Ok(Built { name, artifacts, verification, fit: None })
+    Built { name, artifacts, verification, fit: None }
 }

@@ -21,9 +21,9 @@
 use super::emit::{ConeLutCode, lookup_f32};
 use super::spec::ConeLut;
 use crate::emit::texture::{ktx2_volume, png_srgb_preview};
-use crate::emit::{Artifact, GENERATOR, header_lines};
-use crate::family::ggx::lut::build::{Accumulator, Measure, Quadrature, alpha_of_t, digits3, f16_texture, integrate, mapping_doc, stored, tabulate as tabulate_2d};
-use crate::pipeline::{BuildError, Built, Mode, Verification, committed_texels, compact_json, fmt_err, spec_rel_path};
+use crate::emit::{GENERATOR, header_lines};
+use crate::family::ggx::lut::build::{Accumulator, Measure, lut_built, Quadrature, alpha_of_t, digits3, f16_texture, integrate, mapping_doc, stored, tabulate as tabulate_2d};
+use crate::pipeline::{BuildError, Built, Mode, committed_texels, compact_json, fmt_err, spec_rel_path};
 use crate::spec::Spec;
 use serde::{Deserialize, Serialize};
 use serde_json::{Value, json};
@@ -256,21 +256,5 @@ pub fn build(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> 
         "values_layout": "slice-major, then row-major, n_dot_v fastest: values[(k * height + j) * width + i] = [scale, bias] in f64 (the texture stores the layout's channels of these, rounded to f32 then f16)",
         "values": values,
     });
-    let verification = Verification {
-        points: measured.points,
-        max_abs_error: t.max_abs_error,
-        rms_error: t.rms_error,
-        worst_point: t.worst_point.clone(),
-        max_abs_error_f32: measured.lookup_f32.max_abs_error,
-        rms_error_f32: measured.lookup_f32.rms_error,
-        max_abs_error_in_parameter: None,
-    };
-    let artifacts = vec![
-        Artifact { path: format!("wgsl/{name}.wgsl").into(), contents: wgsl.into() },
-        Artifact { path: format!("src/{name}.rs").into(), contents: rust.into() },
-        Artifact { path: format!("json/{name}.json").into(), contents: compact_json(&json).into() },
-        Artifact { path: format!("data/{name}.ktx2").into(), contents: ktx2 },
-        Artifact { path: format!("data/{name}.png").into(), contents: png },
-    ];
-    Ok(Built { name, artifacts, verification, fit: None })
+    Ok(lut_built(name, [wgsl, rust, compact_json(&json)], ktx2, png, measured.points, t, &measured.lookup_f32))
 }
