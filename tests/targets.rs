@@ -5,13 +5,15 @@
 //!   the SPIR-V words, from the SPIR-V again through naga's SPIR-V front end, and from the C
 //!   header as compiled by the system C compiler;
 //! - every function of the module is in every shading-language output;
-//! - glslangValidator compiles every GLSL file, spirv-val passes every SPIR-V module, naga
-//!   validates the plain WGSL as is and reads the SPIR-V back (MSL and HLSL: naga validated the
-//!   module they were written from; no Linux validator is run on them);
+//! - glslangValidator compiles every GLSL file, spirv-val passes every SPIR-V module, the Slang
+//!   compiler compiles every HLSL file (parsed as HLSL, generated to SPIR-V), naga validates the
+//!   plain WGSL as is and reads the SPIR-V back (MSL: naga validated the module it was written
+//!   from and its constants are compared as text; there is no Metal compiler on Linux);
 //! - `build --target` and `[emit] targets` through the binary, byte-identical at any thread count.
 //!
-//! The validators come from `bash scripts/setup-shader-tools`; without them a test skips with a
-//! note, except under CI=true, where it fails.
+//! The validators come from `bash scripts/setup-shader-tools` (Slang into
+//! target/shader-tools/slang); without them a test skips with a note, except under CI=true,
+//! where it fails.
 
 mod common;
 
@@ -351,6 +353,35 @@ fn glslang_compiles_every_glsl_file() {
     }
     eprintln!("glslangValidator: {n} GLSL files compiled");
     assert_eq!(n, 2 * translated().len());
+}
+
+#[test]
+fn slang_compiles_every_hlsl_file() {
+    // The Slang compiler parses each HLSL file as HLSL, type-checks it and generates SPIR-V from
+    // its entry point (scripts/slang-hlsl-check); there is no DXC or FXC on Linux here.
+    let Some(python) = tool("python3") else { return };
+    let libs = root().join("target/shader-tools/slang");
+    let have = std::fs::read_dir(&libs)
+        .map(|d| d.flatten().any(|e| e.file_name().to_string_lossy().starts_with("libslang-compiler.so")))
+        .unwrap_or(false);
+    if !have {
+        let hint = "bash scripts/setup-shader-tools unpacks Slang into target/shader-tools/slang";
+        assert!(!std::env::var("CI").is_ok_and(|v| v == "true"), "Slang is not installed, and CI runs every validator ({hint})");
+        eprintln!("note: Slang is not installed; skipping the HLSL check ({hint})");
+        return;
+    }
+    let d = tempfile::tempdir().unwrap();
+    let mut files = Vec::new();
+    for m in translated() {
+        let p = d.path().join(format!("{}.hlsl", m.name));
+        std::fs::write(&p, &m.files[&Target::Hlsl]).unwrap();
+        files.push(p);
+    }
+    run_ok(
+        Command::new(&python).arg(root().join("scripts/slang-hlsl-check")).arg(&libs).args(&files),
+        "scripts/slang-hlsl-check",
+    );
+    eprintln!("Slang: {} HLSL files compiled", files.len());
 }
 
 #[test]

@@ -291,6 +291,7 @@ pub fn translate(module: &str, wgsl: &str, targets: &[Target]) -> Result<Vec<Art
                 naga::back::hlsl::Writer::new(&mut code, &options, &pipeline)
                     .write(&ir, &info, None)
                     .map_err(|e| backend(t)(&e))?;
+                let code = hlsl_sampler_registers(&hlsl_brace_initializers(&code));
                 format!("{}{code}", comment_header(&src.header, &note(t))).into_bytes()
             }
             Target::Glsl | Target::GlslEs => {
@@ -343,6 +344,115 @@ pub fn translate(module: &str, wgsl: &str, targets: &[Target]) -> Result<Vec<Art
         out.push(Artifact { path: t.path(module), contents });
     }
     Ok(out)
+}
+
+/// naga initialises a `static const` array or struct by calling a generated constructor
+/// function (`static const float A[2] = Constructarray2_float_(1.0, 2.0);`). HLSL compilers
+/// differ on whether such a call is a constant initialiser: DXC runs it as static
+/// initialisation, Slang rejects it ("static const global initializer must be a compile-time
+/// constant"). An initialiser list (`= { 1.0, 2.0 };`) is a constant expression for all of them,
+/// so the calls in `static const` initialisers become nested braces. The literals are untouched,
+/// so every constant keeps its bits; the constructor functions stay for the code that calls them.
+fn hlsl_brace_initializers(code: &str) -> String {
+    let mut out = String::with_capacity(code.len());
+    for line in code.split_inclusive('\n') {
+        let Some((lhs, rhs)) = line.strip_prefix("static const ").and_then(|_| line.split_once(" = ")) else {
+            out.push_str(line);
+            continue;
+        };
+        if !rhs.starts_with("Construct") {
+            out.push_str(line);
+            continue;
+        }
+        out.push_str(lhs);
+        out.push_str(" = ");
+        // One entry per open parenthesis: whether it opened a constructor call (now a brace).
+        let mut open: Vec<bool> = Vec::new();
+        let mut rest = rhs;
+        while let Some(c) = rest.chars().next() {
+            if rest.starts_with("Construct") {
+                let name_len = rest.find(|c: char| !(c.is_ascii_alphanumeric() || c == '_')).unwrap_or(rest.len());
+                if rest[name_len..].starts_with('(') {
+                    out.push('{');
+                    open.push(true);
+                    rest = &rest[name_len + 1..];
+                    continue;
+                }
+            }
+            match c {
+                '(' => open.push(false),
+                ')' => {
+                    if open.pop() == Some(true) {
+                        out.push('}');
+                        rest = &rest[1..];
+                        continue;
+                    }
+                }
+                _ => {}
+            }
+            out.push(c);
+            rest = &rest[c.len_utf8()..];
+        }
+    }
+    out
+}
+
+/// naga's HLSL binds samplers the way wgpu's Direct3D 12 backend does: every sampler of the
+/// module is read from a heap (`nagaSamplerHeap`) through an index buffer per bind group, as
+/// `static const SamplerState X = nagaSamplerHeap[nagaGroupGSamplerIndexArray[B]];`. An engine
+/// including the file binds samplers itself, and a `static const` resource read from a buffer
+/// is not a constant initialiser for every compiler (Slang rejects it). Each such global becomes
+/// an ordinary register binding, `SamplerState X : register(sB, spaceG);` (the WGSL
+/// `@group(G) @binding(B)`), and the heap and index-buffer declarations go once nothing reads
+/// them. Only the entry point's own globals are bound this way: the emitted functions take
+/// their textures and samplers as arguments.
+fn hlsl_sampler_registers(code: &str) -> String {
+    fn heap_global(line: &str) -> Option<(&str, &str, &str, &str)> {
+        let rest = line.trim_end().strip_prefix("static const ")?;
+        let (ty, rest) = rest.split_once(' ')?;
+        if ty != "SamplerState" && ty != "SamplerComparisonState" {
+            return None;
+        }
+        let (name, rest) = rest.split_once(" = ")?;
+        let heap = if ty == "SamplerState" { "nagaSamplerHeap[" } else { "nagaComparisonSamplerHeap[" };
+        let rest = rest.strip_prefix(heap)?.strip_prefix("nagaGroup")?;
+        let (group, rest) = rest.split_once("SamplerIndexArray[")?;
+        let binding = rest.strip_suffix("]];")?;
+        let digits = |s: &str| !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit());
+        (digits(group) && digits(binding)).then_some((ty, name, group, binding))
+    }
+    let mut lines: Vec<String> = code
+        .split_inclusive('\n')
+        .map(|line| match heap_global(line) {
+            Some((ty, name, group, binding)) => format!("{ty} {name} : register(s{binding}, space{group});\n"),
+            None => line.to_string(),
+        })
+        .collect();
+    // Drop the heap and index-buffer declarations nothing else mentions any more.
+    let declares = |line: &str| -> Option<String> {
+        let t = line.trim_start();
+        let name = if t.starts_with("SamplerState nagaSamplerHeap[") {
+            "nagaSamplerHeap"
+        } else if t.starts_with("SamplerComparisonState nagaComparisonSamplerHeap[") {
+            "nagaComparisonSamplerHeap"
+        } else {
+            let rest = t.strip_prefix("StructuredBuffer<uint> ")?;
+            let name = rest.split_whitespace().next()?;
+            (name.starts_with("nagaGroup") && name.ends_with("SamplerIndexArray")).then_some(name)?
+        };
+        Some(name.to_string())
+    };
+    let used_elsewhere = |name: &str, lines: &[String]| lines.iter().filter(|l| l.contains(name)).count() > 1;
+    let mut k = 0;
+    while k < lines.len() {
+        match declares(&lines[k]) {
+            Some(name) if !used_elsewhere(&name, &lines) => {
+                lines.remove(k);
+            }
+            _ => k += 1,
+        }
+    }
+    lines.concat()
 }
 
 /// A named constant flattened: its scalars in order, and its array shape (outermost first).
@@ -480,6 +590,46 @@ mod tests {
     #[test]
     fn the_module_target_alone_adds_nothing() {
         assert!(translate("x", "not even WGSL", &[Target::Wgsl]).unwrap().is_empty());
+    }
+
+    #[test]
+    fn hlsl_constant_initialisers_become_brace_lists() {
+        let naga_hlsl = "typedef float ret_Constructarray2_float_[2];\n\
+                         static const float A[2] = Constructarray2_float_(1.0, -2.5e-8);\n\
+                         static const float2 B[1] = Constructarray1_float2_(float2(0.5, 1.0));\n\
+                         static const S C = ConstructS(Constructarray2_float_(3.0, 4.0), 1u);\n\
+                         static const float D = 0.25;\n\
+                         float f() { float a[2] = Constructarray2_float_(1.0, 2.0); return a[0]; }\n";
+        let out = hlsl_brace_initializers(naga_hlsl);
+        let lines: Vec<&str> = out.lines().collect();
+        assert_eq!(lines[0], "typedef float ret_Constructarray2_float_[2];");
+        assert_eq!(lines[1], "static const float A[2] = {1.0, -2.5e-8};");
+        assert_eq!(lines[2], "static const float2 B[1] = {float2(0.5, 1.0)};");
+        assert_eq!(lines[3], "static const S C = {{3.0, 4.0}, 1u};");
+        assert_eq!(lines[4], "static const float D = 0.25;");
+        // A constructor call in a function body is an expression and stays one.
+        assert_eq!(lines[5], "float f() { float a[2] = Constructarray2_float_(1.0, 2.0); return a[0]; }");
+    }
+
+    #[test]
+    fn hlsl_heap_samplers_become_register_bindings() {
+        let naga_hlsl = "Texture2D<float4> t : register(t0);\n\
+                         SamplerState nagaSamplerHeap[2048]: register(s0, space0);\n\
+                         SamplerComparisonState nagaComparisonSamplerHeap[2048]: register(s0, space1);\n\
+                         StructuredBuffer<uint> nagaGroup0SamplerIndexArray : register(t0, space255);\n\
+                         static const SamplerState m_keep_binding_1_ = nagaSamplerHeap[nagaGroup0SamplerIndexArray[1]];\n\
+                         float4 f(Texture2D<float4> a, SamplerState s) { return a.SampleLevel(s, float2(0.0, 0.0), 0.0); }\n";
+        let out = hlsl_sampler_registers(naga_hlsl);
+        assert_eq!(
+            out,
+            "Texture2D<float4> t : register(t0);\n\
+             SamplerState m_keep_binding_1_ : register(s1, space0);\n\
+             float4 f(Texture2D<float4> a, SamplerState s) { return a.SampleLevel(s, float2(0.0, 0.0), 0.0); }\n"
+        );
+        // A heap still read elsewhere keeps its declaration.
+        let shared = format!("{naga_hlsl}SamplerState g() {{ return nagaSamplerHeap[0]; }}\n");
+        let out = hlsl_sampler_registers(&shared);
+        assert!(out.contains("SamplerState nagaSamplerHeap[2048]") && !out.contains("nagaComparisonSamplerHeap"));
     }
 
     #[test]
