@@ -278,6 +278,15 @@ pub fn list(paths: &Paths) -> Result<()> {
     Ok(())
 }
 
+/// `fit --data … --emit DIR`: where and what to emit besides printing the fit.
+pub struct FitEmit {
+    pub dir: PathBuf,
+    pub targets: Vec<String>,
+    pub name: Option<String>,
+    pub function: Option<String>,
+    pub args: Option<Vec<String>>,
+}
+
 pub fn fit_data(
     data_path: &Path,
     x_cols: &[String],
@@ -285,8 +294,13 @@ pub fn fit_data(
     model_arg: &str,
     objective: Objective,
     as_json: bool,
+    emit: Option<&FitEmit>,
 ) -> Result<()> {
     let model = load_model(model_arg, x_cols)?;
+    let targets = match emit {
+        Some(e) => crate::emit::targets::parse_list(&e.targets).map_err(|why| input_err(format!("--target: {why}")))?,
+        None => Vec::new(),
+    };
     let data: Data = read_csv(data_path, x_cols, y_col).map_err(input_err)?;
     let opts = FitOptions { objective, ..FitOptions::default() };
     let f = match fit::fit_rescaled(&model, &data, &opts, &data_path.display().to_string()) {
@@ -330,6 +344,77 @@ pub fn fit_data(
             r.rss, r.max_abs_error, r.rms_error, r.condition_number
         );
     }
+    if let Some(e) = emit {
+        emit_data_fit(e, &targets, data_path, x_cols, y_col, model_arg, objective, model, data, f, as_json)?;
+    }
+    Ok(())
+}
+
+/// The files of `fit --data … --emit`, rendered in full before any is written, then written
+/// as one transaction (all or nothing).
+#[allow(clippy::too_many_arguments)]
+fn emit_data_fit(
+    e: &FitEmit,
+    targets: &[crate::emit::targets::Target],
+    data_path: &Path,
+    x_cols: &[String],
+    y_col: &str,
+    model_arg: &str,
+    objective: Objective,
+    model: RationalModel,
+    data: Data,
+    fitted: fit::Fit,
+    as_json: bool,
+) -> Result<()> {
+    let csv_bytes = std::fs::read(data_path).map_err(|err| input_err(format!("{}: {err}", data_path.display())))?;
+    let model_text = if model_arg.trim_start().starts_with("rational(") {
+        None
+    } else {
+        Some(std::fs::read_to_string(model_arg).map_err(|err| input_err(format!("{model_arg}: {err}")))?)
+    };
+    // The default name: the CSV's stem as a module name (lowercase, other characters '_').
+    let stem: String = data_path
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or("fit")
+        .chars()
+        .map(|c| if c.is_ascii_alphanumeric() { c.to_ascii_lowercase() } else { '_' })
+        .collect();
+    let stem = if stem.starts_with(|c: char| c.is_ascii_alphabetic()) { stem } else { format!("fit_{stem}") };
+    let name = e.name.clone().unwrap_or(stem);
+    let function = e.function.clone().unwrap_or_else(|| name.clone());
+    let req = pipeline::data::DataFit {
+        csv: data_path,
+        csv_bytes: &csv_bytes,
+        x: x_cols,
+        y: y_col,
+        model_arg,
+        model_text: model_text.as_deref(),
+        objective,
+        name: &name,
+        function: &function,
+        args: e.args.as_deref(),
+    };
+    let built = match pipeline::data::fit_and_render(&req, model, data, fitted) {
+        Err(err @ pipeline::BuildError::Input { .. }) => return Err(input_err(err)),
+        r => r?,
+    };
+    let mut files = built.artifacts.clone();
+    let wanted = targets.to_vec();
+    files.extend(build::target_artifacts(&built.artifacts, &|_| wanted.clone())?);
+    let written = pipeline::write_all(&e.dir, &files)?;
+    let v = &built.verification;
+    let line = format!(
+        "emitted {} ({} file(s) in {}, {written} written): f32 code max abs {:.3e}, rms {:.3e} over the {} rows",
+        name,
+        files.len(),
+        e.dir.display(),
+        v.max_abs_error_f32,
+        v.rms_error_f32,
+        v.points
+    );
+    // With --json, stdout holds the JSON object only.
+    if as_json { eprintln!("{line}") } else { println!("{line}") }
     Ok(())
 }
 

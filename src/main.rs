@@ -102,6 +102,23 @@ enum Command {
         /// Print the coefficients, errors and worst point as one JSON object.
         #[arg(long)]
         json: bool,
+        /// Also emit the fit like a spec's into this folder: wgsl/NAME.wgsl, src/NAME.rs and
+        /// json/NAME.json (the fit report, f32 coefficients, positivity bound), inputs clamped
+        /// to the data's range; refused unless the denominator is proven positive there.
+        #[arg(long, value_name = "DIR")]
+        emit: Option<PathBuf>,
+        /// With --emit: more outputs (wgsl-plain, hlsl, glsl, glsl-es, msl, spirv, c).
+        #[arg(long, value_delimiter = ',', requires = "emit")]
+        target: Vec<String>,
+        /// With --emit: the module name (default: the CSV file's stem).
+        #[arg(long, requires = "emit")]
+        name: Option<String>,
+        /// With --emit: the emitted function's name (default: the module name).
+        #[arg(long, requires = "emit")]
+        function: Option<String>,
+        /// With --emit: the function's argument names, one per --x column (default: the columns).
+        #[arg(long, value_delimiter = ',', requires = "emit")]
+        args: Option<Vec<String>>,
     },
     /// Print the fitting samples of one spec (grid points and the integral there).
     Samples {
@@ -166,7 +183,10 @@ fn main() -> ExitCode {
         Command::Build { only, shard: Some(shard), shard_dir, .. } => cli::build_shard(&paths, &only, &shard, &shard_dir),
         Command::Build { only, check, target, .. } => cli::build(&paths, &only, check, &target),
         Command::Merge { files } => cli::merge(&paths, &files),
-        Command::Fit { data, x, y, model, objective, json } => cli::fit_data(&data, &x, &y, &model, objective, json),
+        Command::Fit { data, x, y, model, objective, json, emit, target, name, function, args } => {
+            let emit = emit.map(|dir| cli::FitEmit { dir, targets: target, name, function, args });
+            cli::fit_data(&data, &x, &y, &model, objective, json, emit.as_ref())
+        }
         Command::Samples { name, json } => cli::samples(&paths, &name, json),
         Command::Plot { out } => cli::plot(&paths, &out),
         Command::Validate { json } => cli::validate(&paths, json),

@@ -25,6 +25,7 @@ use sha2::{Digest, Sha256};
 use std::path::Path;
 
 pub mod committed;
+pub mod data;
 pub mod fields;
 
 /// Project paths: specs in `fits/`, outputs in `generated/`.
@@ -175,8 +176,12 @@ pub fn with_channel(json: &mut Value, spec: &Spec) {
     }
 }
 
+/// What generated files name as their spec: `fits/FILE`, or the origin of a spec made in memory.
 pub fn spec_rel_path(spec: &Spec) -> String {
-    format!("fits/{}", spec.path.file_name().and_then(|s| s.to_str()).unwrap_or("?"))
+    match &spec.origin {
+        Some(o) => o.clone(),
+        None => format!("fits/{}", spec.path.file_name().and_then(|s| s.to_str()).unwrap_or("?")),
+    }
 }
 
 fn committed_json(root: &Path, spec: &Spec) -> Result<Value, BuildError> {
@@ -317,9 +322,6 @@ pub fn committed_values(spec: &Spec, root: &Path) -> Result<Vec<f64>, BuildError
 }
 
 fn build_fit(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> {
-    let name = spec.file.name.clone();
-    let model = spec.model.as_ref().expect("fit specs carry a model");
-    let fit_section = spec.file.fit.as_ref().expect("fit specs carry [fit]");
     let (coefficients, report, f32s) = match mode {
         Mode::Fit => {
             let counts: Vec<usize> = spec.file.axis.iter().map(|a| a.count).collect();
@@ -327,23 +329,8 @@ fn build_fit(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> 
             let y = sample(spec, &x);
             let data = Data { x, y };
             let f = fit_samples(spec, &data)?;
-            let r = f32round::round_and_reoptimise(
-                model,
-                &f.coefficients,
-                &data,
-                &domain(spec),
-                &f32round::RoundOptions::new(fit_section.objective, fit_section.max_rms),
-                &name,
-            )?;
-            let on_grid = RoundingOnGrid {
-                fitting_samples: data.len(),
-                f64: r.f64,
-                rounded_f32: r.rounded,
-                reoptimised_f32: r.reoptimised,
-                sweeps: r.sweeps,
-                evaluations: r.evaluations,
-            };
-            (f.coefficients, Some(f.report), F32Coefficients { num: r.num, den: r.den, on_grid })
+            let f32s = round_to_f32(spec, &f.coefficients, &data)?;
+            (f.coefficients, Some(f.report), f32s)
         }
         Mode::Committed => {
             let (c, f32s) = committed_fit(spec, root)?;
@@ -351,6 +338,30 @@ fn build_fit(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> 
         }
     };
     fit_from_coefficients(spec, coefficients, report, Some(f32s), &Reference::of_spec(spec), Denominators::Proven)
+}
+
+/// The f32 coefficients of the fit `c` of `spec`'s model to `data`: rounded, then re-optimised
+/// on those samples with the spec's objective inside the box the emitted code clamps to.
+fn round_to_f32(spec: &Spec, c: &DVector<f64>, data: &Data) -> Result<F32Coefficients, BuildError> {
+    let model = spec.model.as_ref().expect("fit specs carry a model");
+    let fit_section = spec.file.fit.as_ref().expect("fit specs carry [fit]");
+    let r = f32round::round_and_reoptimise(
+        model,
+        c,
+        data,
+        &domain(spec),
+        &f32round::RoundOptions::new(fit_section.objective, fit_section.max_rms),
+        &spec.file.name,
+    )?;
+    let on_grid = RoundingOnGrid {
+        fitting_samples: data.len(),
+        f64: r.f64,
+        rounded_f32: r.rounded,
+        reoptimised_f32: r.reoptimised,
+        sweeps: r.sweeps,
+        evaluations: r.evaluations,
+    };
+    Ok(F32Coefficients { num: r.num, den: r.den, on_grid })
 }
 
 /// The committed f64 and f32 coefficients of a fit spec (generated/json/NAME.json under `root`),

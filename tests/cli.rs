@@ -162,26 +162,6 @@ fn build_is_byte_identical_at_any_thread_count() {
     assert_eq!(one, run("2"), "RAYON_NUM_THREADS=1 and =2 must give the same bytes");
 }
 
-fn nist_csv(name: &str, dir: &Path) -> PathBuf {
-    // NIST StRD .dat: data rows after the "Data:  y  x" line; columns y then x.
-    let text = std::fs::read_to_string(root().join("tests/data/nist").join(format!("{name}.dat")))
-        .expect("NIST data in tests/data/nist");
-    let mut csv = String::from("x,y\n");
-    let mut on = false;
-    for line in text.lines() {
-        let cols: Vec<&str> = line.split_whitespace().collect();
-        if on && cols.len() == 2 {
-            csv.push_str(&format!("{},{}\n", cols[1], cols[0]));
-        }
-        if line.starts_with("Data:") && cols.get(1) == Some(&"y") {
-            on = true;
-        }
-    }
-    let p = dir.join(format!("{name}.csv"));
-    std::fs::write(&p, csv).unwrap();
-    p
-}
-
 fn fit_json(args: &[&str]) -> serde_json::Value {
     let o = shadefit(args, None);
     assert!(o.status.success(), "{}", stderr(&o));

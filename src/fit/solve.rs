@@ -32,6 +32,17 @@ pub enum Objective {
     L4,
 }
 
+impl Objective {
+    /// The name `FromStr` and the specs take.
+    pub fn name(self) -> &'static str {
+        match self {
+            Objective::Lsq => "lsq",
+            Objective::Minimax => "minimax",
+            Objective::L4 => "l4",
+        }
+    }
+}
+
 impl std::str::FromStr for Objective {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {

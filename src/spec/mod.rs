@@ -542,6 +542,9 @@ pub struct Spec {
     pub model: Option<RationalModel>,
     /// The channel of a vector quantity the spec takes (`channel`), by index.
     pub channel: Option<usize>,
+    /// For a spec made in memory rather than read from fits/ (a fit of the user's own data):
+    /// what its generated files name as their spec, e.g. the command that made them.
+    pub origin: Option<String>,
 }
 
 /// How a spec evaluates its quantity at a point of its axes: the channel it takes, and the
@@ -749,7 +752,7 @@ impl Spec {
         if file.kind == Kind::Table && file.axis.len() > 2 {
             return Err(at("axis", "tables have one or two axes".into()));
         }
-        Ok(Spec { path: path.to_path_buf(), text, file, quantity, model, channel })
+        Ok(Spec { path: path.to_path_buf(), text, file, quantity, model, channel, origin: None })
     }
 }
 

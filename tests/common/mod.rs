@@ -83,3 +83,24 @@ pub fn snapshot(dir: &Path) -> Vec<(PathBuf, Vec<u8>)> {
     out.sort();
     out
 }
+
+/// NIST StRD data set NAME (tests/data/nist/NAME.dat) as a CSV with columns x, y in `dir`.
+pub fn nist_csv(name: &str, dir: &Path) -> PathBuf {
+    // NIST StRD .dat: data rows after the "Data:  y  x" line; columns y then x.
+    let text = std::fs::read_to_string(root().join("tests/data/nist").join(format!("{name}.dat")))
+        .expect("NIST data in tests/data/nist");
+    let mut csv = String::from("x,y\n");
+    let mut on = false;
+    for line in text.lines() {
+        let cols: Vec<&str> = line.split_whitespace().collect();
+        if on && cols.len() == 2 {
+            csv.push_str(&format!("{},{}\n", cols[1], cols[0]));
+        }
+        if line.starts_with("Data:") && cols.get(1) == Some(&"y") {
+            on = true;
+        }
+    }
+    let p = dir.join(format!("{name}.csv"));
+    std::fs::write(&p, csv).unwrap();
+    p
+}
