@@ -20,8 +20,9 @@
 //!   and span lines.
 //!
 //! Anywhere in code, `shadefit::NAME::item` is also accepted without an import (naga_oil
-//! accepts fully qualified names). Names after a `.` (members) and inside comments are left
-//! alone. Any other `#import` form (another namespace, `*`, `self`), a qualifier that names no
+//! accepts fully qualified names). An item alias (`b as c`) stands for the item wherever the
+//! identifier `c` appears in the importing source, so it should not also name a local, a field
+//! or a parameter there. Names after a `.` (members) and inside comments are left alone. Any other `#import` form (another namespace, `*`, `self`), a qualifier that names no
 //! imported library, a library that does not exist and an item a library does not declare are
 //! errors naming the file and line; other lines are copied unchanged. The result is plain
 //! WGSL for `wgpu::ShaderSource::Wgsl` or naga. naga_oil itself composes the same shaders
