@@ -124,6 +124,10 @@ pub fn target_artifacts(artifacts: &[Artifact], module_targets: &(dyn Fn(&str) -
     for f in files {
         out.extend(f?);
     }
+    let mut all: Vec<Target> = modules.iter().flat_map(|m| m.2.iter().copied()).collect();
+    all.sort();
+    all.dedup();
+    out.extend(targets::package_files(&all));
     Ok(out)
 }
 

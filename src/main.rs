@@ -64,7 +64,8 @@ enum Command {
         force: bool,
         /// Comma-separated outputs besides the WGSL modules, for every module: wgsl (the
         /// modules, always written), wgsl-plain, hlsl, glsl (450 core), glsl-es (ES 300), msl,
-        /// spirv, c (a header of the constants). Specs may add their own ([emit] targets).
+        /// spirv, c (a header of the constants), wesl (a WESL package: the modules and its
+        /// wesl.toml). Specs may add their own ([emit] targets).
         #[arg(long, value_delimiter = ',', value_parser = parse_target, conflicts_with = "scene")]
         target: Vec<shadefit::emit::targets::Target>,
         /// K/N: compute shard K (0-based) of N of the cells of the named specs (default: every

@@ -8,7 +8,9 @@
 //! - glslangValidator compiles every GLSL file, spirv-val passes every SPIR-V module, the Slang
 //!   compiler compiles every HLSL file (parsed as HLSL, generated to SPIR-V), naga validates the
 //!   plain WGSL as is and reads the SPIR-V back (MSL: naga validated the module it was written
-//!   from and its constants are compared as text; there is no Metal compiler on Linux);
+//!   from and its constants are compared as text; there is no Metal compiler on Linux); all the
+//!   plain files together validate as one source (no name declared twice);
+//! - the WESL modules are the plain WGSL (tests/wesl.rs links the package with wesl-rs);
 //! - `build --target` and `[emit] targets` through the binary, byte-identical at any thread count.
 //!
 //! The validators come from `bash scripts/setup-shader-tools` (Slang into
@@ -199,6 +201,27 @@ fn plain_wgsl_is_accepted_by_naga_as_is() {
             .validate(&ir)
             .unwrap_or_else(|e| panic!("{}: {}", m.name, e.emit_to_string(src)));
         assert!(ir.entry_points.is_empty(), "{}: the plain library has no entry point", m.name);
+    }
+    // All plain files at once, as one source (an engine that concatenates them): no name is
+    // declared twice, and naga validates the whole.
+    let all: String = translated().iter().map(|m| text(m, Target::WgslPlain)).collect::<Vec<_>>().join("\n");
+    let ir = naga::front::wgsl::parse_str(&all).unwrap_or_else(|e| panic!("every plain file together: {}", e.emit_to_string(&all)));
+    naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::default())
+        .validate(&ir)
+        .unwrap_or_else(|e| panic!("every plain file together: {}", e.emit_to_string(&all)));
+    let functions: usize = translated().iter().map(|m| m.ir.functions.len()).sum();
+    assert_eq!(ir.functions.len(), functions);
+}
+
+#[test]
+fn wesl_modules_are_the_plain_wgsl() {
+    // The WESL module differs from the plain WGSL in its last header line only (what it is).
+    for m in translated() {
+        let (plain, wesl) = (text(m, Target::WgslPlain), text(m, Target::Wesl));
+        let code = |s: &str| s.lines().skip(m.header.len() + 1).collect::<Vec<_>>().join("\n");
+        assert_eq!(code(plain), code(wesl), "{}", m.name);
+        let note = wesl.lines().nth(m.header.len()).unwrap();
+        assert!(note.starts_with(&format!("// WESL module shadefit::{} (package: wesl.toml)", m.name)), "{note}");
     }
 }
 
@@ -477,7 +500,9 @@ fn build_target_writes_every_target_identically_at_any_thread_count_and_check_ho
         (target_files(d.path()), d)
     };
     let (one, d) = run("1");
-    assert_eq!(one.len(), 2 * (Target::ALL.len() - 1), "two modules in seven targets: {:?}", one.iter().map(|f| &f.0).collect::<Vec<_>>());
+    // Two modules in each target but the module one, and the WESL package's wesl.toml.
+    assert_eq!(one.len(), 2 * (Target::ALL.len() - 1) + 1, "{:?}", one.iter().map(|f| &f.0).collect::<Vec<_>>());
+    assert!(one.iter().any(|f| f.0 == Path::new("wesl/wesl.toml")));
     assert_eq!(one, run("2").0, "RAYON_NUM_THREADS=1 and =2 must give the same bytes");
     // The same targets are up to date; without --target they are not looked at.
     let o = shadefit(&["build", "--check", "--only", "gloss_length,gloss_table", "--target", &all], Some(d.path()));

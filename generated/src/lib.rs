@@ -7,7 +7,8 @@
 //!
 //! Hand-written runtime (in `src/runtime/`):
 //! - [`compose`] / [`compose_shader`]: concatenate WGSL libraries, resolving
-//!   `#import shadefit::NAME` lines (no dependencies, always available);
+//!   `#import shadefit::NAME` lines and naga_oil's forms (`NAME::item` calls, item imports,
+//!   aliases; no dependencies, always available);
 //! - [`lut`]: the lookup-table modules as R32Float textures and WGSL accessors for them
 //!   (texture creation needs the `gpu` feature, which brings in wgpu);
 //! - `gpu` (feature `gpu`): a headless wgpu adapter and device chosen from the environment
@@ -37,7 +38,7 @@ pub struct EmittedFunction {
 
 mod runtime;
 
-pub use runtime::compose::{ComposeError, compose, compose_shader};
+pub use runtime::compose::{ComposeError, compose, compose_shader, compose_shader_named};
 #[cfg(feature = "gpu")]
 pub use runtime::gpu;
 pub use runtime::lut;

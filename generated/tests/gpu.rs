@@ -48,6 +48,15 @@
 //! `table_in_buffer`). Hardware adapters run the emitted text as it is. The texture version
 //! of each table (`lut::Table::wgsl`, R32Float) is checked against the same bound everywhere.
 //!
+//! # Import styles
+//! The shaders above are the crate's flat form: `compose(&[MODULE])`, then an entry point
+//! calling `f(..)`. For every function the first `STYLE_POINTS` points also run through the
+//! two other forms an engine uses, and their result bits must equal the flat run's: naga_oil's
+//! prefixed style (`#import shadefit::MODULE` and a call to `MODULE::f(..)`, resolved by
+//! `compose_shader`), and the plain WGSL (the module without its `#define_import_path` line,
+//! what `build --target wgsl-plain` writes) with the entry point appended. Same arithmetic, so
+//! any difference is a composition error, never rounding.
+//!
 //! # Adapter
 //! wgpu picks the adapter from the environment (`WGPU_BACKEND=vulkan` in CI, where lavapipe
 //! from scripts/setup-vulkan provides it; `WGPU_ADAPTER_NAME` to choose among several). With
@@ -67,7 +76,7 @@ mod fuzz_ps;
 mod sggx;
 
 use shadefit_runtime::lut::{self, LutTexture};
-use shadefit_runtime::{EmittedFunction, FUNCTIONS, compose, gpu};
+use shadefit_runtime::{EmittedFunction, FUNCTIONS, compose, compose_shader, gpu, wgsl};
 use std::io::Write;
 use wgpu::util::DeviceExt;
 
@@ -368,6 +377,7 @@ fn every_emitted_function_equals_its_cpu_version_on_the_gpu() {
         let st = check(f, "const", &pts, &out, &program);
         report(&format!("gpu {:<30} {n:>7} points: {st}{note} [{secs:.1} s]", f.name));
         assert_tight_on_software(software, f.name, &st);
+        same_in_every_style(&runner, f, &pts, &out, moved.as_ref().map(|(_, v)| v.as_slice()));
         functions += 1;
         points += n;
         runs += 1;
@@ -388,6 +398,33 @@ fn every_emitted_function_equals_its_cpu_version_on_the_gpu() {
         }
     }
     report(&format!("gpu: {functions} emitted functions + {} texture versions, {points} points, all within bound", runs - functions));
+}
+
+/// How many points of each function run in the other import styles (a pipeline each; the
+/// points are the first ones of the grid of tests/support/grid.rs).
+const STYLE_POINTS: usize = 512;
+
+/// `f` composed in naga_oil's prefixed style and as plain WGSL gives the flat run's bits `out`
+/// on the first `STYLE_POINTS` points. `table`: on software adapters, the table in a storage
+/// buffer as in the flat run.
+fn same_in_every_style(runner: &Runner, f: &EmittedFunction, pts: &[u32], out: &[u32], table: Option<&[f32]>) {
+    let arity = f.domain.len();
+    let k = (pts.len() / arity).min(STYLE_POINTS);
+    let prefixed = format!("#import shadefit::{}\n{}", f.module, entry_point(&format!("{}::{}", f.module, f.name), arity, 1));
+    let prefixed = compose_shader(&prefixed).unwrap_or_else(|e| panic!("{}: {e}", f.name));
+    let src = wgsl::module(f.module).unwrap();
+    assert_eq!(src.lines().filter(|l| l.starts_with('#')).count(), 1, "{}: one directive", f.module);
+    let plain: String = src.lines().filter(|l| !l.starts_with("#define_import_path")).map(|l| format!("{l}\n")).collect();
+    let plain = plain + &entry_point(f.name, arity, 1);
+    for (style, shader) in [("prefixed", prefixed), ("plain", plain)] {
+        let (shader, extra) = match table {
+            Some(_) => (table_in_buffer(&shader, f.module).0, table.map_or(Extra::None, Extra::Table)),
+            None => (shader, Extra::None),
+        };
+        let got = runner.run(&format!("{} ({style})", f.name), &shader, arity, 1, &pts[..k * arity], extra);
+        let differ = (0..k).filter(|&i| got[i] != out[i]).count();
+        assert_eq!(differ, 0, "{}: {differ} of {k} results differ between the flat and the {style} composition", f.name);
+    }
 }
 
 /// The P̃_s pair of the fuzz family (array result and argument, so not in `FUNCTIONS`): the

@@ -500,7 +500,7 @@ pub struct EmitSection {
     /// names the function returning the coefficients).
     pub evaluator: Option<String>,
     /// Outputs besides the WGSL module (`emit::targets::Target` names: "wgsl-plain", "hlsl",
-    /// "glsl", "glsl-es", "msl", "spirv", "c"; `build` checks them); `build --target` adds to them.
+    /// "glsl", "glsl-es", "msl", "spirv", "c", "wesl"; `build` checks them); `build --target` adds to them.
     pub targets: Option<Vec<String>>,
 }
 
