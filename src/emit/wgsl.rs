@@ -179,11 +179,17 @@ pub fn table_texture_functions(f: &Function<'_>, counts: &[usize], texture: &Tab
              fn {m}_uv({p}) -> vec2<f32> {{\n{inputs}{ts}    return vec2<f32>({u}, {v});\n}}\n\
              \n// {name} from `lut` ({fmt}) through a linear, clamp-to-edge sampler at {m}_uv:\n\
              // the texels and weights of {name}, the weights to the sampler's sub-texel precision.\n\
+             {f32note}\
              fn {name}_sample(lut: texture_2d<f32>, lut_sampler: sampler, {p}) -> f32 {{\n    \
              return textureSampleLevel(lut, lut_sampler, {m}_uv({c}), 0.0).x;\n}}\n",
             name = f.name,
             m = f.module,
             fmt = texture.format,
+            f32note = if texture.format == "r32float" {
+                "// r32float: the device must have float32-filterable (the spec's float32_filterable = true).\n"
+            } else {
+                ""
+            },
             vnote = if counts.len() == 2 { ", v likewise" } else { "; v = 0.5, the one row" },
             p = params.join(", "),
             u = t[0],
