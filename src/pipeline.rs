@@ -68,6 +68,9 @@ pub enum BuildError {
     ErrorBound { spec: String, measured: f64, bound: f64 },
     #[error("{spec}: no builder for kind = \"{kind}\"")]
     UnknownKind { spec: String, kind: String },
+    /// A module's translation to another target (`--target`, `[emit] targets`).
+    #[error(transparent)]
+    Target(#[from] crate::emit::targets::TargetError),
 }
 
 /// Errors of a scene's own build (its specialisations), beyond those of the specs it reads.

@@ -352,8 +352,13 @@ pub struct CustomSpec<'a> {
 }
 
 impl CustomSpec<'_> {
-    /// The common spec; an error names the file and the `kind` line.
+    /// The common spec; an error names the file and the `kind` line. `[emit] targets` is taken
+    /// from the text as it is for every spec (the family's checker accepts the key and leaves it
+    /// to the common one; `build` checks the names).
     pub fn spec_file(self, path: &Path, text: &str) -> Result<SpecFile, SpecError> {
+        let targets = toml::from_str::<toml::Value>(text).ok().and_then(|v| {
+            v.get("emit")?.get("targets")?.as_array()?.iter().map(|t| t.as_str().map(String::from)).collect::<Option<Vec<String>>>()
+        });
         let v = serde_json::json!({
             "name": self.name,
             "kind": "table",
@@ -361,7 +366,7 @@ impl CustomSpec<'_> {
             "description": self.description,
             "tolerance": self.tolerance,
             "axis": self.axes,
-            "emit": {"function": self.function},
+            "emit": {"function": self.function, "targets": targets},
         });
         let mut file: SpecFile =
             serde_json::from_value(v).map_err(|e| SpecError::new(path, line_of(text, "kind"), "kind", e.to_string()))?;
@@ -389,6 +394,9 @@ struct ModuleFile {
 struct ModulePrefix {
     /// Prefix of the emitted function names.
     function: String,
+    /// Outputs besides the WGSL module (read from the text by [`CustomSpec::spec_file`]).
+    #[allow(dead_code)]
+    targets: Option<Vec<String>>,
 }
 
 /// For family kinds that emit one module of functions: the common spec of a module spec of kind
