@@ -239,7 +239,7 @@ pub fn run(paths: &Paths, only: &[String], check: bool, extra: &[Target], tick: 
 
 /// `shadefit build --scene FILE [--force]`: only the nodes the scene reaches, each only when its
 /// inputs or files changed since the scene's last build, then the scene module.
-pub fn run_scene(paths: &Paths, file: &Path, force: bool) -> Result<SceneReport, Error> {
+pub fn run_scene(paths: &Paths, file: &Path, force: bool, extra: &[Target]) -> Result<SceneReport, Error> {
     let sc = Scene::load(file, &family::scene_features())?;
     let specs = load_specs(paths, &[])?;
     let mut scenes = load_scenes(paths)?;
@@ -247,8 +247,29 @@ pub fn run_scene(paths: &Paths, file: &Path, force: bool) -> Result<SceneReport,
         scenes.push(sc.clone());
     }
     let mut tx = Transaction::begin(&paths.generated)?;
-    let report = scene::build(&sc, &specs, &scenes, &paths.generated, force, &custom_builder, &mut tx)
+    // Every module in the `--target` targets and its spec's own, as `build` writes them.
+    let translate = |module: &str, text: &str| -> Result<Vec<Artifact>, BuildError> {
+        let mut t: Vec<Target> = extra.to_vec();
+        if let Some(s) = specs.iter().find(|s| s.file.name == module) {
+            t.extend(spec_targets(s)?);
+        }
+        t.sort();
+        t.dedup();
+        if t.iter().all(|t| *t == Target::Wgsl) {
+            return Ok(Vec::new());
+        }
+        Ok(targets::translate(module, text, &t)?)
+    };
+    let report = scene::build(&sc, &specs, &scenes, &paths.generated, force, &custom_builder, &translate, &mut tx)
         .map_err(|source| Error::Scene { scene: sc.file.name.clone(), source })?;
+    // The package files of those targets (the WESL manifest), as `build` writes them.
+    let mut all: Vec<Target> = extra.to_vec();
+    for s in &specs {
+        all.extend(spec_targets(s).unwrap_or_default());
+    }
+    all.sort();
+    all.dedup();
+    tx.write(&targets::package_files(&all))?;
     tx.commit()?;
     Ok(report)
 }

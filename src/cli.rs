@@ -165,9 +165,9 @@ pub fn build(paths: &Paths, only: &[String], check: bool, targets: &[crate::emit
 
 /// `shadefit build --scene FILE [--force]`: only the nodes the scene reaches, each only when its
 /// inputs or files changed since the scene's last build, then the scene module.
-pub fn build_scene(paths: &Paths, file: &Path, force: bool) -> Result<()> {
+pub fn build_scene(paths: &Paths, file: &Path, force: bool, targets: &[crate::emit::targets::Target]) -> Result<()> {
     let start = std::time::Instant::now();
-    let r = build::run_scene(paths, file, force).map_err(build_err)?;
+    let r = build::run_scene(paths, file, force, targets).map_err(build_err)?;
     let name = file.file_stem().map_or(String::new(), |s| s.to_string_lossy().into_owned());
     println!("scene {name}: {} up to date, {} built", r.up_to_date.len(), r.built.len());
     println!("  built: {}", if r.built.is_empty() { "-".to_string() } else { r.built.join(", ") });

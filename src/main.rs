@@ -65,8 +65,9 @@ enum Command {
         /// Comma-separated outputs besides the WGSL modules, for every module: wgsl (the
         /// modules, always written), wgsl-plain, hlsl, glsl (450 core), glsl-es (ES 300), msl,
         /// spirv, c (a header of the constants), wesl (a WESL package: the modules and its
-        /// wesl.toml). Specs may add their own ([emit] targets).
-        #[arg(long, value_delimiter = ',', value_parser = parse_target, conflicts_with = "scene")]
+        /// wesl.toml). Specs may add their own ([emit] targets). With --scene: the scene module
+        /// and every module it reaches.
+        #[arg(long, value_delimiter = ',', value_parser = parse_target)]
         target: Vec<shadefit::emit::targets::Target>,
         /// K/N: compute shard K (0-based) of N of the cells of the named specs (default: every
         /// spec whose kind shards) into --shard-dir, writing nothing under generated/;
@@ -180,7 +181,7 @@ fn main() -> ExitCode {
         Command::Eval { quantity, params, json, profile, kernel } => {
             cli::eval_with_options(&quantity, &params, json, profile.as_deref(), kernel.as_deref())
         }
-        Command::Build { scene: Some(file), force, .. } => cli::build_scene(&paths, &file, force),
+        Command::Build { scene: Some(file), force, target, .. } => cli::build_scene(&paths, &file, force, &target),
         Command::Build { only, shard: Some(shard), shard_dir, .. } => cli::build_shard(&paths, &only, &shard, &shard_dir),
         Command::Build { only, check, target, .. } => cli::build(&paths, &only, check, &target),
         Command::Merge { files } => cli::merge(&paths, &files),

@@ -16,7 +16,7 @@ use crate::fit::expr;
 use crate::emit::{self, header_lines, rust, wgsl, Artifact, GENERATOR};
 use crate::fit::positivity::{prove_denominator_positive, Positivity};
 use crate::fit::{self, f32round, Data, FitOptions, FitReport};
-use crate::spec::{Kind, Spec};
+use crate::spec::{self, Kind, Spec};
 use nalgebra::DVector;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -69,6 +69,9 @@ pub enum BuildError {
     ErrorBound { spec: String, measured: f64, bound: f64 },
     #[error("{spec}: no builder for kind = \"{kind}\"")]
     UnknownKind { spec: String, kind: String },
+    /// A module's translation to another target (`--target`, `[emit] targets`).
+    #[error(transparent)]
+    Target(#[from] crate::emit::targets::TargetError),
 }
 
 /// Errors of a scene's own build (its specialisations), beyond those of the specs it reads.
@@ -739,12 +742,22 @@ pub fn table_from_values(spec: &Spec, values: Vec<f64>, reference: &Reference) -
     let approx64: Vec<f64> = approx32.iter().map(|&v| v as f64).collect();
     let verification = verify(spec, vx, truth, &approx64, &approx32);
     let hash = input_hash(spec);
-    let err_line = format!(
+    let form = spec.file.emit.form.unwrap_or_default();
+    let tex_format = spec.file.emit.texture_format.unwrap_or_default();
+    let precision = match tex_format {
+        spec::TableTextureFormat::R16float => emit::texture::TextureFormat::Rgba16float,
+        spec::TableTextureFormat::R32float => emit::texture::TextureFormat::Rgba32float,
+    };
+    let mut err_line = format!(
         "linear interpolation of the f32 table: max abs {}, rms {} over {} points",
         fmt_err(verification.max_abs_error_f32),
         fmt_err(verification.rms_error_f32),
         verification.points
     );
+    if form.has_texture() {
+        let storage = v32.iter().map(|&v| (precision.stored(v) - v).abs()).fold(0.0f32, f32::max);
+        err_line.push_str(&format!("; {} texture storage <= {}", tex_format.name(), fmt_err(storage as f64)));
+    }
     let header = header_lines(&spec_rel_path(spec), &hash, &err_line);
     let a = args(spec);
     let func = wgsl::Function {
@@ -786,12 +799,42 @@ pub fn table_from_values(spec: &Spec, values: Vec<f64>, reference: &Reference) -
         let cols: Vec<String> = p.iter().map(|x| format!("{x:?}")).collect();
         csv.push_str(&format!("{},{v:?}\n", cols.join(",")));
     }
-    let artifacts = vec![
-        Artifact { path: format!("wgsl/{name}.wgsl").into(), contents: wgsl::render_module(&header, &func).into() },
-        Artifact { path: format!("src/{name}.rs").into(), contents: rust::render_module(&header, &func, &doc).into() },
+    let ktx2_file = format!("data/{name}.ktx2");
+    let texture = form.has_texture().then(|| wgsl::TableTexture {
+        file: &ktx2_file,
+        format: tex_format.name(),
+        filterable: tex_format == spec::TableTextureFormat::R16float || spec.file.emit.float32_filterable,
+        keep_const: form.has_const(),
+    });
+    let mut rust_text = rust::render_module(&header, &func, &doc);
+    let mut ktx2 = None;
+    if let Some(t) = &texture {
+        let (w, h) = (counts[0] as u32, counts.get(1).copied().unwrap_or(1) as u32);
+        let shadefit = header.join("\n");
+        ktx2 = Some(emit::texture::ktx2_texels(w, h, 1, &v32, precision, &[("shadefit", &shadefit)]));
+        let upper = name.to_uppercase();
+        rust_text.push_str(&format!(
+            "\n/// The table as a KTX2 texture ({fmt}, {w}x{h} texels, one level; texel (i, j) the value at\n\
+             /// point i of the first axis, j of the second), as written by `shadefit build`; read by the\n\
+             /// WGSL function `{f}_load`{sample}.\n\
+             pub const {upper}_KTX2: &[u8] = include_bytes!(\"../{file}\");\n\
+             /// Texel format of [`{upper}_KTX2`] (WebGPU name).\n\
+             pub const {upper}_TEXTURE_FORMAT: &str = \"{fmt}\";\n",
+            fmt = t.format,
+            f = spec.file.emit.function,
+            sample = if t.filterable { format!(" and, through a linear sampler, `{}_sample`", spec.file.emit.function) } else { String::new() },
+            file = ktx2_file,
+        ));
+    }
+    let mut artifacts = vec![
+        Artifact { path: format!("wgsl/{name}.wgsl").into(), contents: wgsl::render_table_module(&header, &func, texture.as_ref()).into() },
+        Artifact { path: format!("src/{name}.rs").into(), contents: rust_text.into() },
         Artifact { path: format!("json/{name}.json").into(), contents: json_text(&json).into() },
         Artifact { path: format!("data/{name}.csv").into(), contents: csv.into() },
     ];
+    if let Some(bytes) = ktx2 {
+        artifacts.push(Artifact { path: ktx2_file.clone().into(), contents: bytes });
+    }
     Ok(Built { name, artifacts, verification, fit: None })
 }
 
@@ -859,8 +902,12 @@ pub fn runtime_index_with_scenes(specs: &[Spec], scenes: &[SceneIndex]) -> Artif
     s.push_str("    ];\n}\n");
     s.push_str("\n/// Every emitted function with its domain and CPU version (for GPU verification).\npub const FUNCTIONS: &[EmittedFunction] = &[\n");
     // Family spec kinds (e.g. RGB LUT lookups) and coefficient fields (see emit::fields) return
-    // arrays: not scalar functions of this list.
-    for spec in specs.iter().filter(|s| !matches!(s.file.kind, Kind::Custom(_) | Kind::Fields)) {
+    // arrays: not scalar functions of this list; a table emitted as a texture only
+    // (`form = "texture"`) has no WGSL function of that name (its `_load` takes a texture).
+    let listed = |s: &&Spec| {
+        !matches!(s.file.kind, Kind::Custom(_) | Kind::Fields) && s.file.emit.form.is_none_or(|f| f.has_const())
+    };
+    for spec in specs.iter().filter(listed) {
         let arity = spec.file.axis.len();
         let domain: Vec<String> = spec
             .file

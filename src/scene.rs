@@ -456,6 +456,7 @@ pub fn build(
     generated: &Path,
     force: bool,
     custom: &dyn Fn(&str) -> Option<pipeline::CustomBuild>,
+    targets: &dyn Fn(&str, &str) -> Result<Vec<emit::Artifact>, BuildError>,
     tx: &mut emit::Transaction,
 ) -> Result<SceneReport, BuildError> {
     let p = plan(scene);
@@ -489,7 +490,7 @@ pub fn build(
     // The specialisations compare themselves with the committed fits of the specs they read
     // (hash-checked): write the rebuilt nodes first, so they read this build's.
     let mut written = tx.write(&artifacts)?;
-    artifacts.clear();
+    let node_wgsl: Vec<emit::Artifact> = artifacts.drain(..).filter(|a| a.path.starts_with("wgsl")).collect();
     let hash = scene_hash(scene, specs, &p)?;
     // The scene JSON records the scene node itself like any other node (input hash, files).
     let scene_fresh = !force && built.is_empty() && recorded_fresh(generated, &previous, &hash);
@@ -505,6 +506,22 @@ pub fn build(
     if !built.is_empty() {
         artifacts.push(runtime_index(specs, scenes));
     }
+    // The other targets of every module the scene reaches and of the scene module, rebuilt or
+    // not (`targets(module, wgsl)`: none unless asked for), from the WGSL just rendered or the
+    // one on disk.
+    let mut translated = Vec::new();
+    for module in p.nodes.iter().cloned().chain(std::iter::once(scene.module())) {
+        let rel = Path::new("wgsl").join(format!("{module}.wgsl"));
+        let text = match artifacts.iter().chain(&node_wgsl).find(|a| a.path == rel) {
+            Some(a) => String::from_utf8_lossy(&a.contents).into_owned(),
+            None => match std::fs::read_to_string(generated.join(&rel)) {
+                Ok(t) => t,
+                Err(_) => continue,
+            },
+        };
+        translated.extend(targets(&module, &text)?);
+    }
+    artifacts.extend(translated);
     written += tx.write(&artifacts)?;
     let skipped = specs.iter().map(|s| s.file.name.clone()).filter(|n| !p.nodes.contains(n)).collect();
     Ok(SceneReport { built, up_to_date, skipped, records, written })

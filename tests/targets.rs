@@ -549,3 +549,77 @@ fn spec_targets_are_emitted_and_checked() {
     let o = shadefit(&["build", "--check", "--target", "dxil"], Some(d.path()));
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
 }
+
+/// The GLSL and SPIR-V files among `files` through glslangValidator and spirv-val (when
+/// installed), each also equal to `translate` of the module's WGSL as written beside it.
+fn validate_written(d: &Path, files: &[PathBuf]) {
+    let (glslang, val) = (tool("glslangValidator"), tool("spirv-val"));
+    let scratch = tempfile::tempdir().unwrap();
+    for f in files {
+        let module = f.file_stem().unwrap().to_str().unwrap();
+        let target = Target::from_name(f.iter().next().unwrap().to_str().unwrap()).unwrap();
+        let wgsl = std::fs::read_to_string(d.join("generated/wgsl").join(format!("{module}.wgsl"))).unwrap();
+        let bytes = std::fs::read(d.join("generated").join(f)).unwrap();
+        let again = translate(module, &wgsl, &[target]).unwrap();
+        assert_eq!(again.iter().find(|a| a.path == *f).map(|a| &a.contents), Some(&bytes), "{}: the translation of the WGSL beside it", f.display());
+        match (target, &glslang, &val) {
+            (Target::Glsl | Target::GlslEs, Some(g), _) => {
+                let p = scratch.path().join(format!("{module}.{}.frag", target.name()));
+                std::fs::write(&p, &bytes).unwrap();
+                run_ok(Command::new(g).arg(&p), &format!("glslangValidator {}", f.display()));
+            }
+            (Target::Spirv, _, Some(v)) => {
+                let p = scratch.path().join(format!("{module}.spv"));
+                std::fs::write(&p, &bytes).unwrap();
+                run_ok(Command::new(v).args(["--target-env", "vulkan1.0"]).arg(&p), &format!("spirv-val {}", f.display()));
+            }
+            _ => {}
+        }
+    }
+}
+
+#[test]
+fn a_lut_kind_takes_emit_targets() {
+    // ggx_dfg_lut (kind = "ggx-dfg-lut"): functions taking a texture and a sampler.
+    let d = scratch();
+    let p = d.path().join("fits/ggx_dfg_lut.toml");
+    let spec = std::fs::read_to_string(&p).unwrap();
+    std::fs::write(&p, spec.replace("[emit]\n", "[emit]\ntargets = [\"glsl\", \"glsl-es\", \"spirv\", \"hlsl\"]\n")).unwrap();
+    let o = shadefit(&["build", "--only", "ggx_dfg_lut"], Some(d.path()));
+    assert!(o.status.success(), "{}", stderr(&o));
+    let names: Vec<PathBuf> = target_files(d.path()).into_iter().map(|f| f.0).collect();
+    assert_eq!(names, ["glsl/ggx_dfg_lut.glsl", "glsl-es/ggx_dfg_lut.glsl", "hlsl/ggx_dfg_lut.hlsl", "spirv/ggx_dfg_lut.spv"].map(PathBuf::from));
+    validate_written(d.path(), &names);
+    let o = shadefit(&["build", "--check", "--only", "ggx_dfg_lut"], Some(d.path()));
+    assert!(o.status.success(), "{}", stderr(&o));
+
+    // An unknown name in a family kind's spec is bad input too (exit 2, file, line, field).
+    std::fs::write(&p, spec.replace("[emit]\n", "[emit]\ntargets = [\"dxil\"]\n")).unwrap();
+    let o = shadefit(&["build", "--only", "ggx_dfg_lut"], Some(d.path()));
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    let e = stderr(&o);
+    let line = spec.lines().position(|l| l == "[emit]").unwrap() + 2;
+    assert!(e.contains(&format!("ggx_dfg_lut.toml:{line}")) && e.contains("targets") && e.contains("dxil"), "{e}");
+}
+
+#[test]
+fn build_scene_takes_targets() {
+    // A scene over the committed outputs: its module and the node modules it reaches (the skin
+    // LUTs, with textures and samplers) in GLSL and SPIR-V, rebuilt or not.
+    let d = scratch();
+    copy_dir(&root().join("generated"), &d.path().join("generated"));
+    copy_dir(&root().join("fits/scenes"), &d.path().join("fits/scenes"));
+    let o = shadefit(&["build", "--scene", "fits/scenes/skin_character.toml", "--target", "glsl,spirv"], Some(d.path()));
+    assert!(o.status.success(), "{}", stderr(&o));
+    let names: Vec<PathBuf> = target_files(d.path()).into_iter().map(|f| f.0).collect();
+    for m in ["scene_skin_character", "skin_punctual_lut", "skin_sh_lut"] {
+        for f in [format!("glsl/{m}.glsl"), format!("spirv/{m}.spv")] {
+            assert!(names.contains(&PathBuf::from(&f)), "{f} in {names:?}");
+        }
+    }
+    validate_written(d.path(), &names);
+    // The scene is up to date: a second run writes nothing, the targets included.
+    let o = shadefit(&["build", "--scene", "fits/scenes/skin_character.toml", "--target", "glsl,spirv"], Some(d.path()));
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("0 file(s) written"), "{}", String::from_utf8_lossy(&o.stdout));
+}

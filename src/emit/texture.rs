@@ -17,7 +17,8 @@
 //!
 //! The level data starts at a multiple of the texel size (8 bytes for RGBA16F, 16 for RGBA32F,
 //! both multiples of 4 as the specification requires). Two-channel textures (RG16F, RG32F:
-//! [`ktx2_texels`]) have two DFD samples (R, G) and start at a multiple of lcm(texel size, 4). Texel values are written as given:
+//! [`ktx2_texels`]) have two DFD samples (R, G), one-channel textures (R16F, R32F: the tables of
+//! `kind = "table"` specs) one, and both start at a multiple of lcm(texel size, 4). Texel values are written as given:
 //! no tonemapping, no gamma (the DFD says so with `KHR_DF_TRANSFER_LINEAR`).
 
 use serde::{Deserialize, Serialize};
@@ -99,23 +100,27 @@ fn pad_to(out: &mut Vec<u8>, align: usize) {
     }
 }
 
-/// Channel ids of an RG (2) or RGBA (4) texel: R = 0, G = 1, B = 2, A = 15.
+/// Channel ids of an R (1), RG (2) or RGBA (4) texel: R = 0, G = 1, B = 2, A = 15.
 fn channel_ids(channels: usize) -> &'static [u32] {
     match channels {
+        1 => &[0],
         2 => &[0, 1],
         4 => &[0, 1, 2, 15],
-        _ => panic!("KTX2 texels have 2 (RG) or 4 (RGBA) channels, not {channels}"),
+        _ => panic!("KTX2 texels have 1 (R), 2 (RG) or 4 (RGBA) channels, not {channels}"),
     }
 }
 
-/// `VkFormat` of `channels` channels in the precision of `format`: R16G16_SFLOAT (83),
-/// R16G16B16A16_SFLOAT (97), R32G32_SFLOAT (103), R32G32B32A32_SFLOAT (109).
+/// `VkFormat` of `channels` channels in the precision of `format` (Vulkan's `VkFormat`
+/// enumerants): R16_SFLOAT (76), R16G16_SFLOAT (83), R16G16B16A16_SFLOAT (97), R32_SFLOAT (100),
+/// R32G32_SFLOAT (103), R32G32B32A32_SFLOAT (109).
 pub fn vk_format(format: TextureFormat, channels: usize) -> u32 {
     match (format, channels) {
+        (TextureFormat::Rgba16float, 1) => 76,
+        (TextureFormat::Rgba32float, 1) => 100,
         (TextureFormat::Rgba16float, 2) => 83,
         (TextureFormat::Rgba32float, 2) => 103,
         (f, 4) => f.vk_format(),
-        _ => panic!("KTX2 texels have 2 (RG) or 4 (RGBA) channels, not {channels}"),
+        _ => panic!("KTX2 texels have 1 (R), 2 (RG) or 4 (RGBA) channels, not {channels}"),
     }
 }
 
@@ -184,7 +189,7 @@ pub fn ktx2_rgba(
     ktx2_texels(width, height, 4, &flat, format, metadata)
 }
 
-/// A KTX2 file of one `width`×`height` image of `channels` (2: RG, 4: RGBA) float channels
+/// A KTX2 file of one `width`×`height` image of `channels` (1: R, 2: RG, 4: RGBA) float channels
 /// per texel, `values[(y * width + x) * channels + c]`, in the precision of `format` (the
 /// layout of [`ktx2_rgba`], which is this with 4 channels).
 pub fn ktx2_texels(
@@ -225,7 +230,7 @@ pub fn ktx2_volume(
     for &c in values {
         format.push(&mut level, c);
     }
-    // lcm(texel size, 4): the texel size for RGBA (8, 16) and RG32F (8); 4 for RG16F.
+    // lcm(texel size, 4): the texel size for RGBA (8, 16), RG32F (8) and R32F (4); 4 for RG16F and R16F.
     let align = texel_size.max(4);
     let level_offset = (kvd_offset + kvd.len()).next_multiple_of(align);
 
@@ -449,17 +454,25 @@ mod tests {
     }
 
     #[test]
-    fn rg_textures_read_back_with_the_ktx2_crate() {
-        for (format, vk) in [(TextureFormat::Rgba16float, 83), (TextureFormat::Rgba32float, 103)] {
+    fn r_and_rg_textures_read_back_with_the_ktx2_crate() {
+        // VkFormat enumerants from the Vulkan specification: R16_SFLOAT 76, R16G16_SFLOAT 83,
+        // R32_SFLOAT 100, R32G32_SFLOAT 103.
+        for (format, channels, vk) in [
+            (TextureFormat::Rgba16float, 1, 76),
+            (TextureFormat::Rgba32float, 1, 100),
+            (TextureFormat::Rgba16float, 2, 83),
+            (TextureFormat::Rgba32float, 2, 103),
+        ] {
             let (w, h) = (3, 5);
-            let v: Vec<f32> = (0..2 * w * h).map(|k| k as f32 / 3.0 - 2.0).collect();
-            let bytes = ktx2_texels(w, h, 2, &v, format, &[]);
+            let v: Vec<f32> = (0..channels as u32 * w * h).map(|k| k as f32 / 3.0 - 2.0).collect();
+            let bytes = ktx2_texels(w, h, channels, &v, format, &[]);
             let r = ktx2::Reader::new(&bytes[..]).expect("a valid KTX2 file");
             assert_eq!(r.header().format.map(|f| f.value()), Some(vk));
+            assert_eq!((r.header().pixel_width, r.header().pixel_height), (w, h));
             let basic = r.basic_dfd().expect("a basic DFD block");
-            assert_eq!(basic.bytes_planes[0] as u32, 2 * format.type_size());
+            assert_eq!(basic.bytes_planes[0] as u32, channels as u32 * format.type_size());
             let ids: Vec<u8> = basic.sample_information.iter().map(|s| s.channel_type).collect();
-            assert_eq!(ids, [0, 1]);
+            assert_eq!(ids, [0u8, 1][..channels]);
             let level = r.levels().next().unwrap();
             assert_eq!((level.data.as_ptr() as usize - bytes.as_ptr() as usize) % 4, 0);
             let ts = format.type_size() as usize;

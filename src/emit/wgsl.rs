@@ -44,7 +44,39 @@ fn array(name: &str, values: &[f32]) -> String {
 }
 
 pub fn render_module(header: &[String], f: &Function<'_>) -> String {
-    let upper = f.module.to_uppercase();
+    render_table_module(header, f, None)
+}
+
+/// A table's texture, as the helpers of [`render_table_module`] read it.
+pub struct TableTexture<'a> {
+    /// The KTX2 file under generated/ (`data/NAME.ktx2`).
+    pub file: &'a str,
+    /// WebGPU name of the texel format (`r16float`, `r32float`).
+    pub format: &'a str,
+    /// Whether the module gets the linear-sampler helper: the format is filterable on the
+    /// engine's device (r16float always; r32float only with `float32-filterable` requested).
+    pub filterable: bool,
+    /// Whether the module keeps the `const` array and the function reading it.
+    pub keep_const: bool,
+}
+
+/// The module of a table function ([`Body::Table`]) with its texture helpers (see
+/// [`table_texture_functions`]); without a texture, [`render_module`].
+pub fn render_table_module(header: &[String], f: &Function<'_>, texture: Option<&TableTexture<'_>>) -> String {
+    let mut s = prelude(header, f);
+    if texture.is_none_or(|t| t.keep_const) {
+        s.push_str(&body(f));
+    }
+    if let (Some(t), Body::Table { counts, .. }) = (texture, &f.body) {
+        let helpers = table_texture_functions(f, counts, t);
+        // After the prelude's blank line, no second one.
+        s.push_str(if t.keep_const { &helpers } else { &helpers[1..] });
+    }
+    s
+}
+
+/// The header, the directive and the input clamp of a module.
+fn prelude(header: &[String], f: &Function<'_>) -> String {
     let mut s = String::new();
     for h in header {
         s.push_str(&format!("// {h}\n"));
@@ -57,9 +89,12 @@ pub fn render_module(header: &[String], f: &Function<'_>) -> String {
          return select(clamp(v, lo, hi), lo, nan);\n}}\n\n",
         m = f.module
     ));
-    let params: Vec<String> = f.args.iter().map(|a| format!("{a}: f32")).collect();
-    let inputs: String = f
-        .args
+    s
+}
+
+/// The `let xK = ...` lines: the clamped inputs, then the derived features.
+fn input_lines(f: &Function<'_>) -> String {
+    f.args
         .iter()
         .zip(f.domain)
         .enumerate()
@@ -67,7 +102,109 @@ pub fn render_module(header: &[String], f: &Function<'_>) -> String {
         .chain(f.derived.iter().enumerate().map(|(k, d)| {
             format!("    let x{} = {};\n", f.args.len() + k, derived_expr(d, &lit, &|fun, v| format!("{fun}({v})")))
         }))
-        .collect();
+        .collect()
+}
+
+/// `tK` (the argument in table steps), `iK` (the lower point) and `fK` (the weight of the upper)
+/// of each table axis, as the table function computes them.
+fn table_index_lines(f: &Function<'_>, counts: &[usize]) -> String {
+    let mut s = String::new();
+    for (i, ((lo, hi), n)) in f.domain.iter().zip(counts.iter()).enumerate() {
+        s.push_str(&format!(
+            "    let t{i} = (x{i} - {lo}) * {scale};\n    let i{i} = min(u32(t{i}), {last}u);\n    let f{i} = t{i} - f32(i{i});\n",
+            lo = lit(*lo),
+            scale = lit((*n as f32 - 1.0) / (hi - lo)),
+            last = n - 2
+        ));
+    }
+    s
+}
+
+/// The functions reading a table from a texture (`texture_2d<f32>`, one channel; a table of
+/// axes n0 (× n1) is n0 × n1 texels, texel (i, j) the value at point i of the first axis and j
+/// of the second, 1 row for one axis):
+/// - `FUNCTION_load(lut, args)`: the table function with each `TABLE[k]` a `textureLoad` of the
+///   same texel; same clamp, index, weights and order, so an r32float texture gives the same f32
+///   arithmetic as the `const` array (no sampler; binds as unfilterable float);
+/// - when `texture.filterable`: `MODULE_uv(args)`, texel-centre coordinates
+///   u = (tK + 0.5) / nK with tK as the table function computes it (v = 0.5 for one axis), and
+///   `FUNCTION_sample(lut, lut_sampler, args)` through a linear, clamp-to-edge sampler, which
+///   interpolates the same two (four) texels with the same weights up to the sampler's weight
+///   precision (Vulkan guarantees 4 sub-texel bits, GPUs have 8).
+pub fn table_texture_functions(f: &Function<'_>, counts: &[usize], texture: &TableTexture<'_>) -> String {
+    let params: Vec<String> = f.args.iter().map(|a| format!("{a}: f32")).collect();
+    let inputs = input_lines(f);
+    let index = table_index_lines(f, counts);
+    let load = |x: &str, y: &str| format!("textureLoad(lut, vec2<u32>({x}, {y}), 0).x");
+    let (w, h) = (counts[0], counts.get(1).copied().unwrap_or(1));
+    let same = if texture.format == "r32float" {
+        format!("// with r32float texels the same f32 arithmetic on the same values as {}.\n", f.name)
+    } else {
+        format!("// the values rounded to {} as stored.\n", texture.format)
+    };
+    let mut s = format!(
+        "\n// The texture form of {name}: the table from `lut` ({file}, {fmt}, {w}x{h} texels,\n\
+         // texel (i, j) the value at point i of the first axis{second}) by textureLoad, with the\n\
+         // clamp, indices, weights and order of {name}; no sampler (bind as unfilterable float);\n\
+         {same}\
+         fn {name}_load(lut: texture_2d<f32>, {p}) -> f32 {{\n{inputs}{index}",
+        name = f.name,
+        file = texture.file,
+        fmt = texture.format,
+        second = if counts.len() == 2 { ", j of the second" } else { "; one row" },
+        p = params.join(", "),
+    );
+    if counts.len() == 1 {
+        s.push_str(&format!("    return {} * (1.0f - f0) + {} * f0;\n}}\n", load("i0", "0u"), load("i0 + 1u", "0u")));
+    } else {
+        s.push_str(&format!(
+            "    let a = {} * (1.0f - f0) + {} * f0;\n    \
+             let b = {} * (1.0f - f0) + {} * f0;\n    \
+             return a * (1.0f - f1) + b * f1;\n}}\n",
+            load("i0", "i1"),
+            load("i0 + 1u", "i1"),
+            load("i0", "i1 + 1u"),
+            load("i0 + 1u", "i1 + 1u"),
+        ));
+    }
+    if texture.filterable {
+        let t: Vec<String> = (0..counts.len()).map(|i| format!("(t{i} + 0.5f) / {}", lit(counts[i] as f32))).collect();
+        let v = t.get(1).cloned().unwrap_or_else(|| "0.5f".into());
+        // The index lines without iK and fK: tK alone.
+        let ts: String = index.lines().filter(|l| l.trim_start().starts_with("let t")).map(|l| format!("{l}\n")).collect();
+        let call: Vec<&str> = f.args.iter().map(String::as_str).collect();
+        s.push_str(&format!(
+            "\n// Texture coordinates of {name}'s arguments at texel centres: u = (t0 + 0.5) / n0,\n\
+             // t0 the argument in table steps as {name} computes it{vnote}.\n\
+             fn {m}_uv({p}) -> vec2<f32> {{\n{inputs}{ts}    return vec2<f32>({u}, {v});\n}}\n\
+             \n// {name} from `lut` ({fmt}) through a linear, clamp-to-edge sampler at {m}_uv:\n\
+             // the texels and weights of {name}, the weights to the sampler's sub-texel precision.\n\
+             {f32note}\
+             fn {name}_sample(lut: texture_2d<f32>, lut_sampler: sampler, {p}) -> f32 {{\n    \
+             return textureSampleLevel(lut, lut_sampler, {m}_uv({c}), 0.0).x;\n}}\n",
+            name = f.name,
+            m = f.module,
+            fmt = texture.format,
+            f32note = if texture.format == "r32float" {
+                "// r32float: the device must have float32-filterable (the spec's float32_filterable = true).\n"
+            } else {
+                ""
+            },
+            vnote = if counts.len() == 2 { ", v likewise" } else { "; v = 0.5, the one row" },
+            p = params.join(", "),
+            u = t[0],
+            c = call.join(", "),
+        ));
+    }
+    s
+}
+
+/// The function of a module (after its prelude).
+fn body(f: &Function<'_>) -> String {
+    let upper = f.module.to_uppercase();
+    let mut s = String::new();
+    let params: Vec<String> = f.args.iter().map(|a| format!("{a}: f32")).collect();
+    let inputs = input_lines(f);
     match &f.body {
         Body::Fit { expr, num, den, clamp } => {
             s.push_str(&array(&format!("{upper}_NUM"), num));
@@ -93,14 +230,7 @@ pub fn render_module(header: &[String], f: &Function<'_>) -> String {
         Body::Table { values, counts } => {
             s.push_str(&array(&format!("{upper}_TABLE"), values));
             s.push_str(&format!("\nfn {}({}) -> f32 {{\n{inputs}", f.name, params.join(", ")));
-            for (i, ((lo, hi), n)) in f.domain.iter().zip(counts.iter()).enumerate() {
-                s.push_str(&format!(
-                    "    let t{i} = (x{i} - {lo}) * {scale};\n    let i{i} = min(u32(t{i}), {last}u);\n    let f{i} = t{i} - f32(i{i});\n",
-                    lo = lit(*lo),
-                    scale = lit((*n as f32 - 1.0) / (hi - lo)),
-                    last = n - 2
-                ));
-            }
+            s.push_str(&table_index_lines(f, counts));
             let t = format!("{upper}_TABLE");
             if counts.len() == 1 {
                 s.push_str(&format!("    return {t}[i0] * (1.0f - f0) + {t}[i0 + 1u] * f0;\n}}\n"));

@@ -122,7 +122,15 @@ fn spec_of(req: &DataFit, model: RationalModel, data: &Data) -> Result<Spec, Bui
         model: None,
         fit: Some(FitSection { objective: req.objective, max_rms: None }),
         fields: None,
-        emit: EmitSection { function: req.function.to_string(), args: req.args.map(<[String]>::to_vec), evaluator: None, targets: None },
+        emit: EmitSection {
+            function: req.function.to_string(),
+            args: req.args.map(<[String]>::to_vec),
+            evaluator: None,
+            targets: None,
+            form: None,
+            texture_format: None,
+            float32_filterable: false,
+        },
     };
     Ok(Spec { path: req.csv.to_path_buf(), text, file, quantity: &DATA, model: Some(model), channel: None, origin: Some(origin) })
 }

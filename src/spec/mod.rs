@@ -352,8 +352,13 @@ pub struct CustomSpec<'a> {
 }
 
 impl CustomSpec<'_> {
-    /// The common spec; an error names the file and the `kind` line.
+    /// The common spec; an error names the file and the `kind` line. `[emit] targets` is taken
+    /// from the text as it is for every spec (the family's checker accepts the key and leaves it
+    /// to the common one; `build` checks the names).
     pub fn spec_file(self, path: &Path, text: &str) -> Result<SpecFile, SpecError> {
+        let targets = toml::from_str::<toml::Value>(text).ok().and_then(|v| {
+            v.get("emit")?.get("targets")?.as_array()?.iter().map(|t| t.as_str().map(String::from)).collect::<Option<Vec<String>>>()
+        });
         let v = serde_json::json!({
             "name": self.name,
             "kind": "table",
@@ -361,7 +366,7 @@ impl CustomSpec<'_> {
             "description": self.description,
             "tolerance": self.tolerance,
             "axis": self.axes,
-            "emit": {"function": self.function},
+            "emit": {"function": self.function, "targets": targets},
         });
         let mut file: SpecFile =
             serde_json::from_value(v).map_err(|e| SpecError::new(path, line_of(text, "kind"), "kind", e.to_string()))?;
@@ -389,6 +394,9 @@ struct ModuleFile {
 struct ModulePrefix {
     /// Prefix of the emitted function names.
     function: String,
+    /// Outputs besides the WGSL module (read from the text by [`CustomSpec::spec_file`]).
+    #[allow(dead_code)]
+    targets: Option<Vec<String>>,
 }
 
 /// For family kinds that emit one module of functions: the common spec of a module spec of kind
@@ -502,6 +510,58 @@ pub struct EmitSection {
     /// Outputs besides the WGSL module (`emit::targets::Target` names: "wgsl-plain", "hlsl",
     /// "glsl", "glsl-es", "msl", "spirv", "c", "wesl"; `build` checks them); `build --target` adds to them.
     pub targets: Option<Vec<String>>,
+    /// kind = "table": the WGSL forms of the table (default `const`).
+    pub form: Option<TableForm>,
+    /// kind = "table" with a texture form: the texel format of `data/NAME.ktx2` (default
+    /// `r32float`).
+    pub texture_format: Option<TableTextureFormat>,
+    /// `texture_format = "r32float"`: the engine requests WebGPU's `float32-filterable` feature,
+    /// so the module also gets the linear-sampler helper `FUNCTION_sample` (without it an
+    /// R32Float table is read by `textureLoad` only).
+    #[serde(default)]
+    pub float32_filterable: bool,
+}
+
+/// How a `kind = "table"` spec's WGSL holds its table: a `const` array read by `FUNCTION`
+/// (`const`), a texture (`data/NAME.ktx2`) read by `FUNCTION_load` and, when the format is
+/// filterable, `FUNCTION_sample` (`texture`), or both in one module (`both`).
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum TableForm {
+    #[default]
+    Const,
+    Texture,
+    Both,
+}
+
+impl TableForm {
+    pub fn has_const(self) -> bool {
+        self != TableForm::Texture
+    }
+
+    pub fn has_texture(self) -> bool {
+        self != TableForm::Const
+    }
+}
+
+/// Texel format of a table texture (WebGPU names): one channel, 16- or 32-bit float.
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum TableTextureFormat {
+    /// IEEE half floats: filterable in core WebGPU; 11 significant bits.
+    R16float,
+    /// f32: the table values exactly; unfilterable in core WebGPU (`float32-filterable`).
+    #[default]
+    R32float,
+}
+
+impl TableTextureFormat {
+    pub fn name(self) -> &'static str {
+        match self {
+            TableTextureFormat::R16float => "r16float",
+            TableTextureFormat::R32float => "r32float",
+        }
+    }
 }
 
 
@@ -644,6 +704,19 @@ impl Spec {
             && let Some((a, why)) = file.axis.iter().take(n_args).find_map(|a| names::check_argument(&a.name).map(|w| (a, w)))
         {
             return Err(at("args", format!("the axis '{}' would name an argument: {why}; give [emit] args", a.name)));
+        }
+        let form = file.emit.form.unwrap_or_default();
+        if file.emit.form.is_some() && file.kind != Kind::Table {
+            return Err(at("form", format!("applies to kind = \"table\" only, not \"{}\"", file.kind.name())));
+        }
+        if file.emit.texture_format.is_some() && !form.has_texture() {
+            return Err(at("texture_format", "needs form = \"texture\" or \"both\"".into()));
+        }
+        if file.emit.float32_filterable && (!form.has_texture() || file.emit.texture_format.unwrap_or_default() != TableTextureFormat::R32float) {
+            return Err(at("float32_filterable", "applies to a texture form with texture_format = \"r32float\" only (r16float is filterable in core WebGPU)".into()));
+        }
+        if form.has_texture() && file.axis.len() > 2 {
+            return Err(at("form", format!("a table texture is 2-D: {} axes", file.axis.len())));
         }
         if let Some(b) = file.max_error
             && !(b > 0.0 && b.is_finite())

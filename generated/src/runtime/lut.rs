@@ -28,6 +28,19 @@
 //! table step. The [`LutTexture::sampler`] made alongside (nearest, clamp-to-edge,
 //! `SamplerBindingType::NonFiltering`) is for shaders that prefer `textureSampleLevel` at
 //! texel centres; the accessor itself needs no sampler.
+//!
+//! # Emitted texture form
+//! A table spec with `[emit] form = "texture"` or `"both"` also has its table as a KTX2 file
+//! (`generated/data/NAME.ktx2`, carried as `NAME_KTX2` and [`Table::ktx2`]): one channel, the
+//! spec's `texture_format` (R32Float, the f32 values exactly, or R16Float, rounded to nearest
+//! half), width `n0`, height `n1` (1 for one axis), texel (i, j) the value at point i of the
+//! first axis and j of the second. The module gains `FUNCTION_load(lut, args)` (textureLoad and
+//! the interpolation of `FUNCTION`, any format, no sampler) and, when the format is filterable
+//! on the engine's device (R16Float; R32Float only with `float32_filterable = true` in the spec),
+//! `FUNCTION_sample(lut, lut_sampler, args)` through a linear, clamp-to-edge sampler at texel
+//! centres. [`Table::upload_ktx2`] uploads the file; asked for a linear sampler it refuses a
+//! 32-bit float texture on a device without `FLOAT32_FILTERABLE`
+//! ([`crate::skin::Ktx2Error::NeedsFloat32Filterable`]), as the skin LUTs do.
 
 /// Texture format of the lookup tables (see the module documentation).
 #[cfg(feature = "gpu")]
@@ -41,6 +54,10 @@ pub struct Table {
     pub function: &'static str,
     pub domain: &'static [[f32; 2]],
     pub values: &'static [f32],
+    /// The table's KTX2 texture (`NAME_KTX2`), when its spec asks for the texture form
+    /// (`[emit] form = "texture"` or `"both"`): read by the emitted `FUNCTION_load` and, for a
+    /// filterable format, `FUNCTION_sample`; [`Table::upload_ktx2`] (feature `gpu`) uploads it.
+    pub ktx2: Option<&'static [u8]>,
 }
 
 /// Every table module compiled in.
@@ -54,6 +71,7 @@ pub const TABLES: &[Table] = &[
         function: "ggx_albedo_avg_lut",
         domain: &crate::ggx_albedo_avg_table::GGX_ALBEDO_AVG_TABLE_DOMAIN,
         values: &crate::ggx_albedo_avg_table::GGX_ALBEDO_AVG_TABLE_TABLE,
+        ktx2: Some(crate::ggx_albedo_avg_table::GGX_ALBEDO_AVG_TABLE_KTX2),
     },
     #[cfg(feature = "ggx")]
     Table {
@@ -61,6 +79,7 @@ pub const TABLES: &[Table] = &[
         function: "ggx_albedo_lut",
         domain: &crate::ggx_albedo_table::GGX_ALBEDO_TABLE_DOMAIN,
         values: &crate::ggx_albedo_table::GGX_ALBEDO_TABLE_TABLE,
+        ktx2: Some(crate::ggx_albedo_table::GGX_ALBEDO_TABLE_KTX2),
     },
     #[cfg(feature = "gloss")]
     Table {
@@ -68,6 +87,7 @@ pub const TABLES: &[Table] = &[
         function: "combine_gloss_lut",
         domain: &crate::gloss_combine_lut::GLOSS_COMBINE_LUT_DOMAIN,
         values: &crate::gloss_combine_lut::GLOSS_COMBINE_LUT_TABLE,
+        ktx2: Some(crate::gloss_combine_lut::GLOSS_COMBINE_LUT_KTX2),
     },
     #[cfg(feature = "gloss")]
     Table {
@@ -75,6 +95,7 @@ pub const TABLES: &[Table] = &[
         function: "normal_length_to_gloss_lut",
         domain: &crate::gloss_inverse_table::GLOSS_INVERSE_TABLE_DOMAIN,
         values: &crate::gloss_inverse_table::GLOSS_INVERSE_TABLE_TABLE,
+        ktx2: Some(crate::gloss_inverse_table::GLOSS_INVERSE_TABLE_KTX2),
     },
     #[cfg(feature = "gloss")]
     Table {
@@ -82,6 +103,7 @@ pub const TABLES: &[Table] = &[
         function: "gloss_to_normal_length_lut",
         domain: &crate::gloss_table::GLOSS_TABLE_DOMAIN,
         values: &crate::gloss_table::GLOSS_TABLE_TABLE,
+        ktx2: Some(crate::gloss_table::GLOSS_TABLE_KTX2),
     },
 ];
 
@@ -142,7 +164,8 @@ impl Table {
         format!("{}_tex", self.function)
     }
 
-    /// Self-contained WGSL for the texture version of the table function: the declaration
+    /// Self-contained WGSL for the texture version of the table function (needs the module's
+    /// const-array function: for a module emitted as a texture only, use its `FUNCTION_load`): the declaration
     /// `@group(group) @binding(binding) var MODULE_tex: texture_2d<f32>;`, a copy of the module's
     /// input clamp, a texel-fetch helper and `FUNCTION_tex(args) -> f32`, which is the emitted
     /// function with every `TABLE[i]` replaced by a `textureLoad` of texel `(i % width, i / width)`.
@@ -230,6 +253,36 @@ mod gpu {
         }
     }
 
+    impl Table {
+        /// Upload the table's KTX2 texture ([`Table::ktx2`]; `None` for a table emitted as a
+        /// `const` array only). `linear`: a linear, clamp-to-edge sampler for
+        /// `FUNCTION_sample`, refused for an R32Float texture on a device without
+        /// `FLOAT32_FILTERABLE`; otherwise a nearest one (`FUNCTION_load` needs none).
+        pub fn upload_ktx2(
+            &'static self,
+            device: &wgpu::Device,
+            queue: &wgpu::Queue,
+            linear: bool,
+        ) -> Option<Result<LutTexture, crate::skin::Ktx2Error>> {
+            let bytes = self.ktx2?;
+            Some(crate::runtime::skin::upload_ktx2(device, queue, self.module, bytes, linear).map(|texture| {
+                let filter = if linear { wgpu::FilterMode::Linear } else { wgpu::FilterMode::Nearest };
+                let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
+                let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+                    label: Some(self.module),
+                    address_mode_u: wgpu::AddressMode::ClampToEdge,
+                    address_mode_v: wgpu::AddressMode::ClampToEdge,
+                    address_mode_w: wgpu::AddressMode::ClampToEdge,
+                    mag_filter: filter,
+                    min_filter: filter,
+                    mipmap_filter: wgpu::MipmapFilterMode::Nearest,
+                    ..Default::default()
+                });
+                LutTexture { table: self, texture, view, sampler }
+            }))
+        }
+    }
+
     impl LutTexture {
         /// Bind group layout entry for the texture (`texture_2d<f32>`, unfilterable float).
         pub fn texture_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
@@ -268,7 +321,9 @@ mod tests {
     fn every_table_module_is_listed() {
         for name in crate::wgsl::NAMES {
             let src = crate::wgsl::module(name).unwrap();
-            let is_table = src.contains(&format!("const {}_TABLE:", name.to_uppercase()));
+            // A table module has a const array, a texture reader (`form = "texture"`), or both.
+            let is_table = src.contains(&format!("const {}_TABLE:", name.to_uppercase()))
+                || src.contains("_load(lut: texture_2d<f32>, ");
             assert_eq!(is_table, table(name).is_some(), "{name}: table module not in lut::TABLES (or listed but not one)");
         }
         for t in TABLES {
@@ -283,6 +338,36 @@ mod tests {
         assert_eq!(table("gloss_table").unwrap().size(), (256, 1));
         assert_eq!(table("gloss_inverse_table").unwrap().size(), (1024, 1));
         assert_eq!(table("gloss_combine_lut").unwrap().size(), (64, 64));
+    }
+
+    #[test]
+    fn ktx2_textures_hold_the_table_values() {
+        for t in TABLES {
+            let load = format!("fn {}_load(lut: texture_2d<f32>", t.function);
+            assert_eq!(t.ktx2.is_some(), t.emitted_wgsl().contains(&load), "{}: NAME_KTX2 iff the WGSL reads it", t.module);
+            let Some(bytes) = t.ktx2 else { continue };
+            let img = crate::skin::Ktx2Image::parse(bytes).unwrap();
+            assert_eq!((img.width, img.height), t.size(), "{}", t.module);
+            let sample = t.emitted_wgsl().contains(&format!("fn {}_sample(", t.function));
+            for (k, &v) in t.values.iter().enumerate() {
+                let got = img.texel(k as u32 % img.width, k as u32 / img.width)[0];
+                match img.format {
+                    crate::skin::LutFormat::R32Float => {
+                        assert_eq!(got.to_bits(), v.to_bits(), "{} texel {k}", t.module);
+                        // Never a linear sampler on R32Float unless the spec asked for it.
+                        assert!(!sample || t.emitted_wgsl().contains("float32-filterable"), "{}", t.module);
+                    }
+                    crate::skin::LutFormat::R16Float => {
+                        // Round to nearest half: within half a unit in the last place of the
+                        // 11-bit significand, |v|·2^-11 for normal halves (|v| >= 2^-14), 2^-25
+                        // below.
+                        let bound = (v.abs() * 2f32.powi(-11)).max(2f32.powi(-25));
+                        assert!((got - v).abs() <= bound, "{} texel {k}: {got} vs {v}", t.module);
+                    }
+                    other => panic!("{}: {other:?} is not a one-channel format", t.module),
+                }
+            }
+        }
     }
 
     #[test]

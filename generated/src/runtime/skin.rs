@@ -69,11 +69,11 @@ pub fn skin_curvature_from_light_normalized(
 pub enum Ktx2Error {
     /// Not a KTX2 file, or shorter than its header says.
     Malformed(&'static str),
-    /// A `VkFormat` other than RGBA16F (97) and RGBA32F (109).
+    /// A `VkFormat` other than R16F (76), R32F (100), RGBA16F (97) and RGBA32F (109).
     Format(u32),
     /// Supercompressed, layered, cube, 3-D or mipmapped: not what shadefit writes.
     Unsupported(&'static str),
-    /// An RGBA32F texture for a linear sampler on a device without `FLOAT32_FILTERABLE`.
+    /// A 32-bit float texture for a linear sampler on a device without `FLOAT32_FILTERABLE`.
     NeedsFloat32Filterable,
 }
 
@@ -81,11 +81,11 @@ impl std::fmt::Display for Ktx2Error {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             Ktx2Error::Malformed(why) => write!(f, "malformed KTX2: {why}"),
-            Ktx2Error::Format(v) => write!(f, "KTX2 VkFormat {v} is not RGBA16F (97) or RGBA32F (109)"),
+            Ktx2Error::Format(v) => write!(f, "KTX2 VkFormat {v} is not R16F (76), R32F (100), RGBA16F (97) or RGBA32F (109)"),
             Ktx2Error::Unsupported(what) => write!(f, "unsupported KTX2: {what}"),
             Ktx2Error::NeedsFloat32Filterable => write!(
                 f,
-                "an RGBA32F LUT is sampled linearly: create the device with wgpu::Features::FLOAT32_FILTERABLE"
+                "a 32-bit float LUT is sampled linearly: create the device with wgpu::Features::FLOAT32_FILTERABLE"
             ),
         }
     }
@@ -93,18 +93,47 @@ impl std::fmt::Display for Ktx2Error {
 
 impl std::error::Error for Ktx2Error {}
 
-/// Texel format of a skin LUT texture.
+/// Texel format of a LUT texture: RGBA for the skin LUTs, one channel for the table modules
+/// (`crate::lut`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum LutFormat {
     Rgba16Float,
     Rgba32Float,
+    R16Float,
+    R32Float,
 }
 
 impl LutFormat {
     /// Whether a linear sampler on this format needs the optional `float32-filterable`
     /// feature (WebGPU: 32-bit float formats are unfilterable in core).
     pub fn needs_float32_filterable(self) -> bool {
-        self == LutFormat::Rgba32Float
+        matches!(self, LutFormat::Rgba32Float | LutFormat::R32Float)
+    }
+
+    /// Channels per texel.
+    pub fn channels(self) -> usize {
+        match self {
+            LutFormat::Rgba16Float | LutFormat::Rgba32Float => 4,
+            LutFormat::R16Float | LutFormat::R32Float => 1,
+        }
+    }
+
+    /// Bytes per channel.
+    pub fn channel_size(self) -> usize {
+        match self {
+            LutFormat::Rgba16Float | LutFormat::R16Float => 2,
+            LutFormat::Rgba32Float | LutFormat::R32Float => 4,
+        }
+    }
+
+    #[cfg(feature = "gpu")]
+    fn wgpu(self) -> wgpu::TextureFormat {
+        match self {
+            LutFormat::Rgba16Float => wgpu::TextureFormat::Rgba16Float,
+            LutFormat::Rgba32Float => wgpu::TextureFormat::Rgba32Float,
+            LutFormat::R16Float => wgpu::TextureFormat::R16Float,
+            LutFormat::R32Float => wgpu::TextureFormat::R32Float,
+        }
     }
 }
 
@@ -129,6 +158,8 @@ impl<'a> Ktx2Image<'a> {
         let format = match u32_at(12) {
             97 => LutFormat::Rgba16Float,
             109 => LutFormat::Rgba32Float,
+            76 => LutFormat::R16Float,
+            100 => LutFormat::R32Float,
             other => return Err(Ktx2Error::Format(other)),
         };
         let (width, height, depth, layers, faces, levels, scheme) =
@@ -140,10 +171,7 @@ impl<'a> Ktx2Image<'a> {
             return Err(Ktx2Error::Unsupported("not a single-level 2-D image"));
         }
         let (offset, length) = (u64_at(80) as usize, u64_at(88) as usize);
-        let texel = match format {
-            LutFormat::Rgba16Float => 8,
-            LutFormat::Rgba32Float => 16,
-        };
+        let texel = format.channels() * format.channel_size();
         if length != width as usize * height as usize * texel {
             return Err(Ktx2Error::Malformed("level length differs from width × height × texel size"));
         }
@@ -151,17 +179,19 @@ impl<'a> Ktx2Image<'a> {
         Ok(Ktx2Image { width, height, format, data })
     }
 
-    /// Texel (x, y) as f32 RGBA (f16 widened exactly).
+    /// Texel (x, y) as f32 RGBA (f16 widened exactly; a one-channel texel is (r, 0, 0, 1), as
+    /// WGSL reads it).
     pub fn texel(&self, x: u32, y: u32) -> [f32; 4] {
         let k = (y * self.width + x) as usize;
-        std::array::from_fn(|c| match self.format {
-            LutFormat::Rgba16Float => {
-                let o = 8 * k + 2 * c;
-                f16_to_f32(u16::from_le_bytes([self.data[o], self.data[o + 1]]))
+        let (n, size) = (self.format.channels(), self.format.channel_size());
+        std::array::from_fn(|c| {
+            if c >= n {
+                return if c == 3 { 1.0 } else { 0.0 };
             }
-            LutFormat::Rgba32Float => {
-                let o = 16 * k + 4 * c;
-                f32::from_le_bytes(self.data[o..o + 4].try_into().expect("4 bytes"))
+            let o = (n * k + c) * size;
+            match size {
+                2 => f16_to_f32(u16::from_le_bytes([self.data[o], self.data[o + 1]])),
+                _ => f32::from_le_bytes(self.data[o..o + 4].try_into().expect("4 bytes")),
             }
         })
     }
@@ -182,7 +212,7 @@ pub fn f16_to_f32(h: u16) -> f32 {
 
 #[cfg(feature = "gpu")]
 mod gpu {
-    use super::{Ktx2Error, Ktx2Image, LutFormat};
+    use super::{Ktx2Error, Ktx2Image};
     use wgpu::util::DeviceExt;
 
     /// Upload a skin LUT's KTX2 bytes (`NAME_KTX2`) as a 2-D texture (`Rgba16Float` or
@@ -194,14 +224,23 @@ mod gpu {
         label: &str,
         ktx2: &[u8],
     ) -> Result<wgpu::Texture, Ktx2Error> {
+        upload(device, queue, label, ktx2, true)
+    }
+
+    /// Upload KTX2 bytes of any [`LutFormat`] as a 2-D texture; `linear`: the texture is to be
+    /// read through a linear sampler, so a 32-bit float format needs `FLOAT32_FILTERABLE`.
+    pub(crate) fn upload(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        label: &str,
+        ktx2: &[u8],
+        linear: bool,
+    ) -> Result<wgpu::Texture, Ktx2Error> {
         let img = Ktx2Image::parse(ktx2)?;
-        if img.format.needs_float32_filterable() && !device.features().contains(wgpu::Features::FLOAT32_FILTERABLE) {
+        if linear && img.format.needs_float32_filterable() && !device.features().contains(wgpu::Features::FLOAT32_FILTERABLE) {
             return Err(Ktx2Error::NeedsFloat32Filterable);
         }
-        let format = match img.format {
-            LutFormat::Rgba16Float => wgpu::TextureFormat::Rgba16Float,
-            LutFormat::Rgba32Float => wgpu::TextureFormat::Rgba32Float,
-        };
+        let format = img.format.wgpu();
         Ok(device.create_texture_with_data(
             queue,
             &wgpu::TextureDescriptor {
@@ -237,6 +276,8 @@ mod gpu {
 
 #[cfg(feature = "gpu")]
 pub use gpu::{create_lut_texture, lut_sampler};
+#[cfg(feature = "gpu")]
+pub(crate) use gpu::upload as upload_ktx2;
 
 #[cfg(test)]
 mod tests {

@@ -75,6 +75,10 @@ enum KernelName {
 #[serde(deny_unknown_fields)]
 struct SkinEmit {
     function: String,
+    /// Outputs besides the WGSL module, as for every spec (`[emit] targets`; the common spec
+    /// reads them from the text: `spec::CustomSpec::spec_file`).
+    #[allow(dead_code)]
+    targets: Option<Vec<String>>,
 }
 
 #[derive(Debug, Clone, Deserialize)]

@@ -48,6 +48,10 @@ enum ConeMapping {
 #[serde(deny_unknown_fields)]
 struct ConeEmit {
     function: String,
+    /// Outputs besides the WGSL module, as for every spec (`[emit] targets`; the common spec
+    /// reads them from the text: `spec::CustomSpec::spec_file`).
+    #[allow(dead_code)]
+    targets: Option<Vec<String>>,
 }
 
 #[derive(Debug, Clone, Deserialize)]
