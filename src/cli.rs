@@ -501,6 +501,8 @@ pub struct BenchArgs {
     pub quick: bool,
     pub json: bool,
     pub only: Vec<String>,
+    /// Family names (empty: every family).
+    pub family: Vec<String>,
     pub python: Option<PathBuf>,
     pub no_python: bool,
 }
@@ -539,7 +541,12 @@ pub fn bench(paths: &Paths, a: &BenchArgs) -> Result<()> {
         generated: &paths.generated,
         python: python.as_ref(),
     };
-    let families = crate::family::families().iter().map(|f| &f.bench).collect::<Vec<_>>();
+    let all = crate::family::families();
+    if let Some(bad) = a.family.iter().find(|n| !all.iter().any(|f| f.name == n.as_str())) {
+        let known: Vec<&str> = all.iter().map(|f| f.name).collect();
+        return Err(input_err(format!("--family: unknown family '{bad}' (known: {})", known.join(", "))));
+    }
+    let families = all.iter().filter(|f| a.family.is_empty() || a.family.iter().any(|n| n == f.name)).map(|f| &f.bench).collect::<Vec<_>>();
     let report = bench::run(Mode::new(a.quick), sections, &inputs, &families)?;
     if a.json {
         println!("{}", serde_json::to_string_pretty(&report)?);

@@ -150,6 +150,9 @@ enum Command {
         /// Sections to run, comma-separated: integrators, fits, tables, forms (default: all).
         #[arg(long, value_delimiter = ',')]
         only: Vec<String>,
+        /// Families whose rows to run, comma-separated (default: all; see `shadefit families`).
+        #[arg(long, value_delimiter = ',')]
+        family: Vec<String>,
         /// Interpreter for the numpy/scipy side (default: tests/python/.venv, else python3);
         /// when given, a failure of that side fails the run.
         #[arg(long, conflicts_with = "no_python")]
@@ -192,8 +195,8 @@ fn main() -> ExitCode {
         Command::Samples { name, json } => cli::samples(&paths, &name, json),
         Command::Plot { out } => cli::plot(&paths, &out),
         Command::Validate { json } => cli::validate(&paths, json),
-        Command::Bench { quick, json, only, python, no_python } => {
-            cli::bench(&paths, &cli::BenchArgs { quick, json, only, python, no_python })
+        Command::Bench { quick, json, only, family, python, no_python } => {
+            cli::bench(&paths, &cli::BenchArgs { quick, json, only, family, python, no_python })
         }
     };
     match result {

@@ -71,6 +71,9 @@ pub mod gloss_length;
 #[path = "gloss_table.rs"]
 pub mod gloss_table;
 #[cfg(feature = "ms")]
+#[path = "ms_diffuse_rational.rs"]
+pub mod ms_diffuse_rational;
+#[cfg(feature = "ms")]
 #[path = "ms_diffuse_slices.rs"]
 pub mod ms_diffuse_slices;
 #[cfg(feature = "ms")]
@@ -147,6 +150,8 @@ pub mod wgsl {
     #[cfg(feature = "gloss")]
     pub const GLOSS_TABLE: &str = include_str!("../wgsl/gloss_table.wgsl");
     #[cfg(feature = "ms")]
+    pub const MS_DIFFUSE_RATIONAL: &str = include_str!("../wgsl/ms_diffuse_rational.wgsl");
+    #[cfg(feature = "ms")]
     pub const MS_DIFFUSE_SLICES: &str = include_str!("../wgsl/ms_diffuse_slices.wgsl");
     #[cfg(feature = "ms")]
     pub const MS_DIFFUSE_SLICES_LAMBERT: &str = include_str!("../wgsl/ms_diffuse_slices_lambert.wgsl");
@@ -214,6 +219,8 @@ pub mod wgsl {
             "gloss_length" => Some(GLOSS_LENGTH),
             #[cfg(feature = "gloss")]
             "gloss_table" => Some(GLOSS_TABLE),
+            #[cfg(feature = "ms")]
+            "ms_diffuse_rational" => Some(MS_DIFFUSE_RATIONAL),
             #[cfg(feature = "ms")]
             "ms_diffuse_slices" => Some(MS_DIFFUSE_SLICES),
             #[cfg(feature = "ms")]
@@ -285,6 +292,8 @@ pub mod wgsl {
         #[cfg(feature = "gloss")]
         "gloss_table",
         #[cfg(feature = "ms")]
+        "ms_diffuse_rational",
+        #[cfg(feature = "ms")]
         "ms_diffuse_slices",
         #[cfg(feature = "ms")]
         "ms_diffuse_slices_lambert",
@@ -341,6 +350,8 @@ pub const FUNCTIONS: &[EmittedFunction] = &[
     EmittedFunction { module: "gloss_length", name: "gloss_to_normal_length", domain: &[[0e0, 1e0]], cpu: Cpu::One(gloss_length::gloss_to_normal_length) },
     #[cfg(feature = "gloss")]
     EmittedFunction { module: "gloss_table", name: "gloss_to_normal_length_lut", domain: &[[0e0, 1e0]], cpu: Cpu::One(gloss_table::gloss_to_normal_length_lut) },
+    #[cfg(feature = "ms")]
+    EmittedFunction { module: "ms_diffuse_rational", name: "ms_diffuse_rational", domain: &[[2.7621358e-3, 1e0], [1e-1, 1e0], [1e-1, 1e0]], cpu: Cpu::Three(ms_diffuse_rational::ms_diffuse_rational) },
     #[cfg(feature = "scenes")]
     EmittedFunction { module: "scene_cobblestone_gloss", name: "cobblestone_gloss_to_normal_length", domain: &[[3e-1, 9e-1]], cpu: Cpu::One(scene_cobblestone_gloss::cobblestone_gloss_to_normal_length) },
     #[cfg(feature = "scenes")]

@@ -40,6 +40,7 @@ against `shadefit eval` at a seeded subset of their verification grid.
 
 from __future__ import annotations
 
+import math
 import tomllib
 
 import numpy as np
@@ -556,6 +557,13 @@ def spec_tolerance(g):
     return float(spec.get("tolerance", 1e-12))   # the spec schema's default (README)
 
 
+# Monte Carlo quantities: a spec's tolerance t means 1/t² paths a point (the standard error at
+# unit per-path deviation, not a bound), and `eval` runs this many paths (msdiffuse's
+# integrals::eval_paths caps at 2^20; eval's default tolerance is below 2^-10). The build's
+# reference at a point then has standard error est·sqrt(paths_eval)·t, est being eval's.
+MONTE_CARLO_EVAL_PATHS = {"ms-diffuse-cosines": 2**20}
+
+
 def check_claim_at(g, names, x, approx, worst):
     """The error of `approx` at points `x` (named `names`; the last is the claimed worst point)
     against `shadefit eval`: at most the claimed maximum everywhere (they are points of the grid it
@@ -572,7 +580,12 @@ def check_claim_at(g, names, x, approx, worst):
     for e, est, p in errs:
         assert e <= ver["max_abs_error"] + tol_spec + est + 1e-12, (p.tolist(), e, ver["max_abs_error"])
     e, est, _ = errs[-1]
-    assert abs(e - ver["max_abs_error"]) <= tol_spec + est + 1e-12, (worst.tolist(), e, ver["max_abs_error"])
+    # The claim was measured against the build's reference: for a Monte Carlo quantity 4 of its
+    # standard errors at the worst point (the worst point of a noisy grid is picked partly by
+    # the noise), else the spec's tolerance.
+    paths = MONTE_CARLO_EVAL_PATHS.get(g["quantity"])
+    ref_err = 4.0 * est * math.sqrt(paths) * tol_spec if paths else tol_spec
+    assert abs(e - ver["max_abs_error"]) <= ref_err + est + 1e-12, (worst.tolist(), e, ver["max_abs_error"])
 
 
 @pytest.mark.parametrize("name", FIELDS)

@@ -31,6 +31,16 @@ fn ms_diffuse(p: &[f64], tol: f64) -> Estimate {
     }
 }
 
+/// π f/ρ at ρ = 1 at (α, n·h, l·h, φd, F0, specular_walks): the slice quantity in the cosines
+/// and GGX α a shader has (θh = acos n·h, θd = acos l·h), the input of the family's fits.
+fn ms_diffuse_cosines(p: &[f64], tol: f64) -> Estimate {
+    let s = walk::Surface { alpha: p[0], rho: 1.0, f0: p[4], specular: specular_of(p[5]) };
+    match directions(p[1].clamp(-1.0, 1.0).acos(), p[2].clamp(-1.0, 1.0).acos(), p[3]) {
+        Some((l, v)) => brdf(&s, l, v, Order::All, eval_key("ms-diffuse-cosines"), cell_of(p), eval_paths(tol), true),
+        None => Estimate::exact(0.0),
+    }
+}
+
 /// The directional albedo at (gloss, n·v, F0, specular_walks).
 fn ms_diffuse_albedo(p: &[f64], tol: f64) -> Estimate {
     let s = surface(p[0], p[2], specular_of(p[3]));
@@ -67,6 +77,24 @@ pub static QUANTITIES: &[QuantityDef] = &[
         ],
         aliases: &[],
         eval: ms_diffuse,
+        inverse: None,
+        channels: &[],
+        eval_channels: None,
+        basis: None,
+    },
+    QuantityDef {
+        name: "ms-diffuse-cosines",
+        doc: "ms-diffuse in a shader's inputs: GGX alpha (not gloss), n.h and l.h; Monte Carlo (error = standard error)",
+        params: &[
+            p("alpha", 1e-4, 1.0, "GGX alpha (the WWII gloss g maps to sqrt(2/(1 + 2^(18 g))))", None),
+            p("n_dot_h", 0.0, 1.0, "cosine of the half vector's polar angle", None),
+            p("l_dot_h", 0.0, 1.0, "cosine of the light's angle to the half vector", None),
+            p("phi_d", 0.0, PI, "difference azimuth (pi/2: BRDF Explorer's slice)", Some(FRAC_PI_2)),
+            F0,
+            WALKS,
+        ],
+        aliases: &[],
+        eval: ms_diffuse_cosines,
         inverse: None,
         channels: &[],
         eval_channels: None,
