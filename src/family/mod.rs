@@ -187,8 +187,15 @@ pub(crate) mod tests {
     /// Families that benchmark no shader form yet, with the reason (each must say why).
     const NO_FORMS: &[(&str, &str)] = &[
         ("sggx", "emits exact formulas (the course's decoder and D): no approximations to rank yet"),
-        ("msdiffuse", "emits simulated tables; the published forms are measured by validate, no shader form of its own yet"),
     ];
+
+    /// Families whose shader forms include no table form, with the reason (each must say why).
+    const NO_TABLE_FORMS: &[(&str, &str)] = &[(
+        "msdiffuse",
+        "its reference is a Monte Carlo walk (standard error ~0.015 rms on the bench grid): a table \
+         of it at growing resolution stops improving at the noise, so tables cannot be ranked by \
+         error; its committed slice tables are measured by validate",
+    )];
 
     #[test]
     fn every_family_s_forms_are_sorted_by_cost_with_a_front_and_tables_converge() {
@@ -201,6 +208,10 @@ pub(crate) mod tests {
             assert!(!quantities.is_empty(), "{} benchmarks no shader form", f.name);
             let rows = quick_forms(f.name);
             testing::every_quantity_has_three_forms_sorted_by_cost_with_a_front(rows, &quantities);
+            if NO_TABLE_FORMS.iter().any(|(n, _)| *n == f.name) {
+                assert!(rows.iter().all(|r| r.table_bytes == 0), "{} has table forms now: take it off NO_TABLE_FORMS", f.name);
+                continue;
+            }
             testing::table_error_decreases_with_resolution(rows, &quantities);
         }
     }
