@@ -19,25 +19,13 @@
 
 mod common;
 
-use common::{copy_dir, root, scratch, shadefit, snapshot, stderr};
+use common::{committed_modules as modules, copy_dir, root, scratch, shadefit, snapshot, stderr};
 use shadefit::emit::targets::{named_constants, translate, Flat, Target};
 use shadefit::emit::Artifact;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::OnceLock;
-
-/// Every committed WGSL module (name, text), in name order.
-fn modules() -> Vec<(String, String)> {
-    let mut out: Vec<(String, String)> = std::fs::read_dir(root().join("generated/wgsl"))
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|x| x == "wgsl"))
-        .map(|p| (p.file_stem().unwrap().to_string_lossy().into_owned(), std::fs::read_to_string(&p).unwrap()))
-        .collect();
-    out.sort();
-    out
-}
 
 struct Module {
     name: String,

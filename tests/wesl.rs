@@ -9,24 +9,11 @@ mod common;
 #[path = "../generated/tests/support/calls.rs"]
 mod calls;
 
-use common::root;
+use common::committed_modules as modules;
 use shadefit::emit::targets::{package_files, translate, Target};
 use std::path::Path;
 use wesl::syntax::{ModulePath, PathOrigin};
 use wesl::{FileResolver, Router, Wesl};
-
-/// Every committed WGSL module (name, text), in name order.
-fn modules() -> Vec<(String, String)> {
-    let mut out: Vec<(String, String)> = std::fs::read_dir(root().join("generated/wgsl"))
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|x| x == "wgsl"))
-        .map(|p| (p.file_stem().unwrap().to_string_lossy().into_owned(), std::fs::read_to_string(&p).unwrap()))
-        .collect();
-    out.sort();
-    assert!(out.len() >= 20, "the committed modules ({})", out.len());
-    out
-}
 
 /// The package as `build --target wesl` writes it, under `dir`.
 fn write_package(dir: &Path) -> Vec<(String, String)> {

@@ -68,6 +68,8 @@
 mod bound;
 #[path = "support/grid.rs"]
 mod grid;
+#[path = "support/harness.rs"]
+mod harness;
 #[cfg(feature = "fuzz")]
 #[path = "support/fuzz_ps.rs"]
 mod fuzz_ps;
@@ -77,17 +79,8 @@ mod sggx;
 
 use shadefit_runtime::lut::{self, LutTexture};
 use shadefit_runtime::{EmittedFunction, FUNCTIONS, compose, compose_shader, gpu, wgsl};
-use std::io::Write;
+use harness::{in_ci, report};
 use wgpu::util::DeviceExt;
-
-/// A line on the real stderr, past the test harness's output capture.
-fn report(line: &str) {
-    let _ = writeln!(std::io::stderr().lock(), "{line}");
-}
-
-fn in_ci() -> bool {
-    std::env::var("CI").is_ok_and(|v| !v.is_empty() && v != "0" && !v.eq_ignore_ascii_case("false"))
-}
 
 const WORKGROUP: u32 = 64;
 

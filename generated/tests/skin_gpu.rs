@@ -16,29 +16,17 @@
 #![allow(clippy::needless_range_loop)]
 
 use shadefit_runtime::{compose, gpu, skin, skin_punctual_lut as punctual, skin_sh_lut as sh};
-use std::io::Write;
 use wgpu::util::DeviceExt;
 
-fn report(line: &str) {
-    let _ = writeln!(std::io::stderr().lock(), "{line}");
-}
-
-fn in_ci() -> bool {
-    std::env::var("CI").is_ok_and(|v| !v.is_empty() && v != "0" && !v.eq_ignore_ascii_case("false"))
-}
+#[path = "support/harness.rs"]
+mod harness;
+use harness::{in_ci, report};
 
 const WORKGROUP: usize = 64;
 
-/// `library` with `const NAME_RGB: array<vec3f, N> = array<vec3f, N>(...);` replaced by a
-/// read-only storage buffer at binding 3 (vec3 in storage has a 16-byte stride).
+/// `library` with its `NAME_RGB` const array moved into a storage buffer at binding 3.
 fn rgb_in_buffer(library: &str, module: &str) -> String {
-    let head = format!("const {}_RGB: array<vec3f, ", module.to_uppercase());
-    let start = library.find(&head).unwrap_or_else(|| panic!("{module}: no `{head}`"));
-    let n_end = library[start + head.len()..].find('>').unwrap() + start + head.len();
-    let n = &library[start + head.len()..n_end];
-    let close = library[start..].find("\n);\n").unwrap() + start;
-    let decl = format!("@group(0) @binding(3) var<storage, read> {}_RGB: array<vec3f, {n}>;", module.to_uppercase());
-    format!("{}{decl}{}", &library[..start], &library[close + 3..])
+    harness::const_array_in_buffer(library, &format!("{}_RGB", module.to_uppercase()), "vec3f")
 }
 
 struct Run<'a> {

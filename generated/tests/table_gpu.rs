@@ -14,29 +14,17 @@
 //! test is skipped, unless `CI` is set.
 
 use shadefit_runtime::{compose, gpu, lut};
-use std::io::Write;
 use wgpu::util::DeviceExt;
 
-fn report(line: &str) {
-    let _ = writeln!(std::io::stderr().lock(), "{line}");
-}
-
-fn in_ci() -> bool {
-    std::env::var("CI").is_ok_and(|v| !v.is_empty() && v != "0" && !v.eq_ignore_ascii_case("false"))
-}
+#[path = "support/harness.rs"]
+mod harness;
+use harness::{in_ci, report};
 
 const WORKGROUP: usize = 64;
 
-/// `library` with `const NAME_TABLE: array<f32, N> = array<f32, N>(...);` replaced by a
-/// read-only storage buffer at binding 3.
+/// `library` with its `NAME_TABLE` const array moved into a storage buffer at binding 3.
 fn table_in_buffer(library: &str, module: &str) -> String {
-    let head = format!("const {}_TABLE: array<f32, ", module.to_uppercase());
-    let start = library.find(&head).unwrap_or_else(|| panic!("{module}: no `{head}`"));
-    let n_end = library[start + head.len()..].find('>').unwrap() + start + head.len();
-    let n = &library[start + head.len()..n_end];
-    let close = library[start..].find("\n);\n").unwrap() + start;
-    let decl = format!("@group(0) @binding(3) var<storage, read> {}_TABLE: array<f32, {n}>;", module.to_uppercase());
-    format!("{}{decl}{}", &library[..start], &library[close + 3..])
+    harness::const_array_in_buffer(library, &format!("{}_TABLE", module.to_uppercase()), "f32")
 }
 
 /// Largest difference between neighbouring table values along either axis.

@@ -104,3 +104,16 @@ pub fn nist_csv(name: &str, dir: &Path) -> PathBuf {
     std::fs::write(&p, csv).unwrap();
     p
 }
+
+/// Every committed WGSL module of generated/wgsl (name, text), in name order.
+pub fn committed_modules() -> Vec<(String, String)> {
+    let mut out: Vec<(String, String)> = std::fs::read_dir(root().join("generated/wgsl"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "wgsl"))
+        .map(|p| (p.file_stem().unwrap().to_string_lossy().into_owned(), std::fs::read_to_string(&p).unwrap()))
+        .collect();
+    out.sort();
+    assert!(out.len() >= 20, "the committed modules ({})", out.len());
+    out
+}
