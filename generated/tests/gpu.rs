@@ -79,7 +79,7 @@ mod sggx;
 
 use shadefit_runtime::lut::{self, LutTexture};
 use shadefit_runtime::{EmittedFunction, FUNCTIONS, compose, compose_shader, gpu, wgsl};
-use harness::{in_ci, report};
+use harness::{device, report};
 use wgpu::util::DeviceExt;
 
 const WORKGROUP: u32 = 64;
@@ -326,21 +326,6 @@ fn check_points(
         failures[..failures.len().min(20)].join("\n")
     );
     st
-}
-
-/// The device, or None (after a message) where the test is skipped.
-fn device(label: &str) -> Option<gpu::Gpu> {
-    match pollster::block_on(gpu::headless(label)) {
-        Ok(g) => {
-            report(&format!("gpu adapter: {}", gpu::describe(&g.adapter.get_info())));
-            Some(g)
-        }
-        Err(e) if in_ci() => panic!("CI is set, so the GPU test must run, but: {e} (run scripts/setup-vulkan, set WGPU_BACKEND=vulkan)"),
-        Err(e) => {
-            report(&format!("gpu test SKIPPED: {e} (install lavapipe with scripts/setup-vulkan; CI=true makes this a failure)"));
-            None
-        }
-    }
 }
 
 #[test]

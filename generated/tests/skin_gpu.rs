@@ -20,7 +20,7 @@ use wgpu::util::DeviceExt;
 
 #[path = "support/harness.rs"]
 mod harness;
-use harness::{in_ci, report};
+use harness::report;
 
 const WORKGROUP: usize = 64;
 
@@ -152,15 +152,7 @@ fn texture_bound(step: f32) -> f32 {
 
 #[test]
 fn skin_luts_and_curvature_on_the_gpu() {
-    let g = match pollster::block_on(gpu::headless("shadefit skin test")) {
-        Ok(g) => g,
-        Err(e) if in_ci() => panic!("CI is set, so the GPU test must run, but: {e}"),
-        Err(e) => {
-            report(&format!("skin gpu test SKIPPED: {e}"));
-            return;
-        }
-    };
-    report(&format!("skin gpu adapter: {}", gpu::describe(&g.adapter.get_info())));
+    let Some(g) = harness::device("shadefit skin test") else { return };
 
     // Punctual: a grid over and beyond the domain (clamps included).
     let kmax = punctual::SKIN_PUNCTUAL_LUT_CURVATURE_MAX;
@@ -324,14 +316,7 @@ fn rgba32f_ktx2(texel: [f32; 4]) -> Vec<u8> {
 
 #[test]
 fn an_rgba32f_lut_needs_float32_filterable() {
-    let g = match pollster::block_on(gpu::headless("shadefit skin format test")) {
-        Ok(g) => g,
-        Err(e) if in_ci() => panic!("CI is set, so the GPU test must run, but: {e}"),
-        Err(e) => {
-            report(&format!("skin format test SKIPPED: {e}"));
-            return;
-        }
-    };
+    let Some(g) = harness::device("shadefit skin format test") else { return };
     let bytes = rgba32f_ktx2([0.25, 0.5, 0.75, 1.0]);
     assert_eq!(skin::Ktx2Image::parse(&bytes).expect("well-formed").format, skin::LutFormat::Rgba32Float);
     // `headless` requests no optional features: the linear sampler cannot filter this texture.

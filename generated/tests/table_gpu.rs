@@ -18,7 +18,7 @@ use wgpu::util::DeviceExt;
 
 #[path = "support/harness.rs"]
 mod harness;
-use harness::{in_ci, report};
+use harness::report;
 
 const WORKGROUP: usize = 64;
 
@@ -72,15 +72,7 @@ fn points(t: &lut::Table) -> Vec<f32> {
 
 #[test]
 fn table_textures_agree_with_the_const_arrays_on_the_gpu() {
-    let g = match pollster::block_on(gpu::headless("shadefit table texture test")) {
-        Ok(g) => g,
-        Err(e) if in_ci() => panic!("CI is set, so the GPU test must run, but: {e}"),
-        Err(e) => {
-            report(&format!("table texture gpu test SKIPPED: {e}"));
-            return;
-        }
-    };
-    report(&format!("table texture gpu adapter: {}", gpu::describe(&g.adapter.get_info())));
+    let Some(g) = harness::device("shadefit table texture test") else { return };
     let device = &g.device;
     let mut tested = 0;
     for t in lut::TABLES.iter().filter(|t| t.ktx2.is_some()) {

@@ -4,6 +4,7 @@
 
 #![allow(dead_code)] // each test uses what it needs
 
+use shadefit_runtime::gpu;
 use std::io::Write;
 
 /// A line on stderr even when the harness captures output (figures the tests measure).
@@ -27,4 +28,20 @@ pub fn const_array_in_buffer(library: &str, name: &str, elem: &str) -> String {
     let close = library[start..].find("\n);\n").unwrap() + start;
     let decl = format!("@group(0) @binding(3) var<storage, read> {name}: array<{elem}, {n}>;");
     format!("{}{decl}{}", &library[..start], &library[close + 3..])
+}
+
+/// The headless device, or None (after a message) where the test is skipped; under CI a
+/// missing adapter is a failure.
+pub fn device(label: &str) -> Option<gpu::Gpu> {
+    match pollster::block_on(gpu::headless(label)) {
+        Ok(g) => {
+            report(&format!("{label}: adapter {}", gpu::describe(&g.adapter.get_info())));
+            Some(g)
+        }
+        Err(e) if in_ci() => panic!("CI is set, so the GPU test must run, but: {e} (run scripts/setup-vulkan, set WGPU_BACKEND=vulkan)"),
+        Err(e) => {
+            report(&format!("{label} SKIPPED: {e} (install lavapipe with scripts/setup-vulkan; CI=true makes this a failure)"));
+            None
+        }
+    }
 }
