@@ -166,7 +166,10 @@ class Problem:
         assert m["objective"] == self.kind
         # Dense grid of the domain for the pole check (Q through the generated form).
         axes = self.gen["axes"]
-        n = 20001 if len(axes) == 1 else 401
+        # Points per axis: ~2e4 in 1-D, ~1.6e5 in 2-D, ~2e6 in 3-D (a 3-D grid at 401 per axis
+        # is 6.4e7 points, re-evaluated by every method's positivity check). The check needs
+        # only points of the domain: a coarser grid can miss a pole, never invent one.
+        n = {1: 20001, 2: 401}.get(len(axes), 129)
         grids = np.meshgrid(*[np.linspace(*a["range"], n) for a in axes], indexing="ij")
         self.dense = np.stack([g.ravel() for g in grids], axis=1)
         self.starts = {"linearised": self.loeb_start()}
