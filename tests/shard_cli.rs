@@ -1,7 +1,10 @@
 //! `build --shard K/N` and `merge`: N shard processes run side by side, merged, give exactly the
 //! bytes of one build; bad shard sets are the user's input (exit 2) and write nothing.
 
-use std::path::{Path, PathBuf};
+mod common;
+
+use common::snapshot as files;
+use std::path::Path;
 use std::process::Command;
 
 const SPEC: &str = "name = \"msd_s\"\nkind = \"ms-diffuse-table\"\nquantity = \"ms-diffuse\"\n\
@@ -20,24 +23,6 @@ fn project(spec: &str) -> tempfile::TempDir {
 
 fn run(dir: &Path, args: &[&str]) -> std::process::Output {
     bin().current_dir(dir).args(args).output().unwrap()
-}
-
-/// Every file under `root`, relative, with its bytes.
-fn files(root: &Path) -> Vec<(PathBuf, Vec<u8>)> {
-    let mut out = Vec::new();
-    let mut stack = vec![root.to_path_buf()];
-    while let Some(d) = stack.pop() {
-        for e in std::fs::read_dir(&d).unwrap() {
-            let p = e.unwrap().path();
-            if p.is_dir() {
-                stack.push(p);
-            } else {
-                out.push((p.strip_prefix(root).unwrap().to_path_buf(), std::fs::read(&p).unwrap()));
-            }
-        }
-    }
-    out.sort();
-    out
 }
 
 #[test]

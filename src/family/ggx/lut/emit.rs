@@ -31,6 +31,27 @@ pub fn input_f32(v: f32) -> f32 {
     if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) }
 }
 
+/// The start of a LUT module's WGSL: the header, the import path, the doc lines and, after
+/// `extra` (the size constant), `{module}_input` (clamp to [0, 1], NaN to 0).
+pub fn wgsl_preamble(header: &[String], module: &str, doc: &str, layout_doc: &[String], extra: &str) -> String {
+    let mut s = String::new();
+    for line in header {
+        s.push_str(&format!("// {line}\n"));
+    }
+    s.push_str(&format!("#define_import_path shadefit::{module}\n\n// {doc}\n"));
+    for line in layout_doc {
+        s.push_str(&format!("// {line}\n"));
+    }
+    s.push_str(extra);
+    s.push_str(&format!(
+        "// Clamp a parameter to [0, 1]; NaN (any exponent-all-ones pattern with a non-zero\n\
+         // mantissa) maps to 0.\nfn {module}_input(v: f32) -> f32 {{\n    \
+         let nan = (bitcast<u32>(v) & 0x7fffffffu) > 0x7f800000u;\n    \
+         return select(clamp(v, 0f, 1f), 0f, nan);\n}}\n\n"
+    ));
+    s
+}
+
 /// Texel indices and weight of texture coordinate `p` ∈ [0, 1] on an axis of `n` texels
 /// (centres at (i + 0.5)/n, clamp to edge), in f32: (i0, i1, f), value = t[i0](1 − f) + t[i1]f.
 pub fn axis_f32(p: f32, n: usize) -> (usize, usize, f32) {
@@ -63,32 +84,13 @@ impl DfgLutCode<'_> {
         ]
     }
 
-    fn decode_wgsl(&self) -> &'static str {
-        match self.layout {
-            Layout::ScaleBias => "t",
-            Layout::Filament => "vec2<f32>(t.y - t.x, t.x)",
-        }
-    }
 
     /// The WGSL library `wgsl/NAME.wgsl`.
     pub fn render_wgsl(&self, header: &[String], doc: &str, mapping_doc: &str) -> String {
         let (m, f, row) = (self.module, self.function, self.row);
         let up = m.to_uppercase();
-        let mut s = String::new();
-        for line in header {
-            s.push_str(&format!("// {line}\n"));
-        }
-        s.push_str(&format!("#define_import_path shadefit::{m}\n\n// {doc}\n"));
-        for line in self.layout_doc(mapping_doc) {
-            s.push_str(&format!("// {line}\n"));
-        }
-        s.push_str(&format!("\nconst {up}_SIZE: vec2<u32> = vec2<u32>({}u, {}u);\n\n", self.width, self.height));
-        s.push_str(&format!(
-            "// Clamp a parameter to [0, 1]; NaN (any exponent-all-ones pattern with a non-zero\n\
-             // mantissa) maps to 0.\nfn {m}_input(v: f32) -> f32 {{\n    \
-             let nan = (bitcast<u32>(v) & 0x7fffffffu) > 0x7f800000u;\n    \
-             return select(clamp(v, 0f, 1f), 0f, nan);\n}}\n\n"
-        ));
+        let size = format!("\nconst {up}_SIZE: vec2<u32> = vec2<u32>({}u, {}u);\n\n", self.width, self.height);
+        let mut s = wgsl_preamble(header, m, doc, &self.layout_doc(mapping_doc), &size);
         s.push_str(&format!(
             "// Texture coordinates of (n·v, {row}): the parameters themselves, clamped to [0, 1].\n\
              fn {f}_uv(n_dot_v: f32, {row}: f32) -> vec2<f32> {{\n    \
@@ -105,7 +107,7 @@ impl DfgLutCode<'_> {
              fn {f}_scale_bias(lut: texture_2d<f32>, lut_sampler: sampler, n_dot_v: f32, {row}: f32) -> vec2<f32> {{\n    \
              let t = {f}_sample(lut, lut_sampler, n_dot_v, {row});\n    \
              return {};\n}}\n\n",
-            self.decode_wgsl()
+            self.layout.decode_wgsl()
         ));
         s.push_str(&format!(
             "// The split-sum specular reflectance F0·scale + bias of a Schlick F0 (F90 = 1).\n\
@@ -183,10 +185,7 @@ impl DfgLutCode<'_> {
              let b = b0[c] * (1.0 - fx) + b1[c] * fx;\n        \
              a * (1.0 - fy) + b * fy\n    }})\n}}\n\n"
         ));
-        let decode = match self.layout {
-            Layout::ScaleBias => "t",
-            Layout::Filament => "[t[1] - t[0], t[0]]",
-        };
+        let decode = self.layout.decode_rust();
         s.push_str(&format!(
             "/// (scale, bias) of the split sum at (n·v, {row}): specular = F0·scale + bias (F90 = 1).\n\
              pub fn {f}_scale_bias(n_dot_v: f32, {row}: f32) -> [f32; 2] {{\n    \

@@ -118,6 +118,22 @@ impl Layout {
         }
     }
 
+    /// WGSL expression of (scale, bias) from the stored texel `t` (a `vec2<f32>`).
+    pub fn decode_wgsl(self) -> &'static str {
+        match self {
+            Layout::ScaleBias => "t",
+            Layout::Filament => "vec2<f32>(t.y - t.x, t.x)",
+        }
+    }
+
+    /// Rust expression of (scale, bias) from the stored texel `t` (an `[f32; 2]`).
+    pub fn decode_rust(self) -> &'static str {
+        match self {
+            Layout::ScaleBias => "t",
+            Layout::Filament => "[t[1] - t[0], t[0]]",
+        }
+    }
+
     /// Names of the stored channels (R, G).
     pub fn channels(self) -> [&'static str; 2] {
         match self {

@@ -20,7 +20,7 @@
 //! texels decoded from them (`F_texel`, f16 → f32), and the same lookups on the CPU: trilinear
 //! with exact f32 weights in the order of [`lookup_f32`].
 
-use crate::family::ggx::lut::emit::{axis_f32, input_f32};
+use crate::family::ggx::lut::emit::{axis_f32, input_f32, wgsl_preamble};
 use crate::family::ggx::lut::spec::{DfgFormat, Layout};
 
 /// One cone LUT module to emit.
@@ -76,33 +76,14 @@ impl ConeLutCode<'_> {
         ]
     }
 
-    fn decode_wgsl(&self) -> &'static str {
-        match self.layout {
-            Layout::ScaleBias => "t",
-            Layout::Filament => "vec2<f32>(t.y - t.x, t.x)",
-        }
-    }
 
     /// The WGSL library `wgsl/NAME.wgsl`.
     pub fn render_wgsl(&self, header: &[String], doc: &str, mapping_doc: &str) -> String {
         let (m, f, row) = (self.module, self.function, self.row);
         let up = m.to_uppercase();
         let d = self.depth;
-        let mut s = String::new();
-        for line in header {
-            s.push_str(&format!("// {line}\n"));
-        }
-        s.push_str(&format!("#define_import_path shadefit::{m}\n\n// {doc}\n"));
-        for line in self.layout_doc(mapping_doc) {
-            s.push_str(&format!("// {line}\n"));
-        }
-        s.push_str(&format!("\nconst {up}_SIZE: vec3<u32> = vec3<u32>({}u, {}u, {d}u);\n\n", self.width, self.height));
-        s.push_str(&format!(
-            "// Clamp a parameter to [0, 1]; NaN (any exponent-all-ones pattern with a non-zero\n\
-             // mantissa) maps to 0.\nfn {m}_input(v: f32) -> f32 {{\n    \
-             let nan = (bitcast<u32>(v) & 0x7fffffffu) > 0x7f800000u;\n    \
-             return select(clamp(v, 0f, 1f), 0f, nan);\n}}\n\n"
-        ));
+        let size = format!("\nconst {up}_SIZE: vec3<u32> = vec3<u32>({}u, {}u, {d}u);\n\n", self.width, self.height);
+        let mut s = wgsl_preamble(header, m, doc, &self.layout_doc(mapping_doc), &size);
         s.push_str(&format!(
             "// Texture coordinates of (n·v, {row}, cos θc): the first two clamped to [0, 1], the cone's\n\
              // w = (cos θc·{} + 0.5)/{d} on the slice centres.\n\
@@ -122,7 +103,7 @@ impl ConeLutCode<'_> {
              fn {f}_scale_bias(lut: texture_3d<f32>, lut_sampler: sampler, n_dot_v: f32, {row}: f32, cos_cone: f32) -> vec2<f32> {{\n    \
              let t = {f}_sample(lut, lut_sampler, n_dot_v, {row}, cos_cone);\n    \
              return {};\n}}\n\n",
-            self.decode_wgsl()
+            self.layout.decode_wgsl()
         ));
         s.push_str(&format!(
             "// The occluded split-sum specular reflectance F0·scale + bias of a Schlick F0 (F90 = 1).\n\
@@ -220,10 +201,7 @@ impl ConeLutCode<'_> {
              let (p0, p1) = (plane(k0), plane(k1));\n    \
              std::array::from_fn(|c| p0[c] * (1.0 - fz) + p1[c] * fz)\n}}\n\n"
         ));
-        let decode = match self.layout {
-            Layout::ScaleBias => "t",
-            Layout::Filament => "[t[1] - t[0], t[0]]",
-        };
+        let decode = self.layout.decode_rust();
         s.push_str(&format!(
             "/// (scale, bias) of the split sum over the cone at (n·v, {row}, cos θc): specular = F0·scale + bias.\n\
              pub fn {f}_scale_bias(n_dot_v: f32, {row}: f32, cos_cone: f32) -> [f32; 2] {{\n    \
