@@ -680,30 +680,22 @@ pub fn compact_json(v: &Value) -> String {
     out
 }
 
+/// Max abs and rms error of the f64 fit and of the emitted f32 code against the integral on the
+/// verification points; a NaN anywhere is the max error (it then fails every bound).
 fn verify(spec: &Spec, vx: &[Vec<f64>], truth: &[f64], a64: &[f64], a32: &[f32]) -> Verification {
-    let n = truth.len();
-    let mut worst = (0usize, 0.0f64);
-    let (mut ss, mut ss32, mut max32) = (0.0, 0.0, 0.0f64);
-    for i in 0..n {
-        let e = (a64[i] - truth[i]).abs();
-        if e > worst.1 {
-            worst = (i, e);
-        }
-        ss += e * e;
-        let e32 = (a32[i] as f64 - truth[i]).abs();
-        ss32 += e32 * e32;
-        max32 = max32.max(e32);
-    }
+    let a32: Vec<f64> = a32.iter().map(|&v| v as f64).collect();
+    let (max_abs_error, rms_error, worst_point) = crate::validate::measure(vx, truth, a64);
+    let (max_abs_error_f32, rms_error_f32, _) = crate::validate::measure(vx, truth, &a32);
     let inverse = spec.quantity.inverse.filter(|_| vx.first().is_some_and(|x| x.len() == 1)).map(|inv| {
-        vx.iter().zip(a64).map(|(x, &v)| (inv(v) - x[0]).abs()).fold(0.0, f64::max)
+        vx.iter().zip(a64).map(|(x, &v)| (inv(v) - x[0]).abs()).fold(0.0, |m: f64, e| if e > m || e.is_nan() { e } else { m })
     });
     Verification {
-        points: n,
-        max_abs_error: worst.1,
-        rms_error: (ss / n as f64).sqrt(),
-        worst_point: vx.get(worst.0).cloned().unwrap_or_default(),
-        max_abs_error_f32: max32,
-        rms_error_f32: (ss32 / n as f64).sqrt(),
+        points: truth.len(),
+        max_abs_error,
+        rms_error,
+        worst_point,
+        max_abs_error_f32,
+        rms_error_f32,
         max_abs_error_in_parameter: inverse,
     }
 }
@@ -1076,5 +1068,68 @@ mod tests {
         assert!(matches!(committed_f32(&model, &c, &m, "t"), Err(BuildError::F32Coefficients { .. })));
         let m = json!({"numerator_f32": [r[0] as f64, r[1] as f64], "denominator_f32": [r[3] as f64]});
         assert!(matches!(committed_f32(&model, &c, &m, "t"), Err(BuildError::F32Coefficients { .. })));
+    }
+
+    fn gloss_length_spec() -> Spec {
+        let text = include_str!("../fits/gloss_length.toml").to_string();
+        Spec::parse(Path::new("fits/gloss_length.toml"), text, crate::family::catalog()).unwrap()
+    }
+
+    /// `verify` against errors worked out by hand: max, rms and the worst point of the f64 fit,
+    /// the same of the f32 values, and the error mapped back through the quantity's inverse.
+    #[test]
+    fn verification_is_measured_from_the_errors() {
+        use crate::family::gloss::integrals::{gloss_from_length, length_from_gloss};
+        let spec = gloss_length_spec();
+        let vx = vec![vec![0.2], vec![0.5], vec![0.8]];
+        let truth: Vec<f64> = vx.iter().map(|x| length_from_gloss(x[0])).collect();
+        // f64 errors +0.01, −0.03, +0.02; f32 errors −0.04, 0, +0.005 (up to f32 rounding).
+        let a64 = [truth[0] + 0.01, truth[1] - 0.03, truth[2] + 0.02];
+        let a32 = [(truth[0] - 0.04) as f32, truth[1] as f32, (truth[2] + 0.005) as f32];
+        let v = verify(&spec, &vx, &truth, &a64, &a32);
+        assert_eq!(v.points, 3);
+        // Three squared errors summed: exact to a few ulps of 1e-3.
+        assert!((v.max_abs_error - 0.03).abs() < 1e-12, "{}", v.max_abs_error);
+        assert!((v.rms_error - (14e-4f64 / 3.0).sqrt()).abs() < 1e-12, "{}", v.rms_error);
+        assert_eq!(v.worst_point, vec![0.5]);
+        // The f32 values carry their rounding, below 1e-7 for values below 1.
+        assert!((v.max_abs_error_f32 - 0.04).abs() < 1e-7, "{}", v.max_abs_error_f32);
+        assert!((v.rms_error_f32 - ((16e-4f64 + 25e-6) / 3.0).sqrt()).abs() < 1e-7, "{}", v.rms_error_f32);
+        // In parameter units: each fitted length mapped back to a gloss by the inverse; the
+        // largest distance to the point's own gloss, from non-zero errors, is well above 1e-3.
+        let p = v.max_abs_error_in_parameter.expect("gloss length has an inverse");
+        let expected = vx.iter().zip(&a64).map(|(x, &l)| (gloss_from_length(l) - x[0]).abs()).fold(0.0, f64::max);
+        assert!(p > 1e-3 && p < 1.0 && (p - expected).abs() < 1e-12, "{p} vs {expected}");
+        // An exact fit has no error in either unit (the inverse is accurate to ~1e-12).
+        let exact = verify(&spec, &vx, &truth, &truth, &truth.iter().map(|&t| t as f32).collect::<Vec<_>>());
+        assert_eq!((exact.max_abs_error, exact.rms_error), (0.0, 0.0));
+        assert!(exact.max_abs_error_in_parameter.unwrap() < 1e-9);
+    }
+
+    /// A NaN from the f64 fit or the f32 code is the max error, so a spec's `max_error` bound
+    /// fails on it (`f64::max` would have dropped it).
+    #[test]
+    fn a_nan_is_the_max_error() {
+        let spec = gloss_length_spec();
+        let vx = vec![vec![0.2], vec![0.5], vec![0.8]];
+        let truth = [0.9, 0.8, 0.7];
+        let v = verify(&spec, &vx, &truth, &[0.9, f64::NAN, 0.7], &[0.9, 0.8, f32::NAN]);
+        assert!(v.max_abs_error.is_nan() && v.max_abs_error_f32.is_nan(), "{v:?}");
+        assert_eq!(v.worst_point, vec![0.5]);
+        assert!(v.max_abs_error_in_parameter.unwrap().is_nan());
+        let v = verify(&spec, &vx, &truth, &truth, &[f32::NAN, 0.8, 0.7]);
+        assert!(v.max_abs_error_f32.is_nan() && v.max_abs_error == 0.0, "{v:?}");
+    }
+
+    /// `tensor` is the full grid, first axis fastest, each axis at its own points.
+    #[test]
+    fn the_grid_runs_first_axis_fastest() {
+        let axes = gloss_length_spec().file.axis;
+        let two = [axes[0].clone(), axes[0].clone()];
+        let a = axes[0].points(3);
+        let b = axes[0].points(2);
+        let want: Vec<Vec<f64>> = b.iter().flat_map(|&y| a.iter().map(move |&x| vec![x, y])).collect();
+        assert_eq!(tensor(&two, &[3, 2]), want);
+        assert_eq!(a, vec![0.0, 0.5, 1.0]);
     }
 }
