@@ -448,7 +448,7 @@ fn sample_errors(fields: &Fields<'_>, theta: &DVector<f64>, data: &[PointData]) 
 }
 
 /// One reweighting step of [`fit_fields`]'s outer loop from the residuals `res` of the current
-/// θ: Lawson's weights (L4: e²), the weighted systems, a warm-started joint solve. `None` when
+/// θ: Lawson's weights (L4: a damped step towards e²), the weighted systems, a warm-started joint solve. `None` when
 /// the weights degenerate or the solve fails (the loop stops); otherwise (residual
 /// evaluations, max error, rms error, residuals) at the new θ.
 fn outer_step(
@@ -459,11 +459,13 @@ fn outer_step(
     opts: &FieldOptions,
     what: &str,
 ) -> Option<(usize, f64, f64, Vec<DVector<f64>>)> {
-    // Lawson: w ← w·|e| (L4: w = e²), scaled to max 1 and floored.
+    // Lawson: w ← w·|e|; L4: w ← √(w·e²), a damped step towards the IRLS weights e² of Σe⁴
+    // (taken whole, e² makes the iterates oscillate and grow: on the noisy test problem Σe⁴
+    // rose 3× and 12× in 4 steps); scaled to max 1 and floored.
     for (wg, eg) in w.iter_mut().zip(res) {
         for (wi, ei) in wg.iter_mut().zip(eg.iter()) {
             *wi = match opts.objective {
-                Objective::L4 => ei * ei,
+                Objective::L4 => (*wi * ei * ei).sqrt(),
                 _ => *wi * ei.abs(),
             };
         }
@@ -606,24 +608,31 @@ pub fn fit_fields(
         // IRLS for Σ|e|^p: weights |e|^(p−2) at the previous optimum. Minimax continues p
         // upward (the L_p optimum tends to the minimax one as p → ∞); jumping straight to
         // Lawson's multiplicative weights concentrates them on a few grid points and lets
-        // the fields run away elsewhere. The iterate with the lowest max error (or, for L4,
-        // the last one) is kept; with an rms cap, only iterates under it qualify.
+        // the fields run away elsewhere. The iterate with the lowest max error (for L4, the
+        // lowest Σe⁴: plain IRLS for p = 4 need not descend, and may end above its least-squares
+        // start) is kept; with an rms cap, only iterates under it qualify.
         //
         // An iterate that qualifies by its errors still needs its denominators proven; that
         // proof runs beside the next iteration, which does not depend on it. When the proof's
         // answer ends the loop, the next iteration is dropped uncounted, so the iterates,
         // counts and result are those of doing each step after the previous proof.
         let n_outer = match opts.objective {
-            Objective::L4 => opts.outer_iters.min(4),
+            // The damped L4 steps settle Σe⁴ to 1e-6 relative in ~10.
+            Objective::L4 => opts.outer_iters.min(12),
             _ => opts.outer_iters,
         };
         let rms_ok = |rms: f64| opts.max_rms.is_none_or(|cap| rms <= cap);
+        // What the objective ranks iterates by (a NaN residual ranks last).
+        let score = |max: f64, res: &[DVector<f64>]| match opts.objective {
+            Objective::L4 => res.iter().flat_map(|e| e.iter()).map(|v| (v * v) * (v * v)).sum::<f64>(),
+            _ => max,
+        };
         let (m0, r0, mut res) = sample_errors(&fields, &fields.theta, data);
         let ok0 = rms_ok(r0) && positive(&fields.full(&fields.theta));
-        let mut best = (if ok0 { m0 } else { f64::INFINITY }, fields.theta.clone());
+        let mut best = (if ok0 { score(m0, &res) } else { f64::INFINITY }, fields.theta.clone());
         let mut w: Vec<Vec<f64>> = data.iter().map(|d| vec![1.0; d.y.len()]).collect();
         let mut since_best = 0;
-        // (max error, θ, full coefficients) of an iterate awaiting its proof.
+        // (score, θ, full coefficients) of an iterate awaiting its proof.
         let mut pending: Option<(f64, DVector<f64>, Vec<DVector<f64>>)> = None;
         loop {
             let more = outer < n_outer;
@@ -646,9 +655,10 @@ pub fn fit_fields(
             outer += 1;
             let Some((e, m, rr, r)) = step else { break };
             evals += e;
+            let s = score(m, &r);
             res = r;
-            if (opts.objective == Objective::L4 || m < best.0) && rms_ok(rr) {
-                pending = Some((m, fields.theta.clone(), fields.full(&fields.theta)));
+            if s < best.0 && rms_ok(rr) {
+                pending = Some((s, fields.theta.clone(), fields.full(&fields.theta)));
             } else {
                 since_best += 1;
                 if since_best >= 6 {
@@ -816,5 +826,74 @@ mod tests {
         let two = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap().install(|| f.normal_equations(&theta));
         assert_eq!(one.0.as_slice(), two.0.as_slice());
         assert_eq!(one.0.as_slice(), a.as_slice());
+    }
+
+    /// The synthetic problem with samples off the model, so that the objectives disagree: the
+    /// first field moved by 0.05·sin(9x), which its rational form cannot follow, and a ±1e-3
+    /// ripple outside every point's basis.
+    fn noisy() -> (Vec<Vec<f64>>, Vec<PointData>) {
+        let (x, mut data) = problem();
+        for (g, (xg, d)) in x.iter().zip(data.iter_mut()).enumerate() {
+            for r in 0..d.y.len() {
+                d.y[r] += 0.05 * (9.0 * xg[0]).sin() * d.design[(r, 0)] + 1e-3 * ((17 * r + 5 * g) as f64 * 0.61).sin();
+            }
+        }
+        (x, data)
+    }
+
+    /// Max, rms and Σe⁴ of the fitted fields' residuals, recomputed from the coefficients
+    /// through `eval_full` (not the fitter's own evaluation).
+    fn errors(models: &[RationalModel], f: &FieldsFit, x: &[Vec<f64>], data: &[PointData]) -> (f64, f64, f64) {
+        let (mut max, mut ss, mut s4, mut n) = (0.0f64, 0.0, 0.0, 0);
+        for (xg, d) in x.iter().zip(data) {
+            let c = DVector::from_iterator(models.len(), models.iter().zip(&f.coefficients).map(|(m, c)| m.eval_full(c, xg)));
+            for e in (&d.design * c - &d.y).iter() {
+                max = max.max(e.abs());
+                ss += e * e;
+                s4 += e.powi(4);
+                n += 1;
+            }
+        }
+        (max, (ss / n as f64).sqrt(), s4)
+    }
+
+    /// On samples the fields cannot represent: the reported errors are those of the returned
+    /// coefficients; stage 1's are those of each point's own least-squares solve (by SVD here);
+    /// minimax has the lowest max error and least squares the lowest rms, L4 the lowest Σe⁴ of
+    /// the three (each is the optimum of its own objective, reached to well within the gaps).
+    #[test]
+    fn each_objective_wins_its_own_measure_and_reports_its_own_errors() {
+        let (x, data) = noisy();
+        let models: Vec<RationalModel> = OFFSETS.iter().map(|&o| field(o)).collect();
+        let fit = |objective| fit_fields(&models, &x, &data, &FieldOptions { objective, ..FieldOptions::default() }, "noisy").unwrap();
+        let (lsq, mm, l4) = (fit(Objective::Lsq), fit(Objective::Minimax), fit(Objective::L4));
+        let mut measured = vec![];
+        for (name, f) in [("lsq", &lsq), ("minimax", &mm), ("l4", &l4)] {
+            let (max, rms, s4) = errors(&models, f, &x, &data);
+            // The same residuals summed in another order: rounding of sums of ~800 terms.
+            assert!((f.max_abs_error - max).abs() <= 1e-12 && (f.rms_error - rms).abs() <= 1e-12, "{name}: reported ({}, {}), measured ({max}, {rms})", f.max_abs_error, f.rms_error);
+            measured.push((max, rms, s4));
+        }
+        let [(lsq_max, lsq_rms, lsq4), (mm_max, mm_rms, mm4), (_, l4_rms, l44)] = measured[..] else { unreachable!() };
+        // Most of the ripple is outside the basis (stage 1's floor below), so minimax gains only
+        // ~5 % on the max error here; 1 % is far above rounding and the solvers' stopping.
+        assert!(mm_max < 0.99 * lsq_max, "minimax max {mm_max} vs least squares {lsq_max}");
+        assert!(lsq_rms < mm_rms && lsq_rms < l4_rms, "rms: lsq {lsq_rms}, minimax {mm_rms}, l4 {l4_rms}");
+        assert!(l44 < lsq4 && l44 < mm4, "Σe⁴: l4 {l44}, lsq {lsq4}, minimax {mm4}");
+        assert!(mm.outer_iterations > 0 && l4.outer_iterations > 0 && lsq.outer_iterations == 0);
+        // Stage 1: the least-squares optimum of each point alone (the floor of the basis).
+        let (mut s1max, mut ss, mut n) = (0.0f64, 0.0, 0);
+        for d in &data {
+            let c = d.design.clone().svd(true, true).solve(&d.y, 1e-12).unwrap();
+            let e = &d.design * c - &d.y;
+            s1max = s1max.max(e.amax());
+            ss += e.norm_squared();
+            n += e.len();
+        }
+        let s1rms = (ss / n as f64).sqrt();
+        // QR and SVD solves of 36×3 systems: residuals agree to ~1e-15 of values ~1.
+        assert!((lsq.stage1_max_abs_error - s1max).abs() < 1e-12, "{} vs {s1max}", lsq.stage1_max_abs_error);
+        assert!((lsq.stage1_rms_error - s1rms).abs() < 1e-12, "{} vs {s1rms}", lsq.stage1_rms_error);
+        assert!(s1max > 1e-3 && s1max < lsq.max_abs_error, "the ripple is partly outside the basis: {s1max}");
     }
 }

@@ -509,6 +509,16 @@ impl Basis {
 mod tests {
     use super::*;
 
+    /// offset + scale·x in each of its three branches, on values exact in binary (so the
+    /// expected sums are exact in f64 and f32 alike).
+    #[test]
+    fn affine_is_offset_plus_scale_times_x() {
+        for (o, s, x, want) in [(0.5, 1.0, 0.25, 0.75), (0.5, -1.0, 0.25, 0.25), (0.5, 2.0, 0.25, 1.0), (-1.0, -0.5, 3.0, -2.5)] {
+            assert_eq!(affine(o, s, x), want, "{o} + {s}·{x}");
+            assert_eq!(affine_f32(o as f32, s as f32, x as f32), want as f32, "{o} + {s}·{x} (f32)");
+        }
+    }
+
     #[test]
     fn term_parsing_ties_monomials() {
         let feats = vec!["x".to_string(), "y".to_string()];

@@ -565,6 +565,15 @@ mod tests {
                     assert!(est.error <= 64.0 * f64::EPSILON * exact, "{name} d={d}: {}", est.error);
                 }
             }
+            // On a panel that does not start at 0 (centre and half-width differ): exact too,
+            // ∫_a^b x^d = (b^(d+1) − a^(d+1)) / (d+1), to rounding of sums of terms ≤ 2^47.
+            for (a, b) in [(0.5, 2.0), (-3.0, -1.0)] {
+                for d in [0, 7, 30, 47] {
+                    let est = integrate(&[(a, b)], &opts, |x| [x.powi(d)]);
+                    let exact = (b.powi(d + 1) - a.powi(d + 1)) / (d + 1) as f64;
+                    assert!((est.value[0] - exact).abs() <= 64.0 * f64::EPSILON * exact.abs(), "{name} [{a}, {b}] d={d}: {} vs {exact}", est.value[0]);
+                }
+            }
         }
     }
 
