@@ -1132,4 +1132,30 @@ mod tests {
         assert_eq!(tensor(&two, &[3, 2]), want);
         assert_eq!(a, vec![0.0, 0.5, 1.0]);
     }
+
+    /// The `measured error:` line names each measure with its value (3 significant digits).
+    #[test]
+    fn the_header_line_carries_every_measure() {
+        let v = Verification {
+            points: 4081,
+            max_abs_error: 1.2345e-3,
+            rms_error: 6.789e-5,
+            worst_point: vec![0.5],
+            max_abs_error_f32: 1.2351e-3,
+            rms_error_f32: 6.8e-5,
+            max_abs_error_in_parameter: None,
+        };
+        assert_eq!(v.header_line(), "max abs 1.234e-3, rms 6.789e-5 over 4081 points (f32 code: max abs 1.235e-3, rms 6.800e-5)");
+    }
+
+    /// Compact JSON is the same JSON (parsed back equal) with number arrays on one line.
+    #[test]
+    fn compact_json_is_the_same_json() {
+        let v = json!({"name": "t", "values": [0.5, -1.25e-7, 3.0], "texels": [[1.0, 2.0], [3.0, 4.0]], "empty": [], "nested": {"n": [1, 2]}});
+        let text = compact_json(&v);
+        assert_eq!(serde_json::from_str::<Value>(&text).unwrap(), v);
+        assert!(text.contains("\"values\": [0.5, -1.25e-7, 3.0]"), "{text}");
+        assert!(text.contains("[1.0, 2.0]") && text.contains("[3.0, 4.0]"), "{text}");
+        assert!(text.ends_with("}\n"));
+    }
 }

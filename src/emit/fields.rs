@@ -282,3 +282,28 @@ pub fn render_rust(header: &[String], f: &FieldsFunction<'_>, doc: &str, c64: &[
     ));
     s
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A monomial's factors are its arguments repeated by their exponents, in argument order.
+    #[test]
+    fn monomial_factors_repeat_each_argument_by_its_exponent() {
+        let args = vec!["u".to_string(), "v".to_string()];
+        let t = |s: &str| Term::parse(s, &args).unwrap();
+        assert_eq!(monomial_factors(&t("1")), None);
+        assert_eq!(monomial_factors(&t("v")), Some(vec![1]));
+        assert_eq!(monomial_factors(&t("u^2*v^3")), Some(vec![0, 0, 1, 1, 1]));
+    }
+
+    /// f64 literals read back to the same bits (Rust parses `1e-3_f64` like `1e-3`).
+    #[test]
+    fn f64_literals_round_trip() {
+        for v in [0.1, -2.5e-300, 1.0 / 3.0, 6.02214076e23, f64::MIN_POSITIVE, 0.0] {
+            let l = rlit64(v);
+            let back: f64 = l.strip_suffix("_f64").unwrap_or_else(|| panic!("{l}")).parse().unwrap();
+            assert_eq!(back.to_bits(), v.to_bits(), "{l}");
+        }
+    }
+}

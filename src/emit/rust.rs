@@ -140,3 +140,32 @@ pub fn table_eval_f32(values: &[f32], counts: &[usize], domain: &[(f32, f32)], x
         a * (1.0 - f1) + b * f1
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Linear and bilinear interpolation worked out by hand on values and positions exact in
+    /// binary (so every product and sum below is exact in f32), clamped at the edges.
+    #[test]
+    fn table_lookups_interpolate_linearly() {
+        // 1-D: 5 nodes on [0, 2] (spacing 0.5), values 0, 1, 4, 9, 16.
+        let v = [0.0, 1.0, 4.0, 9.0, 16.0];
+        let d = [(0.0f32, 2.0f32)];
+        assert_eq!(table_eval_f32(&v, &[5], &d, &[0.75]), 2.5); // halfway between 1 and 4
+        assert_eq!(table_eval_f32(&v, &[5], &d, &[1.625]), 10.75); // a quarter of the way from 9 to 16
+        assert_eq!(table_eval_f32(&v, &[5], &d, &[2.0]), 16.0);
+        assert_eq!(table_eval_f32(&v, &[5], &d, &[-3.0]), 0.0);
+        assert_eq!(table_eval_f32(&v, &[5], &d, &[9.0]), 16.0);
+        // 2-D: 3 × 2 nodes on [0, 1] × [0, 4], value x_i + 10 y_j at node (i, j), first axis
+        // fastest; bilinear interpolation of a bilinear function is exact.
+        let nodes: Vec<f32> = (0..2).flat_map(|j| (0..3).map(move |i| i as f32 * 0.5 + 10.0 * j as f32 * 4.0)).collect();
+        let d2 = [(0.0f32, 1.0f32), (0.0f32, 4.0f32)];
+        for (x, y) in [(0.25f32, 1.0f32), (0.75, 3.0), (1.0, 4.0), (0.0, 0.0), (0.5, 2.0)] {
+            assert_eq!(table_eval_f32(&nodes, &[3, 2], &d2, &[x, y]), x + 10.0 * y, "({x}, {y})");
+        }
+        // x·y is bilinear too, and not separable: the cross term must come from four texels.
+        let nodes: Vec<f32> = (0..2).flat_map(|j| (0..3).map(move |i| (i as f32 * 0.5) * (j as f32 * 4.0))).collect();
+        assert_eq!(table_eval_f32(&nodes, &[3, 2], &d2, &[0.75, 1.0]), 0.75);
+    }
+}

@@ -615,6 +615,35 @@ fn c_header(module: &str, header: &[&str], from: &str, m: &naga::Module) -> Resu
 mod tests {
     use super::*;
 
+    /// The C header holds every named constant with its values read back bit for bit, scalars,
+    /// 1-D and 2-D arrays, under an include guard.
+    #[test]
+    fn the_c_header_holds_every_constant() {
+        let wgsl = "const K: f32 = 0.1;\nconst A: array<f32, 3> = array<f32, 3>(1.5, -2.5e-8, 3.4028235e38);\n\
+                    const V: array<vec2<f32>, 2> = array<vec2<f32>, 2>(vec2<f32>(0.25, 0.5), vec2<f32>(0.75, 1.0));\n\
+                    const N: u32 = 7u;\nfn f() -> f32 { return K + A[1] + V[1].x + f32(N); }\n";
+        let m = naga::front::wgsl::parse_str(wgsl).unwrap();
+        let h = c_header("mod_x", &["line"], "mod_x.wgsl", &m).unwrap();
+        assert!(h.contains("#ifndef SHADEFIT_MOD_X_H") && h.trim_end().ends_with("#endif /* SHADEFIT_MOD_X_H */"), "{h}");
+        // Every number between `= ` and `;` of each declaration, parsed back as f32.
+        let values = |name: &str| -> Vec<f32> {
+            let at = h.find(&format!(" {name}")).unwrap_or_else(|| panic!("{name} missing:\n{h}"));
+            let body = &h[at..];
+            let body = &body[body.find('=').unwrap() + 1..body.find(';').unwrap()];
+            body.split(|c: char| c == ',' || c == '{' || c == '}' || c.is_whitespace())
+                .filter(|t| !t.is_empty())
+                .map(|t| t.trim_end_matches(['f', 'u']).parse::<f32>().unwrap_or_else(|e| panic!("{t}: {e}")))
+                .collect()
+        };
+        assert_eq!(values("K"), vec![0.1f32]);
+        assert!(h.contains("static const float K ="), "{h}");
+        assert_eq!(values("A").iter().map(|v| v.to_bits()).collect::<Vec<_>>(), [1.5f32, -2.5e-8, f32::MAX].map(f32::to_bits).to_vec());
+        assert!(h.contains("static const float V[2][2] ="), "{h}");
+        assert_eq!(values("V"), vec![0.25, 0.5, 0.75, 1.0]);
+        assert_eq!(values("N"), vec![7.0]);
+        assert!(h.contains("static const uint32_t N ="), "{h}");
+    }
+
     #[test]
     fn target_names_round_trip_and_lists_are_sorted() {
         for t in Target::ALL {

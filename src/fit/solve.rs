@@ -652,23 +652,6 @@ mod tests {
     /// Starts stopped for stalling change nothing: the chosen fit is bit for bit the one of
     /// running every start in full. A unit step at x = 0.3 by a 2/3 rational: three of the
     /// linearised starts crawl far above the best and are left stopped.
-    /// Starts stopped for stalling change nothing: the chosen fit is bit for bit the one of
-    /// running every start in full. A unit step at x = 0.3 by a 2/3 rational: three of the
-    /// linearised starts crawl far above the best and are left stopped.
-    #[test]
-    fn explore_stall() {
-        let fs: Vec<(&str, fn(f64) -> f64)> = vec![("step", |x| (x - 0.4).abs()), ("kink2", |x| (x - 0.7).abs().sqrt()), ("step", |x| if x < 0.3 { 0.0 } else { 1.0 }), ("tanh", |x| (20.0 * (x - 0.5)).tanh()), ("sin", |x| (9.0 * x).sin())];
-        for (name, f) in fs { for (m, n) in [(2, 2), (3, 3), (4, 4), (3, 2), (2, 3), (5, 5)] {
-            let model = RationalModel::rational_1d("x", m, n);
-            let x: Vec<Vec<f64>> = (0..200).map(|i| vec![i as f64 / 199.0]).collect();
-            let data = Data { y: x.iter().map(|p| f(p[0])).collect(), x };
-            let lsq = FitOptions::default();
-            let Ok(starts) = linearised_starts(&model, &data, name) else { continue };
-            let (_, left) = multi_start(&model, &data, &lsq, name, &starts, true);
-            eprintln!("EXPLORE {name} {m} {n} left {left}");
-        }}
-    }
-
     #[test]
     fn stalled_starts_do_not_change_the_choice() {
         let model = RationalModel::rational_1d("x", 2, 3);
@@ -687,5 +670,135 @@ mod tests {
         assert_eq!(w.report.rss.to_bits(), f.report.rss.to_bits());
         // The public entry point is the watched multi-start.
         assert_eq!(bits(&fit(&model, &data, &lsq, "step").unwrap().theta), bits(&f.theta));
+    }
+
+    use crate::fit::model::{ModelParts, Term};
+
+    fn parts_1d(num: &[&str], den: &[&str]) -> ModelParts {
+        let f = vec!["x".to_string()];
+        ModelParts {
+            inputs: f.clone(),
+            numerator: num.iter().map(|t| Term::parse(t, &f).unwrap()).collect(),
+            denominator: den.iter().map(|t| Term::parse(t, &f).unwrap()).collect(),
+            ..ModelParts::default()
+        }
+    }
+
+    /// (rss, max abs, rms) of the fit's residuals, recomputed from its coefficients through
+    /// `eval_full` in the data's own units.
+    fn remeasure(model: &RationalModel, f: &Fit, data: &Data) -> (f64, f64, f64) {
+        let r: Vec<f64> = data.x.iter().zip(&data.y).map(|(x, y)| model.eval_full(&f.coefficients, x) - y).collect();
+        let rss: f64 = r.iter().map(|v| v * v).sum();
+        (rss, r.iter().fold(0.0f64, |m, v| m.max(v.abs())), (rss / r.len() as f64).sqrt())
+    }
+
+    /// Data 2^80 in value and 2^70 in input (both rescaled before solving): an exact rational
+    /// with a fixed denominator coefficient is recovered, the fixed one exactly, and the report
+    /// (in the data's units) is that of the returned coefficients.
+    #[test]
+    fn data_far_from_one_is_fitted_in_its_own_units() {
+        let (ys, xs) = (2f64.powi(80), 2f64.powi(70));
+        // P/Q = (1 + 2t − 0.5t²)/(1 + 0.3t + 0.2t²) of t = x/2^70, written in x: the coefficient
+        // of x^k is that of t^k over 2^(70k), and the numerator's times 2^80.
+        let want = [ys, 2.0 * ys / xs, -0.5 * ys / (xs * xs), 0.3 / xs, 0.2 / (xs * xs)];
+        let model = RationalModel::new(ModelParts { fixed: vec![(3, want[3])], ..parts_1d(&["1", "x", "x^2"], &["x", "x^2"]) }).unwrap();
+        let x: Vec<Vec<f64>> = (0..=60).map(|i| vec![xs * i as f64 / 20.0]).collect();
+        let exact = |x: f64| {
+            let t = x / xs;
+            ys * (1.0 + 2.0 * t - 0.5 * t * t) / (1.0 + 0.3 * t + 0.2 * t * t)
+        };
+        let data = Data { y: x.iter().map(|p| exact(p[0])).collect(), x: x.clone() };
+        let f = fit_rescaled(&model, &data, &FitOptions::default(), "scaled").unwrap();
+        assert_eq!(f.coefficients[3], want[3], "the fixed coefficient");
+        for (c, w) in f.coefficients.iter().zip(&want) {
+            // Exact data, condition ~1e3 in the scaled problem: recovered to ~1e-12.
+            assert!((c - w).abs() <= 1e-9 * w.abs(), "{c:e} vs {w:e}");
+        }
+        // Off the model (a ripple of 1 % of the values): the report is the returned fit's.
+        let data = Data { y: x.iter().map(|p| exact(p[0]) * (1.0 + 0.01 * (7.0 * p[0] / xs).sin())).collect(), x };
+        let f = fit_rescaled(&model, &data, &FitOptions::default(), "scaled").unwrap();
+        let (rss, max, rms) = remeasure(&model, &f, &data);
+        let r = &f.report;
+        // Residuals of the scaled problem times exact powers of two: rounding of 61-term sums.
+        assert!((r.rss - rss).abs() <= 1e-9 * rss && rss > 0.0, "rss {} vs {rss}", r.rss);
+        assert!((r.max_abs_error - max).abs() <= 1e-9 * max, "max {} vs {max}", r.max_abs_error);
+        assert!((r.worst_residual.abs() - max).abs() <= 1e-9 * max, "worst residual {} vs {max}", r.worst_residual);
+        assert!((r.rms_error - rms).abs() <= 1e-9 * rms, "rms {} vs {rms}", r.rms_error);
+    }
+
+    /// For a polynomial (no denominator) the Jacobian is the design matrix [1, x, x²]: the
+    /// report's condition number is its σmax/σmin, computed here by nalgebra's SVD of the matrix
+    /// built by hand.
+    #[test]
+    fn the_condition_number_is_that_of_the_jacobian() {
+        let model = RationalModel::rational_1d("x", 2, 0);
+        let x: Vec<Vec<f64>> = (0..=40).map(|i| vec![-1.0 + i as f64 / 10.0]).collect();
+        let data = Data { y: x.iter().map(|p| (2.0 * p[0]).cos()).collect(), x: x.clone() };
+        let f = fit(&model, &data, &FitOptions::default(), "poly").unwrap();
+        let design = DMatrix::from_fn(x.len(), 3, |i, j| x[i][0].powi(j as i32));
+        let sv = design.singular_values();
+        let cond = sv.max() / sv.min();
+        // Two SVDs of one 41×3 matrix: agreement to ~1e-14 of a condition number ~10.
+        assert!(cond > 2.0 && (f.report.condition_number - cond).abs() <= 1e-10 * cond, "{} vs {cond}", f.report.condition_number);
+    }
+
+    fn done(valid: bool, rss: f64) -> Option<Outcome> {
+        let report = FitReport {
+            objective: Objective::Lsq,
+            samples: 1,
+            rss,
+            max_abs_error: 0.0,
+            rms_error: 0.0,
+            max_rel_error: 0.0,
+            worst_point: vec![],
+            worst_residual: 0.0,
+            condition_number: 1.0,
+            iterations: 0,
+            evaluations: 0,
+        };
+        Some(Outcome::Done(valid, Fit { theta: DVector::from_element(1, rss), coefficients: DVector::zeros(0), report }))
+    }
+
+    /// The choice among finished starts, as documented: valid first, then the lower rss, the
+    /// earlier start on a tie; stalled and missing starts are skipped.
+    #[test]
+    fn the_best_start_is_valid_then_lowest_rss_then_first() {
+        let pick = |o: &[Option<Outcome>]| best_done(o).map(|(v, f)| (v, f.report.rss, f.theta[0]));
+        assert_eq!(pick(&[done(true, 2.0), done(true, 1.0), done(true, 3.0)]), Some((true, 1.0, 1.0)));
+        assert_eq!(pick(&[done(false, 0.5), done(true, 3.0), done(false, 0.1)]), Some((true, 3.0, 3.0)));
+        assert_eq!(pick(&[done(false, 0.5), done(false, 0.2), None, Some(Outcome::Stalled { lower: 0.0 })]), Some((false, 0.2, 0.2)));
+        assert_eq!(pick(&[done(true, 1.0), done(true, 3.0), done(true, 2.0)]), Some((true, 1.0, 1.0)));
+        assert_eq!(pick(&[None, Some(Outcome::Stalled { lower: 0.0 })]), None);
+    }
+
+    /// The first start is the least-squares polynomial (Q ≡ 1): on samples of a quadratic it is
+    /// the quadratic itself, with the denominator coefficient 0.
+    #[test]
+    fn the_polynomial_start_is_the_polynomial() {
+        let model = RationalModel::rational_1d("x", 2, 1);
+        let x: Vec<Vec<f64>> = (0..=30).map(|i| vec![i as f64 / 10.0]).collect();
+        let data = Data { y: x.iter().map(|p| 1.0 + 2.0 * p[0] - p[0] * p[0]).collect(), x };
+        let starts = linearised_starts(&model, &data, "quadratic").unwrap();
+        let s = model.full(&starts[0]);
+        // An SVD solve of a 31×3 system with exact data: rounding, ~1e-14.
+        for (c, w) in s.iter().zip([1.0, 2.0, -1.0, 0.0]) {
+            assert!((c - w).abs() < 1e-12, "{s:?}");
+        }
+    }
+
+    /// A clamped model is fitted on the samples strictly inside the clamp: y = clamp(P/Q, 0, 1)
+    /// with P/Q above 1 on part of the range recovers P/Q.
+    #[test]
+    fn a_clamped_model_recovers_the_rational_inside_the_clamp() {
+        let model = RationalModel::new(ModelParts { clamp: Some((0.0, 1.0)), ..parts_1d(&["1", "x"], &["x"]) }).unwrap();
+        let exact = |x: f64| (0.2 + 1.5 * x) / (1.0 + 0.5 * x);
+        let x: Vec<Vec<f64>> = (0..=40).map(|i| vec![i as f64 / 20.0]).collect();
+        let data = Data { y: x.iter().map(|p| exact(p[0]).clamp(0.0, 1.0)).collect(), x };
+        assert!(data.y.iter().filter(|&&y| y == 1.0).count() > 10, "part of the samples is at the clamp");
+        let f = fit(&model, &data, &FitOptions::default(), "clamped").unwrap();
+        // Exact data on the rows that carry information: rounding level.
+        for (c, w) in f.coefficients.iter().zip([0.2, 1.5, 0.5]) {
+            assert!((c - w).abs() < 1e-9, "{:?}", f.coefficients);
+        }
     }
 }
