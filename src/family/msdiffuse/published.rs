@@ -433,6 +433,40 @@ mod tests {
     use super::*;
 
     #[test]
+    fn burley_at_grazing_is_fd90() {
+        // Burley 2012: f_d ∝ (1 + (F_D90 − 1)(1 − cos θl)⁵)(1 + (F_D90 − 1)(1 − cos θv)⁵), F_D90 =
+        // ½ + 2 r cos² θd. At n·l = 0, n·v = 1 the product is F_D90 (and symmetric in l, v).
+        let (r, lh) = (0.5, 0.6);
+        let fd90 = 0.5 + 2.0 * r * lh * lh;
+        for (nl, nv) in [(0.0, 1.0), (1.0, 0.0)] {
+            let c = Cosines { n_dot_l: nl, n_dot_v: nv, n_dot_h: 0.8, l_dot_h: lh, l_dot_v: 0.0 };
+            // A few ulps of the arithmetic.
+            assert!((burley(r, &c) - fd90).abs() < 1e-15, "n·l {nl} n·v {nv}: {} vs {fd90}", burley(r, &c));
+        }
+        // Both grazing: F_D90².
+        let c = Cosines { n_dot_l: 0.0, n_dot_v: 0.0, n_dot_h: 0.8, l_dot_h: lh, l_dot_v: 0.0 };
+        assert!((burley(r, &c) - fd90 * fd90).abs() < 1e-15);
+    }
+
+    #[test]
+    fn at_gloss_picks_every_point_of_that_gloss() {
+        let c = Cosines::at(0.3, 0.2, 1.0).unwrap();
+        let glosses = [0.0, 0.5, 0.0, 1.0, 0.5, 0.0];
+        let s = Slices {
+            points: glosses.iter().map(|&g| vec![g, 0.3, 0.2]).collect(),
+            cosines: vec![c; glosses.len()],
+            values: vec![1.0; glosses.len()],
+            se: vec![0.0; glosses.len()],
+            phi_d: 1.0,
+            f0: 0.04,
+        };
+        assert_eq!(s.at_gloss(0.0), vec![0, 2, 5]);
+        assert_eq!(s.at_gloss(0.5), vec![1, 4]);
+        assert_eq!(s.at_gloss(1.0), vec![3]);
+        assert_eq!(s.at_gloss(0.25), Vec::<usize>::new());
+    }
+
+    #[test]
     fn models_at_known_points() {
         // Closed-form values by hand at l = v = n (θh = θd = 0): cosines all 1.
         let c = Cosines::at(0.0, 0.0, FRAC_PI_2).unwrap();
