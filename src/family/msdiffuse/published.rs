@@ -433,6 +433,31 @@ mod tests {
     use super::*;
 
     #[test]
+    fn talk_rational_against_the_lambert_slice_times_0_9216_is_re_measured() {
+        // The talk's F0 = 0.04 with a constant (1 − F0) at entry and exit scales the F0 = 0 walk
+        // by (1 − 0.04)² = 0.9216. Re-measured here from the committed JSON alone: the gloss-0
+        // layer's cells at θh = (i + ½)/w·π/2, θd = (j + ½)/h·π/2, where the rational's
+        // arguments are n·h = cos θh and l·h = cos θd. 1e-12: the same f64 sums in another order.
+        let generated = Path::new(env!("CARGO_MANIFEST_DIR")).join("generated");
+        let v: Value = serde_json::from_str(&std::fs::read_to_string(generated.join("json/ms_diffuse_slices_lambert.json")).unwrap()).unwrap();
+        assert_eq!(v["gloss"][0].as_f64(), Some(0.0));
+        let (w, h) = (v["axes"][0]["count"].as_u64().unwrap() as usize, v["axes"][1]["count"].as_u64().unwrap() as usize);
+        let mut want = 0.0f64;
+        for j in 0..h {
+            for i in 0..w {
+                let (th, td) = ((i as f64 + 0.5) / w as f64 * FRAC_PI_2, (j as f64 + 0.5) / h as f64 * FRAC_PI_2);
+                let cell = v["slices"][j * w + i][0].as_f64().unwrap();
+                let published = PI * rational(&RATIONAL_NUM, &RATIONAL_DEN, th.cos(), td.cos());
+                want = want.max((published - 0.9216 * cell).abs());
+            }
+        }
+        let items = items(&generated);
+        let it = items.iter().find(|it| it.name.starts_with("ms-diffuse gloss-0 slice")).unwrap();
+        let got = it.extra.iter().find(|(k, _)| k == "max_abs_error_vs_f0_0_times_0.9216").unwrap().1;
+        assert!((got - want).abs() <= 1e-12 * want, "reported {got}, re-measured {want}");
+    }
+
+    #[test]
     fn burley_at_grazing_is_fd90() {
         // Burley 2012: f_d ∝ (1 + (F_D90 − 1)(1 − cos θl)⁵)(1 + (F_D90 − 1)(1 − cos θv)⁵), F_D90 =
         // ½ + 2 r cos² θd. At n·l = 0, n·v = 1 the product is F_D90 (and symmetric in l, v).
