@@ -248,6 +248,22 @@ pub fn eval_furnace(p: &[f64], tol: f64) -> Estimate {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn furnace_error_estimate_covers_a_loose_evaluation() {
+        // At tol 1e-4 the reported error must cover the distance to the same albedo at 1e-11
+        // (plus that one's own reported error); every scheme integrates A and B, so the
+        // estimate is positive.
+        for scheme in 0..Scheme::ALL.len() {
+            for &(alpha, mu, f0) in &[(0.1, 0.3, 0.04), (0.5, 0.8, 1.0), (1.0, 0.1, 0.5)] {
+                let p = [alpha, mu, f0, scheme as f64];
+                let a = eval_furnace(&p, 1e-4);
+                let b = eval_furnace(&p, 1e-11);
+                assert!(a.error > 0.0, "{p:?}: error {}", a.error);
+                assert!((a.value - b.value).abs() <= a.error + b.error, "{p:?}: |Δ| {:e} > {:e}", (a.value - b.value).abs(), a.error);
+            }
+        }
+    }
     use crate::integrate::gauss_legendre;
 
     fn inputs(alpha: f64, mu: f64) -> Inputs {

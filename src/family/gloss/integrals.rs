@@ -173,6 +173,18 @@ mod tests {
     use super::*;
 
     #[test]
+    fn inverse_round_trips_on_a_fine_grid() {
+        // 4095 glosses off the dyadic grid of `inverse_round_trips`: the Illinois steps must
+        // close the bracket everywhere, not only at g = k/64. Bound as there: dL/dg ≥ ~1e-5 near
+        // g = 1, so one ulp of L (1e-16) maps to ≤ 1e-11 in g; 1e-10 leaves 10×.
+        for i in 1..4096 {
+            let g = i as f64 / 4096.0 + 1e-5;
+            let back = gloss_from_length(length_from_gloss(g));
+            assert!((back - g).abs() < 1e-10, "g={g} back={back}");
+        }
+    }
+
+    #[test]
     fn alpha_from_gloss_is_the_published_parameterisation() {
         // COD: WWII's gloss parameterisation (the module docs): α = sqrt(2 / (1 + 2^(18 g))),
         // 18·g inside the sum. At g = k/18 the power is the integer 2^k, so α² is the

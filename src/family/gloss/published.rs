@@ -146,3 +146,21 @@ pub fn items(generated: &Path) -> Vec<Item> {
     out.push(item);
     out
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn uniform_samples_include_both_ends() {
+        // i/(n − 1): quarters are exact in binary, so equality is exact.
+        assert_eq!(uniform(5), vec![0.0, 0.25, 0.5, 0.75, 1.0]);
+        let u = uniform(256);
+        assert_eq!(u.len(), 256);
+        assert_eq!((u[0], u[255]), (0.0, 1.0));
+        // Spacing 1/255 to the rounding of one division (a few ulps of 1).
+        for w in u.windows(2) {
+            assert!((w[1] - w[0] - 1.0 / 255.0).abs() < 4.0 * f64::EPSILON, "{w:?}");
+        }
+    }
+}

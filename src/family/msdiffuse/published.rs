@@ -433,6 +433,65 @@ mod tests {
     use super::*;
 
     #[test]
+    fn talk_rational_against_the_lambert_slice_times_0_9216_is_re_measured() {
+        // The talk's F0 = 0.04 with a constant (1 − F0) at entry and exit scales the F0 = 0 walk
+        // by (1 − 0.04)² = 0.9216. Re-measured here from the committed JSON alone: the gloss-0
+        // layer's cells at θh = (i + ½)/w·π/2, θd = (j + ½)/h·π/2, where the rational's
+        // arguments are n·h = cos θh and l·h = cos θd. 1e-12: the same f64 sums in another order.
+        let generated = Path::new(env!("CARGO_MANIFEST_DIR")).join("generated");
+        let v: Value = serde_json::from_str(&std::fs::read_to_string(generated.join("json/ms_diffuse_slices_lambert.json")).unwrap()).unwrap();
+        assert_eq!(v["gloss"][0].as_f64(), Some(0.0));
+        let (w, h) = (v["axes"][0]["count"].as_u64().unwrap() as usize, v["axes"][1]["count"].as_u64().unwrap() as usize);
+        let mut want = 0.0f64;
+        for j in 0..h {
+            for i in 0..w {
+                let (th, td) = ((i as f64 + 0.5) / w as f64 * FRAC_PI_2, (j as f64 + 0.5) / h as f64 * FRAC_PI_2);
+                let cell = v["slices"][j * w + i][0].as_f64().unwrap();
+                let published = PI * rational(&RATIONAL_NUM, &RATIONAL_DEN, th.cos(), td.cos());
+                want = want.max((published - 0.9216 * cell).abs());
+            }
+        }
+        let items = items(&generated);
+        let it = items.iter().find(|it| it.name.starts_with("ms-diffuse gloss-0 slice")).unwrap();
+        let got = it.extra.iter().find(|(k, _)| k == "max_abs_error_vs_f0_0_times_0.9216").unwrap().1;
+        assert!((got - want).abs() <= 1e-12 * want, "reported {got}, re-measured {want}");
+    }
+
+    #[test]
+    fn burley_at_grazing_is_fd90() {
+        // Burley 2012: f_d ∝ (1 + (F_D90 − 1)(1 − cos θl)⁵)(1 + (F_D90 − 1)(1 − cos θv)⁵), F_D90 =
+        // ½ + 2 r cos² θd. At n·l = 0, n·v = 1 the product is F_D90 (and symmetric in l, v).
+        let (r, lh) = (0.5, 0.6);
+        let fd90 = 0.5 + 2.0 * r * lh * lh;
+        for (nl, nv) in [(0.0, 1.0), (1.0, 0.0)] {
+            let c = Cosines { n_dot_l: nl, n_dot_v: nv, n_dot_h: 0.8, l_dot_h: lh, l_dot_v: 0.0 };
+            // A few ulps of the arithmetic.
+            assert!((burley(r, &c) - fd90).abs() < 1e-15, "n·l {nl} n·v {nv}: {} vs {fd90}", burley(r, &c));
+        }
+        // Both grazing: F_D90².
+        let c = Cosines { n_dot_l: 0.0, n_dot_v: 0.0, n_dot_h: 0.8, l_dot_h: lh, l_dot_v: 0.0 };
+        assert!((burley(r, &c) - fd90 * fd90).abs() < 1e-15);
+    }
+
+    #[test]
+    fn at_gloss_picks_every_point_of_that_gloss() {
+        let c = Cosines::at(0.3, 0.2, 1.0).unwrap();
+        let glosses = [0.0, 0.5, 0.0, 1.0, 0.5, 0.0];
+        let s = Slices {
+            points: glosses.iter().map(|&g| vec![g, 0.3, 0.2]).collect(),
+            cosines: vec![c; glosses.len()],
+            values: vec![1.0; glosses.len()],
+            se: vec![0.0; glosses.len()],
+            phi_d: 1.0,
+            f0: 0.04,
+        };
+        assert_eq!(s.at_gloss(0.0), vec![0, 2, 5]);
+        assert_eq!(s.at_gloss(0.5), vec![1, 4]);
+        assert_eq!(s.at_gloss(1.0), vec![3]);
+        assert_eq!(s.at_gloss(0.25), Vec::<usize>::new());
+    }
+
+    #[test]
     fn models_at_known_points() {
         // Closed-form values by hand at l = v = n (θh = θd = 0): cosines all 1.
         let c = Cosines::at(0.0, 0.0, FRAC_PI_2).unwrap();

@@ -577,6 +577,22 @@ pub(super) mod tests {
     }
 
     #[test]
+    fn png_preview_is_256_pixels_across_a_layer() {
+        // Texels of a 4 × 3 layer are scaled by ⌊256/4⌋ = 64: the preview is 256 wide and
+        // 2 layers × 3 rows × 64 = 384 tall. The cells need not be simulated to be rendered.
+        let s = spec(SPEC);
+        let t = Table::from_spec(&s).unwrap();
+        let n = (t.slice_cells() + t.albedo_cells()) as usize;
+        let cells: Vec<Cell> = (0..n).map(|k| Cell { value: 1.0 + 0.01 * k as f64, se: 0.01 }).collect();
+        let built = render(&s, &t, &cells).unwrap();
+        let png = &built.artifacts.iter().find(|a| a.path.ends_with("data/msd_t.png")).unwrap().contents;
+        // PNG: 8-byte signature, IHDR length and type, then width and height big-endian.
+        assert_eq!(&png[12..16], b"IHDR");
+        let be = |i: usize| u32::from_be_bytes(png[i..i + 4].try_into().unwrap());
+        assert_eq!((be(16), be(20)), (256, 384));
+    }
+
+    #[test]
     fn merl_files_hold_the_walk_at_the_cell_centres() {
         // merl_paths = 2 (1.46M cells a layer, the smallest run): a cell of the file is the
         // estimate at its centre (same key, cell number and paths), and check mode re-renders

@@ -493,6 +493,27 @@ impl Rng {
 mod tests {
     use super::*;
 
+    #[test]
+    fn alphas_invert_from_alphas() {
+        // R(ψ) diag(α_t², α_b²) R(ψ)ᵀ has eigenvalues α_t², α_b² and its α_t axis at ψ
+        // (ψ ∈ (−π/2, π/2]); 1e-15: a few ulps of entries ≤ 1.
+        for (at, ab, psi) in [(0.8, 0.3, 0.4), (0.5, 0.1, -1.2), (0.9, 0.6, 1.5), (0.2, 0.05, 0.0)] {
+            let (t2, b2, p) = Aniso::from_alphas(at, ab, psi).alphas();
+            assert!((t2 - at * at).abs() < 1e-15 && (b2 - ab * ab).abs() < 1e-15, "{at} {ab} {psi}: {t2} {b2}");
+            assert!((p - psi).abs() < 1e-12, "{at} {ab} {psi}: ψ {p}");
+        }
+    }
+
+    #[test]
+    fn encode_of_a_singular_block_has_middle_channel_one_half() {
+        // The doc: the middle channel is ½ where Sxx·Syy = 0; the others are √Sxx, √Syy.
+        assert_eq!(encode(Aniso { sxx: 0.25, sxy: 0.0, syy: 0.0 }), [0.5, 0.5, 0.0]);
+        assert_eq!(encode(Aniso { sxx: 0.0, sxy: 0.0, syy: 0.64 }), [0.0, 0.5, 0.8]);
+        // And a regular one: Sxy/√(Sxx Syy) = 0.03/(0.5·0.3) = 0.2, stored 0.6.
+        let e = encode(Aniso { sxx: 0.25, sxy: 0.03, syy: 0.09 });
+        assert!((e[0] - 0.5).abs() < 1e-16 && (e[1] - 0.6).abs() < 1e-15 && (e[2] - 0.3).abs() < 1e-16, "{e:?}");
+    }
+
     fn texel(theta: f64, phi: f64, at: f64, ab: f64, psi: f64) -> (V3, Aniso) {
         (direction(theta, phi), Aniso::from_alphas(at, ab, psi))
     }

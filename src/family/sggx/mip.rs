@@ -241,6 +241,26 @@ pub fn run(args: &[String]) -> Result<String, CommandError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn texels_read_each_texel_s_own_channels() {
+        // Two RGBA texels. Texel 0: n = +z, channels [0.6, ½, 0.3] decode to Sxx = 0.36, Sxy = 0,
+        // Syy = 0.09, so S = diag(0.36, 0.09, 1). Texel 1: n = (0.6, 0, 0.8) (stored n/2 + ½) and
+        // [0.4, ½, 0.7]: α_t along y with α_t² = 0.49, α_b² = 0.16; the frame turns about y, so
+        // S ŷ = 0.49 ŷ, S n = n and tr S = 1.65. 1e-12: f64 rounding of entries ≤ 1 through a
+        // normalisation and two products.
+        let normal = [0.5, 0.5, 1.0, 0.25, 0.8, 0.5, 0.9, 0.25];
+        let aniso = [0.6, 0.5, 0.3, 1.0, 0.4, 0.5, 0.7, 1.0];
+        let s = texels(&normal, 4, &aniso, 4, 2);
+        assert_eq!(s.len(), 2);
+        let want0 = M3::new(0.36, 0.0, 0.0, 0.0, 0.09, 0.0, 0.0, 0.0, 1.0);
+        assert!((s[0] - want0).abs().max() < 1e-12, "{}", s[0]);
+        let n = V3::new(0.6, 0.0, 0.8);
+        let y = V3::new(0.0, 1.0, 0.0);
+        assert!((s[1] * n - n).norm() < 1e-12, "{}", s[1]);
+        assert!((s[1] * y - 0.49 * y).norm() < 1e-12, "{}", s[1]);
+        assert!((s[1].trace() - 1.65).abs() < 1e-12, "{}", s[1]);
+    }
     use crate::family::sggx::integrals::{Aniso, direction, sggx_from};
 
     #[test]

@@ -398,6 +398,24 @@ mod tests {
     use super::*;
 
     #[test]
+    fn input_hash_is_a_sha256_that_follows_the_spec_text() {
+        let text = "name = \"skin_t\"\nkind = \"skin-lut\"\nquantity = \"skin-sh\"\nresolution = [6]\n\
+             curvature_max = 2.0\ntolerance = 1e-9\n\n[emit]\nfunction = \"skin_t\"\n";
+        let hash_of = |t: &str| {
+            let spec = crate::spec::Spec::parse(Path::new("fits/skin_t.toml"), t.to_string(), crate::family::catalog()).unwrap();
+            let lut = SkinLut::from_spec(&spec).unwrap();
+            input_hash(&spec, &lut)
+        };
+        let h = hash_of(text);
+        // "sha256:" and 32 bytes in lowercase hex (the header format of every generated file).
+        let hex = h.strip_prefix("sha256:").unwrap_or_else(|| panic!("{h:?}"));
+        assert!(hex.len() == 64 && hex.bytes().all(|b| b.is_ascii_digit() || (b'a'..=b'f').contains(&b)), "{h:?}");
+        // Same text, same hash; an edited tolerance makes the generated files stale.
+        assert_eq!(hash_of(text), h);
+        assert_ne!(hash_of(&text.replace("1e-9", "1e-8")), h);
+    }
+
+    #[test]
     fn compact_json_keeps_numbers_on_one_line() {
         let v = json!({"a": [1.0, 2.5], "b": [[0.1, 0.2, 0.3], [1e-20, 2.0, -3.0]], "c": {"d": []}, "e": ["x", "y"]});
         let s = compact_json(&v);

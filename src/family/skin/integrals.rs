@@ -944,6 +944,28 @@ pub fn sh_bands_estimates(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn punctual_error_estimates_cover_the_error() {
+        // At a loose tolerance the reported error must cover the distance to the same integral
+        // at 1e-13 (whose own reported error is added; 1e-15 for rounding of values ≤ 1).
+        let p = default_skin_profile();
+        let loose = Tolerance { abs: 1e-4, rel: 0.0, max_panels: 2000 };
+        let tight = Tolerance { abs: 1e-13, rel: 0.0, max_panels: 20_000 };
+        for kernel in [Kernel::Linear, Kernel::Radial] {
+            for kappa in [0.05, 0.3, 1.0, 3.0] {
+                for nl in [-0.3, 0.0, 0.2, 0.7, 1.0] {
+                    let a = punctual(&p, kernel, kappa, nl, loose).unwrap();
+                    let b = punctual(&p, kernel, kappa, nl, tight).unwrap();
+                    for c in 0..3 {
+                        assert!(a[c].error >= 0.0, "{kernel:?} κ {kappa} n·l {nl} channel {c}: error {}", a[c].error);
+                        let d = (a[c].value - b[c].value).abs();
+                        assert!(d <= a[c].error + b[c].error + 1e-15, "{kernel:?} κ {kappa} n·l {nl} channel {c}: |Δ| {d:e} > error {:e}", a[c].error);
+                    }
+                }
+            }
+        }
+    }
     use crate::integrate::adaptive;
     use std::time::Instant;
 
