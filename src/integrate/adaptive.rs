@@ -577,6 +577,31 @@ mod tests {
         }
     }
 
+    /// The Gauss pair's QUADPACK estimate from its definition: raw = |Q32 − Q24|, resasc =
+    /// ∫|f − mean| and resabs = ∫|f| by the 32-point rule, all times the half-width, worked out
+    /// here from the nodes of `gauss_legendre` on a panel [1, 3] of f(x) = x^60 / 3^60.
+    #[test]
+    fn gauss_pair_quadpack_estimate_is_qk_from_its_parts() {
+        let pair = GaussPair::new(32, 24);
+        let f = |x: f64| (x / 3.0).powi(60);
+        let (c, h) = (2.0, 1.0);
+        let rule = |n: usize| {
+            let (x, w) = crate::integrate::gauss_legendre(n);
+            x.iter().zip(&w).map(|(x, w)| w * f(c + h * x)).sum::<f64>()
+        };
+        let (q32, q24) = (rule(32), rule(24));
+        let (x, w) = crate::integrate::gauss_legendre(32);
+        let mean = 0.5 * q32;
+        let resasc: f64 = x.iter().zip(&w).map(|(x, w)| w * (f(c + h * x) - mean).abs()).sum();
+        let resabs: f64 = x.iter().zip(&w).map(|(x, w)| w * f(c + h * x).abs()).sum();
+        let want = quadpack_error(((q32 - q24) * h).abs(), resasc * h, resabs * h);
+        let opts = Options { rule: Rule::GaussPair(&pair), ..Options::quadpack([1.0], 0.0, 1) };
+        let est = integrate(&[(1.0, 3.0)], &opts, |x| [f(x)]);
+        // The same sums in the same order: equal to rounding.
+        assert!(want > 0.0 && (est.error - want).abs() <= 1e-12 * want, "{} vs {want}", est.error);
+        assert!((est.value[0] - q32 * h).abs() <= 1e-15 * est.value[0]);
+    }
+
     #[test]
     fn peaked_integrands_meet_the_tolerance_and_the_estimate_bounds_the_error() {
         for eps in [1e-1, 1e-2, 1e-3, 1e-4] {
