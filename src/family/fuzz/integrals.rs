@@ -1265,6 +1265,16 @@ mod r_horizon;
 mod tests {
     use super::*;
 
+    #[test]
+    fn fiber_is_the_unit_vector_at_theta_f_from_the_normal() {
+        // t = (sin θf, 0, cos θf): at θf = π/3, t·n = cos(π/3) = 1/2 and |t| = 1 (1e-15: one
+        // rounding in sin, cos and the squares).
+        let t = FuzzParams::new(0.5, std::f64::consts::FRAC_PI_3).fiber();
+        assert!((t[2] - 0.5).abs() < 1e-15 && t[1] == 0.0, "{t:?}");
+        assert!((t[0] * t[0] + t[1] * t[1] + t[2] * t[2] - 1.0).abs() < 1e-15, "{t:?}");
+        assert!(t[0] > 0.0, "{t:?}");
+    }
+
     /// Factor on P_s's error estimate where it serves as a tolerance: the estimate is the
     /// panels' |K21 − G10| summed, and near grazing, where a cone breakpoint u·t = ±sin θf
     /// approaches the horizon, it was measured ~5x below the true error (tests/stress.rs,

@@ -245,3 +245,52 @@ pub fn items(generated: &Path) -> Vec<Item> {
     });
     out
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn listing_1_with_rows_3_and_4_exchanged_follows_p_s() {
+        // P̃_s (Listings 1–2, rows 3 and 4 exchanged as the validation item finds) against P_s
+        // integrated to 1e-9 on the 16 × 16 fitting directions at (α, θf) = (0.5, 0.8), against
+        // the best 6-term least-squares fit there (the form's floor, re-measured here).
+        let (alpha, theta_f) = (0.5, 0.8);
+        let c = published_ps_coeffs(alpha, theta_f);
+        let dirs = fuzz::fitting_directions(16, 16);
+        let mut basis = nalgebra::DMatrix::zeros(dirs.len(), 6);
+        let mut y = nalgebra::DVector::zeros(dirs.len());
+        let mut worst = 0.0f64;
+        for (i, &(tu, pu)) in dirs.iter().enumerate() {
+            let (nu, tdu) = (tu.cos(), tu.sin() * pu.cos() * theta_f.sin() + tu.cos() * theta_f.cos());
+            let truth = fuzz::ps(alpha, theta_f, tu, pu, 1e-9).value;
+            worst = worst.max((ps_from_coeffs_swapped(&c, nu, tdu) - truth).abs());
+            for (j, v) in [1.0, nu, tdu, nu * nu, nu * tdu, tdu * tdu].iter().enumerate() {
+                basis[(i, j)] = *v;
+            }
+            y[i] = truth;
+        }
+        let fitted = basis.clone().svd(true, true).solve(&y, 1e-12).unwrap();
+        let floor = (&basis * &fitted - &y).amax();
+        // Listing 1 fits the c_i jointly over (α, θf), so at one (α, θf) it sits near the
+        // per-point least-squares floor (the validation item's finding: "at the floor"); 1.5×
+        // the floor leaves room for the joint fit's compromise (measured 1.02×).
+        assert!(worst <= 1.5 * floor, "published max {worst:e}, floor {floor:e}, c {c:?}, fitted {fitted:?}");
+    }
+
+    #[test]
+    fn features_are_the_eq_2_monomials() {
+        // β = 1 − α, γ = cos θf, δ = sin θf, and the listing's order β γ δ β² γ² βγ βδ β³ γ³ δ³
+        // β²γ β²δ βγ², recomputed with powi (1e-15: a few roundings on values ≤ 1).
+        let (alpha, theta_f) = (0.5f64, std::f64::consts::FRAC_PI_3);
+        let (b, g, d) = (0.5f64, 0.5f64, 0.75f64.sqrt());
+        let want = [
+            b, g, d, b.powi(2), g.powi(2), b * g, b * d, b.powi(3), g.powi(3), d.powi(3),
+            b.powi(2) * g, b.powi(2) * d, b * g.powi(2),
+        ];
+        let got = features(alpha, theta_f);
+        for k in 0..13 {
+            assert!((got[k] - want[k]).abs() < 1e-15, "feature {k}: {} vs {}", got[k], want[k]);
+        }
+    }
+}

@@ -61,6 +61,22 @@ mod tests {
         build(&spec(text), Mode::Fit, Path::new("")).unwrap()
     }
 
+    #[test]
+    fn verify_samples_the_unit_square_four_times_denser() {
+        // The verification points are the centres of a grid VERIFY_DENSITY (4) times denser than
+        // the 10 × 7 texels: 40 × 28 points, all in [0, 1]², 38 × 26 of them in the interior
+        // (between the outer texel centres), where bilinear filtering of a curved E cannot be
+        // exact, so the interior error is positive.
+        let lut = DfgLut::parse(Path::new("fits/ggx_t.toml"), SPEC).unwrap();
+        let (values, _) = tabulate(&lut);
+        let m = super::build::verify(&lut, &values).unwrap();
+        assert_eq!(m.points, 40 * 28);
+        for x in [&m.texture.worst_point, &m.texture_interior.worst_point] {
+            assert!(x.len() == 2 && x.iter().all(|c| (0.0..=1.0).contains(c)), "{x:?}");
+        }
+        assert!(m.texture_interior.max_abs_error > 0.0, "{:?}", m.texture_interior);
+    }
+
     fn artifact<'a>(b: &'a Built, suffix: &str) -> &'a [u8] {
         &b.artifacts.iter().find(|a| a.path.to_str().unwrap().ends_with(suffix)).unwrap().contents
     }

@@ -516,6 +516,29 @@ fn lut_items(generated: &Path, pts: &[[f64; 3]], refs: &[[f64; 4]]) -> Vec<Item>
 mod tests {
     use super::*;
 
+    #[test]
+    fn max_error_is_the_largest_absolute_deviation() {
+        // Hand-worked: so(r, μ, v) = r at r = 0.1, 0.2, 0.3 against references 0, 0.5, 0.1:
+        // deviations 0.1, −0.3, 0.2, so the largest |so − SO| is |0.2 − 0.5| (compared
+        // exactly: the same single f64 subtraction).
+        let pts = [[0.1, 0.5, 0.5], [0.2, 0.5, 0.5], [0.3, 0.5, 0.5]];
+        let refs = [[0.0; 4], [0.5, 0.0, 0.0, 0.0], [0.1, 0.0, 0.0, 0.0]];
+        let m = max_error(&pts, &refs, |r, _, _| r);
+        assert_eq!(m, (0.2f64 - 0.5).abs(), "{m}");
+    }
+
+    #[test]
+    fn row_of_alpha_inverts_each_row_mapping() {
+        // The cone LUT rows: α itself, r = √α, and gloss with α = alpha_from_gloss(g), so
+        // alpha_from_gloss(row) must give α back (1e-12: the gloss inverse's round trip,
+        // measured 1.1e-13 worst in gloss::integrals' tests).
+        assert_eq!(row_of_alpha("alpha", 0.3), 0.3);
+        assert_eq!(row_of_alpha("roughness", 0.25), 0.5);
+        let g = row_of_alpha("gloss", 0.3);
+        let back = crate::family::gloss::integrals::alpha_from_gloss(g);
+        assert!((0.0..=1.0).contains(&g) && (back - 0.3).abs() < 1e-12, "g={g} back={back}");
+    }
+
     /// The shared solid angle by brute force: a midpoint grid in (cos θ, φ) over cap `b`
     /// (axis +z), counting the cells whose centres lie in cap `a` (axis tilted by d in xz).
     fn brute(a: f64, b: f64, d: f64, n: usize) -> f64 {

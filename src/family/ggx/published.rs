@@ -617,6 +617,16 @@ mod tests {
     use super::*;
 
     #[test]
+    fn stats_are_max_abs_rms_and_mean_by_hand() {
+        // e = (3, −4): max |e| = 4, rms = √((9 + 16)/2) = √12.5, mean = −0.5. 1e-15: one
+        // rounding in the sum and the square root.
+        let (max, rms, mean) = stats(&[3.0, -4.0]);
+        assert_eq!(max, 4.0);
+        assert!((rms - 12.5f64.sqrt()).abs() < 1e-15, "{rms}");
+        assert_eq!(mean, -0.5);
+    }
+
+    #[test]
     fn published_forms_at_hand_computed_points() {
         // Karis at r = 0.5, n·v = 1, by hand from the published text: r = 0.5·c0 + c1 =
         // (0.5, 0.02875, 0.754, −0.029); min(0.25, 2^−9.28 = 0.0016097) = 0.0016097;

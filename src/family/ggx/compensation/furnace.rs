@@ -387,6 +387,17 @@ mod tests {
     use super::*;
 
     #[test]
+    fn kc_quadrature_check_agrees_with_the_identity() {
+        // Kulla–Conty at F = 1 is exactly 1 with the identity 2∫(1 − E)μ dμ = 1 − E_avg; with
+        // the integral re-measured by 48-point Gauss–Legendre (E at 1e-9, E_avg at 1e-8) the
+        // two agree to the integrators' tolerance times the amplification (1 − E)/(1 − E_avg)
+        // (< 10 at r = 0.5), so 1e-5 leaves a wide margin while a wrong sign in 1 − E is O(1).
+        let grid = Grid::exact(&[0.5], &[0.2, 0.8]);
+        let (dev, at) = kc_quadrature_check(&grid);
+        assert!(dev < 1e-5, "{dev} at {at:?}");
+    }
+
+    #[test]
     fn table_integral_of_a_linear_interpolant_is_exact() {
         // A 1 × 2-point "E" that is linear in μ: E = 1 − μ/2 ⇒ 2∫(μ/2)μ dμ = 1/3 (2-point GL
         // is exact for the quadratic; f32 storage of 1 and 0.5 is exact).

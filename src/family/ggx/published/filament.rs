@@ -105,6 +105,20 @@ mod tests {
     use super::*;
 
     #[test]
+    fn table_texel_estimates_the_integral_at_its_alpha() {
+        // Texel (64, 62): n·v = 64.5/128, perceptual r = 63.5/128 (row_roughness), so α = r².
+        // Against the height-correlated integral at that (n·v, α) to 1e-9. 5e-3: a 1024-point
+        // Hammersley estimate of this smooth mid-range integrand (the mirror test above shows
+        // the estimator's form is exact at α → 0); stored f64 before the f16 rounding.
+        let t = table();
+        let (i, j) = (64, 62);
+        let r = (j as f64 + 1.5) / SIZE as f64;
+        let want = exact((i as f64 + 0.5) / SIZE as f64, r * r, 1e-9);
+        let got = t.f64s[j * SIZE + i];
+        assert!((got[0] - want[0]).abs() < 5e-3 && (got[1] - want[1]).abs() < 5e-3, "{got:?} vs {want:?}");
+    }
+
+    #[test]
     fn hammersley_matches_the_radical_inverse() {
         // radical_inverse₂(1) = 0.5, (2) = 0.25, (3) = 0.75, (6) = 0.375: bit reversal, by hand.
         for (i, want) in [(1u32, 0.5), (2, 0.25), (3, 0.75), (6, 0.375)] {

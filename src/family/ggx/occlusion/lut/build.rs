@@ -258,3 +258,30 @@ pub fn build(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> 
     });
     Ok(lut_built(name, [wgsl, rust, compact_json(&json)], ktx2, png, measured.points, t, &measured.lookup_f32))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn trilinear_reproduces_a_linear_field_with_slices_at_k_over_d_minus_1() {
+        // Texels holding channel 0 = k (the slice index) and channel 1 = i + 10 j on a
+        // 4 × 3 × 3 volume. Slices sit at c = k/(d − 1), so c = 0.75 reads 1.5; texel centres
+        // sit at (i + 0.5)/w, so u = 0.5 reads i = 1.5 and t = 0.5 reads j = 1. Trilinear
+        // weights reproduce a linear field; 1e-14: a few roundings on values ≤ 12.
+        let (w, h, d) = (4, 3, 3);
+        let mut texels = vec![[0.0; 2]; w * h * d];
+        for k in 0..d {
+            for j in 0..h {
+                for i in 0..w {
+                    texels[(k * h + j) * w + i] = [k as f64, i as f64 + 10.0 * j as f64];
+                }
+            }
+        }
+        let v = trilinear(&texels, (w, h, d), 0.5, 0.5, 0.75);
+        assert!((v[0] - 1.5).abs() < 1e-14 && (v[1] - 11.5).abs() < 1e-14, "{v:?}");
+        // Clamped to edge and to the last slice.
+        let v = trilinear(&texels, (w, h, d), 1.0, 0.0, 1.0);
+        assert!((v[0] - 2.0).abs() < 1e-14 && (v[1] - 3.0).abs() < 1e-14, "{v:?}");
+    }
+}
