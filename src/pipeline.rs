@@ -437,7 +437,7 @@ pub fn fit_from_coefficients(
     if let Some(i) = approx32.iter().position(|v| !v.is_finite()) {
         return Err(BuildError::NonFinite { spec: name, at: vx[i].clone() });
     }
-    let verification = verify(spec, vx, truth, &approx64, &approx32);
+    let verification = verify(inverse_1d(spec, vx), vx, truth, &approx64, &approx32);
     let hash = input_hash(spec);
     let err_line = verification.header_line();
     let header = header_lines(&spec_rel_path(spec), &hash, &err_line);
@@ -680,13 +680,34 @@ pub fn compact_json(v: &Value) -> String {
     out
 }
 
+/// Max abs, rms and worst point of `approx − truth` over `points`; a NaN is the worst point and
+/// the max (it then fails every bound).
+pub fn measure(points: &[Vec<f64>], truth: &[f64], approx: &[f64]) -> (f64, f64, Vec<f64>) {
+    let mut worst = (0, 0.0f64);
+    let mut ss = 0.0;
+    for (i, (t, a)) in truth.iter().zip(approx).enumerate() {
+        let e = (a - t).abs();
+        if e > worst.1 || e.is_nan() {
+            worst = (i, e);
+        }
+        ss += e * e;
+    }
+    (worst.1, (ss / truth.len().max(1) as f64).sqrt(), points.get(worst.0).cloned().unwrap_or_default())
+}
+
+/// The spec's quantity's inverse, for a 1-D spec (errors in parameter units).
+fn inverse_1d(spec: &Spec, vx: &[Vec<f64>]) -> Option<fn(f64) -> f64> {
+    spec.quantity.inverse.filter(|_| vx.first().is_some_and(|x| x.len() == 1))
+}
+
 /// Max abs and rms error of the f64 fit and of the emitted f32 code against the integral on the
-/// verification points; a NaN anywhere is the max error (it then fails every bound).
-fn verify(spec: &Spec, vx: &[Vec<f64>], truth: &[f64], a64: &[f64], a32: &[f32]) -> Verification {
+/// verification points, and through `inverse` in parameter units; a NaN anywhere is the max
+/// error (it then fails every bound).
+fn verify(inverse: Option<fn(f64) -> f64>, vx: &[Vec<f64>], truth: &[f64], a64: &[f64], a32: &[f32]) -> Verification {
     let a32: Vec<f64> = a32.iter().map(|&v| v as f64).collect();
-    let (max_abs_error, rms_error, worst_point) = crate::validate::measure(vx, truth, a64);
-    let (max_abs_error_f32, rms_error_f32, _) = crate::validate::measure(vx, truth, &a32);
-    let inverse = spec.quantity.inverse.filter(|_| vx.first().is_some_and(|x| x.len() == 1)).map(|inv| {
+    let (max_abs_error, rms_error, worst_point) = measure(vx, truth, a64);
+    let (max_abs_error_f32, rms_error_f32, _) = measure(vx, truth, &a32);
+    let inverse = inverse.map(|inv| {
         vx.iter().zip(a64).map(|(x, &v)| (inv(v) - x[0]).abs()).fold(0.0, |m: f64, e| if e > m || e.is_nan() { e } else { m })
     });
     Verification {
@@ -732,7 +753,7 @@ pub fn table_from_values(spec: &Spec, values: Vec<f64>, reference: &Reference) -
         })
         .collect();
     let approx64: Vec<f64> = approx32.iter().map(|&v| v as f64).collect();
-    let verification = verify(spec, vx, truth, &approx64, &approx32);
+    let verification = verify(inverse_1d(spec, vx), vx, truth, &approx64, &approx32);
     let hash = input_hash(spec);
     let form = spec.file.emit.form.unwrap_or_default();
     let tex_format = spec.file.emit.texture_format.unwrap_or_default();
@@ -1070,23 +1091,17 @@ mod tests {
         assert!(matches!(committed_f32(&model, &c, &m, "t"), Err(BuildError::F32Coefficients { .. })));
     }
 
-    fn gloss_length_spec() -> Spec {
-        let text = include_str!("../fits/gloss_length.toml").to_string();
-        Spec::parse(Path::new("fits/gloss_length.toml"), text, crate::family::catalog()).unwrap()
-    }
-
     /// `verify` against errors worked out by hand: max, rms and the worst point of the f64 fit,
-    /// the same of the f32 values, and the error mapped back through the quantity's inverse.
+    /// the same of the f32 values, and the error mapped back through an inverse (here x ↦ x²,
+    /// inverted by the square root).
     #[test]
     fn verification_is_measured_from_the_errors() {
-        use crate::family::gloss::integrals::{gloss_from_length, length_from_gloss};
-        let spec = gloss_length_spec();
         let vx = vec![vec![0.2], vec![0.5], vec![0.8]];
-        let truth: Vec<f64> = vx.iter().map(|x| length_from_gloss(x[0])).collect();
+        let truth: Vec<f64> = vx.iter().map(|x| x[0] * x[0]).collect();
         // f64 errors +0.01, −0.03, +0.02; f32 errors −0.04, 0, +0.005 (up to f32 rounding).
         let a64 = [truth[0] + 0.01, truth[1] - 0.03, truth[2] + 0.02];
         let a32 = [(truth[0] - 0.04) as f32, truth[1] as f32, (truth[2] + 0.005) as f32];
-        let v = verify(&spec, &vx, &truth, &a64, &a32);
+        let v = verify(Some(f64::sqrt), &vx, &truth, &a64, &a32);
         assert_eq!(v.points, 3);
         // Three squared errors summed: exact to a few ulps of 1e-3.
         assert!((v.max_abs_error - 0.03).abs() < 1e-12, "{}", v.max_abs_error);
@@ -1095,42 +1110,39 @@ mod tests {
         // The f32 values carry their rounding, below 1e-7 for values below 1.
         assert!((v.max_abs_error_f32 - 0.04).abs() < 1e-7, "{}", v.max_abs_error_f32);
         assert!((v.rms_error_f32 - ((16e-4f64 + 25e-6) / 3.0).sqrt()).abs() < 1e-7, "{}", v.rms_error_f32);
-        // In parameter units: each fitted length mapped back to a gloss by the inverse; the
-        // largest distance to the point's own gloss, from non-zero errors, is well above 1e-3.
-        let p = v.max_abs_error_in_parameter.expect("gloss length has an inverse");
-        let expected = vx.iter().zip(&a64).map(|(x, &l)| (gloss_from_length(l) - x[0]).abs()).fold(0.0, f64::max);
-        assert!(p > 1e-3 && p < 1.0 && (p - expected).abs() < 1e-12, "{p} vs {expected}");
-        // An exact fit has no error in either unit (the inverse is accurate to ~1e-12).
-        let exact = verify(&spec, &vx, &truth, &truth, &truth.iter().map(|&t| t as f32).collect::<Vec<_>>());
+        // In parameter units, by hand: |√(x² + e) − x| at each point, the largest at x = 0.5
+        // (√0.22 − 0.5); the same square roots, so equal to rounding.
+        let p = v.max_abs_error_in_parameter.expect("an inverse was given");
+        let expected = [(0.05f64.sqrt() - 0.2).abs(), (0.22f64.sqrt() - 0.5).abs(), (0.66f64.sqrt() - 0.8).abs()].into_iter().fold(0.0, f64::max);
+        assert!((p - expected).abs() < 1e-12 && p > 1e-2, "{p} vs {expected}");
+        // An exact fit has no error in either unit; no inverse, no parameter error.
+        let exact = verify(Some(f64::sqrt), &vx, &truth, &truth, &truth.iter().map(|&t| t as f32).collect::<Vec<_>>());
         assert_eq!((exact.max_abs_error, exact.rms_error), (0.0, 0.0));
-        assert!(exact.max_abs_error_in_parameter.unwrap() < 1e-9);
+        assert!(exact.max_abs_error_in_parameter.unwrap() < 1e-15);
+        assert_eq!(verify(None, &vx, &truth, &a64, &a32).max_abs_error_in_parameter, None);
     }
 
     /// A NaN from the f64 fit or the f32 code is the max error, so a spec's `max_error` bound
     /// fails on it (`f64::max` would have dropped it).
     #[test]
     fn a_nan_is_the_max_error() {
-        let spec = gloss_length_spec();
         let vx = vec![vec![0.2], vec![0.5], vec![0.8]];
         let truth = [0.9, 0.8, 0.7];
-        let v = verify(&spec, &vx, &truth, &[0.9, f64::NAN, 0.7], &[0.9, 0.8, f32::NAN]);
+        let v = verify(Some(f64::sqrt), &vx, &truth, &[0.9, f64::NAN, 0.7], &[0.9, 0.8, f32::NAN]);
         assert!(v.max_abs_error.is_nan() && v.max_abs_error_f32.is_nan(), "{v:?}");
         assert_eq!(v.worst_point, vec![0.5]);
         assert!(v.max_abs_error_in_parameter.unwrap().is_nan());
-        let v = verify(&spec, &vx, &truth, &truth, &[f32::NAN, 0.8, 0.7]);
+        let v = verify(None, &vx, &truth, &truth, &[f32::NAN, 0.8, 0.7]);
         assert!(v.max_abs_error_f32.is_nan() && v.max_abs_error == 0.0, "{v:?}");
     }
 
     /// `tensor` is the full grid, first axis fastest, each axis at its own points.
     #[test]
     fn the_grid_runs_first_axis_fastest() {
-        let axes = gloss_length_spec().file.axis;
-        let two = [axes[0].clone(), axes[0].clone()];
-        let a = axes[0].points(3);
-        let b = axes[0].points(2);
-        let want: Vec<Vec<f64>> = b.iter().flat_map(|&y| a.iter().map(move |&x| vec![x, y])).collect();
+        let axis = |name: &str, range: [f64; 2]| spec::AxisSpec { name: name.into(), range, count: 2, verify: None };
+        let two = [axis("x", [0.0, 1.0]), axis("y", [-2.0, 2.0])];
+        let want = vec![vec![0.0, -2.0], vec![0.5, -2.0], vec![1.0, -2.0], vec![0.0, 2.0], vec![0.5, 2.0], vec![1.0, 2.0]];
         assert_eq!(tensor(&two, &[3, 2]), want);
-        assert_eq!(a, vec![0.0, 0.5, 1.0]);
     }
 
     /// The `measured error:` line names each measure with its value (3 significant digits).

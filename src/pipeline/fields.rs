@@ -321,7 +321,7 @@ pub fn fields_from_coefficients(
             a32.push(v32);
         }
     }
-    let verification: Verification = super::verify(spec, &pts, &t, &a64, &a32);
+    let verification: Verification = super::verify(super::inverse_1d(spec, &pts), &pts, &t, &a64, &a32);
     let hash = input_hash(spec);
     let err_line = verification.header_line();
     let header = header_lines(&spec_rel_path(spec), &hash, &err_line);

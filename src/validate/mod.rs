@@ -22,19 +22,7 @@ pub struct Item {
     pub findings: Vec<String>,
 }
 
-/// Max abs, rms and worst point of `approx − truth` over `points`.
-pub fn measure(points: &[Vec<f64>], truth: &[f64], approx: &[f64]) -> (f64, f64, Vec<f64>) {
-    let mut worst = (0, 0.0f64);
-    let mut ss = 0.0;
-    for (i, (t, a)) in truth.iter().zip(approx).enumerate() {
-        let e = (a - t).abs();
-        if e > worst.1 || e.is_nan() {
-            worst = (i, e);
-        }
-        ss += e * e;
-    }
-    (worst.1, (ss / truth.len().max(1) as f64).sqrt(), points.get(worst.0).cloned().unwrap_or_default())
-}
+pub use crate::pipeline::measure;
 
 impl Item {
     /// An item measured from `approx − truth` over `points`, with no extras or findings yet.
