@@ -680,6 +680,11 @@ pub fn compact_json(v: &Value) -> String {
     out
 }
 
+/// The larger of two errors, a NaN being the largest (`f64::max` drops it).
+pub fn nan_max(a: f64, b: f64) -> f64 {
+    if b > a || b.is_nan() { b } else { a }
+}
+
 /// Max abs, rms and worst point of `approx − truth` over `points`; a NaN is the worst point and
 /// the max (it then fails every bound).
 pub fn measure(points: &[Vec<f64>], truth: &[f64], approx: &[f64]) -> (f64, f64, Vec<f64>) {
@@ -708,7 +713,7 @@ fn verify(inverse: Option<fn(f64) -> f64>, vx: &[Vec<f64>], truth: &[f64], a64: 
     let (max_abs_error, rms_error, worst_point) = measure(vx, truth, a64);
     let (max_abs_error_f32, rms_error_f32, _) = measure(vx, truth, &a32);
     let inverse = inverse.map(|inv| {
-        vx.iter().zip(a64).map(|(x, &v)| (inv(v) - x[0]).abs()).fold(0.0, |m: f64, e| if e > m || e.is_nan() { e } else { m })
+        vx.iter().zip(a64).map(|(x, &v)| (inv(v) - x[0]).abs()).fold(0.0, nan_max)
     });
     Verification {
         points: truth.len(),
@@ -1169,5 +1174,26 @@ mod tests {
         assert!(text.contains("\"values\": [0.5, -1.25e-7, 3.0]"), "{text}");
         assert!(text.contains("[1.0, 2.0]") && text.contains("[3.0, 4.0]"), "{text}");
         assert!(text.ends_with("}\n"));
+    }
+
+    /// Max abs, rms and worst point worked out by hand; errors of either sign count.
+    #[test]
+    fn measure_is_max_rms_and_worst_point() {
+        let points = vec![vec![0.0, 1.0], vec![1.0, 1.0], vec![2.0, 1.0]];
+        let (max, rms, worst) = measure(&points, &[1.0, 2.0, 3.0], &[1.5, 1.0, 3.25]);
+        assert_eq!(max, 1.0);
+        // (0.25 + 1 + 0.0625) / 3, each term exact in binary.
+        assert_eq!(rms, (1.3125f64 / 3.0).sqrt());
+        assert_eq!(worst, vec![1.0, 1.0]);
+        assert_eq!(measure(&points, &[1.0, 2.0, 3.0], &[1.0, 2.0, 3.0]), (0.0, 0.0, vec![0.0, 1.0]));
+    }
+
+    /// A NaN approximation is the worst point, and the max stays NaN past later finite errors.
+    #[test]
+    fn a_nan_is_worst() {
+        let points = vec![vec![0.0], vec![1.0], vec![2.0]];
+        let (max, rms, worst) = measure(&points, &[1.0, 2.0, 3.0], &[1.0, f64::NAN, 7.0]);
+        assert!(max.is_nan() && rms.is_nan());
+        assert_eq!(worst, vec![1.0]);
     }
 }

@@ -64,29 +64,3 @@ impl Item {
 pub fn all(generated: &Path, validators: &[fn(&Path) -> Vec<Item>]) -> Vec<Item> {
     validators.iter().flat_map(|v| v(generated)).collect()
 }
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// Max abs, rms and worst point worked out by hand; errors of either sign count.
-    #[test]
-    fn measure_is_max_rms_and_worst_point() {
-        let points = vec![vec![0.0, 1.0], vec![1.0, 1.0], vec![2.0, 1.0]];
-        let (max, rms, worst) = measure(&points, &[1.0, 2.0, 3.0], &[1.5, 1.0, 3.25]);
-        assert_eq!(max, 1.0);
-        // (0.25 + 1 + 0.0625) / 3, each term exact in binary.
-        assert_eq!(rms, (1.3125f64 / 3.0).sqrt());
-        assert_eq!(worst, vec![1.0, 1.0]);
-        assert_eq!(measure(&points, &[1.0, 2.0, 3.0], &[1.0, 2.0, 3.0]), (0.0, 0.0, vec![0.0, 1.0]));
-    }
-
-    /// A NaN approximation is the worst point, and the max stays NaN past later finite errors.
-    #[test]
-    fn a_nan_is_worst() {
-        let points = vec![vec![0.0], vec![1.0], vec![2.0]];
-        let (max, rms, worst) = measure(&points, &[1.0, 2.0, 3.0], &[1.0, f64::NAN, 7.0]);
-        assert!(max.is_nan() && rms.is_nan());
-        assert_eq!(worst, vec![1.0]);
-    }
-}

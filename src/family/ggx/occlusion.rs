@@ -182,7 +182,7 @@ fn max_error(pts: &[[f64; 3]], refs: &[[f64; 4]], so: impl Fn(f64, f64, f64) -> 
     pts.par_iter()
         .zip(refs)
         .map(|(&[r, mu, v], t)| (so(r, mu, v) - t[0]).abs())
-        .reduce(|| 0.0, |a, b| if a > b || a.is_nan() { a } else { b })
+        .reduce(|| 0.0, crate::pipeline::nan_max)
 }
 
 /// Root mean square of so(p) − SO (F0 = 4 %) over the grid (squares summed in grid order).
