@@ -828,6 +828,61 @@ mod tests {
         assert_eq!(one.0.as_slice(), a.as_slice());
     }
 
+    /// With a denominator driven below Q_MIN the barrier residuals join the normal equations:
+    /// (JᵀJ, Jᵀr, cost) equal the dense products of the residuals extended by
+    /// Q_PENALTY·(Q_MIN − Q) at the points where Q = 1 + b·x < Q_MIN, Q written out here from
+    /// the model's form (not the fitter's basis), and the cost equals `cost`'s own penalty sum.
+    #[test]
+    fn barrier_terms_enter_only_their_own_fields_diagonal_block() {
+        let (x, data) = problem();
+        let models: Vec<RationalModel> = OFFSETS.iter().map(|&o| field(o)).collect();
+        let systems: Vec<Reduced> = data.iter().map(|d| reduce(&d.design, &d.y, None)).collect();
+        let mut theta = DVector::from_iterator(12, (0..12).map(|i| 0.3 * ((i as f64) * 1.7).sin()));
+        // Field 0's b = −1.02: Q = 1 − 1.02x < Q_MIN for x > 0.931, i.e. x = 0.95 and 1 (Q =
+        // 0.031, −0.02), each ≥ 0.01 from Q_MIN so a difference step of 1e-6 never crosses it;
+        // field 2's b = −0.97: Q < Q_MIN at x = 1 only (Q = 0.03). Field 1 stays ≥ 0.5.
+        theta[3] = -1.02;
+        theta[7] = 0.2;
+        theta[11] = -0.97;
+        let f = Fields::new(&models, &x, systems, theta.clone());
+        let xs: Vec<f64> = x.iter().map(|p| p[0]).collect();
+        let extended = |t: &DVector<f64>| {
+            let mut r: Vec<f64> = f.residuals_at(t).iter().copied().collect();
+            for k in 0..3 {
+                for &xv in &xs {
+                    let q = 1.0 + t[4 * k + 3] * xv;
+                    if q < Q_MIN {
+                        r.push(Q_PENALTY * (Q_MIN - q));
+                    }
+                }
+            }
+            DVector::from_vec(r)
+        };
+        let r0 = extended(&theta);
+        assert_eq!(r0.len(), 21 * 3 + 3, "three barrier residuals");
+        let (np, h) = (f.n_params(), 1e-6);
+        let mut j = DMatrix::zeros(r0.len(), np);
+        for p in 0..np {
+            let (mut tp, mut tm) = (theta.clone(), theta.clone());
+            tp[p] += h;
+            tm[p] -= h;
+            j.set_column(p, &((extended(&tp) - extended(&tm)) / (2.0 * h)));
+        }
+        let (a, g, cost) = f.normal_equations(&theta);
+        let (dense, grad) = (j.tr_mul(&j), j.tr_mul(&r0));
+        // Central differences of rationals whose poles stay ≥ 0.02 from the grid (the barrier
+        // rows are linear, exact): truncation ~h²·f‴ with f‴ ≲ 1e6 near the pole, plus
+        // rounding ~1e-16/h, both far below 1e-6 of the entries' scale.
+        assert!((&a - &dense).amax() <= 1e-6 * dense.amax(), "JᵀJ off by {:e} of {:e}", (&a - &dense).amax(), dense.amax());
+        assert!((&g - &grad).amax() <= 1e-6 * grad.amax(), "Jᵀr off by {:e} of {:e}", (&g - &grad).amax(), grad.amax());
+        // The penalty rows hold b_0 alone or b_2 alone: the b_0–b_2 entry is the data rows'
+        // coupling only, which a barrier term placed off the diagonal blocks would change.
+        assert!((a[(3, 11)] - dense[(3, 11)]).abs() <= 1e-6 * dense.amax(), "b0–b2 coupling {} vs {}", a[(3, 11)], dense[(3, 11)]);
+        // The same squares summed in another order: rounding of a 66-term sum.
+        assert!((cost - r0.norm_squared()).abs() <= 1e-12 * cost, "cost {cost} vs {}", r0.norm_squared());
+        assert!((cost - f.cost(&theta)).abs() <= 1e-12 * cost, "cost {cost} vs cost() {}", f.cost(&theta));
+    }
+
     /// The synthetic problem with samples off the model, so that the objectives disagree: the
     /// first field moved by 0.05·sin(9x), which its rational form cannot follow, and a ±1e-3
     /// ripple outside every point's basis.
