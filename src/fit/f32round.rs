@@ -304,6 +304,43 @@ mod tests {
         assert_eq!(step_ulps(f32::MIN, -1), None);
     }
 
+    /// Residuals (3, −4, 0, 12): max 12; Σr² = 169, rms = √(169/4) = 6.5; Σr⁴ =
+    /// 81 + 256 + 20736 = 21073, all exact in f64. A NaN residual counts as infinite.
+    #[test]
+    fn errors_are_the_max_rms_and_fourth_power_sum() {
+        let r = [3.0, -4.0, 0.0, 12.0];
+        for (objective, want) in [(Objective::Minimax, 12.0), (Objective::Lsq, 6.5), (Objective::L4, 21073.0)] {
+            let e = Errors::of(r.iter().copied(), objective);
+            assert_eq!(e, Errors { objective: want, max_abs_error: 12.0, rms_error: 6.5 }, "{objective:?}");
+        }
+        let e = Errors::of([1.0, f64::NAN].into_iter(), Objective::Lsq);
+        assert_eq!((e.max_abs_error, e.rms_error), (f64::INFINITY, f64::INFINITY));
+        assert_eq!(Errors::of(std::iter::empty(), Objective::Lsq).rms_error, 0.0);
+    }
+
+    /// The search's score is max |r|, Σr², Σr⁴ of the emitted f32 function's residuals, each
+    /// recomputed here from the f32 value through `eval_f32`, and None once it reaches the bound.
+    #[test]
+    fn the_search_scores_the_objective_of_the_f32_function() {
+        let model = RationalModel::rational_1d("x", 1, 1);
+        let x: Vec<Vec<f64>> = (0..5).map(|i| vec![i as f64 / 4.0]).collect();
+        let y: Vec<f64> = x.iter().map(|p| 0.3 + 0.9 * p[0] * p[0]).collect();
+        let f = F32Function { expr: expr::model_expr(&model), features: x.iter().map(|p| vec![p[0] as f32]).collect(), y: &y, clamp: None };
+        let (num, den) = ([0.25f32, 1.0], [0.5f32]);
+        let r: Vec<f64> = x.iter().zip(&y).map(|(p, y)| expr::eval_f32(&f.expr, &[p[0] as f32], &num, &den) as f64 - y).collect();
+        assert!(r.iter().all(|v| v.abs() > 1e-3), "residuals away from 0: {r:?}");
+        let max = r.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let s2: f64 = r.iter().map(|v| v * v).sum();
+        let s4: f64 = r.iter().map(|v| v.powi(4)).sum();
+        // The same terms summed in the same order, (a·a)·(a·a) against powi(4): a few ulps.
+        for (objective, want) in [(Objective::Minimax, max), (Objective::Lsq, s2), (Objective::L4, s4)] {
+            let got = f.score(&num, &den, objective, f64::INFINITY).unwrap();
+            assert!((got - want).abs() <= 1e-14 * want, "{objective:?}: {got} vs {want}");
+            assert_eq!(f.score(&num, &den, objective, want * (1.0 - 1e-9)), None, "{objective:?} reaches its bound");
+        }
+        assert!((f.rms(&num, &den) - (s2 / 5.0).sqrt()).abs() <= 1e-15, "rms");
+    }
+
     fn samples(lo: f64, hi: f64, n: usize, f: impl Fn(f64) -> f64) -> Data {
         let x: Vec<Vec<f64>> = (0..n).map(|i| vec![lo + (hi - lo) * i as f64 / (n - 1) as f64]).collect();
         let y = x.iter().map(|p| f(p[0])).collect();

@@ -786,6 +786,30 @@ mod tests {
         }
     }
 
+    /// An L4 fit is a least-squares solve followed by a solve of Σr⁴ from its optimum: it
+    /// reports both stages' iterations and evaluations, each stage re-run here on its own, and
+    /// its Σr⁴ is no higher than the least-squares optimum's.
+    #[test]
+    fn an_l4_fit_counts_both_stages() {
+        let model = RationalModel::rational_1d("x", 2, 1);
+        let x: Vec<Vec<f64>> = (0..=30).map(|i| vec![i as f64 / 10.0]).collect();
+        let data = Data { y: x.iter().map(|p| (0.7 * p[0]).exp()).collect(), x };
+        for solver in [LsqSolver::Lm, LsqSolver::GaussNewton] {
+            let start = linearised_starts(&model, &data, "exp").unwrap().remove(0);
+            let opts = FitOptions { objective: Objective::L4, solver, ..FitOptions::default() };
+            let mut p = Residuals::new(&model, &data, start.clone());
+            let (t4, iters, evals) = l4(&mut p, &opts, "exp").unwrap();
+            let mut q = Residuals::new(&model, &data, start);
+            let (t2, it0, ev0) = least_squares(&mut q, solver, "exp").unwrap();
+            q.fourth_power = true;
+            let (_, it, ev) = least_squares(&mut q, solver, "exp").unwrap();
+            assert!(it0 >= 2 && it >= 2, "{solver:?}: stages of {it0} and {it} iterations");
+            assert_eq!((iters, evals), (it0 + it, ev0 + ev), "{solver:?}");
+            let s4 = |t: &DVector<f64>| p.raw(t).iter().map(|r| r.powi(4)).sum::<f64>();
+            assert!(s4(&t4) <= s4(&t2), "{solver:?}: Σr⁴ {} vs least squares {}", s4(&t4), s4(&t2));
+        }
+    }
+
     /// A clamped model is fitted on the samples strictly inside the clamp: y = clamp(P/Q, 0, 1)
     /// with P/Q above 1 on part of the range recovers P/Q.
     #[test]

@@ -1265,6 +1265,113 @@ mod r_horizon;
 mod tests {
     use super::*;
 
+    /// The fitting directions are the midpoints of the n_theta × n_phi cells of (0, π/2) × (0, π),
+    /// θu-major: for 2 × 3, θu ∈ {π/8, 3π/8} and φu ∈ {π/6, π/2, 5π/6}.
+    #[test]
+    fn fitting_directions_are_cell_midpoints() {
+        let d = fitting_directions(2, 3);
+        let want = [(1.0, 1.0), (1.0, 3.0), (1.0, 5.0), (3.0, 1.0), (3.0, 3.0), (3.0, 5.0)];
+        assert_eq!(d.len(), 6);
+        for (&(t, p), &(i, j)) in d.iter().zip(&want) {
+            // One product and one quotient of π: 1 ulp.
+            assert!((t - i * PI / 8.0).abs() < 1e-15 && (p - j * PI / 6.0).abs() < 1e-15, "{d:?}");
+        }
+    }
+
+    /// The grazing scale from its definition in the doc: s = min(|w* + a|, 8δ·α s_a²/sqrt((1−α²)s_a² + α²))
+    /// with w* = −sin θf cos η_u / sqrt(cos²θf + sin²θf cos²η_u) and δ the distance in Δ from
+    /// −η_u ± η₀ to π, η₀ = acos(w cos θf / (sqrt(1 − w²) sin θf)) at w = −a (here through acos,
+    /// not the half-angle atan2 of the code). Lights chosen so each term is the smaller at least once.
+    #[test]
+    fn graze_scale_is_the_smaller_of_its_two_scales() {
+        let alpha = 0.3f64;
+        let dist = |x: f64| {
+            let d = (x - PI).rem_euclid(2.0 * PI);
+            d.min(2.0 * PI - d)
+        };
+        let expected = |theta_f: f64, a: f64, eta_u: f64| {
+            let (st, ct) = f64::sin_cos(theta_f);
+            let sa = (1.0 - a * a).sqrt();
+            let ce = eta_u.cos();
+            let s1 = (-st * ce / (ct * ct + st * st * ce * ce).sqrt() + a).abs();
+            let w = -a;
+            let cos_eta0 = w * ct / ((1.0 - w * w).sqrt() * st);
+            if cos_eta0.abs() >= 1.0 {
+                return (s1, f64::INFINITY);
+            }
+            let eta0 = cos_eta0.acos();
+            let delta = dist(-eta_u - eta0).min(dist(-eta_u + eta0));
+            (s1, 8.0 * delta * alpha * sa * sa / ((1.0 - alpha * alpha) * sa * sa + alpha * alpha).sqrt())
+        };
+        // (θf, a, η_u): outside the arc (no arc term); inside, far from the dip; inside, the arc
+        // boundary 0.01 from the dip; a nearly flat fiber where the arc term is the smaller
+        // (s ≈ 0.083 against 0.2, found by a scan over η_u).
+        let cases = [(0.6, 0.9, 0.7), (0.6, 0.2, 2.5), (0.6, 0.2, 1.2779), (0.6, -0.3, 0.4), (1.4, 0.2, FRAC_PI_2), (1.4, 0.2, -1.4726)];
+        let mut arc_won = false;
+        for (theta_f, a, eta_u) in cases {
+            let (s1, s2) = expected(theta_f, a, eta_u);
+            arc_won |= s2 < s1;
+            let got = Layer::new(alpha, theta_f).graze_scale(a, (1.0 - a * a).sqrt(), eta_u);
+            // Two routes to η₀ (acos against a half-angle atan2) and a few roundings: 1e-12.
+            assert!((got - s1.min(s2)).abs() <= 1e-12 * s1.min(s2).max(1e-3), "θf = {theta_f}, a = {a}, η_u = {eta_u}: {got} vs ({s1}, {s2})");
+        }
+        assert!(arc_won, "no case exercises the arc term");
+    }
+
+    /// The pieces of a light's w-range tile [−1, sin θf] without gap or overlap, each end a cut:
+    /// −1, −sin θf, sin θf, the cone w = −a and, with a grazing band [s, L/2], −a ± s and −a ± L/2
+    /// (L = 2α sqrt((1−α²)s_a² + α²)/(1−α²), the peak width written out here), where they fall
+    /// inside; the log-mapped pieces are the band's.
+    #[test]
+    fn pieces_tile_the_w_range_at_the_cuts() {
+        for (alpha, theta_f, a, band) in [(0.3, 0.6, 0.7, Some(1e-4)), (0.3, 0.6, 0.7, None), (0.5, 1.2, -0.2, Some(1e-3)), (0.2, 0.9, 0.5, Some(2e-3))] {
+            let layer = Layer::new(alpha, theta_f);
+            let st = f64::sin(theta_f);
+            let sa = (1.0f64 - a * a).sqrt();
+            let l = 2.0 * alpha * ((1.0 - alpha * alpha) * sa * sa + alpha * alpha).sqrt() / (1.0 - alpha * alpha);
+            let w0 = -a;
+            let mut want = vec![-1.0, -st, st, w0];
+            if let Some(s) = band {
+                want.extend([w0 - s, w0 + s, w0 - 0.5 * l, w0 + 0.5 * l]);
+            }
+            want.retain(|&w| (-1.0..=st).contains(&w));
+            want.sort_by(f64::total_cmp);
+            want.dedup();
+            // The ends of each piece, in w, sorted along the range.
+            let mut ends: Vec<(f64, f64, bool, bool)> = layer
+                .pieces(a, sa, band)
+                .iter()
+                .map(|p| {
+                    let (e0, e1) = (p.map(0.0).0 + w0, p.map(1.0).0 + w0);
+                    (e0.min(e1), e0.max(e1), p.log, matches!(p.region, Region::Full))
+                })
+                .collect();
+            ends.sort_by(|x, y| x.0.total_cmp(&y.0));
+            let mut cuts = vec![ends[0].0];
+            for (k, e) in ends.iter().enumerate() {
+                // Each end maps back from asinh/ln/φ coordinates: rounding ~1e-15, ~1e-12 at
+                // the log pieces' tiny ends.
+                if k > 0 {
+                    assert!((e.0 - ends[k - 1].1).abs() < 1e-12, "gap or overlap at {}: {ends:?}", e.0);
+                }
+                cuts.push(e.1);
+                if let Some(s) = band {
+                    let (lo, hi) = ((e.0 - w0).abs().min((e.1 - w0).abs()), (e.0 - w0).abs().max((e.1 - w0).abs()));
+                    // On the arc the band is log-mapped only when the cone itself is on the arc.
+                    let mapped = e.3 || (w0 > -st && w0 < st);
+                    let in_band = mapped && (e.0 - w0) * (e.1 - w0) > 0.0 && lo >= s * (1.0 - 1e-6) && hi <= 0.5 * l * (1.0 + 1e-6);
+                    assert_eq!(e.2, in_band, "log map of [{}, {}] (band [{s}, {}])", e.0, e.1, 0.5 * l);
+                } else {
+                    assert!(!e.2);
+                }
+            }
+            assert_eq!(cuts.len(), want.len(), "cuts {cuts:?}, expected {want:?}");
+            for (c, w) in cuts.iter().zip(&want) {
+                assert!((c - w).abs() < 1e-12, "cuts {cuts:?}, expected {want:?}");
+            }
+        }
+    }
+
     #[test]
     fn fiber_is_the_unit_vector_at_theta_f_from_the_normal() {
         // t = (sin θf, 0, cos θf): at θf = π/3, t·n = cos(π/3) = 1/2 and |t| = 1 (1e-15: one

@@ -367,19 +367,25 @@ pub fn items(generated: &Path) -> Vec<Item> {
                  emitted f32 lookup, the albedo at F = 1 is off 1 by up to {t:.2e}."
             ));
         }
-        it.findings.push(match r.scheme {
-            Scheme::Single => format!("Loses 1 - E(μ): up to {l:.3} at {}.", fmt_point(&lp)),
-            Scheme::BevyOld => format!(
-                "Gains B/A at F0 = 1: up to {g:.3} at {} on this grid, unbounded as n·v → 0 and α → 0 (A → 1 - (1 - n·v)^5 → 0): \
-                 the fireflies of bevy PR #22833. With A + B (PR #23514) it is Turquin's scheme, exact at F = 1.",
-                fmt_point(&gp)
-            ),
-            _ if r.f1_max_dev < 1e-6 => "Conserves energy at F = 1 (algebraically exact; the residual is the integrators').".into(),
-            _ => format!("Deviates from 1 by up to {:.2e} at F = 1.", r.f1_max_dev),
-        });
+        it.findings.push(energy_finding(r.scheme, r.f1_max_dev, (g, &fmt_point(&gp)), (l, &fmt_point(&lp))));
         out.push(it);
     }
     out
+}
+
+/// What a scheme does to energy at F = 1: single scattering's loss and bevy's old gain (each with
+/// its worst point), otherwise conservation when the albedo's largest deviation from 1 is below
+/// 1e-6 (the integrators' residual through factors ≤ 1/E), else that deviation.
+fn energy_finding(scheme: Scheme, f1_max_dev: f64, (g, gp): (f64, &str), (l, lp): (f64, &str)) -> String {
+    match scheme {
+        Scheme::Single => format!("Loses 1 - E(μ): up to {l:.3} at {lp}."),
+        Scheme::BevyOld => format!(
+            "Gains B/A at F0 = 1: up to {g:.3} at {gp} on this grid, unbounded as n·v → 0 and α → 0 (A → 1 - (1 - n·v)^5 → 0): \
+             the fireflies of bevy PR #22833. With A + B (PR #23514) it is Turquin's scheme, exact at F = 1."
+        ),
+        _ if f1_max_dev < 1e-6 => "Conserves energy at F = 1 (algebraically exact; the residual is the integrators').".into(),
+        _ => format!("Deviates from 1 by up to {f1_max_dev:.2e} at F = 1."),
+    }
 }
 
 #[cfg(test)]
@@ -448,6 +454,20 @@ mod tests {
             if r.scheme != Scheme::BevyOld {
                 assert!(r.f0_range.iter().all(|&(_, hi)| hi <= 1.0 + 1e-7), "{:?}", r);
             }
+        }
+    }
+
+    /// The energy finding names the loss, the gain, conservation below 1e-6 and a deviation
+    /// above it (with the numbers it is given, printed as the report prints them).
+    #[test]
+    fn energy_finding_says_conserves_only_below_its_threshold() {
+        let (g, l) = ((0.25, "r = 0.1"), (0.125, "r = 0.9"));
+        assert_eq!(energy_finding(Scheme::Single, 0.125, g, l), "Loses 1 - E(μ): up to 0.125 at r = 0.9.");
+        assert!(energy_finding(Scheme::BevyOld, 0.25, g, l).starts_with("Gains B/A at F0 = 1: up to 0.250 at r = 0.1 on this grid"));
+        for s in [Scheme::KullaConty, Scheme::Turquin, Scheme::FdezAguera, Scheme::Cycles] {
+            assert!(energy_finding(s, 3e-9, g, l).starts_with("Conserves energy at F = 1"), "{s:?}");
+            assert!(energy_finding(s, 9.9e-7, g, l).starts_with("Conserves energy"), "{s:?}");
+            assert_eq!(energy_finding(s, 2e-6, g, l), "Deviates from 1 by up to 2.00e-6 at F = 1.", "{s:?}");
         }
     }
 }
