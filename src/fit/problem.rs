@@ -176,3 +176,85 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Residuals<'_> {
         j.iter().all(|v| v.is_finite()).then_some(j)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fit::model::{ModelParts, Term};
+
+    fn model(fixed: Vec<(usize, f64)>, clamp: Option<(f64, f64)>) -> RationalModel {
+        let f = vec!["x".to_string()];
+        let t = |s: &str| Term::parse(s, &f).unwrap();
+        RationalModel::new(ModelParts {
+            inputs: f.clone(),
+            numerator: vec![t("1"), t("x"), t("x^2")],
+            denominator: vec![t("x"), t("x^2")],
+            offset: 0.25,
+            fixed,
+            clamp,
+            ..ModelParts::default()
+        })
+        .unwrap()
+    }
+
+    /// The Jacobian of the weighted residuals (plain, weighted, Σr⁴'s s = r|r|, a fixed
+    /// coefficient mapped out, samples at a clamp) against central differences of `weighted`.
+    #[test]
+    fn the_jacobian_is_that_of_the_weighted_residuals() {
+        let x: Vec<Vec<f64>> = (0..25).map(|i| vec![i as f64 / 12.0]).collect();
+        let data = Data { y: x.iter().map(|p| (1.3 * p[0]).sin() + 0.2).collect(), x };
+        let cases = [(vec![], None), (vec![(1, 0.5)], None), (vec![], Some((0.0, 0.9)))];
+        for (fixed, clamp) in cases {
+            let m = model(fixed.clone(), clamp);
+            let n = m.n_free();
+            let theta = DVector::from_iterator(n, (0..n).map(|i| 0.4 * ((i as f64) * 2.3 + 0.5).cos()));
+            let mut p = Residuals::new(&m, &data, theta.clone());
+            if clamp.is_some() {
+                let free = model(fixed.clone(), None);
+                let v = Residuals::new(&free, &data, theta.clone()).raw(&theta) + DVector::from_column_slice(&data.y);
+                // Samples on both sides of the clamp, none within the difference step of it.
+                assert!(v.iter().any(|&v| v > 0.9 + 1e-3) && v.iter().any(|&v| v < 0.9 - 1e-3));
+                assert!(v.iter().all(|&v| (v - 0.9).abs() > 1e-4 && v.abs() > 1e-4), "{v:?}");
+            }
+            for (weights, fourth) in [(false, false), (true, false), (false, true), (true, true)] {
+                if weights {
+                    p.set_weights(&(0..25).map(|i| 0.5 + (i % 3) as f64).collect::<Vec<_>>());
+                } else {
+                    p.set_weights(&[1.0; 25]);
+                }
+                p.fourth_power = fourth;
+                let j = p.jacobian_at(&theta);
+                let h = 1e-6;
+                for k in 0..n {
+                    let (mut tp, mut tm) = (theta.clone(), theta.clone());
+                    tp[k] += h;
+                    tm[k] -= h;
+                    let fd = (p.weighted(&tp) - p.weighted(&tm)) / (2.0 * h);
+                    // Central differences of smooth residuals (Q ≥ 0.6 here): truncation ~h²
+                    // times third derivatives of O(10), rounding ~1e-16/h; r|r| is C¹ with a
+                    // kink in its second derivative only at r = 0, none within h of a sample.
+                    let err = (j.column(k) - &fd).amax();
+                    assert!(err <= 1e-7 * fd.amax().max(1.0), "fixed {fixed:?}, clamp {clamp:?}, weights {weights}, r⁴ {fourth}, column {k}: off by {err:e}");
+                }
+            }
+        }
+    }
+
+    /// Σr⁴ through `weighted`: the squared norm of s = r|r| is Σr⁴ of the raw residuals, each
+    /// weighted by w² (√w applied before squaring).
+    #[test]
+    fn the_fourth_power_residuals_sum_to_the_fourth_powers() {
+        let m = model(vec![], None);
+        let x: Vec<Vec<f64>> = (0..9).map(|i| vec![i as f64 / 8.0]).collect();
+        let data = Data { y: x.iter().map(|p| p[0].exp()).collect(), x };
+        let theta = DVector::from_vec(vec![0.9, 0.8, 0.1, -0.2, 0.05]);
+        let mut p = Residuals::new(&m, &data, theta.clone());
+        let w: Vec<f64> = (0..9).map(|i| 1.0 + i as f64).collect();
+        p.set_weights(&w);
+        p.fourth_power = true;
+        let r = p.raw(&theta);
+        let want: f64 = r.iter().zip(&w).map(|(r, w)| w * w * r.powi(4)).sum();
+        // The same nine terms through sqrt and squares: a few ulps.
+        assert!((p.weighted(&theta).norm_squared() - want).abs() <= 1e-14 * want, "{} vs {want}", p.weighted(&theta).norm_squared());
+    }
+}

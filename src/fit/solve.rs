@@ -810,6 +810,62 @@ mod tests {
         }
     }
 
+    /// Data that is all zero has no scale to take out: the fit is the zero rational (the
+    /// numerator 0, the denominator free but finite), and the report says zero error.
+    #[test]
+    fn all_zero_data_fits_the_zero_rational() {
+        let model = RationalModel::rational_1d("x", 2, 1);
+        let x: Vec<Vec<f64>> = (0..=10).map(|i| vec![i as f64 / 10.0]).collect();
+        let data = Data { y: vec![0.0; x.len()], x };
+        let f = fit_rescaled(&model, &data, &FitOptions::default(), "zero").unwrap();
+        assert!(f.coefficients.iter().all(|c| c.is_finite()), "{:?}", f.coefficients);
+        // Exact data: the numerator's least-squares solution is 0 to rounding.
+        assert!(f.coefficients.rows(0, 3).amax() < 1e-12, "{:?}", f.coefficients);
+        assert!(f.report.max_abs_error < 1e-12, "{:?}", f.report);
+    }
+
+    /// A pin given in the data's own units (x = 2^70 · 0.5) holds after the input is rescaled:
+    /// the fitted rational takes the pinned value there, to the rounding of the scaled problem.
+    #[test]
+    fn pins_far_from_one_hold_in_the_datas_units() {
+        use crate::fit::model::Pin;
+        let xs = 2f64.powi(70);
+        let target = |x: f64| {
+            let t = x / xs;
+            (1.0 + 2.0 * t) / (1.0 + 0.5 * t) + 0.02 * (5.0 * t).sin()
+        };
+        let at = 0.5 * xs;
+        let pinned = target(at) + 0.01;
+        let model =
+            RationalModel::new(ModelParts { pins: vec![Pin { at: vec![at], value: pinned, eliminate: 0 }], ..parts_1d(&["1", "x", "x^2"], &["x"]) })
+                .unwrap();
+        let x: Vec<Vec<f64>> = (0..=40).map(|i| vec![xs * i as f64 / 20.0]).collect();
+        let data = Data { y: x.iter().map(|p| target(p[0])).collect(), x };
+        let f = fit_rescaled(&model, &data, &FitOptions::default(), "pinned").unwrap();
+        let v = model.eval_full(&f.coefficients, &[at]);
+        // The pin eliminates a coefficient exactly; evaluation rounding of terms ~10: 1e-13.
+        assert!((v - pinned).abs() < 1e-13, "f({at:e}) = {v} vs pin {pinned}");
+    }
+
+    /// With an rms cap the minimax iterates are kept only while their rms (√(Σr²/n)) is within
+    /// it: a cap 1.5× the least-squares rms still lets minimax lower the max error well below
+    /// the least-squares one, and the result honours the cap.
+    #[test]
+    fn minimax_under_an_rms_cap_lowers_the_max_error_within_the_cap() {
+        let model = RationalModel::rational_1d("x", 2, 1);
+        let x: Vec<Vec<f64>> = (0..=100).map(|i| vec![i as f64 / 100.0]).collect();
+        let data = Data { y: x.iter().map(|p| (3.0 * p[0]).sin()).collect(), x };
+        let lsq = fit(&model, &data, &FitOptions::default(), "sin").unwrap();
+        let cap = 1.5 * lsq.report.rms_error;
+        let opts = FitOptions { objective: Objective::Minimax, max_rms: Some(cap), ..FitOptions::default() };
+        let f = fit(&model, &data, &opts, "sin").unwrap();
+        let (_, max, rms) = remeasure(&model, &f, &data);
+        assert!(rms <= cap, "rms {rms} over the cap {cap}");
+        // Minimax on a smooth function gains ~2× on the max error over least squares; 0.8×
+        // is far from both the stopping tolerance and a fit that never left the start.
+        assert!(max < 0.8 * lsq.report.max_abs_error, "max {max} vs least squares {}", lsq.report.max_abs_error);
+    }
+
     /// A clamped model is fitted on the samples strictly inside the clamp: y = clamp(P/Q, 0, 1)
     /// with P/Q above 1 on part of the range recovers P/Q.
     #[test]
