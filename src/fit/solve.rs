@@ -848,22 +848,28 @@ mod tests {
     }
 
     /// With an rms cap the minimax iterates are kept only while their rms (√(Σr²/n)) is within
-    /// it: a cap 1.5× the least-squares rms still lets minimax lower the max error well below
-    /// the least-squares one, and the result honours the cap.
+    /// it, and the polish (which knows no cap) is skipped: a cap 1.05× the least-squares rms
+    /// still lets minimax lower the max error well below the least-squares one, and the result
+    /// honours the cap.
     #[test]
     fn minimax_under_an_rms_cap_lowers_the_max_error_within_the_cap() {
         let model = RationalModel::rational_1d("x", 2, 1);
         let x: Vec<Vec<f64>> = (0..=100).map(|i| vec![i as f64 / 100.0]).collect();
         let data = Data { y: x.iter().map(|p| (3.0 * p[0]).sin()).collect(), x };
         let lsq = fit(&model, &data, &FitOptions::default(), "sin").unwrap();
-        let cap = 1.5 * lsq.report.rms_error;
-        let opts = FitOptions { objective: Objective::Minimax, max_rms: Some(cap), ..FitOptions::default() };
-        let f = fit(&model, &data, &opts, "sin").unwrap();
+        let minimax = FitOptions { objective: Objective::Minimax, ..FitOptions::default() };
+        let free = remeasure(&model, &fit(&model, &data, &minimax, "sin").unwrap(), &data);
+        let cap = 1.05 * lsq.report.rms_error;
+        // The cap binds: the unconstrained minimax fit (Lawson then the LP polish) is above it
+        // (measured: its rms is 1.105× the least-squares rms).
+        assert!(free.2 > cap, "unconstrained minimax rms {} within the cap {cap}", free.2);
+        let f = fit(&model, &data, &FitOptions { max_rms: Some(cap), ..minimax }, "sin").unwrap();
         let (_, max, rms) = remeasure(&model, &f, &data);
         assert!(rms <= cap, "rms {rms} over the cap {cap}");
-        // Minimax on a smooth function gains ~2× on the max error over least squares; 0.8×
-        // is far from both the stopping tolerance and a fit that never left the start.
-        assert!(max < 0.8 * lsq.report.max_abs_error, "max {max} vs least squares {}", lsq.report.max_abs_error);
+        // Within 1.05× the least-squares rms, Lawson's iterates still lower the max error well
+        // below least squares' (measured 0.73×); 0.9× is far from both the stopping tolerance
+        // and a fit that never left the start.
+        assert!(max < 0.9 * lsq.report.max_abs_error, "max {max} vs least squares {} (unconstrained {})", lsq.report.max_abs_error, free.1);
     }
 
     /// A clamped model is fitted on the samples strictly inside the clamp: y = clamp(P/Q, 0, 1)
