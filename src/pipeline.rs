@@ -24,6 +24,8 @@ use serde_json::{json, Value};
 use sha2::{Digest, Sha256};
 use std::path::Path;
 
+#[cfg(test)]
+mod build_tests;
 pub mod committed;
 pub mod data;
 pub mod fields;

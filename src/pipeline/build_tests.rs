@@ -1,0 +1,248 @@
+//! The build of a fit spec and of a table spec, end to end, on a quantity with a closed form
+//! (e^−x on [0, 2], with its inverse −ln y): every number the build writes is re-measured here
+//! from the written coefficients or values against the closed form, and the committed JSON is
+//! read back (and refused when it is tampered with).
+
+use super::*;
+use crate::integrate::Estimate;
+use crate::quantity::{ParamSpec, QuantityDef};
+use crate::spec::Catalog;
+
+static EXP: QuantityDef = QuantityDef {
+    name: "exp-decay",
+    doc: "e^-x (a closed form the build's results are checked against)",
+    params: &[ParamSpec { name: "x", min: 0.0, max: 2.0, doc: "argument", integer: false, default: None }],
+    aliases: &[],
+    eval: |p, _| Estimate { value: (-p[0]).exp(), error: 0.0, evals: 1 },
+    inverse: Some(|y| -y.ln()),
+    channels: &[],
+    eval_channels: None,
+    basis: None,
+};
+
+fn spec(text: &str) -> Spec {
+    let catalog = Catalog { quantities: vec![&EXP], kinds: vec![] };
+    let name = text.split('"').nth(1).unwrap();
+    Spec::parse(Path::new(&format!("fits/{name}.toml")), text.to_string(), &catalog).unwrap()
+}
+
+const FIT: &str = r#"
+name = "exp_fit"
+kind = "fit"
+quantity = "exp-decay"
+description = "e^-x by a 2/2 rational"
+
+[[axis]]
+name = "x"
+range = [0.0, 2.0]
+count = 64
+verify = 501
+
+[model]
+numerator = ["1", "x", "x^2"]
+denominator = ["x", "x^2"]
+
+[fit]
+objective = "minimax"
+
+[emit]
+function = "exp_fit"
+"#;
+
+fn file<'a>(b: &'a Built, path: &str) -> &'a [u8] {
+    &b.artifacts.iter().find(|a| a.path == Path::new(path)).unwrap_or_else(|| panic!("no {path}")).contents
+}
+
+fn json_of(b: &Built) -> Value {
+    serde_json::from_slice(file(b, &format!("json/{}.json", b.name))).unwrap()
+}
+
+fn floats(v: &Value) -> Vec<f64> {
+    v.as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect()
+}
+
+/// The verification grid of the spec, written out: 501 points over [0, 2].
+fn verify_points() -> Vec<f64> {
+    (0..501).map(|i| if i == 500 { 2.0 } else { 2.0 * i as f64 / 500.0 }).collect()
+}
+
+#[test]
+fn a_fit_spec_reports_the_errors_of_what_it_writes() {
+    let s = spec(FIT);
+    let tmp = tempfile::tempdir().unwrap();
+    let b = build_spec(&s, Mode::Fit, tmp.path(), &|_| None).unwrap();
+    let j = json_of(&b);
+    let m = &j["model"];
+    let c = floats(&m["coefficients"]);
+    let (num, den) = (floats(&m["numerator_f32"]), floats(&m["denominator_f32"]));
+    assert_eq!((c.len(), num.len(), den.len()), (5, 3, 2));
+    let r64 = |x: f64| (c[0] + c[1] * x + c[2] * x * x) / (1.0 + c[3] * x + c[4] * x * x);
+    let model = s.model.as_ref().unwrap();
+    let e = expr::model_expr(model);
+    let (n32, d32): (Vec<f32>, Vec<f32>) = (num.iter().map(|&v| v as f32).collect(), den.iter().map(|&v| v as f32).collect());
+    let r32 = |x: f64| expr::eval_f32(&e, &[x as f32], &n32, &d32) as f64;
+    let (mut m64, mut m32, mut mp, mut ss64, mut ss32) = (0.0f64, 0.0f64, 0.0f64, 0.0, 0.0);
+    let mut worst = 0.0;
+    for x in verify_points() {
+        let t = (-x).exp();
+        let (e64, e32) = ((r64(x) - t).abs(), (r32(x) - t).abs());
+        if e64 > m64 {
+            worst = x;
+        }
+        m64 = m64.max(e64);
+        m32 = m32.max(e32);
+        mp = mp.max((-r64(x).ln() - x).abs());
+        ss64 += e64 * e64;
+        ss32 += e32 * e32;
+    }
+    let v = &b.verification;
+    // The same residuals re-summed here (the f64 fit evaluated in another order): 1e-15 of
+    // values ~1, far below the errors (~1e-5).
+    assert_eq!(v.points, 501);
+    assert!((v.max_abs_error - m64).abs() < 1e-15 && (v.rms_error - (ss64 / 501.0).sqrt()).abs() < 1e-15, "{v:?} vs {m64}");
+    assert!((v.max_abs_error_f32 - m32).abs() < 1e-15 && (v.rms_error_f32 - (ss32 / 501.0).sqrt()).abs() < 1e-15, "{v:?} vs {m32}");
+    assert!((v.max_abs_error_in_parameter.unwrap() - mp).abs() < 1e-13, "{v:?} vs {mp}");
+    assert_eq!(v.worst_point, vec![worst]);
+    // The JSON and the files' headers carry the same figures.
+    assert_eq!(j["verification"]["max_abs_error_f32"].as_f64(), Some(v.max_abs_error_f32));
+    let header = format!("max abs {:.3e}, rms {:.3e} over 501 points", v.max_abs_error, v.rms_error);
+    for f in ["wgsl/exp_fit.wgsl", "src/exp_fit.rs"] {
+        assert!(String::from_utf8_lossy(file(&b, f)).contains(&header), "{f} lacks '{header}'");
+    }
+    // A 2/2 rational of e^−x on [0, 2]: its minimax error is 3.2e-5 (measured; Padé [2/2] alone
+    // is 4e-3 at x = 2); the f32 code adds rounding ~1e-7.
+    assert!(m64 < 1e-4 && m32 < m64 + 1e-6, "{m64} {m32}");
+    // The f32 coefficients are the rounded f64 ones moved by at most MAX_ULPS.
+    for (a, b) in num.iter().chain(&den).zip(&c) {
+        assert!(f32round::ulps_between(*b as f32, *a as f32).unsigned_abs() <= f32round::MAX_ULPS as u64, "{a} vs {b}");
+    }
+    // The denominator's bound is a lower bound, and positive: Q = 1 + c3 x + c4 x² sampled densely.
+    let qmin = (0..=20000).map(|i| 2.0 * i as f64 / 20000.0).map(|x| 1.0 + c[3] * x + c[4] * x * x).fold(f64::MAX, f64::min);
+    let lower = m["denominator_lower_bound"].as_f64().unwrap();
+    assert!(lower > 0.0 && lower <= qmin, "bound {lower}, sampled min {qmin}");
+    // The fitting report is the fit's: its max error on the 64 fitting samples, re-measured.
+    let fit = b.fit.as_ref().unwrap();
+    let on64 = (0..64).map(|i| if i == 63 { 2.0 } else { 2.0 * i as f64 / 63.0 }).map(|x| (r64(x) - (-x).exp()).abs()).fold(0.0, f64::max);
+    assert!((fit.max_abs_error - on64).abs() < 1e-15, "{} vs {on64}", fit.max_abs_error);
+    assert_eq!(fit.samples, 64);
+    // The re-optimisation's report: on the fitting samples, never worse than plain rounding.
+    let fr = &j["f32_rounding"];
+    assert_eq!(fr["fitting_samples"].as_u64(), Some(64));
+    let (rounded, reopt) = (fr["rounded_f32"]["max_abs_error"].as_f64().unwrap(), fr["reoptimised_f32"]["max_abs_error"].as_f64().unwrap());
+    assert!(reopt <= rounded, "{reopt} > {rounded}");
+}
+
+#[test]
+fn committed_fits_rebuild_byte_for_byte_and_tampering_is_refused() {
+    let s = spec(FIT);
+    let tmp = tempfile::tempdir().unwrap();
+    let root = tmp.path();
+    let b = build_spec(&s, Mode::Fit, root, &|_| None).unwrap();
+    write_all(root, &b.artifacts).unwrap();
+    assert!(stale(root, &b.artifacts).is_empty());
+    let again = build_spec(&s, Mode::Committed, root, &|_| None).unwrap();
+    for (a, c) in b.artifacts.iter().zip(&again.artifacts) {
+        assert_eq!(a.path, c.path);
+        assert!(a.contents == c.contents, "{} differs when rebuilt from the committed JSON", a.path.display());
+    }
+    let path = root.join("json/exp_fit.json");
+    let original = std::fs::read_to_string(&path).unwrap();
+    let tamper = |f: &dyn Fn(&mut Value)| {
+        let mut v: Value = serde_json::from_str(&original).unwrap();
+        f(&mut v);
+        std::fs::write(&path, json_text(&v)).unwrap();
+        build_spec(&s, Mode::Committed, root, &|_| None)
+    };
+    // An f32 coefficient MAX_ULPS + 1 steps from its rounded f64 one; one MAX_ULPS away passes.
+    let moved = |k: i64| {
+        move |v: &mut Value| {
+            let c0 = v["model"]["coefficients"][0].as_f64().unwrap() as f32;
+            v["model"]["numerator_f32"][0] = json!(f32round::step_ulps(c0, k).unwrap());
+        }
+    };
+    assert!(matches!(tamper(&moved(f32round::MAX_ULPS as i64 + 1)), Err(BuildError::F32Coefficients { .. })));
+    assert!(tamper(&moved(f32round::MAX_ULPS as i64)).is_ok());
+    assert!(matches!(tamper(&|v| v["input_hash"] = json!("sha256:0")), Err(BuildError::SpecChanged { .. })));
+    assert!(matches!(tamper(&|v| v["model"]["coefficients"] = json!([1.0, 0.0])), Err(BuildError::NoCommitted { .. })));
+    assert!(matches!(tamper(&|v| { v.as_object_mut().unwrap().remove("f32_rounding"); }), Err(BuildError::NoCommitted { .. })));
+    std::fs::write(&path, &original).unwrap();
+    // The spec's max_error bounds the f32 code's measured error, in either mode.
+    let bound = b.verification.max_abs_error_f32;
+    let tight = spec(&FIT.replace("description =", &format!("max_error = {:e}\ndescription =", bound * 0.5)));
+    assert!(matches!(build_spec(&tight, Mode::Fit, root, &|_| None), Err(BuildError::ErrorBound { .. })));
+    let loose = spec(&FIT.replace("description =", &format!("max_error = {:e}\ndescription =", bound * 1.01)));
+    assert!(build_spec(&loose, Mode::Fit, root, &|_| None).is_ok());
+    // A file no artifact is, in an output folder, is an orphan; a changed file is stale.
+    std::fs::write(root.join("wgsl/left_over.wgsl"), "x").unwrap();
+    assert_eq!(orphans(root, &b.artifacts), vec!["wgsl/left_over.wgsl".to_string()]);
+    std::fs::write(root.join("src/exp_fit.rs"), "changed").unwrap();
+    assert_eq!(stale(root, &b.artifacts), vec!["src/exp_fit.rs".to_string()]);
+}
+
+const TABLE: &str = r#"
+name = "exp_table"
+kind = "table"
+quantity = "exp-decay"
+description = "e^-x by a 17-point table"
+
+[[axis]]
+name = "x"
+range = [0.0, 2.0]
+count = 17
+verify = 501
+
+[emit]
+function = "exp_table"
+"#;
+
+/// Linear interpolation of the f32 table at x, written out: e^−x at the nodes 2i/16.
+fn lerp(values: &[f64], x: f64) -> f64 {
+    let t = x / 0.125;
+    let i = (t.floor() as usize).min(15);
+    let f = t - i as f64;
+    values[i] * (1.0 - f) + values[i + 1] * f
+}
+
+#[test]
+fn a_table_spec_holds_the_quantity_and_reports_its_interpolation_error() {
+    let s = spec(TABLE);
+    let tmp = tempfile::tempdir().unwrap();
+    let root = tmp.path();
+    let b = build_spec(&s, Mode::Fit, root, &|_| None).unwrap();
+    let j = json_of(&b);
+    let values = floats(&j["values"]);
+    assert_eq!(values.len(), 17);
+    for (i, v) in values.iter().enumerate() {
+        assert_eq!(*v, (-(i as f64) / 8.0).exp(), "node {i}");
+    }
+    let v32: Vec<f64> = values.iter().map(|&v| v as f32 as f64).collect();
+    let (mut m, mut ss) = (0.0f64, 0.0);
+    for x in verify_points() {
+        let e = lerp(&v32, x) - (-x).exp();
+        m = m.max(e.abs());
+        ss += e * e;
+    }
+    // Interpolation error h²/8·max|f''| = 0.125²/8 ≈ 2e-3 (measured 1.83e-3); the emitted f32 interpolation
+    // differs from this f64 one by f32 rounding of the weights and products (~1e-7).
+    let v = &b.verification;
+    assert!(m > 1e-3 && (v.max_abs_error_f32 - m).abs() < 1e-6, "{v:?} vs {m}");
+    assert!((v.rms_error_f32 - (ss / 501.0).sqrt()).abs() < 1e-6, "{v:?}");
+    // The CSV lists every node and its value.
+    let csv = String::from_utf8(file(&b, "data/exp_table.csv").to_vec()).unwrap();
+    let rows: Vec<&str> = csv.lines().filter(|l| !l.starts_with('#')).collect();
+    assert_eq!(rows[0], "x,value");
+    assert_eq!(rows.len(), 18);
+    assert_eq!(rows[9], format!("1.0,{:?}", (-1.0f64).exp()));
+    // Read back from the committed JSON: the same files; a table of another size is refused.
+    write_all(root, &b.artifacts).unwrap();
+    let again = build_spec(&s, Mode::Committed, root, &|_| None).unwrap();
+    assert!(b.artifacts.iter().zip(&again.artifacts).all(|(a, c)| a.path == c.path && a.contents == c.contents));
+    let other = spec(&TABLE.replace("count = 17", "count = 9"));
+    // The spec text changed, so its hash did too: refused as changed before its size is read.
+    assert!(matches!(build_spec(&other, Mode::Committed, root, &|_| None), Err(BuildError::SpecChanged { .. })));
+    let path = root.join("json/exp_table.json");
+    let mut t: Value = serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
+    t["values"] = json!(values[..16]);
+    std::fs::write(&path, json_text(&t)).unwrap();
+    assert!(matches!(build_spec(&s, Mode::Committed, root, &|_| None), Err(BuildError::NoCommitted { .. })));
+}
