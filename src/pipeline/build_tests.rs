@@ -246,3 +246,121 @@ fn a_table_spec_holds_the_quantity_and_reports_its_interpolation_error() {
     std::fs::write(&path, json_text(&t)).unwrap();
     assert!(matches!(build_spec(&s, Mode::Committed, root, &|_| None), Err(BuildError::NoCommitted { .. })));
 }
+
+/// Exact fields c_k(o) = offset_k + (a_k + b_k o)/(1 + d_k o) of f(o, u) = c0 + c1 u + c2 u².
+const FIELDS_TRUE: [[f64; 3]; 3] = [[1.0, 2.0, 0.5], [-0.3, 0.7, 0.2], [0.2, -0.1, -0.3]];
+const FIELDS_OFFSETS: [f64; 3] = [0.5, 0.0, 0.0];
+
+fn field_value(k: usize, o: f64) -> f64 {
+    let [a, b, d] = FIELDS_TRUE[k];
+    FIELDS_OFFSETS[k] + (a + b * o) / (1.0 + d * o)
+}
+
+fn fields_value(o: f64, u: f64) -> f64 {
+    field_value(0, o) + field_value(1, o) * u + field_value(2, o) * u * u
+}
+
+static QUADRATIC: crate::quantity::InnerBasis = crate::quantity::InnerBasis {
+    inner: 1,
+    args: &["u"],
+    arg_domain: &[(-1.0, 1.0)],
+    terms: &["1", "u", "u^2"],
+    to_args: |_, i| vec![i[0]],
+    sample: |o, inner, _| inner.iter().map(|i| Estimate { value: fields_value(o[0], i[0]), error: 0.0, evals: 1 }).collect(),
+    range: (-10.0, 10.0),
+};
+
+static FIELDS_Q: QuantityDef = QuantityDef {
+    name: "quadratic-fields",
+    doc: "a quadratic in u whose coefficients are rationals in o",
+    params: &[
+        ParamSpec { name: "o", min: 0.0, max: 1.0, doc: "outer", integer: false, default: None },
+        ParamSpec { name: "u", min: -1.0, max: 1.0, doc: "inner", integer: false, default: None },
+    ],
+    aliases: &[],
+    eval: |p, _| Estimate { value: fields_value(p[0], p[1]), error: 0.0, evals: 1 },
+    inverse: None,
+    channels: &[],
+    eval_channels: None,
+    basis: Some(&QUADRATIC),
+};
+
+const FIELDS: &str = r#"
+name = "quad_fields"
+kind = "fields"
+quantity = "quadratic-fields"
+description = "three exact rational fields"
+
+[[axis]]
+name = "o"
+range = [0.0, 1.0]
+count = 17
+verify = 33
+
+[[axis]]
+name = "u"
+range = [-1.0, 1.0]
+count = 9
+verify = 11
+
+[model]
+numerator = ["1", "o"]
+denominator = ["o"]
+
+[fields]
+offsets = [0.5, 0.0, 0.0]
+
+[fit]
+objective = "lsq"
+
+[emit]
+function = "quad_coeffs"
+evaluator = "quad"
+"#;
+
+/// A fields spec whose fields are exactly representable: the build recovers them, says its
+/// errors are at rounding level, proves each Q = 1 + d·o positive with a bound below its true
+/// minimum on [0, 1], and rebuilds from its committed JSON byte for byte.
+#[test]
+fn a_fields_spec_recovers_exact_fields_and_reads_back() {
+    let catalog = Catalog { quantities: vec![&FIELDS_Q], kinds: vec![] };
+    let s = Spec::parse(Path::new("fits/quad_fields.toml"), FIELDS.to_string(), &catalog).unwrap();
+    let tmp = tempfile::tempdir().unwrap();
+    let root = tmp.path();
+    let b = build_spec(&s, Mode::Fit, root, &|_| None).unwrap();
+    let j = json_of(&b);
+    let fields = j["fields"].as_array().unwrap();
+    assert_eq!(fields.len(), 3);
+    for (k, f) in fields.iter().enumerate() {
+        let c = floats(&f["coefficients"]);
+        assert_eq!(f["offset"].as_f64(), Some(FIELDS_OFFSETS[k]));
+        // Exact data, a well-conditioned 3-term basis at every o: recovered to ~1e-12.
+        for (got, want) in c.iter().zip(FIELDS_TRUE[k]) {
+            assert!((got - want).abs() < 1e-9, "field {k}: {c:?}");
+        }
+        let d = FIELDS_TRUE[k][2];
+        let qmin = (1.0f64).min(1.0 + d);
+        let lower = f["denominator_lower_bound"].as_f64().unwrap();
+        assert!(lower > 0.0 && lower <= qmin + 1e-12, "field {k}: bound {lower}, min {qmin}");
+    }
+    let v = &b.verification;
+    // f64 fields equal to the truth to ~1e-12; the f32 code rounds coefficients and arithmetic
+    // (values ≤ ~4: a few ulps of 2^-22), so its error is above 1e-9 and below 1e-5.
+    assert_eq!(v.points, 33 * 11);
+    assert!(v.max_abs_error < 1e-9, "{v:?}");
+    assert!(v.max_abs_error_f32 > 1e-9 && v.max_abs_error_f32 < 1e-5, "{v:?}");
+    assert!(v.rms_error <= v.max_abs_error && v.rms_error_f32 <= v.max_abs_error_f32);
+    assert!(j["fit"]["max_abs_error"].as_f64().unwrap() < 1e-9, "{}", j["fit"]);
+    assert_eq!(j["fit"]["grid_points"].as_u64(), Some(17));
+    assert_eq!(j["fit"]["inner_samples"].as_u64(), Some(9));
+    write_all(root, &b.artifacts).unwrap();
+    let again = build_spec(&s, Mode::Committed, root, &|_| None).unwrap();
+    for (a, c) in b.artifacts.iter().zip(&again.artifacts) {
+        assert!(a.path == c.path && a.contents == c.contents, "{} differs when rebuilt", a.path.display());
+    }
+    let path = root.join("json/quad_fields.json");
+    let mut t: Value = serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
+    t["input_hash"] = json!("sha256:0");
+    std::fs::write(&path, json_text(&t)).unwrap();
+    assert!(matches!(build_spec(&s, Mode::Committed, root, &|_| None), Err(BuildError::SpecChanged { .. })));
+}
