@@ -1265,6 +1265,17 @@ mod r_horizon;
 mod tests {
     use super::*;
 
+    /// G at subnormal d (or μv) takes its limit with a bound instead of quadrature nodes that
+    /// would need 1/d: G ≤ d/μv, so at d = 1e-310 the value is 0 within that bound; at μv =
+    /// 1e-310 with d = 0.5, G → 1.
+    #[test]
+    fn g_at_subnormal_arguments_is_its_limit() {
+        let e = g(1e-310, 0.5, 1e-9);
+        assert!(e.value == 0.0 && e.error <= 1e-310 / 0.5 * (1.0 + 1e-12) && e.error > 0.0, "{e:?}");
+        let e = g(0.5, 1e-310, 1e-9);
+        assert!(e.value.is_finite() && (e.value - 1.0).abs() <= e.error.max(1e-9), "{e:?}");
+    }
+
     /// The fitting directions are the midpoints of the n_theta × n_phi cells of (0, π/2) × (0, π),
     /// θu-major: for 2 × 3, θu ∈ {π/8, 3π/8} and φu ∈ {π/6, π/2, 5π/6}.
     #[test]

@@ -520,6 +520,25 @@ fn lut_items(generated: &Path, pts: &[[f64; 3]], refs: &[[f64; 4]]) -> Vec<Item>
 mod tests {
     use super::*;
 
+    /// With the specular cone centred on the visibility cone (n·v = 1, d = 0) the visible
+    /// fraction is the ratio of cap areas (1 − cos a_v)/(1 − cos a_s) when the specular cone is
+    /// the wider, and 1 when it is inside.
+    #[test]
+    fn jimenez_with_concentric_cones_is_the_ratio_of_cap_areas() {
+        let k = JIMENEZ;
+        for (v, r) in [(0.5, 0.9), (0.8, 0.7), (0.3, 0.2)] {
+            let cos_v = cone_of_visibility(v);
+            let cos_s = (k * r * r).exp2();
+            let want = if cos_s >= cos_v { 1.0 } else { (1.0 - cos_v) / (1.0 - cos_s) };
+            let got = jimenez_with(k, 1.0, v, r);
+            // Cap areas through acos and back: 1e-12.
+            assert!((got - want).abs() < 1e-12, "v = {v}, r = {r}: {got} vs {want}");
+        }
+        // Not vacuous: one case is partial.
+        let (cos_v, cos_s) = (cone_of_visibility(0.5), (k * 0.81f64).exp2());
+        assert!(cos_s < cos_v, "the first case's specular cone is the wider");
+    }
+
     #[test]
     fn max_error_is_the_largest_absolute_deviation() {
         // Hand-worked: so(r, μ, v) = r at r = 0.1, 0.2, 0.3 against references 0, 0.5, 0.1:

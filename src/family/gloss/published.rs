@@ -151,6 +151,15 @@ pub fn items(generated: &Path) -> Vec<Item> {
 mod tests {
     use super::*;
 
+    /// The published form (c0 + c1 g + c2 g² + c3 g³)/(1 + c4 g + c5 g²) at g = 0.5 with
+    /// c = (1, 2, 3, 4, 5, 6), by hand: (1 + 1 + 0.75 + 0.5)/(1 + 2.5 + 1.5) = 3.25/5 = 0.65.
+    #[test]
+    fn the_rational_is_the_published_form() {
+        let v = rational_1d(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0], 0.5);
+        // Exact binary fractions but for the final quotient: one rounding.
+        assert!((v - 0.65).abs() < 1e-16, "{v}");
+    }
+
     #[test]
     fn uniform_samples_include_both_ends() {
         // i/(n − 1): quarters are exact in binary, so equality is exact.

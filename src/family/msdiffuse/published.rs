@@ -432,6 +432,18 @@ fn per_gloss(it: &mut Item, s: &Slices, approx: &[f64]) {
 mod tests {
     use super::*;
 
+    /// The shipped hand fit at g = 0.5, l·h = 1, n·l = 0.5, n·v = 0.8, n·h = 0.64, by hand from
+    /// the talk's formula: f0 = 1; f1 = (1 − 0.75/32)(1 − 0.75·0.2⁵) = 0.9765625·0.99976 =
+    /// 0.976328125; t = 0.6, f_d = 1 − 0.6·0.023671875 = 0.985796875; f_b = 3.625·2^(−15.4·0.8)
+    /// = 3.625·2^−12.32 = 7.0895466e-4. Total 0.98650582966.
+    #[test]
+    fn hand_fit_at_a_hand_computed_point() {
+        let c = Cosines { n_dot_l: 0.5, n_dot_v: 0.8, n_dot_h: 0.64, l_dot_h: 1.0, l_dot_v: 0.0 };
+        let v = hand_fit(0.5, &c);
+        // The digits kept by hand: 1e-10.
+        assert!((v - 0.98650582966).abs() < 1e-10, "{v}");
+    }
+
     #[test]
     fn talk_rational_against_the_lambert_slice_times_0_9216_is_re_measured() {
         // The talk's F0 = 0.04 with a constant (1 − F0) at entry and exit scales the F0 = 0 walk

@@ -263,6 +263,26 @@ pub fn items(_generated: &Path) -> Vec<Item> {
 mod tests {
     use super::*;
 
+    /// The random footprints keep their documented ranges: 2–4 texels, normals within 60° of
+    /// z, both α ∈ [0.1, 0.8] (read back as the square roots of the eigenvalues), weights in
+    /// [0.2, 1].
+    #[test]
+    fn random_cases_stay_in_their_documented_ranges() {
+        for case in random_cases(64, 7) {
+            assert!((2..=4).contains(&case.texels.len()), "{}", case.name);
+            for (w, n, a) in &case.texels {
+                assert!((0.2..=1.0).contains(w), "{}: weight {w}", case.name);
+                // cos 60° = 0.5, and unit length (1e-15: rounding of sin² + cos²).
+                assert!(n.z >= 0.5 - 1e-15 && (n.norm() - 1.0).abs() < 1e-15, "{}: normal {n:?}", case.name);
+                let (t2, b2, _) = a.alphas();
+                // Eigenvalues of a 2×2 built from the alphas: a few ulps.
+                for al in [t2.sqrt(), b2.sqrt()] {
+                    assert!(al >= 0.1 - 1e-12 && al <= 0.8 + 1e-12, "{}: α {al}", case.name);
+                }
+            }
+        }
+    }
+
     #[test]
     fn filter_pairs_sample_the_axis_angle_uniformly() {
         // The larger eigenvalue's axis of each block, ½·atan2(2 Sxy, Sxx − Syy) mod π, is ψ or

@@ -945,6 +945,13 @@ pub fn sh_bands_estimates(
 mod tests {
     use super::*;
 
+    /// The spec names of the curvature mappings (what the skin specs write and read).
+    #[test]
+    fn curvature_mappings_are_named_as_in_the_specs() {
+        assert_eq!(CurvatureMapping::Linear.name(), "linear");
+        assert_eq!(CurvatureMapping::Sqrt.name(), "sqrt");
+    }
+
     #[test]
     fn punctual_error_estimates_cover_the_error() {
         // At a loose tolerance the reported error must cover the distance to the same integral

@@ -392,6 +392,31 @@ fn energy_finding(scheme: Scheme, f1_max_dev: f64, (g, gp): (f64, &str), (l, lp)
 mod tests {
     use super::*;
 
+    /// The grid is roughness-major: point (j, i) is input j·len(μ) + i.
+    #[test]
+    fn grid_points_are_roughness_major() {
+        let inputs = (0..6).map(|k| Inputs { a: k as f64, b: 0.0, e_avg: 0.0 }).collect();
+        let g = Grid { roughness: vec![0.2, 0.8], mu: vec![0.1, 0.5, 1.0], inputs };
+        assert_eq!((g.at(0, 2).a, g.at(1, 0).a, g.at(1, 2).a), (2.0, 3.0, 5.0));
+    }
+
+    /// With tables equal to the exact inputs and 2∫(1 − E)μ dμ = 1 − E_avg, the tabulated
+    /// Kulla–Conty and Turquin albedos at F = 1 are 1 (E = A + B = 0.8, E_avg = 0.75:
+    /// 0.8 + 1·0.2·0.25/0.25 and 0.8·(1 + 0.2/0.8)); the schemes without a tabulated form are None.
+    #[test]
+    fn tabulated_furnace_conserves_energy_at_f1_with_exact_tables() {
+        let exact = Inputs { a: 0.7, b: 0.1, e_avg: 0.75 };
+        for s in [Scheme::KullaConty, Scheme::Turquin] {
+            let v = furnace_tabulated(s, 1.0, &exact, 0.8, 0.75, 0.25).unwrap();
+            // A few roundings of values ~1.
+            assert!((v - 1.0).abs() < 1e-15, "{s:?}: {v}");
+        }
+        assert!(furnace_tabulated(Scheme::Cycles, 1.0, &exact, 0.8, 0.75, 0.25).is_some());
+        for s in [Scheme::Single, Scheme::BevyOld, Scheme::FdezAguera] {
+            assert_eq!(furnace_tabulated(s, 1.0, &exact, 0.8, 0.75, 0.25), None, "{s:?}");
+        }
+    }
+
     #[test]
     fn kc_quadrature_check_agrees_with_the_identity() {
         // Kulla–Conty at F = 1 is exactly 1 with the identity 2∫(1 − E)μ dμ = 1 − E_avg; with

@@ -407,3 +407,24 @@ pub fn lut_built(
     ];
     Built { name, artifacts, verification, fit: None }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Bilinear filtering of texels that are linear in the texel index, f(i, j) = i + 10j (and
+    /// 2i − j), returns the same linear function at the texel-space point (u·w − ½, t·h − ½),
+    /// clamped to the edge texels outside their centres.
+    #[test]
+    fn bilinear_reproduces_a_linear_function_and_clamps_at_the_edges() {
+        let (w, h) = (4usize, 3usize);
+        let texels: Vec<[f64; 2]> = (0..h).flat_map(|j| (0..w).map(move |i| [i as f64 + 10.0 * j as f64, 2.0 * i as f64 - j as f64])).collect();
+        for (u, t) in [(0.3, 0.4), (0.5, 0.5), (0.7, 0.2), (0.05, 0.9), (0.99, 0.01)] {
+            let x = (u * w as f64 - 0.5).clamp(0.0, (w - 1) as f64);
+            let y = (t * h as f64 - 0.5).clamp(0.0, (h - 1) as f64);
+            let got = bilinear(&texels, (w, h), u, t);
+            // Weights and products of small integers: a few ulps.
+            assert!((got[0] - (x + 10.0 * y)).abs() < 1e-12 && (got[1] - (2.0 * x - y)).abs() < 1e-12, "({u}, {t}): {got:?}");
+        }
+    }
+}
