@@ -287,6 +287,73 @@ pub fn render_rust(header: &[String], f: &FieldsFunction<'_>, doc: &str, c64: &[
 mod tests {
     use super::*;
 
+    /// The evaluator's sum Σ c_k b_k with b = (1, u, u²·v) at (u, v) = (0.5, 4) and c = (1, 2, 3):
+    /// 1 + 2·0.5 + 3·(0.25·4) = 5, exact in f32.
+    #[test]
+    fn basis_sum_multiplies_each_monomials_arguments() {
+        let args = vec!["u".to_string(), "v".to_string()];
+        let terms: Vec<Term> = ["1", "u", "u^2*v"].iter().map(|s| Term::parse(s, &args).unwrap()).collect();
+        assert_eq!(basis_sum_f32(&terms, &[1.0, 2.0, 3.0], &[0.5, 4.0]), 5.0);
+        assert_eq!(basis_sum_f32(&terms[1..], &[2.0, 3.0], &[0.5, 4.0]), 4.0);
+    }
+
+    /// The Rust module declares the domain, each field's f32 arrays and the f64 coefficients,
+    /// every literal reading back to the value it was given.
+    #[test]
+    fn the_rust_module_carries_every_coefficient() {
+        let model = crate::fit::model::RationalModel::rational_1d("o", 1, 1);
+        let e = crate::fit::expr::model_expr(&model);
+        let fields = [
+            Field { expr: e.clone(), num: vec![0.1, -2.5], den: vec![0.3] },
+            Field { expr: e, num: vec![1.0 / 3.0, 7.0], den: vec![-0.2] },
+        ];
+        let (args, eval_args) = (vec!["o".to_string()], vec!["u".to_string()]);
+        let terms: Vec<Term> = ["1", "u"].iter().map(|s| Term::parse(s, &eval_args).unwrap()).collect();
+        let f = FieldsFunction {
+            module: "quad",
+            name: "quad_coeffs",
+            args: &args,
+            derived: &[],
+            domain: &[(0.0, 1.0)],
+            fields: &fields,
+            evaluator: "quad",
+            eval_args: &eval_args,
+            eval_domain: &[(-1.0, 1.0)],
+            terms: &terms,
+            range: (-4.0, 4.0),
+        };
+        let c64 = vec![(vec![0.1, -2.5], vec![0.3]), (vec![1.0 / 3.0, 7.0], vec![-0.2])];
+        let text = render_rust(&["header line".to_string()], &f, "the doc", &c64);
+        assert!(text.starts_with("//! header line\n"), "{text}");
+        // The literals of one `pub const NAME: [...] = [...];`, read back.
+        let array = |name: &str| -> Vec<f64> {
+            let start = text.find(&format!("pub const {name}:")).unwrap_or_else(|| panic!("no {name} in {text}"));
+            let body = &text[start..];
+            let body = &body[body.find("= [").unwrap() + 3..];
+            let body = &body[..body.find("];").unwrap()];
+            body.replace(['[', ']'], "")
+                .split(',')
+                .map(str::trim)
+                .filter(|v| !v.is_empty())
+                .map(|v| match v.strip_suffix("_f32") {
+                    Some(l) => l.parse::<f32>().unwrap() as f64,
+                    None => v.trim_end_matches("_f64").parse().unwrap(),
+                })
+                .collect()
+        };
+        let f32s = |v: &[f64]| v.iter().map(|&x| x as f32 as f64).collect::<Vec<_>>();
+        assert_eq!(array("QUAD_DOMAIN"), vec![0.0, 1.0]);
+        assert_eq!(array("QUAD_NUM0"), f32s(&[0.1, -2.5]));
+        assert_eq!(array("QUAD_DEN0"), f32s(&[0.3]));
+        assert_eq!(array("QUAD_NUM1"), f32s(&[1.0 / 3.0, 7.0]));
+        assert_eq!(array("QUAD_DEN1"), f32s(&[-0.2]));
+        assert_eq!(array("QUAD_NUM0_F64"), vec![0.1, -2.5]);
+        assert_eq!(array("QUAD_DEN0_F64"), vec![0.3]);
+        assert_eq!(array("QUAD_NUM1_F64"), vec![1.0 / 3.0, 7.0]);
+        assert_eq!(array("QUAD_DEN1_F64"), vec![-0.2]);
+        assert!(text.contains("pub fn quad_coeffs(") && text.contains("pub fn quad("), "{text}");
+    }
+
     /// A monomial's factors are its arguments repeated by their exponents, in argument order.
     #[test]
     fn monomial_factors_repeat_each_argument_by_its_exponent() {
