@@ -615,6 +615,28 @@ fn c_header(module: &str, header: &[&str], from: &str, m: &naga::Module) -> Resu
 mod tests {
     use super::*;
 
+    /// The entry point that keeps every function alive calls each one with a zero of each
+    /// argument type (scalars, a vector, a struct) and binds one global per resource type: two
+    /// functions taking a texture and a sampler share the same two bindings. The module with it
+    /// appended parses and validates.
+    #[test]
+    fn the_keep_entry_point_calls_every_function_with_one_binding_per_resource_type() {
+        let src = "struct P { x: f32 }\n\
+                   fn a(x: f32, n: u32, i: i32, b: bool, v: vec3<f32>, p: P) -> f32 { return x + p.x; }\n\
+                   fn t(tex: texture_2d<f32>, s: sampler, uv: vec2<f32>) -> vec4<f32> { return textureSampleLevel(tex, s, uv, 0.0); }\n\
+                   fn u(s: sampler, tex: texture_2d<f32>) -> vec4<f32> { return textureSampleLevel(tex, s, vec2<f32>(0.5), 0.0); }\n\
+                   fn w() {}\n";
+        let m = naga::front::wgsl::parse_str(src).unwrap();
+        let ep = keep_entry_point("k", &m).unwrap();
+        let (all, _) = parse("k", &format!("{src}{ep}")).unwrap_or_else(|e| panic!("{e}\n{ep}"));
+        assert_eq!(all.global_variables.len(), 2, "{ep}");
+        assert_eq!(all.entry_points.len(), 1);
+        for call in ["_ = a(0f, 0u, 0i, false, vec3<f32>(), P());", "_ = t(k_keep_binding_0, k_keep_binding_1, vec2<f32>());", "_ = u(k_keep_binding_1, k_keep_binding_0);", "    w();"] {
+            assert!(ep.contains(call), "no '{call}' in {ep}");
+        }
+        assert!(ep.contains("var k_keep_binding_0: texture_2d<f32>;") && ep.contains("var k_keep_binding_1: sampler;"), "{ep}");
+    }
+
     /// The C header holds every named constant with its values read back bit for bit, scalars,
     /// 1-D and 2-D arrays, under an include guard.
     #[test]

@@ -276,3 +276,27 @@ pub fn derived_expr(
 pub fn strip_directives(src: &str) -> String {
     src.lines().filter(|l| !l.trim_start().starts_with('#')).collect::<Vec<_>>().join("\n")
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A constant array: its values read back through naga in order, six to a line.
+    #[test]
+    fn arrays_read_back_through_naga() {
+        let values: Vec<f32> = (0..8).map(|i| 0.1 * i as f32 - 0.25).collect();
+        let text = array("C", &values);
+        assert_eq!(text.lines().count(), 4, "{text}");
+        let m = naga::front::wgsl::parse_str(&text).unwrap_or_else(|e| panic!("{}", e.emit_to_string(&text)));
+        let (_, c) = m.constants.iter().next().unwrap();
+        let naga::Expression::Compose { components, .. } = &m.global_expressions[c.init] else { panic!("{text}") };
+        let got: Vec<f32> = components
+            .iter()
+            .map(|h| match m.global_expressions[*h] {
+                naga::Expression::Literal(naga::Literal::F32(v)) => v,
+                ref e => panic!("{e:?}"),
+            })
+            .collect();
+        assert_eq!(got, values);
+    }
+}
