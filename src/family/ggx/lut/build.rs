@@ -412,6 +412,19 @@ pub fn lut_built(
 mod tests {
     use super::*;
 
+    /// The module doc names the function, the quantity, the G it integrates and the light cone.
+    #[test]
+    fn the_description_names_the_g_and_the_cone() {
+        let text = "name = \"ggx_t\"\nkind = \"ggx-dfg-lut\"\nquantity = \"ggx-env\"\nresolution = [10, 7]\n\n[emit]\nfunction = \"ggx_t\"\n";
+        let path = std::path::Path::new("fits/ggx_t.toml");
+        let hc = describe(&DfgLut::parse(path, text).unwrap());
+        assert_eq!(hc, "`ggx_t` looks up the GGX split-sum environment BRDF (scale, bias) of quantity `ggx-env` (height-correlated Smith G2, Schlick Fc).");
+        let ue4 = describe(&DfgLut::parse(path, &text.replace("ggx-env", "ggx-env-ue4")).unwrap());
+        assert!(ue4.contains("`ggx-env-ue4` (UE4's separable Schlick–Smith G (k = α/2), Schlick Fc)"), "{ue4}");
+        let cone = describe(&DfgLut::parse(path, &text.replace("resolution", "cos_cone = 0.5\nresolution")).unwrap());
+        assert!(cone.contains("Schlick Fc, lights in the cone n·l ≥ 0.5)."), "{cone}");
+    }
+
     /// Bilinear filtering of texels that are linear in the texel index, f(i, j) = i + 10j (and
     /// 2i − j), returns the same linear function at the texel-space point (u·w − ½, t·h − ½),
     /// clamped to the edge texels outside their centres.
