@@ -615,6 +615,25 @@ fn c_header(module: &str, header: &[&str], from: &str, m: &naga::Module) -> Resu
 mod tests {
     use super::*;
 
+    /// GLSL says its version (4.50 core, ES 3.00); SPIR-V is version 1.0 and carries the
+    /// functions' names (OpName) and the WGSL source (OpSource), which the validators and
+    /// debuggers read.
+    #[test]
+    fn glsl_and_spirv_carry_their_versions_names_and_source() {
+        let src = "// h\n#define_import_path shadefit::m\nfn emitted_f(x: f32) -> f32 { return x * 2.0; }\n";
+        let out = translate("m", src, &[Target::Glsl, Target::GlslEs, Target::Spirv]).unwrap();
+        let texts: Vec<String> = out.iter().map(|a| String::from_utf8_lossy(&a.contents).into_owned()).collect();
+        assert!(texts.iter().any(|t| t.contains("#version 450 core")), "{texts:?}");
+        assert!(texts.iter().any(|t| t.contains("#version 300 es")), "{texts:?}");
+        let spv = out.iter().find(|a| a.contents.starts_with(&0x0723_0203u32.to_le_bytes())).expect("a SPIR-V module");
+        let word = |k: usize| u32::from_le_bytes(spv.contents[4 * k..4 * k + 4].try_into().unwrap());
+        assert_eq!(word(1), 0x0001_0000, "SPIR-V version 1.0");
+        let bytes = &spv.contents;
+        let has = |needle: &[u8]| bytes.windows(needle.len()).any(|w| w == needle);
+        assert!(has(b"emitted_f"), "no OpName of the function");
+        assert!(has(b"return x * 2.0"), "no OpSource text");
+    }
+
     /// The entry point that keeps every function alive calls each one with a zero of each
     /// argument type (scalars, a vector, a struct) and binds one global per resource type: two
     /// functions taking a texture and a sampler share the same two bindings. The module with it
