@@ -21,9 +21,13 @@ static EXP: QuantityDef = QuantityDef {
 };
 
 fn spec(text: &str) -> Spec {
-    let catalog = Catalog { quantities: vec![&EXP], kinds: vec![] };
+    spec_in(text, &Catalog { quantities: vec![&EXP], kinds: vec![] })
+}
+
+/// A spec from its text, at `fits/NAME.toml` (NAME: the first quoted string, `name = "…"`).
+fn spec_in(text: &str, catalog: &Catalog) -> Spec {
     let name = text.split('"').nth(1).unwrap();
-    Spec::parse(Path::new(&format!("fits/{name}.toml")), text.to_string(), &catalog).unwrap()
+    Spec::parse(Path::new(&format!("fits/{name}.toml")), text.to_string(), catalog).unwrap()
 }
 
 const FIT: &str = r#"
@@ -61,9 +65,10 @@ fn floats(v: &Value) -> Vec<f64> {
     v.as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect()
 }
 
-/// The verification grid of the spec, written out: 501 points over [0, 2].
-fn verify_points() -> Vec<f64> {
-    (0..501).map(|i| if i == 500 { 2.0 } else { 2.0 * i as f64 / 500.0 }).collect()
+/// n uniform points over [0, 2], the last exactly 2: the specs' grids written out (501: the
+/// verification grid; 64: the fitting samples).
+fn uniform(n: usize) -> Vec<f64> {
+    (0..n).map(|i| if i + 1 == n { 2.0 } else { 2.0 * i as f64 / (n - 1) as f64 }).collect()
 }
 
 #[test]
@@ -83,7 +88,7 @@ fn a_fit_spec_reports_the_errors_of_what_it_writes() {
     let r32 = |x: f64| expr::eval_f32(&e, &[x as f32], &n32, &d32) as f64;
     let (mut m64, mut m32, mut mp, mut ss64, mut ss32) = (0.0f64, 0.0f64, 0.0f64, 0.0, 0.0);
     let mut worst = 0.0;
-    for x in verify_points() {
+    for x in uniform(501) {
         let t = (-x).exp();
         let (e64, e32) = ((r64(x) - t).abs(), (r32(x) - t).abs());
         if e64 > m64 {
@@ -122,13 +127,13 @@ fn a_fit_spec_reports_the_errors_of_what_it_writes() {
     assert!(lower > 0.0 && lower <= qmin, "bound {lower}, sampled min {qmin}");
     // The fitting report is the fit's: its max error on the 64 fitting samples, re-measured.
     let fit = b.fit.as_ref().unwrap();
-    let on64 = (0..64).map(|i| if i == 63 { 2.0 } else { 2.0 * i as f64 / 63.0 }).map(|x| (r64(x) - (-x).exp()).abs()).fold(0.0, f64::max);
+    let on64 = uniform(64).into_iter().map(|x| (r64(x) - (-x).exp()).abs()).fold(0.0, f64::max);
     assert!((fit.max_abs_error - on64).abs() < 1e-15, "{} vs {on64}", fit.max_abs_error);
     assert_eq!(fit.samples, 64);
     // It is the spec's objective, minimax: its max error on the fitting samples is well below
     // that of the least-squares fit of the same samples (a minimax fit of a smooth function
     // gains ~2× on the max error; 0.8× is far from both).
-    let x64: Vec<Vec<f64>> = (0..64).map(|i| vec![if i == 63 { 2.0 } else { 2.0 * i as f64 / 63.0 }]).collect();
+    let x64: Vec<Vec<f64>> = uniform(64).into_iter().map(|x| vec![x]).collect();
     let data = Data { y: x64.iter().map(|x| (-x[0]).exp()).collect(), x: x64 };
     let lsq = fit::fit(model, &data, &FitOptions::default(), "lsq").unwrap();
     assert!(fit.max_abs_error < 0.8 * lsq.report.max_abs_error, "minimax {} vs least squares {}", fit.max_abs_error, lsq.report.max_abs_error);
@@ -225,7 +230,7 @@ fn a_table_spec_holds_the_quantity_and_reports_its_interpolation_error() {
     }
     let v32: Vec<f64> = values.iter().map(|&v| v as f32 as f64).collect();
     let (mut m, mut ss) = (0.0f64, 0.0);
-    for x in verify_points() {
+    for x in uniform(501) {
         let e = lerp(&v32, x) - (-x).exp();
         m = m.max(e.abs());
         ss += e * e;
@@ -331,8 +336,7 @@ evaluator = "quad"
 /// minimum on [0, 1], and rebuilds from its committed JSON byte for byte.
 #[test]
 fn a_fields_spec_recovers_exact_fields_and_reads_back() {
-    let catalog = Catalog { quantities: vec![&FIELDS_Q], kinds: vec![] };
-    let s = Spec::parse(Path::new("fits/quad_fields.toml"), FIELDS.to_string(), &catalog).unwrap();
+    let s = spec_in(FIELDS, &Catalog { quantities: vec![&FIELDS_Q], kinds: vec![] });
     let tmp = tempfile::tempdir().unwrap();
     let root = tmp.path();
     let b = build_spec(&s, Mode::Fit, root, &|_| None).unwrap();
@@ -397,11 +401,7 @@ static RIPPLED_Q: QuantityDef = QuantityDef {
 fn the_specs_objective_and_rms_cap_reach_the_fitters() {
     let catalog = Catalog { quantities: vec![&RIPPLED_Q, &EXP], kinds: vec![] };
     let tmp = tempfile::tempdir().unwrap();
-    let build = |text: &str| {
-        let name = text.split('"').nth(1).unwrap();
-        let s = Spec::parse(Path::new(&format!("fits/{name}.toml")), text.to_string(), &catalog).unwrap();
-        build_spec(&s, Mode::Fit, tmp.path(), &|_| None).unwrap()
-    };
+    let build = |text: &str| build_spec(&spec_in(text, &catalog), Mode::Fit, tmp.path(), &|_| None).unwrap();
     for (text, kind) in [(FIELDS.replace("quadratic-fields", "rippled-fields"), "fields"), (FIT.to_string(), "fit")] {
         let with = |objective: &str, cap: Option<f64>| {
             let t = text.replace("objective = \"lsq\"", "objective = \"OBJ\"").replace("objective = \"minimax\"", "objective = \"OBJ\"");
