@@ -930,8 +930,9 @@ mod tests {
             measured.push((max, rms, s4));
         }
         let [(lsq_max, lsq_rms, lsq4), (mm_max, mm_rms, mm4), (_, l4_rms, l44)] = measured[..] else { unreachable!() };
-        // Most of the ripple is outside the basis (stage 1's floor below), so minimax gains only
-        // ~5 % on the max error here; 1 % is far above rounding and the solvers' stopping.
+        // Minimax lowers the max error by 41 % here (0.0319 against 0.0536 when this was
+        // written); a bound of 1 % only says it does not lose, the compass-search test below
+        // judges how close it gets.
         assert!(mm_max < 0.99 * lsq_max, "minimax max {mm_max} vs least squares {lsq_max}");
         assert!(lsq_rms < mm_rms && lsq_rms < l4_rms, "rms: lsq {lsq_rms}, minimax {mm_rms}, l4 {l4_rms}");
         assert!(l44 < lsq4 && l44 < mm4, "Σe⁴: l4 {l44}, lsq {lsq4}, minimax {mm4}");
@@ -950,5 +951,133 @@ mod tests {
         assert!((lsq.stage1_max_abs_error - s1max).abs() < 1e-12, "{} vs {s1max}", lsq.stage1_max_abs_error);
         assert!((lsq.stage1_rms_error - s1rms).abs() < 1e-12, "{} vs {s1rms}", lsq.stage1_rms_error);
         assert!(s1max > 1e-3 && s1max < lsq.max_abs_error, "the ripple is partly outside the basis: {s1max}");
+    }
+
+    /// Every objective is equivariant in the data's scale: the samples times 2⁻⁴⁰ (a power of
+    /// two, so every product, quotient and square root of the fit scales exactly) give the
+    /// numerators times 2⁻⁴⁰, the same denominators and the errors times 2⁻⁴⁰. The fields here
+    /// have no offset (a constant that would not scale), and their denominators stay far above
+    /// the barrier's Q_MIN, the fit's one absolute constant. Any stopping rule or weight that
+    /// compares an absolute quantity (a cost, a gain, a residual) breaks it: at this scale the
+    /// cost is ~1e-25.
+    #[test]
+    fn every_objective_is_equivariant_in_the_datas_scale() {
+        let (x, data) = noisy();
+        let s = 2f64.powi(-40);
+        let scaled: Vec<PointData> = data.iter().map(|d| PointData { design: d.design.clone(), y: &d.y * s }).collect();
+        let models: Vec<RationalModel> = (0..3).map(|_| field(0.0)).collect();
+        for objective in [Objective::Lsq, Objective::Minimax, Objective::L4] {
+            let opts = FieldOptions { objective, ..FieldOptions::default() };
+            let a = fit_fields(&models, &x, &data, &opts, "unit").unwrap();
+            let b = fit_fields(&models, &x, &scaled, &opts, "scaled").unwrap();
+            for (k, (ca, cb)) in a.coefficients.iter().zip(&b.coefficients).enumerate() {
+                // Numerator a0..a2 (scaled), denominator b (not): exact, bit for bit.
+                let expect = DVector::from_vec(vec![ca[0] * s, ca[1] * s, ca[2] * s, ca[3]]);
+                assert_eq!(cb.as_slice(), expect.as_slice(), "{objective:?}: field {k}");
+            }
+            assert_eq!((b.max_abs_error, b.rms_error), (a.max_abs_error * s, a.rms_error * s), "{objective:?}");
+            assert_eq!((b.lm_evaluations, b.outer_iterations), (a.lm_evaluations, a.outer_iterations), "{objective:?}");
+        }
+    }
+
+    /// The minimax fit cannot be improved by a compass search on its max error (each
+    /// coefficient moved ± a step, the step halved from 1e-2 to 1e-9 when no move helps): the
+    /// search, started from the returned coefficients, lowers the max error by less than 3 %,
+    /// while from the least-squares fit it lowers it by more than 10 %.
+    #[test]
+    fn the_minimax_fields_fit_is_not_improved_by_a_compass_search() {
+        let (x, data) = noisy();
+        let models: Vec<RationalModel> = OFFSETS.iter().map(|&o| field(o)).collect();
+        let max = |c: &[DVector<f64>]| {
+            let mut m = 0.0f64;
+            for (xg, d) in x.iter().zip(&data) {
+                let v = DVector::from_iterator(3, models.iter().zip(c).map(|(m, c)| m.eval_full(c, xg)));
+                m = m.max((&d.design * v - &d.y).amax());
+            }
+            m
+        };
+        let search = |c0: &[DVector<f64>]| {
+            let (f0, mut c, mut step) = (max(c0), c0.to_vec(), 1e-2);
+            let mut f = f0;
+            while step > 1e-9 {
+                let mut moved = false;
+                for k in 0..c.len() {
+                    for i in 0..c[k].len() {
+                        for sign in [1.0, -1.0] {
+                            let mut t = c.clone();
+                            t[k][i] += sign * step;
+                            let ft = max(&t);
+                            if ft < f {
+                                (c, f, moved) = (t, ft, true);
+                            }
+                        }
+                    }
+                }
+                if !moved {
+                    step *= 0.5;
+                }
+            }
+            (f0 - f) / f0
+        };
+        let fit = |objective| fit_fields(&models, &x, &data, &FieldOptions { objective, ..FieldOptions::default() }, "noisy").unwrap();
+        let (lsq, mm) = (search(&fit(Objective::Lsq).coefficients), search(&fit(Objective::Minimax).coefficients));
+        // Lawson's reweighting stops near, not at, the minimax optimum: the search gained 1.1 %
+        // from it when this was written, 15 % from least squares (compass search stalls on a
+        // max's kinks, so it finds only part of the 41 % minimax gains). 3 % sits between the
+        // 1.1 % and the 8 % it gains from a fit reweighted by w + |e| instead of w·|e|.
+        assert!(mm < 0.03, "a compass search lowers the minimax fit's max error by {mm}");
+        assert!(lsq > 0.1, "a compass search lowers the least-squares fit's max error by only {lsq}");
+    }
+
+    /// The L4 fit is a stationary point of Σe⁴ (its errors recomputed through `eval_full`, not
+    /// the fitter's weights): along the steepest descent direction of Σe⁴ from the returned
+    /// coefficients no step lowers it by more than 1e-6 of its value, while from the
+    /// least-squares fit the same search gains more than 1e-3.
+    #[test]
+    fn the_l4_fields_fit_is_a_stationary_point_of_the_fourth_power_sum() {
+        let (x, data) = noisy();
+        let models: Vec<RationalModel> = OFFSETS.iter().map(|&o| field(o)).collect();
+        let s4 = |c: &[DVector<f64>]| {
+            let f = FieldsFit {
+                coefficients: c.to_vec(),
+                stage1: vec![],
+                max_abs_error: 0.0,
+                rms_error: 0.0,
+                stage1_max_abs_error: 0.0,
+                stage1_rms_error: 0.0,
+                lm_evaluations: 0,
+                outer_iterations: 0,
+            };
+            errors(&models, &f, &x, &data).2
+        };
+        // The best fraction of Σe⁴ a line search along −∇Σe⁴ (central differences, h = 1e-6)
+        // removes: steps 2^-j · 0.1/‖∇‖ for j = 0..40 (the coefficients are O(1)).
+        let descent = |c0: &[DVector<f64>]| {
+            let f0 = s4(c0);
+            let mut g: Vec<DVector<f64>> = c0.iter().map(|c| DVector::zeros(c.len())).collect();
+            for k in 0..c0.len() {
+                for i in 0..c0[k].len() {
+                    let (mut p, mut m) = (c0.to_vec(), c0.to_vec());
+                    p[k][i] += 1e-6;
+                    m[k][i] -= 1e-6;
+                    g[k][i] = (s4(&p) - s4(&m)) / 2e-6;
+                }
+            }
+            let norm = g.iter().map(|v| v.norm_squared()).sum::<f64>().sqrt();
+            let mut best = 0.0f64;
+            for j in 0..40 {
+                let t = 0.1 / norm * 2f64.powi(-j);
+                let c: Vec<DVector<f64>> = c0.iter().zip(&g).map(|(c, g)| c - g * t).collect();
+                best = best.max((f0 - s4(&c)) / f0);
+            }
+            best
+        };
+        let fit = |objective| fit_fields(&models, &x, &data, &FieldOptions { objective, ..FieldOptions::default() }, "noisy").unwrap();
+        let (lsq, l4) = (descent(&fit(Objective::Lsq).coefficients), descent(&fit(Objective::L4).coefficients));
+        // The damped reweighting settles Σe⁴ to ~1e-6 relative (the outer loop's comment): a
+        // descent step from the L4 fit gained 6e-9 when this was written, from the
+        // least-squares fit 8e-3. The bounds sit a factor ~100 and ~8 from those.
+        assert!(l4 < 1e-6, "a descent step lowers the L4 fit's Σe⁴ by {l4}");
+        assert!(lsq > 1e-3, "a descent step lowers the least-squares fit's Σe⁴ by only {lsq}");
     }
 }
