@@ -250,6 +250,36 @@ pub fn items(generated: &Path) -> Vec<Item> {
 mod tests {
     use super::*;
 
+    /// The validation items of the committed outputs: one for each listing, in order; Q̃'s
+    /// error re-measured against E₃ by the test's own quadrature (Q = 2·E₃(d), E₃(d) =
+    /// ∫₀¹ u·e^(−d/u) du after t = 1/u); and P̃_s's least-squares floor below every other
+    /// 6-term table in rms (per (α, θf) it is the rms optimum of the 256 directions, so over
+    /// the grid too).
+    #[test]
+    fn published_items_are_each_listing_re_measured() {
+        let items = items(&Path::new(env!("CARGO_MANIFEST_DIR")).join("generated"));
+        let names: Vec<&str> = items.iter().map(|i| i.name.as_str()).collect();
+        assert_eq!(names, ["fuzz_q (Listing 4)", "fuzz_g (Listing 3)", "fuzz_r (Listing 5)", "fuzz_ps (Listings 1–2, Eq. 1 as printed)"]);
+        // Simpson's rule on 4000 panels: the integrand u·e^(−d/u) is smooth on [0, 1], its
+        // error below 1e-12 here; the max of 2049 differences agrees to that.
+        let e3 = |d: f64| {
+            let n = 4000;
+            let f = |u: f64| if u == 0.0 { 0.0 } else { u * (-d / u).exp() };
+            let h = 1.0 / n as f64;
+            (0..=n).map(|i| f(i as f64 * h) * if i == 0 || i == n { 1.0 } else if i % 2 == 1 { 4.0 } else { 2.0 }).sum::<f64>() * h / 3.0
+        };
+        let q = &items[0];
+        let want = (0..2049).map(|i| 0.5 * i as f64 / 2048.0).map(|d| (published_q(d) - 2.0 * e3(d)).abs()).fold(0.0f64, f64::max);
+        assert!((q.max_abs_error - want).abs() < 1e-9, "Q̃: reported {}, re-measured {want}", q.max_abs_error);
+        assert_eq!(q.points, 2049);
+        let ps = &items[3];
+        let extra = |k: &str| ps.extra.iter().find(|(n, _)| n == k).unwrap().1;
+        let floor = extra("best_6_term_fit_rms_error");
+        assert!(floor > 0.0 && floor <= extra("rows_3_4_swapped_rms_error") && floor <= ps.rms_error, "floor {floor}");
+        assert!(extra("rows_3_4_swapped_max_abs_error") < ps.max_abs_error, "the exchange is the finding");
+        assert_eq!(ps.points, 17 * 17 * 256);
+    }
+
     #[test]
     fn listing_1_with_rows_3_and_4_exchanged_follows_p_s() {
         // P̃_s (Listings 1–2, rows 3 and 4 exchanged as the validation item finds) against P_s

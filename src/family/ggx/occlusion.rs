@@ -465,6 +465,34 @@ pub fn lut_readers(generated: &Path) -> Vec<LutReader> {
     lut::plot::committed(generated).unwrap_or_default().into_iter().map(LutReader::new).collect()
 }
 
+/// Errors of an occluded split sum read from a table against the integral over the cone.
+struct OccludedSpecular {
+    /// Max and rms of |F0·scale + bias − (F0·scale_c + bias_c)| (F0 = 4 %), and where the max is.
+    max: f64,
+    rms: f64,
+    worst: Vec<f64>,
+    /// Max abs error of the scale and of the bias alone.
+    channels: [f64; 2],
+}
+
+/// The occluded split sum itself (what the shader uses) against the integral over the cone:
+/// `read(n·v, α, cos θc)` gives the table's [scale, bias] at each point [r, n·v, V] of `pts`
+/// (α = r², cos θc = sqrt(1 − V)); `refs` holds the integral's occluded scale and bias at [2], [3].
+fn occluded_specular(pts: &[[f64; 3]], refs: &[[f64; 4]], read: impl Fn(f64, f64, f64) -> [f64; 2]) -> OccludedSpecular {
+    let (mut max, mut ss, mut worst, mut ch) = (0.0f64, 0.0, vec![0.0; 3], [0.0f64; 2]);
+    for (p, t) in pts.iter().zip(refs) {
+        let [s, b] = read(p[1], p[0] * p[0], cone_of_visibility(p[2]));
+        let e = (F0 * s + b - (F0 * t[2] + t[3])).abs();
+        ss += e * e;
+        ch = [ch[0].max((s - t[2]).abs()), ch[1].max((b - t[3]).abs())];
+        if e > max {
+            max = e;
+            worst = p.to_vec();
+        }
+    }
+    OccludedSpecular { max, rms: (ss / pts.len() as f64).sqrt(), worst, channels: ch }
+}
+
 /// The COD: WWII table audit: each committed cone LUT, trilinear, against the cone integral.
 fn lut_items(generated: &Path, pts: &[[f64; 3]], refs: &[[f64; 4]]) -> Vec<Item> {
     let mut items = Vec::new();
@@ -483,19 +511,8 @@ fn lut_items(generated: &Path, pts: &[[f64; 3]], refs: &[[f64; 4]]) -> Vec<Item>
                 l.width, l.height, l.depth, l.row, l.depth - 1, l.row
             ),
         );
-        // The occluded split sum itself (what the shader uses) against the integral over the cone.
-        let (mut refl_max, mut refl_ss, mut refl_worst, mut ch) = (0.0f64, 0.0, vec![0.0; 3], [0.0f64; 2]);
-        for (p, t) in pts.iter().zip(refs) {
-            let [s, b] = reader.scale_bias(p[1], p[0] * p[0], cone_of_visibility(p[2]));
-            let e = (F0 * s + b - (F0 * t[2] + t[3])).abs();
-            refl_ss += e * e;
-            ch = [ch[0].max((s - t[2]).abs()), ch[1].max((b - t[3]).abs())];
-            if e > refl_max {
-                refl_max = e;
-                refl_worst = p.to_vec();
-            }
-        }
-        let refl_rms = (refl_ss / pts.len() as f64).sqrt();
+        let OccludedSpecular { max: refl_max, rms: refl_rms, worst: refl_worst, channels: ch } =
+            occluded_specular(pts, refs, |mu, alpha, cos_c| reader.scale_bias(mu, alpha, cos_c));
         item.extra.push(("occluded_specular_max_abs_error".into(), refl_max));
         item.extra.push(("occluded_specular_rms_error".into(), refl_rms));
         item.extra.push(("scale_max_abs_error".into(), ch[0]));
@@ -519,6 +536,39 @@ fn lut_items(generated: &Path, pts: &[[f64; 3]], refs: &[[f64; 4]]) -> Vec<Item>
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The occluded split sum's errors by hand: a reader returning [n·v + α, cos θc] at three
+    /// points against references chosen so the errors are 0.02·0.04 + 0.01 = 0.0108, 0 and
+    /// 0.05·0.04 − 0.03 = −0.028 (abs 0.028, the worst, at the third point).
+    #[test]
+    fn occluded_specular_errors_by_hand() {
+        let pts = [[0.5, 0.25, 0.75], [1.0, 0.5, 0.0], [0.2, 1.0, 0.36]];
+        // At each point n·v + r² and sqrt(1 − V): [0.5, 0.5], [1.5, 1.0], [1.04, 0.8].
+        let refs = [[9.0, 9.0, 0.5 - 0.02, 0.5 - 0.01], [9.0, 9.0, 1.5, 1.0], [9.0, 9.0, 1.04 - 0.05, 0.8 + 0.03]];
+        let o = occluded_specular(&pts, &refs, |mu, alpha, cos_c| [mu + alpha, cos_c]);
+        // Sums and differences of values ~1: rounding 1e-15.
+        let close = |a: f64, b: f64| (a - b).abs() < 1e-14;
+        assert!(close(o.max, 0.028), "max {}", o.max);
+        assert_eq!(o.worst, vec![0.2, 1.0, 0.36]);
+        let rms = ((0.0108f64.powi(2) + 0.028f64.powi(2)) / 3.0).sqrt();
+        assert!(close(o.rms, rms), "rms {} vs {rms}", o.rms);
+        assert!(close(o.channels[0], 0.05) && close(o.channels[1], 0.03), "channels {:?}", o.channels);
+    }
+
+    /// The typo finding's figures against closed forms: over n·v with density 2μ, the printed
+    /// factor μ⁴ averages ∫2μ·μ⁴ dμ = 1/3 and the corrected 1 − (1 − μ)⁴ averages
+    /// 1 − 2·B(2, 5) = 14/15; the two readings differ most at μ = ½, by 1 − 2·(½)⁴ = 0.875.
+    #[test]
+    fn the_typo_findings_figures_are_the_closed_forms() {
+        let item = typo_item();
+        let extra = |k: &str| item.extra.iter().find(|(n, _)| n == k).map(|e| e.1).unwrap();
+        // Midpoint rule on 4096 cells: error h²/24·[f′] ≈ 2.5e-8 for these quintics.
+        assert!((extra("mean_factor_printed") - 1.0 / 3.0).abs() < 1e-7, "{}", extra("mean_factor_printed"));
+        assert!((extra("mean_factor_corrected") - 14.0 / 15.0).abs() < 1e-7, "{}", extra("mean_factor_corrected"));
+        // μ = ½ is a grid point (32/64); the difference there is exact in binary.
+        assert_eq!((item.max_abs_error, item.worst_point.as_slice()), (0.875, &[0.5][..]));
+        assert_eq!(item.points, 65);
+    }
 
     /// With the specular cone centred on the visibility cone (n·v = 1, d = 0) the visible
     /// fraction is the ratio of cap areas (1 − cos a_v)/(1 − cos a_s) when the specular cone is

@@ -621,6 +621,39 @@ pub fn figures(out: &Path, _generated: &Path) -> Result<Vec<PathBuf>, PlotError>
 mod tests {
     use super::*;
 
+    /// The Filament measures sit where the shader reads: column c of the grid at the texel
+    /// centre n·v = (cols[c] + ½)/128, grid row k at perceptual roughness (k + ½)/128 (row 128:
+    /// 1); each against the height-correlated integral computed directly at that point, and
+    /// the own-roughness errors pair table row j with grid row j + 1 (the row's roughness is
+    /// (j + 1.5)/128, `row_roughness`).
+    #[test]
+    fn filament_measures_are_at_the_texels_coordinates() {
+        let fm = filament_measures();
+        let n = filament::SIZE;
+        assert_eq!(fm.cols, (0..n).step_by(4).collect::<Vec<_>>());
+        for (c, k) in [(0, 0), (5, 40), (17, 127), (31, 128)] {
+            let r = if k < n { (k as f64 + 0.5) / n as f64 } else { 1.0 };
+            let want = filament::exact((fm.cols[c] as f64 + 0.5) / n as f64, r * r, 1e-10);
+            let got = fm.exact(c, k);
+            // The grid's tolerance 1e-7 against a direct integral at 1e-10.
+            assert!((got[0] - want[0]).abs() < 2e-7 && (got[1] - want[1]).abs() < 2e-7, "({c}, {k}): {got:?} vs {want:?}");
+        }
+        let own = fm.errors(1, false, true);
+        let shader = fm.errors(1, false, false);
+        for (j, c) in [(0, 3), (70, 12), (127, 31)] {
+            let i = fm.cols[c];
+            let texel = fm.table.f64s[j * n + i][1];
+            let mu = (i as f64 + 0.5) / n as f64;
+            let r_own = filament::row_roughness(j, n);
+            let r_shader = (j as f64 + 0.5) / n as f64;
+            let e_own = texel - filament::exact(mu, r_own * r_own, 1e-10)[1];
+            let e_shader = texel - filament::exact(mu, r_shader * r_shader, 1e-10)[1];
+            let at = j * fm.cols.len() + c;
+            assert!((own[at] - e_own).abs() < 2e-7, "own ({j}, {c}): {} vs {e_own}", own[at]);
+            assert!((shader[at] - e_shader).abs() < 2e-7, "shader ({j}, {c}): {} vs {e_shader}", shader[at]);
+        }
+    }
+
     #[test]
     fn stats_are_max_abs_rms_and_mean_by_hand() {
         // e = (3, −4): max |e| = 4, rms = √((9 + 16)/2) = √12.5, mean = −0.5. 1e-15: one

@@ -444,6 +444,31 @@ mod tests {
         assert!((v - 0.98650582966).abs() < 1e-10, "{v}");
     }
 
+    /// The items of the committed slices, computed once for the tests that read them (seconds).
+    fn committed_items() -> &'static [Item] {
+        static ITEMS: std::sync::OnceLock<Vec<Item>> = std::sync::OnceLock::new();
+        ITEMS.get_or_init(|| items(&Path::new(env!("CARGO_MANIFEST_DIR")).join("generated")))
+    }
+
+    /// The reference's rms standard error reported beside the gloss-0 items, re-measured from
+    /// the committed JSON alone: sqrt of the mean of the squared standard errors of the
+    /// gloss-0 layer's cells (slices[j·w + i][1]).
+    #[test]
+    fn the_gloss_0_reference_standard_error_is_re_measured() {
+        let generated = Path::new(env!("CARGO_MANIFEST_DIR")).join("generated");
+        let v: Value = serde_json::from_str(&std::fs::read_to_string(generated.join("json/ms_diffuse_slices.json")).unwrap()).unwrap();
+        assert_eq!(v["gloss"][0].as_f64(), Some(0.0));
+        let n = (v["axes"][0]["count"].as_u64().unwrap() * v["axes"][1]["count"].as_u64().unwrap()) as usize;
+        let se: Vec<f64> = (0..n).map(|k| v["slices"][k][1].as_f64().unwrap()).collect();
+        let want = (se.iter().map(|s| s * s).sum::<f64>() / n as f64).sqrt();
+        // Not vacuous: the simulation's errors are neither 0 nor 1.
+        assert!(want > 1e-6 && want < 0.1, "{want}");
+        let it = committed_items().iter().find(|it| it.name.starts_with("ms-diffuse gloss-0 slice: published")).unwrap();
+        let got = it.extra.iter().find(|(k, _)| k == "reference_rms_standard_error").unwrap().1;
+        // The same squares summed in the same order: 1e-14 relative.
+        assert!((got - want).abs() <= 1e-14 * want, "reported {got}, re-measured {want}");
+    }
+
     #[test]
     fn talk_rational_against_the_lambert_slice_times_0_9216_is_re_measured() {
         // The talk's F0 = 0.04 with a constant (1 − F0) at entry and exit scales the F0 = 0 walk
@@ -463,8 +488,7 @@ mod tests {
                 want = want.max((published - 0.9216 * cell).abs());
             }
         }
-        let items = items(&generated);
-        let it = items.iter().find(|it| it.name.starts_with("ms-diffuse gloss-0 slice")).unwrap();
+        let it = committed_items().iter().find(|it| it.name.starts_with("ms-diffuse gloss-0 slice")).unwrap();
         let got = it.extra.iter().find(|(k, _)| k == "max_abs_error_vs_f0_0_times_0.9216").unwrap().1;
         assert!((got - want).abs() <= 1e-12 * want, "reported {got}, re-measured {want}");
     }
