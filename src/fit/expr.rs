@@ -206,6 +206,36 @@ mod tests {
         assert_eq!(s, "1 + (x0 + x1 + x2)");
     }
 
+    /// The emitted tree evaluates the model for every shape of term: a constant, a lone
+    /// variable, a power, a cross term, tied terms with and without a constant (1 + x, x + y²),
+    /// a lead term, a factor and an offset; against the model's own f64 evaluation
+    /// (`eval_full`, which sums basis values, not the tree) at points across the unit square.
+    #[test]
+    fn the_emitted_tree_evaluates_the_model_for_every_term_shape() {
+        use crate::fit::model::ModelParts;
+        let f = vec!["x".to_string(), "y".to_string()];
+        let t = |s: &str| Term::parse(s, &f).unwrap();
+        let m = RationalModel::new(ModelParts {
+            inputs: f.clone(),
+            numerator: vec![t("1"), t("x"), t("1 + x"), t("x + y^2"), t("x*y")],
+            denominator: vec![t("y"), t("1 + x*y"), t("x^2")],
+            lead: Some(t("1 + y")),
+            offset: 0.25,
+            factor: Some(t("1 + x^2")),
+            ..ModelParts::default()
+        })
+        .unwrap();
+        let c = DVector::from_vec(vec![0.5, -1.25, 0.75, 2.0, -0.5, 0.3, 0.2, -0.1]);
+        let (num, den) = f32_arrays(&m, &c);
+        let e = model_expr(&m);
+        for (x, y) in [(0.0, 0.0), (0.3, 0.8), (1.0, 0.5), (0.7, 1.0)] {
+            let want = m.eval_full(&c, &[x, y]);
+            let got = eval_f32(&e, &[x as f32, y as f32], &num, &den) as f64;
+            // f32 rounding of ~20 operations on values ≤ 10 (Q ≥ 1 here): 1e-5.
+            assert!((got - want).abs() < 1e-5, "({x}, {y}): tree {got}, model {want}");
+        }
+    }
+
     #[test]
     fn horner_form_matches_direct_sum() {
         let m = RationalModel::rational_1d("x", 3, 2);
