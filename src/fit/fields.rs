@@ -86,7 +86,6 @@ pub fn reduce(b: &DMatrix<f64>, y: &DVector<f64>, sqrt_w: Option<&[f64]>) -> Red
 pub struct Stage1 {
     pub coefficients: Vec<f64>,
     pub condition: f64,
-    pub rms: f64,
 }
 
 pub fn stage1(b: &DMatrix<f64>, y: &DVector<f64>) -> Stage1 {
@@ -96,8 +95,7 @@ pub fn stage1(b: &DMatrix<f64>, y: &DVector<f64>) -> Stage1 {
     let smin = s.min();
     let condition = if smin > 0.0 { smax / smin } else { f64::INFINITY };
     let c = svd.solve(y, RCOND * smax).unwrap_or_else(|_| DVector::zeros(b.ncols()));
-    let rms = ((b * &c - y).norm_squared() / y.len().max(1) as f64).sqrt();
-    Stage1 { coefficients: c.iter().copied().collect(), condition, rms }
+    Stage1 { coefficients: c.iter().copied().collect(), condition }
 }
 
 /// The joint stage-2 problem: residuals R_g c(x_g; θ) − z_g for all grid points.
