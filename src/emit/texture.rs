@@ -526,7 +526,8 @@ mod tests {
     fn unorm_mip_chains_read_back_with_the_ktx2_crate() {
         // 5×3 → 2×1 → 1×1; RG8 and RGBA16: the ktx2 crate's reader (independent) finds the
         // format, the three levels in order and the codes (round(v · (2^bits − 1))).
-        for (channels, bits) in [(2usize, 8u32), (4, 16)] {
+        // VkFormat enumerants from the Vulkan specification: R8G8_UNORM 16, R16G16B16A16_UNORM 91.
+        for (channels, bits, vk) in [(2usize, 8u32, 16u32), (4, 16, 91)] {
             let sizes = [(5u32, 3u32), (2, 1), (1, 1)];
             let levels: Vec<UnormLevel> = sizes
                 .iter()
@@ -536,8 +537,18 @@ mod tests {
             let bytes = ktx2_unorm_mips(&levels, channels, bits, &[]);
             let r = ktx2::Reader::new(&bytes[..]).expect("a valid KTX2 file");
             let hd = r.header();
-            assert_eq!(hd.format.map(|f| f.value()), Some(vk_format_unorm(channels, bits)));
+            assert_eq!(hd.format.map(|f| f.value()), Some(vk));
             assert_eq!((hd.pixel_width, hd.pixel_height, hd.level_count), (5, 3, 3));
+            // The DFD's integer samples (KDF 1.3 §5): no qualifiers, lower 0, upper 2^bits − 1.
+            let basic = r.basic_dfd().expect("a basic DFD block");
+            assert_eq!(basic.bytes_planes[0] as usize, channels * bits as usize / 8);
+            let samples = &basic.sample_information;
+            assert_eq!(samples.iter().map(|s| s.channel_type).collect::<Vec<_>>(), if channels == 2 { vec![0u8, 1] } else { vec![0, 1, 2, 15] });
+            for (k, smp) in samples.iter().enumerate() {
+                assert_eq!((smp.bit_offset as u32, smp.bit_length.get() as u32), (k as u32 * bits, bits));
+                assert!(smp.channel_type_qualifiers.is_empty());
+                assert_eq!((smp.lower, smp.upper), (0, (1u32 << bits) - 1));
+            }
             let q = ((1u64 << bits) - 1) as f64;
             for (k, level) in r.levels().enumerate() {
                 let want: Vec<u32> = levels[k].values.iter().map(|v| (v * q).round() as u32).collect();

@@ -281,6 +281,28 @@ pub fn strip_directives(src: &str) -> String {
 mod tests {
     use super::*;
 
+    /// Every shape of derived feature, rendered and evaluated by naga's constant evaluator
+    /// (`const d = <expression of x0>;` with x0 a constant): the value is the feature's own f32
+    /// evaluation (`Derived::eval_f32`) at x0 = 0.3.
+    #[test]
+    fn derived_features_evaluate_in_naga_as_in_f32() {
+        let inputs = vec!["x".to_string()];
+        for text in ["x", "0.5 - x", "0.25 + x", "2*x", "1 + 3*x", "1 - 2*x", "0 - x", "cos(x)", "sin(x)"] {
+            let d = crate::fit::model::Derived::parse("d", text, &inputs).unwrap();
+            let expr = derived_expr(&d, &lit, &|fun, v| format!("{fun}({v})"));
+            let src = format!("const x0: f32 = 0.3;\nconst d: f32 = {expr};\n");
+            let m = naga::front::wgsl::parse_str(&src).unwrap_or_else(|e| panic!("{}", e.emit_to_string(&src)));
+            let c = m.constants.iter().find(|(_, c)| c.name.as_deref() == Some("d")).unwrap().1;
+            let naga::Expression::Literal(naga::Literal::F32(got)) = m.global_expressions[c.init] else {
+                panic!("{text}: {src} is not folded to a literal")
+            };
+            let want = d.eval_f32(&[0.3]);
+            // One f32 operation or two (exact agreement), or naga's cos/sin against Rust's f32
+            // ones: a few ulps of values ≤ 1.6.
+            assert!((got - want).abs() <= 4.0 * f32::EPSILON, "{text}: naga {got} from '{expr}', f32 {want}");
+        }
+    }
+
     /// A constant array: its values read back through naga in order, six to a line.
     #[test]
     fn arrays_read_back_through_naga() {
