@@ -978,6 +978,29 @@ mod tests {
         }
     }
 
+    /// Minimax under an rms cap between least squares' rms and the uncapped minimax's: the
+    /// result keeps its rms under the cap (re-measured from the coefficients) and still lowers
+    /// the max error below least squares'; the uncapped fit, above the cap, has the lowest max.
+    #[test]
+    fn fields_minimax_under_an_rms_cap_keeps_the_cap() {
+        let (x, data) = noisy();
+        let models: Vec<RationalModel> = OFFSETS.iter().map(|&o| field(o)).collect();
+        let fit = |objective, max_rms| fit_fields(&models, &x, &data, &FieldOptions { objective, max_rms, ..FieldOptions::default() }, "noisy").unwrap();
+        let (lsq, free) = (fit(Objective::Lsq, None), fit(Objective::Minimax, None));
+        let (lsq_max, lsq_rms, _) = errors(&models, &lsq, &x, &data);
+        let (free_max, free_rms, _) = errors(&models, &free, &x, &data);
+        // The cap binds: half way from least squares' rms to the uncapped minimax's.
+        let cap = lsq_rms + 0.5 * (free_rms - lsq_rms);
+        assert!(free_rms > cap, "uncapped rms {free_rms} vs cap {cap}");
+        let capped = fit(Objective::Minimax, Some(cap));
+        let (max, rms, _) = errors(&models, &capped, &x, &data);
+        assert!(rms <= cap, "rms {rms} above the cap {cap}");
+        // Strict improvements: the first reweighting steps lower the max error while the rms is
+        // still near least squares'; the uncapped search can only do better.
+        assert!(max < lsq_max, "capped max {max} vs least squares {lsq_max}");
+        assert!(free_max <= max, "uncapped max {free_max} vs capped {max}");
+    }
+
     /// The minimax fit cannot be improved by a compass search on its max error (each
     /// coefficient moved ± a step, the step halved from 1e-2 to 1e-9 when no move helps): the
     /// search, started from the returned coefficients, lowers the max error by less than 3 %,
