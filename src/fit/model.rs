@@ -556,6 +556,28 @@ mod tests {
         assert!((m.eval_full(&c, &[1.0]) - 0.9).abs() < 1e-14);
     }
 
+    /// `range` is the exact range of every kind of derived feature: it holds every value at
+    /// 100001 points of the interval, and its ends are reached within the sampling's error
+    /// (spacing ≤ 1.5e-4, so cos/sin at the nearest sample lie within (7.5e-5)²/2 ≈ 2.8e-9 of
+    /// an interior extremum; affine ends are sampled exactly). Intervals inside one period, across one
+    /// or both extrema, over several periods, and negative.
+    #[test]
+    fn derived_ranges_are_tight_against_dense_sampling() {
+        let inputs = vec!["x".to_string()];
+        let features = ["cos(x)", "sin(x)", "1 - 2*x", "0.5 + 3*x", "x"];
+        let intervals = [(0.5, 5.5), (0.1, 1.5), (-0.5, 4.0), (2.0, 9.0), (-7.0, -6.0), (1.0, 1.0 + 1e-3), (-3.0, 12.0)];
+        for text in features {
+            let d = Derived::parse("d", text, &inputs).unwrap();
+            for &(lo, hi) in &intervals {
+                let (r0, r1) = d.range(&[(lo, hi)]);
+                let v: Vec<f64> = (0..=100_000).map(|k| d.eval(&[lo + (hi - lo) * k as f64 / 100_000.0])).collect();
+                let (v0, v1) = v.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| (a.min(x), b.max(x)));
+                assert!(v0 >= r0 - 1e-12 && v1 <= r1 + 1e-12, "{text} on [{lo}, {hi}]: samples [{v0}, {v1}] outside [{r0}, {r1}]");
+                assert!(v0 - r0 < 1e-8 && r1 - v1 < 1e-8, "{text} on [{lo}, {hi}]: range [{r0}, {r1}] wider than samples [{v0}, {v1}]");
+            }
+        }
+    }
+
     #[test]
     fn derived_features_parse_and_bound() {
         let inputs = vec!["alpha".to_string(), "theta_f".to_string()];
