@@ -911,5 +911,28 @@ mod tests {
         for (c, w) in f.coefficients.iter().zip([0.2, 1.5, 0.5]) {
             assert!((c - w).abs() < 1e-9, "{:?}", f.coefficients);
         }
+        // The reweighted linearised starts leave the samples at the clamp out (they are not
+        // P/Q), so on the rest they are the rational itself: SVD rounding, ~1e-14.
+        let starts = linearised_starts(&model, &data, "clamped").unwrap();
+        for (k, st) in starts.iter().enumerate().skip(1) {
+            for (c, w) in model.full(st).iter().zip([0.2, 1.5, 0.5]) {
+                assert!((c - w).abs() < 1e-9, "start {k}: {st:?}");
+            }
+        }
+    }
+
+    /// A fixed numerator coefficient of data far from one (values ~2⁻⁵⁰) holds in the data's
+    /// units: the scaled problem fixes it divided by the same power of two as the data, so the
+    /// fit of an exact rational reports the fixed value and recovers the others.
+    #[test]
+    fn fixed_coefficients_far_from_one_hold_in_the_datas_units() {
+        let ys = 2f64.powi(-50);
+        let model = RationalModel::new(ModelParts { fixed: vec![(0, 0.2 * ys)], ..parts_1d(&["1", "x"], &["x"]) }).unwrap();
+        let x: Vec<Vec<f64>> = (0..=40).map(|i| vec![i as f64 / 20.0]).collect();
+        let data = Data { y: x.iter().map(|p| ys * (0.2 + 1.5 * p[0]) / (1.0 + 0.5 * p[0])).collect(), x };
+        let f = fit_rescaled(&model, &data, &FitOptions::default(), "fixed").unwrap();
+        assert_eq!(f.coefficients[0], 0.2 * ys, "the fixed coefficient, exactly");
+        // Exact data: the free coefficients to rounding (relative 1e-9 of their units).
+        assert!((f.coefficients[1] - 1.5 * ys).abs() < 1e-9 * ys && (f.coefficients[2] - 0.5).abs() < 1e-9, "{:?}", f.coefficients);
     }
 }
