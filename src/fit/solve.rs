@@ -811,6 +811,27 @@ mod tests {
         }
     }
 
+    /// The linearised starts do not depend on the feature's units: x times 2³⁰ scales the
+    /// columns of x^k by 2^(30k) exactly, the column scaling takes that out, and every start's
+    /// coefficient of x^k comes back times 2^(−30k), bit for bit. Unscaled, the columns' norms
+    /// would span ~1e18 and the SVD's rank decision (1e-13 relative) would drop x²'s.
+    #[test]
+    fn linearised_starts_are_equivariant_in_the_features_scale() {
+        let model = RationalModel::rational_1d("x", 2, 2);
+        let sx = 2f64.powi(30);
+        let x: Vec<Vec<f64>> = (0..=40).map(|i| vec![0.075 * i as f64]).collect();
+        let y: Vec<f64> = x.iter().map(|p| (1.0 + 2.0 * p[0]).ln() + 0.3).collect();
+        let a = linearised_starts(&model, &Data { x: x.clone(), y: y.clone() }, "unit").unwrap();
+        let b = linearised_starts(&model, &Data { x: x.iter().map(|p| vec![p[0] * sx]).collect(), y }, "scaled").unwrap();
+        assert_eq!(a.len(), b.len());
+        // Powers of x in the free parameters: numerator 1, x, x²; denominator x, x².
+        let degree = [0, 1, 2, 1, 2];
+        for (k, (sa, sb)) in a.iter().zip(&b).enumerate() {
+            let want: Vec<f64> = sa.iter().zip(degree).map(|(v, d)| v * sx.powi(-d)).collect();
+            assert_eq!(sb.as_slice(), want.as_slice(), "start {k}");
+        }
+    }
+
     /// An L4 fit is a least-squares solve followed by a solve of Σr⁴ from its optimum: it
     /// reports both stages' iterations and evaluations, each stage re-run here on its own, and
     /// its Σr⁴ is no higher than the least-squares optimum's.
