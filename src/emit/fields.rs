@@ -298,7 +298,8 @@ mod tests {
     }
 
     /// The Rust module declares the domain, each field's f32 arrays and the f64 coefficients,
-    /// every literal reading back to the value it was given.
+    /// every literal reading back to the value it was given; the WGSL module of the same
+    /// fields validates in naga and returns every field.
     #[test]
     fn the_rust_module_carries_every_coefficient() {
         let model = crate::fit::model::RationalModel::rational_1d("o", 1, 1);
@@ -323,6 +324,18 @@ mod tests {
             range: (-4.0, 4.0),
         };
         let c64 = vec![(vec![0.1, -2.5], vec![0.3]), (vec![1.0 / 3.0, 7.0], vec![-0.2])];
+        // The WGSL module validates in naga, and its coefficient function returns one composed
+        // value per field (an empty body would be `array<f32, 2>()`, the zero value).
+        let wgsl = crate::emit::wgsl::strip_directives(&render_wgsl(&["header line".to_string()], &f));
+        let m = naga::front::wgsl::parse_str(&wgsl).unwrap_or_else(|e| panic!("{}", e.emit_to_string(&wgsl)));
+        naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all()).validate(&m).unwrap();
+        let (_, coeffs) = m.functions.iter().find(|(_, g)| g.name.as_deref() == Some("quad_coeffs")).unwrap();
+        let returned = coeffs.body.iter().find_map(|st| match st {
+            naga::Statement::Return { value: Some(v) } => Some(*v),
+            _ => None,
+        });
+        let naga::Expression::Compose { components, .. } = &coeffs.expressions[returned.unwrap()] else { panic!("{wgsl}") };
+        assert_eq!(components.len(), 2, "{wgsl}");
         let text = render_rust(&["header line".to_string()], &f, "the doc", &c64);
         assert!(text.starts_with("//! header line\n"), "{text}");
         // The literals of one `pub const NAME: [...] = [...];`, read back.
