@@ -475,3 +475,20 @@ fn a_validation_item_measures_the_committed_refit() {
     assert!(bare.add_refit(&generated, "no_such_fit", &catalog, &points, &truth).is_none());
     assert!(bare.extra.is_empty() && bare.findings.is_empty());
 }
+
+/// The runtime index lists for GPU verification the scalar functions only: a fit and a table
+/// emitted as a constant, not a table emitted as a texture alone (its `_load` takes a texture)
+/// nor a fields spec (it returns an array); every module is indexed all the same.
+#[test]
+fn the_runtime_index_lists_only_scalar_functions() {
+    let catalog = Catalog { quantities: vec![&EXP, &FIELDS_Q], kinds: vec![] };
+    let texture_only = TABLE.replace("exp_table", "exp_texture").replace("[emit]", "[emit]\nform = \"texture\"");
+    let specs = [spec_in(FIT, &catalog), spec_in(TABLE, &catalog), spec_in(&texture_only, &catalog), spec_in(FIELDS, &catalog)];
+    let text = String::from_utf8(runtime_index(&specs).contents).unwrap();
+    let functions = &text[text.find("pub const FUNCTIONS").expect("the FUNCTIONS list")..];
+    let listed: Vec<&str> = functions.lines().filter_map(|l| l.split("name: \"").nth(1)).map(|r| r.split('"').next().unwrap()).collect();
+    assert_eq!(listed, ["exp_fit", "exp_table"], "{functions}");
+    for s in &specs {
+        assert!(text[..text.find("pub const FUNCTIONS").unwrap()].contains(&format!("\"{}\"", s.file.name)), "module {} not indexed:\n{text}", s.file.name);
+    }
+}
