@@ -25,7 +25,7 @@ use sha2::{Digest, Sha256};
 use std::path::Path;
 
 #[cfg(test)]
-mod build_tests;
+pub(crate) mod build_tests;
 pub mod committed;
 pub mod data;
 pub mod fields;

@@ -8,7 +8,7 @@ use crate::integrate::Estimate;
 use crate::quantity::{ParamSpec, QuantityDef};
 use crate::spec::Catalog;
 
-static EXP: QuantityDef = QuantityDef {
+pub(crate) static EXP: QuantityDef = QuantityDef {
     name: "exp-decay",
     doc: "e^-x (a closed form the build's results are checked against)",
     params: &[ParamSpec { name: "x", min: 0.0, max: 2.0, doc: "argument", integer: false, default: None }],
@@ -20,7 +20,7 @@ static EXP: QuantityDef = QuantityDef {
     basis: None,
 };
 
-fn spec(text: &str) -> Spec {
+pub(crate) fn spec(text: &str) -> Spec {
     spec_in(text, &Catalog { quantities: vec![&EXP], kinds: vec![] })
 }
 
@@ -30,7 +30,7 @@ fn spec_in(text: &str, catalog: &Catalog) -> Spec {
     Spec::parse(Path::new(&format!("fits/{name}.toml")), text.to_string(), catalog).unwrap()
 }
 
-const FIT: &str = r#"
+pub(crate) const FIT: &str = r#"
 name = "exp_fit"
 kind = "fit"
 quantity = "exp-decay"
@@ -57,17 +57,17 @@ fn file<'a>(b: &'a Built, path: &str) -> &'a [u8] {
     &b.artifacts.iter().find(|a| a.path == Path::new(path)).unwrap_or_else(|| panic!("no {path}")).contents
 }
 
-fn json_of(b: &Built) -> Value {
+pub(crate) fn json_of(b: &Built) -> Value {
     serde_json::from_slice(file(b, &format!("json/{}.json", b.name))).unwrap()
 }
 
-fn floats(v: &Value) -> Vec<f64> {
+pub(crate) fn floats(v: &Value) -> Vec<f64> {
     v.as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect()
 }
 
 /// n uniform points over [0, 2], the last exactly 2: the specs' grids written out (501: the
 /// verification grid; 64: the fitting samples).
-fn uniform(n: usize) -> Vec<f64> {
+pub(crate) fn uniform(n: usize) -> Vec<f64> {
     (0..n).map(|i| if i + 1 == n { 2.0 } else { 2.0 * i as f64 / (n - 1) as f64 }).collect()
 }
 
@@ -434,46 +434,6 @@ fn the_specs_objective_and_rms_cap_reach_the_fitters() {
         // no reweighted iterate is within this cap: the start is kept).
         assert!(capped.1 <= cap && capped.0 <= lsq.0, "{kind}: capped {capped:?}, cap {cap}, least squares {lsq:?}");
     }
-}
-
-/// A validation item beside its committed refit: `Item::add_refit` loads the refit through its
-/// spec (`fits/NAME.toml` next to the outputs), evaluates it at the item's points and adds its
-/// errors; each is re-measured here from the written coefficients against the closed form. A
-/// refit that is not committed adds nothing.
-#[test]
-fn a_validation_item_measures_the_committed_refit() {
-    let catalog = Catalog { quantities: vec![&EXP], kinds: vec![] };
-    let tmp = tempfile::tempdir().unwrap();
-    let generated = tmp.path().join("generated");
-    std::fs::create_dir_all(tmp.path().join("fits")).unwrap();
-    std::fs::write(tmp.path().join("fits/exp_fit.toml"), FIT).unwrap();
-    let b = build_spec(&spec(FIT), Mode::Fit, &generated, &|_| None).unwrap();
-    write_all(&generated, &b.artifacts).unwrap();
-    let c = floats(&json_of(&b)["model"]["coefficients"]);
-    let r64 = |x: f64| (c[0] + c[1] * x + c[2] * x * x) / (1.0 + c[3] * x + c[4] * x * x);
-    // A "published" form to set beside it: the Taylor polynomial 1 − x + x²/2.
-    let xs = uniform(21);
-    let points: Vec<Vec<f64>> = xs.iter().map(|&x| vec![x]).collect();
-    let truth: Vec<f64> = xs.iter().map(|&x| (-x).exp()).collect();
-    let taylor: Vec<f64> = xs.iter().map(|&x| 1.0 - x + 0.5 * x * x).collect();
-    let mut item = crate::validate::Item::measured("taylor", "a test", "x ∈ [0, 2]", &points, &truth, &taylor);
-    let values = item.add_refit(&generated, "exp_fit", &catalog, &points, &truth).expect("the refit is committed");
-    let (mut max, mut ss) = (0.0f64, 0.0);
-    for ((&x, v), t) in xs.iter().zip(&values).zip(&truth) {
-        // The refit evaluated through its model against the coefficients written out: rounding.
-        assert!((v - r64(x)).abs() < 1e-15, "refit at {x}: {v} vs {}", r64(x));
-        max = max.max((r64(x) - t).abs());
-        ss += (r64(x) - t).powi(2);
-    }
-    let extra = |k: &str| item.extra.iter().find(|(n, _)| n == k).unwrap().1;
-    assert!((extra("refit_max_abs_error") - max).abs() < 1e-15, "{} vs {max}", extra("refit_max_abs_error"));
-    assert!((extra("refit_rms_error") - (ss / 21.0).sqrt()).abs() < 1e-15);
-    // The Taylor form's own error (at x = 2: 1 − e⁻² ≈ 0.865) is far above the refit's.
-    assert!(item.max_abs_error > 0.8 && max < 1e-3, "taylor {}, refit {max}", item.max_abs_error);
-    assert_eq!(item.findings.len(), 1, "{:?}", item.findings);
-    let mut bare = crate::validate::Item::measured("taylor", "a test", "x ∈ [0, 2]", &points, &truth, &taylor);
-    assert!(bare.add_refit(&generated, "no_such_fit", &catalog, &points, &truth).is_none());
-    assert!(bare.extra.is_empty() && bare.findings.is_empty());
 }
 
 /// The runtime index lists for GPU verification the scalar functions only: a fit and a table

@@ -64,3 +64,50 @@ impl Item {
 pub fn all(generated: &Path, validators: &[fn(&Path) -> Vec<Item>]) -> Vec<Item> {
     validators.iter().flat_map(|v| v(generated)).collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::pipeline::build_tests::{floats, json_of, spec, uniform, EXP, FIT};
+    use crate::pipeline::{build_spec, write_all, Mode};
+
+    /// A validation item beside its committed refit: `Item::add_refit` loads the refit through its
+    /// spec (`fits/NAME.toml` next to the outputs), evaluates it at the item's points and adds its
+    /// errors; each is re-measured here from the written coefficients against the closed form. A
+    /// refit that is not committed adds nothing.
+    #[test]
+    fn a_validation_item_measures_the_committed_refit() {
+        let catalog = Catalog { quantities: vec![&EXP], kinds: vec![] };
+        let tmp = tempfile::tempdir().unwrap();
+        let generated = tmp.path().join("generated");
+        std::fs::create_dir_all(tmp.path().join("fits")).unwrap();
+        std::fs::write(tmp.path().join("fits/exp_fit.toml"), FIT).unwrap();
+        let b = build_spec(&spec(FIT), Mode::Fit, &generated, &|_| None).unwrap();
+        write_all(&generated, &b.artifacts).unwrap();
+        let c = floats(&json_of(&b)["model"]["coefficients"]);
+        let r64 = |x: f64| (c[0] + c[1] * x + c[2] * x * x) / (1.0 + c[3] * x + c[4] * x * x);
+        // A "published" form to set beside it: the Taylor polynomial 1 − x + x²/2.
+        let xs = uniform(21);
+        let points: Vec<Vec<f64>> = xs.iter().map(|&x| vec![x]).collect();
+        let truth: Vec<f64> = xs.iter().map(|&x| (-x).exp()).collect();
+        let taylor: Vec<f64> = xs.iter().map(|&x| 1.0 - x + 0.5 * x * x).collect();
+        let mut item = Item::measured("taylor", "a test", "x ∈ [0, 2]", &points, &truth, &taylor);
+        let values = item.add_refit(&generated, "exp_fit", &catalog, &points, &truth).expect("the refit is committed");
+        let (mut max, mut ss) = (0.0f64, 0.0);
+        for ((&x, v), t) in xs.iter().zip(&values).zip(&truth) {
+            // The refit evaluated through its model against the coefficients written out: rounding.
+            assert!((v - r64(x)).abs() < 1e-15, "refit at {x}: {v} vs {}", r64(x));
+            max = max.max((r64(x) - t).abs());
+            ss += (r64(x) - t).powi(2);
+        }
+        let extra = |k: &str| item.extra.iter().find(|(n, _)| n == k).unwrap().1;
+        assert!((extra("refit_max_abs_error") - max).abs() < 1e-15, "{} vs {max}", extra("refit_max_abs_error"));
+        assert!((extra("refit_rms_error") - (ss / 21.0).sqrt()).abs() < 1e-15);
+        // The Taylor form's own error (at x = 2: 1 − e⁻² ≈ 0.865) is far above the refit's.
+        assert!(item.max_abs_error > 0.8 && max < 1e-3, "taylor {}, refit {max}", item.max_abs_error);
+        assert_eq!(item.findings.len(), 1, "{:?}", item.findings);
+        let mut bare = Item::measured("taylor", "a test", "x ∈ [0, 2]", &points, &truth, &taylor);
+        assert!(bare.add_refit(&generated, "no_such_fit", &catalog, &points, &truth).is_none());
+        assert!(bare.extra.is_empty() && bare.findings.is_empty());
+    }
+}
