@@ -579,12 +579,20 @@ mod tests {
 
     /// The Gauss pair's QUADPACK estimate from its definition: raw = |Q32 − Q24|, resasc =
     /// ∫|f − mean| and resabs = ∫|f| by the 32-point rule, all times the half-width, worked out
-    /// here from the nodes of `gauss_legendre` on a panel [1, 3] of f(x) = x^60 / 3^60.
+    /// here from the nodes of `gauss_legendre`, on two panels: [1, 3] of f(x) = x^60 / 3^60,
+    /// where the estimate is the roundoff floor, and [0, 1] of √x, where it is
+    /// resasc·(200 raw/resasc)^1.5 (both asserted, so each term of the definition is used).
     #[test]
     fn gauss_pair_quadpack_estimate_is_qk_from_its_parts() {
+        type F = fn(f64) -> f64;
+        let cases: [(F, f64, f64, bool); 2] = [(|x| (x / 3.0).powi(60), 2.0, 1.0, true), (|x| x.sqrt(), 0.5, 0.5, false)];
+        for (f, c, h, floored) in cases {
+            gauss_pair_estimate_from_parts(f, c, h, floored);
+        }
+    }
+
+    fn gauss_pair_estimate_from_parts(f: fn(f64) -> f64, c: f64, h: f64, floored: bool) {
         let pair = GaussPair::new(32, 24);
-        let f = |x: f64| (x / 3.0).powi(60);
-        let (c, h) = (2.0, 1.0);
         let rule = |n: usize| {
             let (x, w) = crate::integrate::gauss_legendre(n);
             x.iter().zip(&w).map(|(x, w)| w * f(c + h * x)).sum::<f64>()
@@ -594,12 +602,55 @@ mod tests {
         let mean = 0.5 * q32;
         let resasc: f64 = x.iter().zip(&w).map(|(x, w)| w * (f(c + h * x) - mean).abs()).sum();
         let resabs: f64 = x.iter().zip(&w).map(|(x, w)| w * f(c + h * x).abs()).sum();
-        let want = quadpack_error(((q32 - q24) * h).abs(), resasc * h, resabs * h);
+        let raw = ((q32 - q24) * h).abs();
+        let want = quadpack_error(raw, resasc * h, resabs * h);
+        let floor = 50.0 * f64::EPSILON * resabs * h;
+        assert_eq!(want == floor, floored, "the estimate is the floor: {want:e} vs {floor:e}");
+        assert!(floored || 200.0 * raw < resasc * h, "the estimate scales resasc by (200 raw/resasc)^1.5 < 1");
         let opts = Options { rule: Rule::GaussPair(&pair), ..Options::quadpack([1.0], 0.0, 1) };
-        let est = integrate(&[(1.0, 3.0)], &opts, |x| [f(x)]);
+        let est = integrate(&[(c - h, c + h)], &opts, |x| [f(x)]);
         // The same sums in the same order: equal to rounding.
         assert!(want > 0.0 && (est.error - want).abs() <= 1e-12 * want, "{} vs {want}", est.error);
         assert!((est.value[0] - q32 * h).abs() <= 1e-15 * est.value[0]);
+    }
+
+    /// One K21 panel with QUADPACK's estimate against QUADPACK itself: `scipy.integrate.quad(f,
+    /// a, b, limit=1, full_output=1)` (scipy 1.17.1, the pinned version, QUADPACK's dqagse: one dqk21 panel,
+    /// neval 21) gave these values and error estimates.
+    #[test]
+    fn one_kronrod_panel_gives_quadpacks_value_and_estimate() {
+        type F = fn(f64) -> f64;
+        let cases: [(&str, F, f64, f64, f64, f64, f64); 3] = [
+            // The estimate is resasc itself ((200 raw / resasc)^1.5 > 1): the same sums as
+            // QUADPACK in another order, so equal to a few ulps (1e-12 leaves room).
+            ("1/(x²+0.01)", |x| 1.0 / (x * x + 0.01), -1.0, 1.0, 30.381916895831775, 34.74494563251439, 1e-12),
+            // resasc·(200 raw/resasc)^1.5 with raw = |K21 − G10| ≈ 3e-3 of the value: raw's
+            // rounding (~1e-16/3e-3 relative) enters at the power 1.5: 1e-9 leaves room.
+            ("√x", |x: f64| x.sqrt(), 0.0, 1.0, 0.6666714560647555, 0.004949759040028709, 1e-9),
+            // raw ≈ 1e-11 of the value, so its rounding is ~1e-5 relative, 1.5× in the
+            // estimate: 1e-3. A wrong term of resasc moves it by more than 10 %.
+            ("eˣ·cos 10x", |x: f64| x.exp() * (10.0 * x).cos(), 0.0, 1.0, -0.178899602876759, 1.8389000683061663e-12, 1e-3),
+        ];
+        for (name, f, a, b, value, error, tol) in cases {
+            let est = integrate(&[(a, b)], &Options::quadpack([1.0], 0.0, 1), |x| [f(x)]);
+            assert!((est.value[0] - value).abs() <= 1e-14 * value.abs(), "{name}: value {} vs QUADPACK {value}", est.value[0]);
+            assert!((est.error - error).abs() <= tol * error, "{name}: estimate {:e} vs QUADPACK {error:e}", est.error);
+        }
+    }
+
+    /// A constant integrand: K21 and the Gauss pair are exact to rounding, so raw and resasc
+    /// are rounding noise and the estimate is QUADPACK's floor 50 ε ∫|f| = 50 ε · 3 · 2.
+    #[test]
+    fn a_constant_integrands_estimate_is_the_roundoff_floor() {
+        let pair = GaussPair::new(32, 24);
+        let floor = 50.0 * f64::EPSILON * 6.0;
+        for (name, rule) in [("K21", Rule::Kronrod21), ("G32/G24", Rule::GaussPair(&pair))] {
+            let opts = Options { rule, ..Options::quadpack([1.0], 0.0, 1) };
+            let est = integrate(&[(0.0, 2.0)], &opts, |_| [3.0]);
+            // ∫|f| is a weight sum times 3: its rounding is a few ulps.
+            assert!((est.error - floor).abs() <= 1e-14 * floor, "{name}: estimate {:e} vs 50 ε ∫|f| = {floor:e}", est.error);
+            assert!((est.value[0] - 6.0).abs() <= 1e-14, "{name}: value {}", est.value[0]);
+        }
     }
 
     #[test]
