@@ -51,10 +51,14 @@ fn targets() -> Vec<Target> {
                 continue;
             }
             let sampled = f.arguments.iter().any(|a| matches!(m.types[a.ty].inner, naga::TypeInner::Image { .. }));
-            let bind = match (sampled, timing::ktx2(module)) {
-                (true, Some(k)) => timing::Bind::Ktx2(k),
-                (true, None) => panic!("{name} samples a texture of no known KTX2 file"),
-                (false, _) => timing::Bind::None,
+            let sampler = f.arguments.iter().any(|a| matches!(m.types[a.ty].inner, naga::TypeInner::Sampler { .. }));
+            let table = lut::table(module).filter(|t| t.ktx2.is_some());
+            let bind = match (sampled, table, timing::ktx2(module)) {
+                (true, Some(t), _) if !sampler => timing::Bind::TableKtx2(t),
+                (true, Some(_), _) => timing::Bind::Unbound("a table's R32Float texture through a linear sampler"),
+                (true, None, Some(k)) => timing::Bind::Ktx2(k),
+                (true, None, None) => timing::Bind::Unbound("a texture this harness does not upload"),
+                (false, ..) => timing::Bind::None,
             };
             out.push(Target { module: module.into(), const_array: reads_const_array(&m, f), function: name, library: library.clone(), bind });
         }
@@ -88,11 +92,15 @@ fn timing_over_a_4k_dispatch() {
     let before = baseline();
     println!("\n| module | function | ms per 3840x2160 dispatch |\n|---|---|---:|");
     for t in targets() {
-        let ms = if software && t.const_array { "- (const array)".to_string() } else { format!("{:.1}", timing::time(&g, &t)) };
+        let ms = match t.bind {
+            timing::Bind::Unbound(why) => format!("- ({why})"),
+            _ if software && t.const_array => "- (const array)".to_string(),
+            _ => format!("{:.3}", timing::time(&g, &t)),
+        };
         println!("| {} | {} | {ms} |", t.module, t.function);
     }
     let after = baseline();
-    println!("\nbaseline kernel (arguments and write only): {before:.1} ms before, {after:.1} ms after the functions, per 3840x2160 dispatch");
+    println!("\nbaseline kernel (arguments and write only): {before:.3} ms before, {after:.3} ms after the functions, per 3840x2160 dispatch");
 }
 
 mod timing {
@@ -110,6 +118,11 @@ mod timing {
         Table(&'static lut::Table),
         /// A skin LUT's KTX2 texture and a linear sampler, at 2 and 3.
         Ktx2(&'static [u8]),
+        /// A table's own KTX2 texture at 2 (`lut::Table::upload_ktx2`), read by its
+        /// `FUNCTION_load`.
+        TableKtx2(&'static lut::Table),
+        /// Not timed: what it would need (printed in the table).
+        Unbound(&'static str),
     }
 
     /// `library`, extra declarations, and an entry point that runs the statement `call` and
@@ -144,6 +157,8 @@ mod timing {
     pub fn time(g: &gpu::Gpu, t: &Target) -> f64 {
         let decls = match t.bind {
             Bind::Ktx2(_) => "@group(0) @binding(2) var shadefit_tex: texture_2d<f32>;\n@group(0) @binding(3) var shadefit_smp: sampler;\n",
+            Bind::TableKtx2(_) => "@group(0) @binding(2) var shadefit_tex: texture_2d<f32>;\n",
+            Bind::Unbound(why) => panic!("{}: not timed: {why}", t.function),
             _ => "",
         };
         let m = super::parse(&t.library);
@@ -165,6 +180,12 @@ mod timing {
                     naga::TypeInner::Array { .. } => "array<f32, 6>(c0, c1, c2, 0.1, 0.2, 0.3)".into(),
                     naga::TypeInner::Image { .. } => "shadefit_tex".into(),
                     naga::TypeInner::Sampler { .. } => "shadefit_smp".into(),
+                    // A struct of f32 fields (a decoded texel): the pixel's floats in turn.
+                    naga::TypeInner::Struct { members, .. } => {
+                        let name = m.types[a.ty].name.clone().expect("a named struct");
+                        let fields: Vec<&str> = (0..members.len()).map(|i| floats[i % floats.len()]).collect();
+                        format!("{name}({})", fields.join(", "))
+                    }
                     other => panic!("{}: no timing argument for {other:?}", t.function),
                 }
             })
@@ -175,6 +196,9 @@ mod timing {
             Some(naga::TypeInner::Vector { size, .. }) => (0..*size as usize).map(|i| format!("r[{i}]")).collect::<Vec<_>>().join(" + "),
             Some(naga::TypeInner::Array { size: naga::ArraySize::Constant(n), .. }) => {
                 (0..n.get() as usize).map(|i| format!("r[{i}]")).collect::<Vec<_>>().join(" + ")
+            }
+            Some(naga::TypeInner::Struct { members, .. }) => {
+                members.iter().map(|m| format!("r.{}", m.name.as_deref().unwrap_or_default())).collect::<Vec<_>>().join(" + ")
             }
             other => panic!("{}: no reduction of {other:?}", t.function),
         };
@@ -204,6 +228,7 @@ mod timing {
             mapped_at_creation: false,
         });
         let table;
+        let table_ktx2;
         let ktx;
         let view;
         let sampler;
@@ -213,6 +238,11 @@ mod timing {
             Bind::Table(t) => {
                 table = t.create_texture(device, &g.queue);
                 entries.push(wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&table.view) });
+            }
+            Bind::Unbound(why) => panic!("{label}: not timed: {why}"),
+            Bind::TableKtx2(t) => {
+                table_ktx2 = t.upload_ktx2(device, &g.queue, false).expect("the table's KTX2").expect("KTX2");
+                entries.push(wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&table_ktx2.view) });
             }
             Bind::Ktx2(bytes) => {
                 ktx = skin::create_lut_texture(device, &g.queue, label, bytes).expect("KTX2");

@@ -115,9 +115,9 @@ fn wgsl_equals_rust_bit_for_bit() {
 #[test]
 fn bound_covers_simulated_gpus() {
     let gpus = [
-        bound::Gpu { fuse: true, div_ulps: 2, flush_subnormals: true, trig: 0.999 },
-        bound::Gpu { fuse: true, div_ulps: -2, flush_subnormals: false, trig: -0.999 },
-        bound::Gpu { fuse: false, div_ulps: -2, flush_subnormals: true, trig: 0.5 },
+        bound::Gpu { fuse: true, div_ulps: 2, flush_subnormals: true, trig: 0.999, distribute: true },
+        bound::Gpu { fuse: true, div_ulps: -2, flush_subnormals: false, trig: -0.999, distribute: false },
+        bound::Gpu { fuse: false, div_ulps: -2, flush_subnormals: true, trig: 0.5, distribute: true },
     ];
     for f in FUNCTIONS {
         let program = bound::Program::new(&compose(&[f.module]).unwrap());
@@ -150,8 +150,8 @@ fn fuzz_ps_pair_equals_rust_and_is_bounded() {
     let program = bound::Program::new(&(compose(&["fuzz_ps"]).unwrap() + fuzz_ps::WRAPPERS));
     let gpus = [
         bound::Gpu::default(),
-        bound::Gpu { fuse: true, div_ulps: 2, flush_subnormals: true, trig: 0.999 },
-        bound::Gpu { fuse: true, div_ulps: -2, flush_subnormals: false, trig: -0.999 },
+        bound::Gpu { fuse: true, div_ulps: 2, flush_subnormals: true, trig: 0.999, distribute: false },
+        bound::Gpu { fuse: true, div_ulps: -2, flush_subnormals: false, trig: -0.999, distribute: false },
     ];
     for case in fuzz_ps::cases() {
         let h = program.function(case.name);
@@ -182,4 +182,25 @@ fn fuzz_ps_pair_equals_rust_and_is_bounded() {
             case.name, case.outputs
         );
     }
+}
+
+/// The gloss inverse table at the lower end of its domain on a GPU that distributes its index
+/// `(x − c)·k` into `fma(x, k, −fl(c·k))`: the simulated GPU returns, bit for bit, what an
+/// NVIDIA H200 returned (Vulkan, driver 580.159, `tests/gpu.rs` on 2026-11-25): −7.984941e-9
+/// where the CPU returns 0, i.e. the first table step 3.9132943e-4 times the index
+/// c·k − fl(c·k) = −2.04e-5. The bound covers it; without the distribution rule it is 0 there.
+#[cfg(feature = "gloss")]
+#[test]
+fn a_distributing_gpu_gives_what_an_h200_gave() {
+    let program = bound::Program::new(&compose(&["gloss_inverse_table"]).unwrap());
+    let h = program.function("normal_length_to_gloss_lut");
+    let distributing = bound::Gpu { distribute: true, ..Default::default() };
+    for x in [0.0, 0.5, 2.0 / 3.0] {
+        let (v, g, d) = program.simulate(h, &[x], distributing);
+        assert_eq!(v, 0.0, "CPU at {x}");
+        assert_eq!(g, -7.984941e-9, "distributing GPU at {x}");
+        assert!((g as f64 - v as f64).abs() <= d, "bound {d:e} at {x}");
+    }
+    let (_, strict, _) = program.simulate(h, &[0.0], bound::Gpu::default());
+    assert_eq!(strict, 0.0, "a GPU that evaluates as written");
 }
