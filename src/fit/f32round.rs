@@ -420,6 +420,30 @@ mod tests {
         assert!(r.num[1..].iter().zip(&rounded(&fixed, &f.coefficients).0[1..]).any(|(a, b)| a != b));
     }
 
+    /// The search never takes a denominator coefficient the proof cannot pass, the first one
+    /// included: c/(1 + d·x) on the box [0, 1] from d = −1 + 2^-24 (denominator ≥ 2^-24 there),
+    /// with data of d = −1 − 2^-23 sampled on [0, ½] only. Two ulps down, d = −1 − 2^-23, fits
+    /// the data exactly but has a pole at x = 1 − 2^-23 inside the box; d = −1 reaches 0 at
+    /// x = 1. So d must stay where it is, though the objective pulls it down.
+    #[test]
+    fn the_search_keeps_the_first_denominator_coefficient_provable() {
+        let feats = vec!["x".to_string()];
+        let terms = |ts: &[&str]| ts.iter().map(|t| Term::parse(t, &feats).unwrap()).collect::<Vec<_>>();
+        let m = RationalModel::new(ModelParts { inputs: feats.clone(), numerator: terms(&["1"]), denominator: terms(&["x"]), ..ModelParts::default() })
+            .unwrap();
+        let pole = -1.0 - 2f64.powi(-23);
+        let d = samples(0.0, 0.5, 65, |x| 1.0 / (1.0 + pole * x));
+        let start = DVector::from_vec(vec![1.0, -1.0 + 2f64.powi(-24)]);
+        for objective in [Objective::Minimax, Objective::Lsq] {
+            let r = round_and_reoptimise(&m, &start, &d, &[(0.0, 1.0)], &RoundOptions::new(objective, None), "pole").unwrap();
+            assert!(r.den[0] > -1.0, "{objective:?}: d = {} leaves no positive denominator on [0, 1]", r.den[0]);
+            assert!(matches!(prove_denominator_positive(&m, &widen(&r.num, &r.den), &[(0.0, 1.0)]), Positivity::Proven { .. }));
+            // Not vacuous: the data would rather have the pole's coefficient.
+            let f = |dd: f32| (0..d.y.len()).map(|i| (1.0 / (1.0 + dd as f64 * d.x[i][0]) - d.y[i]).abs()).fold(0.0, f64::max);
+            assert!(f(pole as f32) < f(r.den[0]), "{objective:?}");
+        }
+    }
+
     #[test]
     fn pins_and_positivity_survive_the_search() {
         // A rational with both ends pinned (as gloss_length is), fitted minimax.

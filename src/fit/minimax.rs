@@ -176,6 +176,20 @@ mod tests {
     use crate::fit::model::{Derived, ModelParts, RationalModel, Term};
     use crate::fit::{fit, Data, FitOptions, Objective};
 
+    /// The LP's samples as documented at [`FULL_LP`]: all of them up to 512; above, the
+    /// max(8·params, 256) largest |r|, in index order. Residuals |r_i| = ((i·7919) mod 1000)
+    /// are distinct, so "the k largest" are the indices whose value is ≥ 1000 − k.
+    #[test]
+    fn the_working_set_is_the_largest_residuals_by_the_documented_count() {
+        let r = DVector::from_fn(1000, |i, _| ((i * 7919) % 1000) as f64 * if i % 2 == 0 { 1.0 } else { -1.0 });
+        for (params, k) in [(3, 256), (32, 256), (40, 320), (200, 1000)] {
+            let want: Vec<usize> = (0..1000).filter(|&i| r[i].abs() >= (1000 - k) as f64).collect();
+            assert_eq!(working_set(&r, params), want, "{params} parameters");
+        }
+        let small = DVector::from_fn(512, |i, _| i as f64);
+        assert_eq!(working_set(&small, 40), (0..512).collect::<Vec<_>>());
+    }
+
     /// R̃'s form (fits/fuzz_r.toml) over α ∈ [0.15, 1], θ ∈ [0, π/2]: γ = cos θ is 6e-17 at the
     /// last grid column and γ³ is 2e-49 there, so the Jacobian's rows span ~1e49.
     fn r_form() -> RationalModel {
