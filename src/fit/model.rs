@@ -554,6 +554,31 @@ mod tests {
         // The map is exact up to rounding of a 2×2 solve on O(1) numbers.
         assert!((m.eval_full(&c, &[0.0]) - 0.5).abs() < 1e-14);
         assert!((m.eval_full(&c, &[1.0]) - 0.9).abs() < 1e-14);
+
+        // With an offset, a factor and a lead term, at pins where the factor is 1.5 and 3
+        // and the lead 1.25 and 5: the model is offset + factor·N/(lead + D).
+        let feats = vec!["x".to_string()];
+        let terms = |ts: &[&str]| ts.iter().map(|s| Term::parse(s, &feats).unwrap()).collect::<Vec<_>>();
+        let m = RationalModel::new(ModelParts {
+            inputs: feats.clone(),
+            numerator: terms(&["1", "x", "x^2"]),
+            denominator: terms(&["x"]),
+            lead: Some(Term::parse("1 + x^2", &feats).unwrap()),
+            offset: 0.25,
+            factor: Some(Term::parse("1 + x", &feats).unwrap()),
+            pins: vec![Pin { at: vec![0.5], value: 0.8, eliminate: 0 }, Pin { at: vec![2.0], value: -1.5, eliminate: 2 }],
+            ..ModelParts::default()
+        })
+        .unwrap();
+        assert_eq!(m.n_free(), 2);
+        for theta in [[0.3, -1.2], [4.0, 0.01]] {
+            let c = m.full(&DVector::from_vec(theta.to_vec()));
+            for (x, v) in [(0.5, 0.8), (2.0, -1.5)] {
+                let (n, q) = (c[0] + c[1] * x + c[2] * x * x, 1.0 + x * x + c[3] * x);
+                // Rounding of a 2×2 solve on O(1) numbers, then of this evaluation.
+                assert!((0.25 + (1.0 + x) * n / q - v).abs() < 1e-13, "pin at {x}: θ = {theta:?}");
+            }
+        }
     }
 
     /// `range` is the exact range of every kind of derived feature: it holds every value at
