@@ -726,6 +726,30 @@ mod tests {
         assert!((r.rms_error - rms).abs() <= 1e-9 * rms, "rms {} vs {rms}", r.rms_error);
     }
 
+    /// Rescaling is by exact powers of two (of the data's largest magnitudes, rounded in log2:
+    /// here 1 and 0.84, so 2^70 and 2^80), so the fit of data 2^80 in value and 2^70 in input
+    /// is the fit of the same data in units of one, its coefficients times 2^(80 − 70k) for
+    /// x^k in the numerator and 2^(−70k) in the denominator, bit for bit (off the model: a 1 %
+    /// ripple), and so is its max error times 2^80.
+    #[test]
+    fn rescaled_fits_are_the_unit_fit_times_powers_of_two() {
+        let model = RationalModel::new(parts_1d(&["1", "x", "x^2"], &["x", "x^2"])).unwrap();
+        let t: Vec<f64> = (0..=60).map(|i| i as f64 / 60.0).collect();
+        let y = |t: f64| 0.5 * (1.0 + 2.0 * t - 0.5 * t * t) / (1.0 + 0.3 * t + 0.2 * t * t) * (1.0 + 0.01 * (7.0 * t).sin());
+        let unit = Data { x: t.iter().map(|&t| vec![t]).collect(), y: t.iter().map(|&t| y(t)).collect() };
+        let scaled = Data { x: t.iter().map(|&t| vec![t * 2f64.powi(70)]).collect(), y: unit.y.iter().map(|v| v * 2f64.powi(80)).collect() };
+        for objective in [Objective::Lsq, Objective::Minimax] {
+            let opts = FitOptions { objective, ..FitOptions::default() };
+            let a = fit(&model, &unit, &opts, "unit").unwrap();
+            let b = fit_rescaled(&model, &scaled, &opts, "scaled").unwrap();
+            let powers = [80, 10, -60, -70, -140];
+            for (k, p) in powers.iter().enumerate() {
+                assert_eq!(b.coefficients[k], a.coefficients[k] * 2f64.powi(*p), "{objective:?} coefficient {k}");
+            }
+            assert_eq!(b.report.max_abs_error, a.report.max_abs_error * 2f64.powi(80), "{objective:?}");
+        }
+    }
+
     /// For a polynomial (no denominator) the Jacobian is the design matrix [1, x, x²]: the
     /// report's condition number is its σmax/σmin, computed here by nalgebra's SVD of the matrix
     /// built by hand.
