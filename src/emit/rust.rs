@@ -145,6 +145,23 @@ pub fn table_eval_f32(values: &[f32], counts: &[usize], domain: &[(f32, f32)], x
 mod tests {
     use super::*;
 
+    /// An emitted array: six values a line (so a 4096-entry table stays readable and its diffs
+    /// local), each a literal that reads back to the same f32 bits, in order.
+    #[test]
+    fn arrays_hold_six_round_trip_literals_a_line() {
+        let values: Vec<f32> = (0..20).map(|i| (i as f32 * 0.37).sin() / 3.0 + if i == 7 { f32::MIN_POSITIVE } else { 0.0 }).collect();
+        let text = array("T", "Values.", &values);
+        let body: Vec<&str> = text.lines().skip(2).take_while(|l| *l != "];").collect();
+        assert_eq!(body.len(), 4, "{text}");
+        let mut read = Vec::new();
+        for line in &body {
+            let items: Vec<&str> = line.split(',').map(str::trim).filter(|v| !v.is_empty()).collect();
+            assert!(items.len() <= 6, "{line}");
+            read.extend(items.iter().map(|v| v.trim_end_matches("_f32").parse::<f32>().unwrap()));
+        }
+        assert_eq!(read.iter().map(|v| v.to_bits()).collect::<Vec<_>>(), values.iter().map(|v| v.to_bits()).collect::<Vec<_>>());
+    }
+
     /// Linear and bilinear interpolation worked out by hand on values and positions exact in
     /// binary (so every product and sum below is exact in f32), clamped at the edges.
     #[test]
