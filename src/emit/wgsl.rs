@@ -303,6 +303,34 @@ mod tests {
         }
     }
 
+    /// A whole module: the header lines as comments, the import-path directive, then a
+    /// source that naga validates (the directive stripped, as a composer does), whose table
+    /// function passes its argument through the module's input clamp.
+    #[test]
+    fn a_rendered_module_names_itself_and_validates() {
+        let args = vec!["x".to_string()];
+        let f = Function {
+            module: "m",
+            name: "m_lut",
+            args: &args,
+            derived: &[],
+            domain: &[(0.25, 2.0)],
+            body: Body::Table { values: &[0.0, 1.0, 4.0, 9.0, 16.0], counts: &[5] },
+        };
+        let header = vec!["spec: fits/m.toml".to_string(), "measured error: max abs 0".to_string()];
+        let src = render_module(&header, &f);
+        let lines: Vec<&str> = src.lines().collect();
+        assert_eq!(lines[..3], ["// spec: fits/m.toml", "// measured error: max abs 0", "#define_import_path shadefit::m"], "{src}");
+        let plain = strip_directives(&src);
+        let m = naga::front::wgsl::parse_str(&plain).unwrap_or_else(|e| panic!("{}", e.emit_to_string(&plain)));
+        naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all())
+            .validate(&m)
+            .unwrap_or_else(|e| panic!("{}", e.emit_to_string(&plain)));
+        let names: Vec<&str> = m.functions.iter().filter_map(|(_, f)| f.name.as_deref()).collect();
+        assert_eq!(names, ["m_input", "m_lut"]);
+        assert!(src.contains("let x0 = m_input(x, 2.5e-1f, 2e0f);"), "{src}");
+    }
+
     /// A constant array: its values read back through naga in order, six to a line.
     #[test]
     fn arrays_read_back_through_naga() {
