@@ -452,3 +452,46 @@ fn the_runtime_index_lists_only_scalar_functions() {
         assert!(text[..text.find("pub const FUNCTIONS").unwrap()].contains(&format!("\"{}\"", s.file.name)), "module {} not indexed:\n{text}", s.file.name);
     }
 }
+
+/// e^−x and e^−2x as the two channels of one quantity.
+static EXP_PAIR: QuantityDef = QuantityDef {
+    name: "exp-pair",
+    doc: "e^-x (channel slow) and e^-2x (channel fast)",
+    params: &[ParamSpec { name: "x", min: 0.0, max: 2.0, doc: "argument", integer: false, default: None }],
+    aliases: &[],
+    eval: |p, _| Estimate { value: (-p[0]).exp(), error: 0.0, evals: 1 },
+    inverse: None,
+    channels: &["slow", "fast"],
+    eval_channels: Some(|p, _| {
+        [1.0f64, 2.0].iter().map(|k| Estimate { value: (-k * p[0]).exp(), error: 0.0, evals: 1 }).collect()
+    }),
+    basis: None,
+};
+
+/// A fit and a table of one channel of a vector quantity: each JSON names the channel, and
+/// what was fitted or tabulated is that channel (e^−2x, re-measured from the written
+/// coefficients and values); a scalar quantity's JSON names none.
+#[test]
+fn a_channel_spec_records_and_builds_its_channel() {
+    let catalog = Catalog { quantities: vec![&EXP, &EXP_PAIR], kinds: vec![] };
+    let tmp = tempfile::tempdir().unwrap();
+    let fast = |text: &str| text.replace("quantity = \"exp-decay\"", "quantity = \"exp-pair\"\nchannel = \"fast\"");
+    let fit = build_spec(&spec_in(&fast(FIT), &catalog), Mode::Fit, tmp.path(), &|_| None).unwrap();
+    let j = json_of(&fit);
+    assert_eq!(j["channel"], "fast");
+    let c = floats(&j["model"]["coefficients"]);
+    let r = |x: f64| (c[0] + c[1] * x + c[2] * x * x) / (1.0 + c[3] * x + c[4] * x * x);
+    // A 2/2 minimax rational of e^−2x on [0, 2] is within 1e-3 (of e^−x: 1e-4); e^−x, the
+    // other channel, is 0.23 away at x = 1.
+    let worst = uniform(201).iter().map(|&x| (r(x) - (-2.0 * x).exp()).abs()).fold(0.0, f64::max);
+    assert!(worst < 1e-3, "{worst}");
+    let table = build_spec(&spec_in(&fast(TABLE), &catalog), Mode::Fit, tmp.path(), &|_| None).unwrap();
+    let j = json_of(&table);
+    assert_eq!(j["channel"], "fast");
+    for (i, v) in floats(&j["values"]).iter().enumerate() {
+        // f32 values of e^−2x at the nodes: within half an f32 ulp (≤ 2^-25 for values ≤ 1).
+        assert!((v - (-2.0 * 0.125 * i as f64).exp()).abs() <= 2f64.powi(-25), "node {i}: {v}");
+    }
+    let scalar = build_spec(&spec(FIT), Mode::Fit, tmp.path(), &|_| None).unwrap();
+    assert!(json_of(&scalar).get("channel").is_none());
+}
