@@ -160,6 +160,19 @@ mod tests {
         assert!((v - 0.65).abs() < 1e-16, "{v}");
     }
 
+    /// The published fit's constraints, as the FindFit code states them: the rational passes
+    /// through the Monte Carlo table's ends, 0.666670 at gloss 0 and 0.999958 at gloss 1
+    /// (c3 solved from the second). With the text's 0.99958 the end is off by ~4e-4 of it.
+    #[test]
+    fn the_published_fit_passes_through_the_tables_ends() {
+        let c = published_fit_coefficients(PUBLISHED_ENDS.1);
+        assert_eq!(rational_1d(&c, 0.0), PUBLISHED_ENDS.0);
+        // Six O(10) terms summed and one quotient: a few ulps of 10.
+        assert!((rational_1d(&c, 1.0) - PUBLISHED_ENDS.1).abs() < 1e-14, "{}", rational_1d(&c, 1.0));
+        let typo = published_fit_coefficients(0.99958);
+        assert!((rational_1d(&typo, 1.0) - PUBLISHED_ENDS.1).abs() > 1e-4);
+    }
+
     #[test]
     fn uniform_samples_include_both_ends() {
         // i/(n − 1): quarters are exact in binary, so equality is exact.
