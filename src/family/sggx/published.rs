@@ -308,6 +308,31 @@ mod tests {
         }
     }
 
+    /// The random-footprint items report, per method, the largest distance over the
+    /// footprints, its index, the rms and the mean of the distances, re-measured here from
+    /// the comparisons themselves (same sums: equal to rounding).
+    #[test]
+    fn random_footprint_items_report_their_distances() {
+        let comparisons = comparisons();
+        let random = &comparisons[course_cases().len()..];
+        let items = items(Path::new("generated"));
+        let picks: [(&str, fn(&Comparison) -> f64); 3] =
+            [("(a)", |c| c.linear.tv), ("(b)", |c| c.estimation.tv), ("(c)", |c| c.lean.tv)];
+        for (method, pick) in picks {
+            let it = items.iter().find(|i| i.name.contains("random footprints") && i.name.contains(method)).unwrap();
+            let tv: Vec<f64> = random.iter().map(pick).collect();
+            let max = tv.iter().copied().fold(0.0, f64::max);
+            let rms = (tv.iter().map(|t| t * t).sum::<f64>() / tv.len() as f64).sqrt();
+            let mean = tv.iter().sum::<f64>() / tv.len() as f64;
+            assert_eq!(it.max_abs_error, max, "{method}");
+            assert_eq!(tv[it.worst_point[0] as usize], max, "{method}");
+            assert!((it.rms_error - rms).abs() <= 1e-15 * rms, "{method}: rms {} vs {rms}", it.rms_error);
+            assert!((it.extra[0].1 - mean).abs() <= 1e-15 * mean, "{method}: mean");
+            // Not a degenerate sample: the three differ (power means of unequal values).
+            assert!(mean < rms && rms < max, "{method}: {mean} {rms} {max}");
+        }
+    }
+
     #[test]
     fn course_cases_rank_the_filters_as_the_course_shows() {
         // A coarser rule (nodes every ~5 mrad, ≥ 20 per lobe width): the distances it gives are
