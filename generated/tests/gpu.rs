@@ -329,6 +329,21 @@ fn check_points(
     Ok(st)
 }
 
+/// Report one run of `name` over `n` points: its deviations, or that it is out of bound (the
+/// points then go to `failed`, for the test to list every such run before it fails).
+fn outcome(name: &str, n: usize, note: &str, secs: f64, software: bool, result: Result<Stats, String>, failed: &mut Vec<String>) {
+    match result {
+        Ok(st) => {
+            report(&format!("gpu {name:<30} {n:>7} points: {st}{note} [{secs:.1} s]"));
+            assert_tight_on_software(software, name, &st);
+        }
+        Err(e) => {
+            report(&format!("gpu {name:<30} {n:>7} points: OUT OF BOUND{note} [{secs:.1} s]"));
+            failed.push(format!("{name}: {e}"));
+        }
+    }
+}
+
 #[test]
 fn every_emitted_function_equals_its_cpu_version_on_the_gpu() {
     let Some(gpu) = device("shadefit-runtime gpu test") else { return };
@@ -355,16 +370,7 @@ fn every_emitted_function_equals_its_cpu_version_on_the_gpu() {
         let t0 = std::time::Instant::now();
         let out = runner.run(f.name, &shader, arity, 1, &pts, extra);
         let secs = t0.elapsed().as_secs_f64();
-        match check(f, "const", &pts, &out, &program) {
-            Ok(st) => {
-                report(&format!("gpu {:<30} {n:>7} points: {st}{note} [{secs:.1} s]", f.name));
-                assert_tight_on_software(software, f.name, &st);
-            }
-            Err(e) => {
-                report(&format!("gpu {:<30} {n:>7} points: OUT OF BOUND{note} [{secs:.1} s]", f.name));
-                failed.push(format!("{}: {e}", f.name));
-            }
-        }
+        outcome(f.name, n, note, secs, software, check(f, "const", &pts, &out, &program), &mut failed);
         same_in_every_style(&runner, f, &pts, &out, moved.as_ref().map(|(_, v)| v.as_slice()));
         functions += 1;
         points += n;
@@ -378,16 +384,8 @@ fn every_emitted_function_equals_its_cpu_version_on_the_gpu() {
             let secs = t0.elapsed().as_secs_f64();
             // Same arithmetic as the emitted function, values fetched from the texture: same bound.
             let (w, h) = t.size();
-            match check(f, "texture", &pts, &out, &program) {
-                Ok(st) => {
-                    report(&format!("gpu {:<30} {n:>7} points: {st} (R32Float {w}x{h} texture) [{secs:.1} s]", t.accessor_name()));
-                    assert_tight_on_software(software, &t.accessor_name(), &st);
-                }
-                Err(e) => {
-                    report(&format!("gpu {:<30} {n:>7} points: OUT OF BOUND (R32Float {w}x{h} texture) [{secs:.1} s]", t.accessor_name()));
-                    failed.push(format!("{}: {e}", t.accessor_name()));
-                }
-            }
+            let note = format!(" (R32Float {w}x{h} texture)");
+            outcome(&t.accessor_name(), n, &note, secs, software, check(f, "texture", &pts, &out, &program), &mut failed);
             points += n;
             runs += 1;
         }

@@ -14,7 +14,8 @@ struct Target {
     module: String,
     function: String,
     library: String,
-    bind: timing::Bind,
+    /// What to bind, or why it is not timed (printed in the table).
+    bind: Result<timing::Bind, &'static str>,
     /// It indexes a module-scope `const` array at a computed index (a table in the shader).
     const_array: bool,
 }
@@ -54,11 +55,11 @@ fn targets() -> Vec<Target> {
             let sampler = f.arguments.iter().any(|a| matches!(m.types[a.ty].inner, naga::TypeInner::Sampler { .. }));
             let table = lut::table(module).filter(|t| t.ktx2.is_some());
             let bind = match (sampled, table, timing::ktx2(module)) {
-                (true, Some(t), _) if !sampler => timing::Bind::TableKtx2(t),
-                (true, Some(_), _) => timing::Bind::Unbound("a table's R32Float texture through a linear sampler"),
-                (true, None, Some(k)) => timing::Bind::Ktx2(k),
-                (true, None, None) => timing::Bind::Unbound("a texture this harness does not upload"),
-                (false, ..) => timing::Bind::None,
+                (true, Some(t), _) if !sampler => Ok(timing::Bind::TableKtx2(t)),
+                (true, Some(_), _) => Err("a table's R32Float texture through a linear sampler"),
+                (true, None, Some(k)) => Ok(timing::Bind::Ktx2(k)),
+                (true, None, None) => Err("a texture this harness does not upload"),
+                (false, ..) => Ok(timing::Bind::None),
             };
             out.push(Target { module: module.into(), const_array: reads_const_array(&m, f), function: name, library: library.clone(), bind });
         }
@@ -68,7 +69,7 @@ fn targets() -> Vec<Target> {
             module: format!("{} (lut::Table::wgsl)", t.module),
             function: t.accessor_name(),
             library: t.wgsl(0, 2),
-            bind: timing::Bind::Table(t),
+            bind: Ok(timing::Bind::Table(t)),
             const_array: false,
         });
     }
@@ -92,10 +93,10 @@ fn timing_over_a_4k_dispatch() {
     let before = baseline();
     println!("\n| module | function | ms per 3840x2160 dispatch |\n|---|---|---:|");
     for t in targets() {
-        let ms = match t.bind {
-            timing::Bind::Unbound(why) => format!("- ({why})"),
-            _ if software && t.const_array => "- (const array)".to_string(),
-            _ => format!("{:.3}", timing::time(&g, &t)),
+        let ms = match &t.bind {
+            Err(why) => format!("- ({why})"),
+            Ok(_) if software && t.const_array => "- (const array)".to_string(),
+            Ok(bind) => format!("{:.3}", timing::time(&g, &t, bind)),
         };
         println!("| {} | {} | {ms} |", t.module, t.function);
     }
@@ -121,8 +122,6 @@ mod timing {
         /// A table's own KTX2 texture at 2 (`lut::Table::upload_ktx2`), read by its
         /// `FUNCTION_load`.
         TableKtx2(&'static lut::Table),
-        /// Not timed: what it would need (printed in the table).
-        Unbound(&'static str),
     }
 
     /// `library`, extra declarations, and an entry point that runs the statement `call` and
@@ -153,12 +152,11 @@ mod timing {
         }
     }
 
-    /// Milliseconds for the target's function.
-    pub fn time(g: &gpu::Gpu, t: &Target) -> f64 {
-        let decls = match t.bind {
+    /// Milliseconds for the target's function, with `bind` bound.
+    pub fn time(g: &gpu::Gpu, t: &Target, bind: &Bind) -> f64 {
+        let decls = match bind {
             Bind::Ktx2(_) => "@group(0) @binding(2) var shadefit_tex: texture_2d<f32>;\n@group(0) @binding(3) var shadefit_smp: sampler;\n",
             Bind::TableKtx2(_) => "@group(0) @binding(2) var shadefit_tex: texture_2d<f32>;\n",
-            Bind::Unbound(why) => panic!("{}: not timed: {why}", t.function),
             _ => "",
         };
         let m = super::parse(&t.library);
@@ -203,7 +201,7 @@ mod timing {
             other => panic!("{}: no reduction of {other:?}", t.function),
         };
         let call = format!("let r = {}({});", t.function, args.join(", "));
-        run(g, &t.function, &kernel(&t.library, decls, &call, &reduce), t.bind.clone())
+        run(g, &t.function, &kernel(&t.library, decls, &call, &reduce), bind.clone())
     }
 
     /// Compile, warm up, then the best of five timed dispatches (submit to completion), in ms.
@@ -239,7 +237,6 @@ mod timing {
                 table = t.create_texture(device, &g.queue);
                 entries.push(wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&table.view) });
             }
-            Bind::Unbound(why) => panic!("{label}: not timed: {why}"),
             Bind::TableKtx2(t) => {
                 table_ktx2 = t.upload_ktx2(device, &g.queue, false).expect("the table's KTX2").expect("KTX2");
                 entries.push(wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&table_ktx2.view) });

@@ -65,6 +65,11 @@ pub(crate) fn floats(v: &Value) -> Vec<f64> {
     v.as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect()
 }
 
+/// FIT's model, (c0 + c1 x + c2 x²)/(1 + c3 x + c4 x²), written out at x.
+pub(crate) fn fit_rational(c: &[f64], x: f64) -> f64 {
+    (c[0] + c[1] * x + c[2] * x * x) / (1.0 + c[3] * x + c[4] * x * x)
+}
+
 /// n uniform points over [0, 2], the last exactly 2: the specs' grids written out (501: the
 /// verification grid; 64: the fitting samples).
 pub(crate) fn uniform(n: usize) -> Vec<f64> {
@@ -81,7 +86,7 @@ fn a_fit_spec_reports_the_errors_of_what_it_writes() {
     let c = floats(&m["coefficients"]);
     let (num, den) = (floats(&m["numerator_f32"]), floats(&m["denominator_f32"]));
     assert_eq!((c.len(), num.len(), den.len()), (5, 3, 2));
-    let r64 = |x: f64| (c[0] + c[1] * x + c[2] * x * x) / (1.0 + c[3] * x + c[4] * x * x);
+    let r64 = |x: f64| fit_rational(&c, x);
     let model = s.model.as_ref().unwrap();
     let e = expr::model_expr(model);
     let (n32, d32): (Vec<f32>, Vec<f32>) = (num.iter().map(|&v| v as f32).collect(), den.iter().map(|&v| v as f32).collect());
@@ -480,7 +485,7 @@ fn a_channel_spec_records_and_builds_its_channel() {
     let j = json_of(&fit);
     assert_eq!(j["channel"], "fast");
     let c = floats(&j["model"]["coefficients"]);
-    let r = |x: f64| (c[0] + c[1] * x + c[2] * x * x) / (1.0 + c[3] * x + c[4] * x * x);
+    let r = |x: f64| fit_rational(&c, x);
     // A 2/2 minimax rational of e^−2x on [0, 2] is within 1e-3 (of e^−x: 1e-4); e^−x, the
     // other channel, is 0.23 away at x = 1.
     let worst = uniform(201).iter().map(|&x| (r(x) - (-2.0 * x).exp()).abs()).fold(0.0, f64::max);

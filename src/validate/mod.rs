@@ -68,7 +68,7 @@ pub fn all(generated: &Path, validators: &[fn(&Path) -> Vec<Item>]) -> Vec<Item>
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::pipeline::build_tests::{floats, json_of, spec, uniform, EXP, FIT};
+    use crate::pipeline::build_tests::{fit_rational, floats, json_of, spec, uniform, EXP, FIT};
     use crate::pipeline::{build_spec, write_all, Mode};
 
     /// A validation item beside its committed refit: `Item::add_refit` loads the refit through its
@@ -85,7 +85,7 @@ mod tests {
         let b = build_spec(&spec(FIT), Mode::Fit, &generated, &|_| None).unwrap();
         write_all(&generated, &b.artifacts).unwrap();
         let c = floats(&json_of(&b)["model"]["coefficients"]);
-        let r64 = |x: f64| (c[0] + c[1] * x + c[2] * x * x) / (1.0 + c[3] * x + c[4] * x * x);
+        let r64 = |x: f64| fit_rational(&c, x);
         // A "published" form to set beside it: the Taylor polynomial 1 − x + x²/2.
         let xs = uniform(21);
         let points: Vec<Vec<f64>> = xs.iter().map(|&x| vec![x]).collect();

@@ -121,12 +121,6 @@ enum V {
     Arr(Rc<Vec<V>>),
 }
 
-impl Shape {
-    fn is_shifted(self) -> bool {
-        matches!(self, Shape::Shifted { .. })
-    }
-}
-
 /// What an f32 value is, as far as a driver's rewriting of the expression that uses it goes.
 #[derive(Clone, Copy, Debug)]
 enum Shape {
@@ -443,14 +437,15 @@ impl Program {
                         // fl(fl(sa·a + sc·c)·k) that skips the CPU's rounding of the sum,
                         // ≤ |k|·½ ulp of it (0 if exact), and adds the rounding of c·k,
                         // ≤ ½ ulp of it; the one rounding of the result is the ε below.
+                        // (the shifted operand's shape and CPU value, the constant k)
                         let shifted = match (sx, sy) {
-                            (Shape::Shifted { ga, sa, c, sc, exact }, Shape::Const) => Some((ga, sa, c, sc, exact, y)),
-                            (Shape::Const, Shape::Shifted { ga, sa, c, sc, exact }) => Some((ga, sa, c, sc, exact, x)),
+                            (s @ Shape::Shifted { .. }, Shape::Const) => Some((s, x64, y)),
+                            (Shape::Const, s @ Shape::Shifted { .. }) => Some((s, y64, x)),
                             _ => None,
                         };
-                        if let Some((ga, sa, c, sc, exact, k)) = shifted {
+                        if let Some((Shape::Shifted { ga, sa, c, sc, exact }, value, k)) = shifted {
                             let k64 = k as f64;
-                            let sum = if exact { 0.0 } else { k64.abs() * 0.5 * ulp(if sx.is_shifted() { x64 } else { y64 }) };
+                            let sum = if exact { 0.0 } else { k64.abs() * 0.5 * ulp(value) };
                             d = self.fresh(d, sum + 0.5 * ulp(c as f64 * k64));
                             if self.gpu.get().distribute {
                                 g = (sa * ga).mul_add(k, sc * c * k);

@@ -205,8 +205,12 @@ fn hardware_filter_item(bits: u32) -> Item {
 }
 
 pub fn items(_generated: &Path) -> Vec<Item> {
+    items_of(&comparisons())
+}
+
+/// The items of [`comparisons`]: the course's cases, then the random footprints.
+fn items_of(comparisons: &[Comparison]) -> Vec<Item> {
     let rule_points = SphereRule::standard().points.len();
-    let comparisons = comparisons();
     let mut out = Vec::new();
     for c in &comparisons[..course_cases().len()] {
         out.push(distance_item("(a) linear S filter", c, &c.linear, rule_points));
@@ -315,7 +319,7 @@ mod tests {
     fn random_footprint_items_report_their_distances() {
         let comparisons = comparisons();
         let random = &comparisons[course_cases().len()..];
-        let items = items(Path::new("generated"));
+        let items = items_of(&comparisons);
         let picks: [(&str, fn(&Comparison) -> f64); 3] =
             [("(a)", |c| c.linear.tv), ("(b)", |c| c.estimation.tv), ("(c)", |c| c.lean.tv)];
         for (method, pick) in picks {
