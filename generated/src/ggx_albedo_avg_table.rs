@@ -28,7 +28,7 @@ pub fn ggx_albedo_avg_lut(alpha: f32) -> f32 {
     let x0 = input(alpha, 1e-4_f32, 1e0_f32);
     let t0 = (x0 - 1e-4_f32) * 3.1003101e1_f32;
     let i0 = (t0 as u32).min(30);
-    let f0 = t0 - i0 as f32;
+    let f0 = (t0 - i0 as f32).clamp(0.0, 1.0);
     let i0 = i0 as usize;
     GGX_ALBEDO_AVG_TABLE_TABLE[i0] * (1.0 - f0) + GGX_ALBEDO_AVG_TABLE_TABLE[i0 + 1] * f0
 }

@@ -194,10 +194,10 @@ pub fn ggx_albedo_lut(alpha: f32, n_dot_v: f32) -> f32 {
     let x1 = input(n_dot_v, 0e0_f32, 1e0_f32);
     let t0 = (x0 - 1e-4_f32) * 3.1003101e1_f32;
     let i0 = (t0 as u32).min(30);
-    let f0 = t0 - i0 as f32;
+    let f0 = (t0 - i0 as f32).clamp(0.0, 1.0);
     let t1 = (x1 - 0e0_f32) * 3.1e1_f32;
     let i1 = (t1 as u32).min(30);
-    let f1 = t1 - i1 as f32;
+    let f1 = (t1 - i1 as f32).clamp(0.0, 1.0);
     let k = (i1 * 32 + i0) as usize;
     let a = GGX_ALBEDO_TABLE_TABLE[k] * (1.0 - f0) + GGX_ALBEDO_TABLE_TABLE[k + 1] * f0;
     let b = GGX_ALBEDO_TABLE_TABLE[k + 32] * (1.0 - f0) + GGX_ALBEDO_TABLE_TABLE[k + 33] * f0;

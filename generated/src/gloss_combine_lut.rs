@@ -706,10 +706,10 @@ pub fn combine_gloss_lut(x: f32, y: f32) -> f32 {
     let x1 = input(y, 0e0_f32, 1e0_f32);
     let t0 = (x0 - 0e0_f32) * 6.3e1_f32;
     let i0 = (t0 as u32).min(62);
-    let f0 = t0 - i0 as f32;
+    let f0 = (t0 - i0 as f32).clamp(0.0, 1.0);
     let t1 = (x1 - 0e0_f32) * 6.3e1_f32;
     let i1 = (t1 as u32).min(62);
-    let f1 = t1 - i1 as f32;
+    let f1 = (t1 - i1 as f32).clamp(0.0, 1.0);
     let k = (i1 * 64 + i0) as usize;
     let a = GLOSS_COMBINE_LUT_TABLE[k] * (1.0 - f0) + GLOSS_COMBINE_LUT_TABLE[k + 1] * f0;
     let b = GLOSS_COMBINE_LUT_TABLE[k + 64] * (1.0 - f0) + GLOSS_COMBINE_LUT_TABLE[k + 65] * f0;

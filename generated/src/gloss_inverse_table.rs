@@ -193,7 +193,7 @@ pub fn normal_length_to_gloss_lut(length: f32) -> f32 {
     let x0 = input(length, 6.666667e-1_f32, 1e0_f32);
     let t0 = (x0 - 6.666667e-1_f32) * 3.0690002e3_f32;
     let i0 = (t0 as u32).min(1022);
-    let f0 = t0 - i0 as f32;
+    let f0 = (t0 - i0 as f32).clamp(0.0, 1.0);
     let i0 = i0 as usize;
     GLOSS_INVERSE_TABLE_TABLE[i0] * (1.0 - f0) + GLOSS_INVERSE_TABLE_TABLE[i0 + 1] * f0
 }

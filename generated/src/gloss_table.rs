@@ -65,7 +65,7 @@ pub fn gloss_to_normal_length_lut(gloss: f32) -> f32 {
     let x0 = input(gloss, 0e0_f32, 1e0_f32);
     let t0 = (x0 - 0e0_f32) * 2.55e2_f32;
     let i0 = (t0 as u32).min(254);
-    let f0 = t0 - i0 as f32;
+    let f0 = (t0 - i0 as f32).clamp(0.0, 1.0);
     let i0 = i0 as usize;
     GLOSS_TABLE_TABLE[i0] * (1.0 - f0) + GLOSS_TABLE_TABLE[i0 + 1] * f0
 }

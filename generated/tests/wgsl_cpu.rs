@@ -185,22 +185,30 @@ fn fuzz_ps_pair_equals_rust_and_is_bounded() {
 }
 
 /// The gloss inverse table at the lower end of its domain on a GPU that distributes its index
-/// `(x − c)·k` into `fma(x, k, −fl(c·k))`: the simulated GPU returns, bit for bit, what an
-/// NVIDIA H200 returned (Vulkan, driver 580.159, `tests/gpu.rs` on 2026-11-25): −7.984941e-9
-/// where the CPU returns 0, i.e. the first table step 3.9132943e-4 times the index
+/// `(x − c)·k` into `fma(x, k, −fl(c·k))`. As the module was when an NVIDIA H200 ran it
+/// (Vulkan, driver 580.159, `tests/gpu.rs` on 2026-11-25), with the upper weight `f0 = t0 −
+/// f32(i0)` unclamped, the simulated GPU returns, bit for bit, what the H200 returned:
+/// −7.984941e-9 where the CPU returns 0, i.e. the first table step 3.9132943e-4 times the index
 /// c·k − fl(c·k) = −2.04e-5. The bound covers it; without the distribution rule it is 0 there.
+/// The module as emitted now clamps that weight to [0, 1], and the same GPU returns 0.
 #[cfg(feature = "gloss")]
 #[test]
 fn a_distributing_gpu_gives_what_an_h200_gave() {
-    let program = bound::Program::new(&compose(&["gloss_inverse_table"]).unwrap());
-    let h = program.function("normal_length_to_gloss_lut");
+    let now = compose(&["gloss_inverse_table"]).unwrap();
+    let clamped = "let f0 = clamp(t0 - f32(i0), 0.0f, 1.0f);";
+    assert_eq!(now.matches(clamped).count(), 2, "the const-array and texture forms clamp their weight");
+    let then = now.replace(clamped, "let f0 = t0 - f32(i0);");
     let distributing = bound::Gpu { distribute: true, ..Default::default() };
-    for x in [0.0, 0.5, 2.0 / 3.0] {
-        let (v, g, d) = program.simulate(h, &[x], distributing);
-        assert_eq!(v, 0.0, "CPU at {x}");
-        assert_eq!(g, -7.984941e-9, "distributing GPU at {x}");
-        assert!((g as f64 - v as f64).abs() <= d, "bound {d:e} at {x}");
+    for (text, gpu_value) in [(&then, -7.984941e-9), (&now, 0.0)] {
+        let program = bound::Program::new(text);
+        let h = program.function("normal_length_to_gloss_lut");
+        for x in [0.0, 0.5, 2.0 / 3.0] {
+            let (v, g, d) = program.simulate(h, &[x], distributing);
+            assert_eq!(v, 0.0, "CPU at {x}");
+            assert_eq!(g, gpu_value, "distributing GPU at {x}");
+            assert!((g as f64 - v as f64).abs() <= d, "bound {d:e} at {x}");
+        }
+        let (_, strict, _) = program.simulate(h, &[0.0], bound::Gpu::default());
+        assert_eq!(strict, 0.0, "a GPU that evaluates as written");
     }
-    let (_, strict, _) = program.simulate(h, &[0.0], bound::Gpu::default());
-    assert_eq!(strict, 0.0, "a GPU that evaluates as written");
 }

@@ -24,7 +24,7 @@ fn ggx_albedo_avg_lut(alpha: f32) -> f32 {
     let x0 = ggx_albedo_avg_table_input(alpha, 1e-4f, 1e0f);
     let t0 = (x0 - 1e-4f) * 3.1003101e1f;
     let i0 = min(u32(t0), 30u);
-    let f0 = t0 - f32(i0);
+    let f0 = clamp(t0 - f32(i0), 0.0f, 1.0f);
     return GGX_ALBEDO_AVG_TABLE_TABLE[i0] * (1.0f - f0) + GGX_ALBEDO_AVG_TABLE_TABLE[i0 + 1u] * f0;
 }
 
@@ -36,6 +36,6 @@ fn ggx_albedo_avg_lut_load(lut: texture_2d<f32>, alpha: f32) -> f32 {
     let x0 = ggx_albedo_avg_table_input(alpha, 1e-4f, 1e0f);
     let t0 = (x0 - 1e-4f) * 3.1003101e1f;
     let i0 = min(u32(t0), 30u);
-    let f0 = t0 - f32(i0);
+    let f0 = clamp(t0 - f32(i0), 0.0f, 1.0f);
     return textureLoad(lut, vec2<u32>(i0, 0u), 0).x * (1.0f - f0) + textureLoad(lut, vec2<u32>(i0 + 1u, 0u), 0).x * f0;
 }

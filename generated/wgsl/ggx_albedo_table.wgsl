@@ -190,10 +190,10 @@ fn ggx_albedo_lut(alpha: f32, n_dot_v: f32) -> f32 {
     let x1 = ggx_albedo_table_input(n_dot_v, 0e0f, 1e0f);
     let t0 = (x0 - 1e-4f) * 3.1003101e1f;
     let i0 = min(u32(t0), 30u);
-    let f0 = t0 - f32(i0);
+    let f0 = clamp(t0 - f32(i0), 0.0f, 1.0f);
     let t1 = (x1 - 0e0f) * 3.1e1f;
     let i1 = min(u32(t1), 30u);
-    let f1 = t1 - f32(i1);
+    let f1 = clamp(t1 - f32(i1), 0.0f, 1.0f);
     let k = i1 * 32u + i0;
     let a = GGX_ALBEDO_TABLE_TABLE[k] * (1.0f - f0) + GGX_ALBEDO_TABLE_TABLE[k + 1u] * f0;
     let b = GGX_ALBEDO_TABLE_TABLE[k + 32u] * (1.0f - f0) + GGX_ALBEDO_TABLE_TABLE[k + 33u] * f0;
@@ -209,10 +209,10 @@ fn ggx_albedo_lut_load(lut: texture_2d<f32>, alpha: f32, n_dot_v: f32) -> f32 {
     let x1 = ggx_albedo_table_input(n_dot_v, 0e0f, 1e0f);
     let t0 = (x0 - 1e-4f) * 3.1003101e1f;
     let i0 = min(u32(t0), 30u);
-    let f0 = t0 - f32(i0);
+    let f0 = clamp(t0 - f32(i0), 0.0f, 1.0f);
     let t1 = (x1 - 0e0f) * 3.1e1f;
     let i1 = min(u32(t1), 30u);
-    let f1 = t1 - f32(i1);
+    let f1 = clamp(t1 - f32(i1), 0.0f, 1.0f);
     let a = textureLoad(lut, vec2<u32>(i0, i1), 0).x * (1.0f - f0) + textureLoad(lut, vec2<u32>(i0 + 1u, i1), 0).x * f0;
     let b = textureLoad(lut, vec2<u32>(i0, i1 + 1u), 0).x * (1.0f - f0) + textureLoad(lut, vec2<u32>(i0 + 1u, i1 + 1u), 0).x * f0;
     return a * (1.0f - f1) + b * f1;

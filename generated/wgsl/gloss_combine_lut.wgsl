@@ -702,10 +702,10 @@ fn combine_gloss_lut(x: f32, y: f32) -> f32 {
     let x1 = gloss_combine_lut_input(y, 0e0f, 1e0f);
     let t0 = (x0 - 0e0f) * 6.3e1f;
     let i0 = min(u32(t0), 62u);
-    let f0 = t0 - f32(i0);
+    let f0 = clamp(t0 - f32(i0), 0.0f, 1.0f);
     let t1 = (x1 - 0e0f) * 6.3e1f;
     let i1 = min(u32(t1), 62u);
-    let f1 = t1 - f32(i1);
+    let f1 = clamp(t1 - f32(i1), 0.0f, 1.0f);
     let k = i1 * 64u + i0;
     let a = GLOSS_COMBINE_LUT_TABLE[k] * (1.0f - f0) + GLOSS_COMBINE_LUT_TABLE[k + 1u] * f0;
     let b = GLOSS_COMBINE_LUT_TABLE[k + 64u] * (1.0f - f0) + GLOSS_COMBINE_LUT_TABLE[k + 65u] * f0;
@@ -721,10 +721,10 @@ fn combine_gloss_lut_load(lut: texture_2d<f32>, x: f32, y: f32) -> f32 {
     let x1 = gloss_combine_lut_input(y, 0e0f, 1e0f);
     let t0 = (x0 - 0e0f) * 6.3e1f;
     let i0 = min(u32(t0), 62u);
-    let f0 = t0 - f32(i0);
+    let f0 = clamp(t0 - f32(i0), 0.0f, 1.0f);
     let t1 = (x1 - 0e0f) * 6.3e1f;
     let i1 = min(u32(t1), 62u);
-    let f1 = t1 - f32(i1);
+    let f1 = clamp(t1 - f32(i1), 0.0f, 1.0f);
     let a = textureLoad(lut, vec2<u32>(i0, i1), 0).x * (1.0f - f0) + textureLoad(lut, vec2<u32>(i0 + 1u, i1), 0).x * f0;
     let b = textureLoad(lut, vec2<u32>(i0, i1 + 1u), 0).x * (1.0f - f0) + textureLoad(lut, vec2<u32>(i0 + 1u, i1 + 1u), 0).x * f0;
     return a * (1.0f - f1) + b * f1;

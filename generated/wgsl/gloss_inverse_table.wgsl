@@ -189,7 +189,7 @@ fn normal_length_to_gloss_lut(length: f32) -> f32 {
     let x0 = gloss_inverse_table_input(length, 6.666667e-1f, 1e0f);
     let t0 = (x0 - 6.666667e-1f) * 3.0690002e3f;
     let i0 = min(u32(t0), 1022u);
-    let f0 = t0 - f32(i0);
+    let f0 = clamp(t0 - f32(i0), 0.0f, 1.0f);
     return GLOSS_INVERSE_TABLE_TABLE[i0] * (1.0f - f0) + GLOSS_INVERSE_TABLE_TABLE[i0 + 1u] * f0;
 }
 
@@ -201,6 +201,6 @@ fn normal_length_to_gloss_lut_load(lut: texture_2d<f32>, length: f32) -> f32 {
     let x0 = gloss_inverse_table_input(length, 6.666667e-1f, 1e0f);
     let t0 = (x0 - 6.666667e-1f) * 3.0690002e3f;
     let i0 = min(u32(t0), 1022u);
-    let f0 = t0 - f32(i0);
+    let f0 = clamp(t0 - f32(i0), 0.0f, 1.0f);
     return textureLoad(lut, vec2<u32>(i0, 0u), 0).x * (1.0f - f0) + textureLoad(lut, vec2<u32>(i0 + 1u, 0u), 0).x * f0;
 }

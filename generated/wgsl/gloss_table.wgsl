@@ -61,7 +61,7 @@ fn gloss_to_normal_length_lut(gloss: f32) -> f32 {
     let x0 = gloss_table_input(gloss, 0e0f, 1e0f);
     let t0 = (x0 - 0e0f) * 2.55e2f;
     let i0 = min(u32(t0), 254u);
-    let f0 = t0 - f32(i0);
+    let f0 = clamp(t0 - f32(i0), 0.0f, 1.0f);
     return GLOSS_TABLE_TABLE[i0] * (1.0f - f0) + GLOSS_TABLE_TABLE[i0 + 1u] * f0;
 }
 
@@ -73,6 +73,6 @@ fn gloss_to_normal_length_lut_load(lut: texture_2d<f32>, gloss: f32) -> f32 {
     let x0 = gloss_table_input(gloss, 0e0f, 1e0f);
     let t0 = (x0 - 0e0f) * 2.55e2f;
     let i0 = min(u32(t0), 254u);
-    let f0 = t0 - f32(i0);
+    let f0 = clamp(t0 - f32(i0), 0.0f, 1.0f);
     return textureLoad(lut, vec2<u32>(i0, 0u), 0).x * (1.0f - f0) + textureLoad(lut, vec2<u32>(i0 + 1u, 0u), 0).x * f0;
 }

@@ -90,7 +90,7 @@ pub fn render_module(header: &[String], f: &Function<'_>, doc: &str) -> String {
             ));
             for (i, ((lo, hi), n)) in f.domain.iter().zip(counts.iter()).enumerate() {
                 s.push_str(&format!(
-                    "    let t{i} = (x{i} - {lo}) * {scale};\n    let i{i} = (t{i} as u32).min({last});\n    let f{i} = t{i} - i{i} as f32;\n",
+                    "    let t{i} = (x{i} - {lo}) * {scale};\n    let i{i} = (t{i} as u32).min({last});\n    let f{i} = (t{i} - i{i} as f32).clamp(0.0, 1.0);\n",
                     lo = lit(*lo),
                     scale = lit((*n as f32 - 1.0) / (hi - lo)),
                     last = n - 2
@@ -126,7 +126,7 @@ pub fn table_eval_f32(values: &[f32], counts: &[usize], domain: &[(f32, f32)], x
         let t = (xd - lo) * ((counts[d] as f32 - 1.0) / (hi - lo));
         let i = (t as u32).min(counts[d] as u32 - 2);
         idx[d] = i as usize;
-        frac[d] = t - i as f32;
+        frac[d] = (t - i as f32).clamp(0.0, 1.0);
     }
     if counts.len() == 1 {
         let i = idx[0];
@@ -184,5 +184,27 @@ mod tests {
         // x·y is bilinear too, and not separable: the cross term must come from four texels.
         let nodes: Vec<f32> = (0..2).flat_map(|j| (0..3).map(move |i| (i as f32 * 0.5) * (j as f32 * 4.0))).collect();
         assert_eq!(table_eval_f32(&nodes, &[3, 2], &d2, &[0.75, 1.0]), 0.75);
+    }
+
+    /// Where (hi − lo)·scale rounds above n − 1 in f32 (16 points on [0.1, 0.9]: 15.000001,
+    /// worked out with numpy's float32), the upper weight would be 1.000001 and the lookup at
+    /// hi would extrapolate past the last value; clamped, it returns the last value exactly
+    /// and every lookup lies between its two neighbours.
+    #[test]
+    fn table_weights_stay_in_zero_one_where_the_index_rounds_past_the_last_point() {
+        let (lo, hi) = (0.1f32, 0.9f32);
+        let scale = 15.0f32 / (hi - lo);
+        assert!((hi - lo) * scale > 15.0, "the case this test is about");
+        let mut v = [0.0f32; 16];
+        v[15] = 1000.0;
+        assert_eq!(table_eval_f32(&v, &[16], &[(lo, hi)], &[hi]), 1000.0);
+        // The same axis second in a 2-D table, values 1000 on its last row.
+        let v2: Vec<f32> = (0..16).flat_map(|j| [if j == 15 { 1000.0 } else { 0.0 }; 2]).collect();
+        assert_eq!(table_eval_f32(&v2, &[2, 16], &[(0.0, 1.0), (lo, hi)], &[0.5, hi]), 1000.0);
+        for k in 0..=1000 {
+            let x = lo + (hi - lo) * k as f32 / 1000.0;
+            let y = table_eval_f32(&v, &[16], &[(lo, hi)], &[x]);
+            assert!((0.0..=1000.0).contains(&y), "{y} at {x}");
+        }
     }
 }

@@ -105,13 +105,17 @@ fn input_lines(f: &Function<'_>) -> String {
         .collect()
 }
 
-/// `tK` (the argument in table steps), `iK` (the lower point) and `fK` (the weight of the upper)
-/// of each table axis, as the table function computes them.
+/// `tK` (the argument in table steps), `iK` (the lower point) and `fK` (the weight of the upper,
+/// clamped to [0, 1]) of each table axis, as the table function computes them. The clamp keeps
+/// the interpolation convex where tK leaves [0, n − 1] by a rounding: at the top, where
+/// (hi − lo)·scale rounds above n − 1, and at the bottom on a GPU that rewrites (x − lo)·scale
+/// as fma(x, scale, −fl(lo·scale)) (an NVIDIA driver does; WGSL cannot forbid it), which made
+/// a table of non-negative values return −8e-9 at its first point.
 fn table_index_lines(f: &Function<'_>, counts: &[usize]) -> String {
     let mut s = String::new();
     for (i, ((lo, hi), n)) in f.domain.iter().zip(counts.iter()).enumerate() {
         s.push_str(&format!(
-            "    let t{i} = (x{i} - {lo}) * {scale};\n    let i{i} = min(u32(t{i}), {last}u);\n    let f{i} = t{i} - f32(i{i});\n",
+            "    let t{i} = (x{i} - {lo}) * {scale};\n    let i{i} = min(u32(t{i}), {last}u);\n    let f{i} = clamp(t{i} - f32(i{i}), 0.0f, 1.0f);\n",
             lo = lit(*lo),
             scale = lit((*n as f32 - 1.0) / (hi - lo)),
             last = n - 2
