@@ -181,16 +181,16 @@ fn counts_match_hand_counts() {
     let get = |f: &str| &rows.iter().find(|r| r.function == f).unwrap_or_else(|| panic!("no row {f}")).counts;
     {
         // gloss_to_normal_length_lut: the input clamp (mask, compare, clamp, select: 4 other);
-        // t0 = (x0 − 0)·255 (1 add, 1 mul); i0 = min(u32(t0), 254) (2 other); f0 = t0 − f32(i0)
-        // (1 add, 1 other); T[i0]·(1 − f0) + T[i0 + 1]·f0 (2 add, 2 mul, 1 integer add, two
-        // loads at computed indices).
+        // t0 = (x0 − 0)·255 (1 add, 1 mul); i0 = min(u32(t0), 254) (2 other); f0 =
+        // clamp(t0 − f32(i0), 0, 1) (1 add, 2 other); T[i0]·(1 − f0) + T[i0 + 1]·f0 (2 add, 2
+        // mul, 1 integer add, two loads at computed indices).
         let c = get("gloss_to_normal_length_lut");
         assert_eq!((c.add, c.mul, c.div, c.transc, c.tex), (4, 3, 0, 0, 0), "{c:?}");
-        assert_eq!((c.const_loads, c.other), (2, 8), "{c:?}");
+        assert_eq!((c.const_loads, c.other), (2, 9), "{c:?}");
         // The texture accessor: the same arithmetic, two fetches instead of the loads, each
         // with its texel address (i % width, i / width: 2 other).
         let t = get("gloss_to_normal_length_lut_tex");
-        assert_eq!((t.add, t.mul, t.tex, t.const_loads, t.other), (4, 3, 2, 0, 12), "{t:?}");
+        assert_eq!((t.add, t.mul, t.tex, t.const_loads, t.other), (4, 3, 2, 0, 13), "{t:?}");
     }
     {
         // fuzz_average_penetration: one input clamp (4 other); (N[0] + x0·(N[1] + x0·N[2])) / 1:
