@@ -240,6 +240,33 @@ mod tests {
         }
     }
 
+    /// A sample whose model value lies exactly on a clamp limit keeps its Jacobian row: the
+    /// derivative from inside the clamp, the side a descent that lowers its residual moves to.
+    /// A zero row there would tell the solver that the residual cannot change. f = c₀ + c₁x
+    /// with clamp [0, 1] at θ = (0, 1) meets 0 at x = 0 and 1 at x = 1; ∂f/∂c = (1, x), by hand.
+    #[test]
+    fn a_sample_on_a_clamp_limit_keeps_the_inside_derivative() {
+        let f = vec!["x".to_string()];
+        let t = |s: &str| Term::parse(s, &f).unwrap();
+        let m = RationalModel::new(ModelParts {
+            inputs: f.clone(),
+            numerator: vec![t("1"), t("x")],
+            clamp: Some((0.0, 1.0)),
+            ..ModelParts::default()
+        })
+        .unwrap();
+        let data = Data { x: vec![vec![0.0], vec![0.5], vec![1.0], vec![2.0]], y: vec![0.5; 4] };
+        let theta = DVector::from_vec(vec![0.0, 1.0]);
+        let p = Residuals::new(&m, &data, theta.clone());
+        assert_eq!(p.raw(&theta).as_slice(), &[-0.5, 0.0, 0.5, 0.5], "on the limits at x = 0 and 1, clamped at x = 2");
+        let j = p.jacobian_at(&theta);
+        // Rows (1, x) on and inside the limits, zero where the clamp holds the value (x = 2).
+        assert_eq!(j.row(0).iter().copied().collect::<Vec<_>>(), [1.0, 0.0], "x = 0, on the lower limit");
+        assert_eq!(j.row(1).iter().copied().collect::<Vec<_>>(), [1.0, 0.5]);
+        assert_eq!(j.row(2).iter().copied().collect::<Vec<_>>(), [1.0, 1.0], "x = 1, on the upper limit");
+        assert_eq!(j.row(3).iter().copied().collect::<Vec<_>>(), [0.0, 0.0], "x = 2, clamped");
+    }
+
     /// Σr⁴ through `weighted`: the squared norm of s = r|r| is Σr⁴ of the raw residuals, each
     /// weighted by w² (√w applied before squaring).
     #[test]
