@@ -367,6 +367,39 @@ mod tests {
         assert!(text.contains("pub fn quad_coeffs(") && text.contains("pub fn quad("), "{text}");
     }
 
+    /// The coefficient function evaluates each field's rational (n₀ + n₁o)/(1 + d₀o) at the
+    /// outer input, in field order, and the evaluator sums c₀ + c₁u and clamps it to the range;
+    /// at o = 0.5 the fields below are 2/2 = 1 and 2/0.5 = 4, exact in f32 (by hand).
+    #[test]
+    fn coefficients_and_evaluator_compute_the_fields_rationals() {
+        let model = crate::fit::model::RationalModel::rational_1d("o", 1, 1);
+        let e = crate::fit::expr::model_expr(&model);
+        let fields = [
+            Field { expr: e.clone(), num: vec![1.0, 2.0], den: vec![2.0] },
+            Field { expr: e, num: vec![3.0, -2.0], den: vec![-1.0] },
+        ];
+        let (args, eval_args) = (vec!["o".to_string()], vec!["u".to_string()]);
+        let terms: Vec<Term> = ["1", "u"].iter().map(|s| Term::parse(s, &eval_args).unwrap()).collect();
+        let f = FieldsFunction {
+            module: "quad",
+            name: "quad_coeffs",
+            args: &args,
+            derived: &[],
+            domain: &[(0.0, 1.0)],
+            fields: &fields,
+            evaluator: "quad",
+            eval_args: &eval_args,
+            eval_domain: &[(-1.0, 1.0)],
+            terms: &terms,
+            range: (-4.0, 4.0),
+        };
+        let c = coefficients_f32(&f, &[0.5]);
+        assert_eq!(c, [1.0, 4.0]);
+        assert_eq!(evaluator_f32(&f, &c, &[0.5]), 3.0); // 1 + 4·0.5
+        assert_eq!(evaluator_f32(&f, &c, &[1.0]), 4.0); // 5, clamped to the range's top
+        assert_eq!(evaluator_f32(&f, &c, &[-3.0]), -3.0); // u clamped to −1: 1 − 4
+    }
+
     /// A monomial's factors are its arguments repeated by their exponents, in argument order.
     #[test]
     fn monomial_factors_repeat_each_argument_by_its_exponent() {
