@@ -500,3 +500,26 @@ fn a_channel_spec_records_and_builds_its_channel() {
     let scalar = build_spec(&spec(FIT), Mode::Fit, tmp.path(), &|_| None).unwrap();
     assert!(json_of(&scalar).get("channel").is_none());
 }
+
+/// A LUT's committed texels are read back in order, each its N numbers; a texel of another
+/// length, a non-number, a missing `values` or another texel count is an error naming the
+/// spec and what is wrong, never a table of zeros.
+#[test]
+fn committed_texels_read_back_each_texel_or_say_why_not() {
+    let v = serde_json::json!({"values": [[1.5, -2.0], [3.0, 0.25], [1e-300, 7.0]]});
+    let t: Vec<[f64; 2]> = committed_texels(&v, "lut_a", 3, "[scale, bias]").unwrap();
+    assert_eq!(t, [[1.5, -2.0], [3.0, 0.25], [1e-300, 7.0]]);
+    let err = |v: serde_json::Value, texels: usize| committed_texels::<2>(&v, "lut_a", texels, "[scale, bias]").unwrap_err().to_string();
+    let no_array = "lut_a: generated/json/lut_a.json is missing or unreadable (no array 'values' of [scale, bias] numbers)";
+    assert!(err(v.clone(), 4).contains("texel count differs from the spec"), "{}", err(v.clone(), 4));
+    assert!(err(v.clone(), 4).starts_with("lut_a: "));
+    for bad in [
+        serde_json::json!({"values": [[1.5, -2.0], [3.0], [1e-300, 7.0]]}),
+        serde_json::json!({"values": [[1.5, -2.0], [3.0, 0.25, 1.0], [1e-300, 7.0]]}),
+        serde_json::json!({"values": [[1.5, -2.0], [3.0, "x"], [1e-300, 7.0]]}),
+        serde_json::json!({"values": [1.5, -2.0, 3.0]}),
+        serde_json::json!({"texels": [[1.5, -2.0]]}),
+    ] {
+        assert!(err(bad.clone(), 3).starts_with(no_array), "{bad}: {}", err(bad.clone(), 3));
+    }
+}
