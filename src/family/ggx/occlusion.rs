@@ -537,6 +537,44 @@ fn lut_items(generated: &Path, pts: &[[f64; 3]], refs: &[[f64; 4]]) -> Vec<Item>
 mod tests {
     use super::*;
 
+    /// The readers are the committed cone LUTs, one for each spec of that kind in fits/
+    /// (read here from the TOML files), and each reads back the hemisphere integral at its
+    /// texel centres on slice 0 (cos θc = 0): `env` recomputed at 1e-9 against the stored f16
+    /// texel; bound: f16's half ulp (2⁻¹¹ relative) plus the build's tolerance (1e-7) and
+    /// the recomputation's.
+    #[test]
+    fn lut_readers_read_every_committed_cone_lut_back() {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+        let mut specs: Vec<String> = std::fs::read_dir(root.join("fits"))
+            .unwrap()
+            .filter_map(|e| {
+                let text = std::fs::read_to_string(e.ok()?.path()).ok()?;
+                let t: toml::Table = text.parse().ok()?;
+                (t.get("kind")?.as_str()? == "ggx-cone-lut").then(|| t["name"].as_str().unwrap().to_string())
+            })
+            .collect();
+        specs.sort();
+        let readers = lut_readers(&root.join("generated"));
+        assert!(!specs.is_empty());
+        assert_eq!(readers.iter().map(|r| r.name().to_string()).collect::<Vec<_>>(), specs);
+        for reader in &readers {
+            let l = &reader.lut;
+            for (i, j) in [(0, 0), (5, 17), (16, 3), (31, 31), (20, 28)] {
+                let (u, t) = ((i as f64 + 0.5) / l.width as f64, (j as f64 + 0.5) / l.height as f64);
+                let alpha = match l.row.as_str() {
+                    "gloss" => crate::family::gloss::integrals::alpha_from_gloss(t),
+                    "alpha" => t,
+                    _ => t * t,
+                };
+                let got = reader.scale_bias(u, alpha, 0.0);
+                let want = integrals::env(alpha, u, 0.0, Shadowing::HeightCorrelated, 1e-9);
+                for (g, w) in got.iter().zip([want.scale, want.bias]) {
+                    assert!((g - w).abs() <= w.abs() * 2f64.powi(-11) + 1e-7 + 1e-9, "{} texel ({i}, {j}): {got:?} vs {want:?}", reader.name());
+                }
+            }
+        }
+    }
+
     /// The occluded split sum's errors by hand: a reader returning [n·v + α, cos θc] at three
     /// points against references chosen so the errors are 0.02·0.04 + 0.01 = 0.0108, 0 and
     /// 0.05·0.04 − 0.03 = −0.028 (abs 0.028, the worst, at the third point).
