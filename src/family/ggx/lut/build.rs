@@ -432,7 +432,8 @@ mod tests {
     fn bilinear_reproduces_a_linear_function_and_clamps_at_the_edges() {
         let (w, h) = (4usize, 3usize);
         let texels: Vec<[f64; 2]> = (0..h).flat_map(|j| (0..w).map(move |i| [i as f64 + 10.0 * j as f64, 2.0 * i as f64 - j as f64])).collect();
-        for (u, t) in [(0.3, 0.4), (0.5, 0.5), (0.7, 0.2), (0.05, 0.9), (0.99, 0.01)] {
+        // The last four lie outside [0, 1]², where clamp to edge reads the border texels.
+        for (u, t) in [(0.3, 0.4), (0.5, 0.5), (0.7, 0.2), (0.05, 0.9), (0.99, 0.01), (1.3, 0.5), (-0.2, 1.4), (2.0, -1.0), (0.6, 1.0 + 1e-9)] {
             let x = (u * w as f64 - 0.5).clamp(0.0, (w - 1) as f64);
             let y = (t * h as f64 - 0.5).clamp(0.0, (h - 1) as f64);
             let got = bilinear(&texels, (w, h), u, t);
