@@ -297,32 +297,48 @@ mod tests {
         assert_eq!(basis_sum_f32(&terms[1..], &[2.0, 3.0], &[0.5, 4.0]), 4.0);
     }
 
+    /// Two fields (n₀ + n₁o)/(1 + d₀o) of the outer input o ∈ [0, 1] and the evaluator
+    /// c₀ + c₁u, u ∈ [−1, 1], clamped to [−4, 4].
+    struct Quad {
+        fields: [Field; 2],
+        args: Vec<String>,
+        eval_args: Vec<String>,
+        terms: Vec<Term>,
+    }
+
+    impl Quad {
+        fn new([(n0, d0), (n1, d1)]: [(Vec<f32>, Vec<f32>); 2]) -> Quad {
+            let e = crate::fit::expr::model_expr(&crate::fit::model::RationalModel::rational_1d("o", 1, 1));
+            let fields = [Field { expr: e.clone(), num: n0, den: d0 }, Field { expr: e, num: n1, den: d1 }];
+            let eval_args = vec!["u".to_string()];
+            let terms = ["1", "u"].iter().map(|s| Term::parse(s, &eval_args).unwrap()).collect();
+            Quad { fields, args: vec!["o".to_string()], eval_args, terms }
+        }
+
+        fn function(&self) -> FieldsFunction<'_> {
+            FieldsFunction {
+                module: "quad",
+                name: "quad_coeffs",
+                args: &self.args,
+                derived: &[],
+                domain: &[(0.0, 1.0)],
+                fields: &self.fields,
+                evaluator: "quad",
+                eval_args: &self.eval_args,
+                eval_domain: &[(-1.0, 1.0)],
+                terms: &self.terms,
+                range: (-4.0, 4.0),
+            }
+        }
+    }
+
     /// The Rust module declares the domain, each field's f32 arrays and the f64 coefficients,
     /// every literal reading back to the value it was given; the WGSL module of the same
     /// fields validates in naga and returns every field.
     #[test]
     fn the_rust_module_carries_every_coefficient() {
-        let model = crate::fit::model::RationalModel::rational_1d("o", 1, 1);
-        let e = crate::fit::expr::model_expr(&model);
-        let fields = [
-            Field { expr: e.clone(), num: vec![0.1, -2.5], den: vec![0.3] },
-            Field { expr: e, num: vec![1.0 / 3.0, 7.0], den: vec![-0.2] },
-        ];
-        let (args, eval_args) = (vec!["o".to_string()], vec!["u".to_string()]);
-        let terms: Vec<Term> = ["1", "u"].iter().map(|s| Term::parse(s, &eval_args).unwrap()).collect();
-        let f = FieldsFunction {
-            module: "quad",
-            name: "quad_coeffs",
-            args: &args,
-            derived: &[],
-            domain: &[(0.0, 1.0)],
-            fields: &fields,
-            evaluator: "quad",
-            eval_args: &eval_args,
-            eval_domain: &[(-1.0, 1.0)],
-            terms: &terms,
-            range: (-4.0, 4.0),
-        };
+        let q = Quad::new([(vec![0.1, -2.5], vec![0.3]), (vec![1.0 / 3.0, 7.0], vec![-0.2])]);
+        let f = q.function();
         let c64 = vec![(vec![0.1, -2.5], vec![0.3]), (vec![1.0 / 3.0, 7.0], vec![-0.2])];
         // The WGSL module validates in naga, and its coefficient function returns one composed
         // value per field (an empty body would be `array<f32, 2>()`, the zero value).
@@ -372,27 +388,8 @@ mod tests {
     /// at o = 0.5 the fields below are 2/2 = 1 and 2/0.5 = 4, exact in f32 (by hand).
     #[test]
     fn coefficients_and_evaluator_compute_the_fields_rationals() {
-        let model = crate::fit::model::RationalModel::rational_1d("o", 1, 1);
-        let e = crate::fit::expr::model_expr(&model);
-        let fields = [
-            Field { expr: e.clone(), num: vec![1.0, 2.0], den: vec![2.0] },
-            Field { expr: e, num: vec![3.0, -2.0], den: vec![-1.0] },
-        ];
-        let (args, eval_args) = (vec!["o".to_string()], vec!["u".to_string()]);
-        let terms: Vec<Term> = ["1", "u"].iter().map(|s| Term::parse(s, &eval_args).unwrap()).collect();
-        let f = FieldsFunction {
-            module: "quad",
-            name: "quad_coeffs",
-            args: &args,
-            derived: &[],
-            domain: &[(0.0, 1.0)],
-            fields: &fields,
-            evaluator: "quad",
-            eval_args: &eval_args,
-            eval_domain: &[(-1.0, 1.0)],
-            terms: &terms,
-            range: (-4.0, 4.0),
-        };
+        let q = Quad::new([(vec![1.0, 2.0], vec![2.0]), (vec![3.0, -2.0], vec![-1.0])]);
+        let f = q.function();
         let c = coefficients_f32(&f, &[0.5]);
         assert_eq!(c, [1.0, 4.0]);
         assert_eq!(evaluator_f32(&f, &c, &[0.5]), 3.0); // 1 + 4·0.5
