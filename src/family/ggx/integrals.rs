@@ -636,41 +636,44 @@ mod tests {
     /// times its estimate (measured when this test was written).
     #[test]
     fn phi_panels_let_the_estimate_see_the_pole_below_the_horizon() {
-        for shadowing in [HC, Shadowing::Separable { k: 0.15 }] {
-            for &alpha in &[1e-6, 1.5e-5, 1e-3] {
-                for &mu in &[1e-4, 0.004, 0.2, 0.7] {
-                    for &c in &[0.0, 0.3] {
-                        let view = View::new(alpha, mu, c, shadowing);
-                        for k in 1..200 {
-                            let (sh, ch) = (0.5 * PI * k as f64 / 200.0).sin_cos();
-                            let kappa = view.kappa(sh, ch);
-                            if !(kappa > -1.0 && kappa < 1.0) {
-                                continue;
-                            }
-                            let phi_max = kappa.acos();
-                            let f = |phi: f64| view.integrand(sh, ch, phi.cos());
-                            let mut halving = Vec::new();
-                            let mut lo = 0.0;
-                            for j in 1..60 {
-                                let b = phi_max - phi_max * 0.5f64.powi(j);
-                                if b > lo {
-                                    halving.push((lo, b));
-                                    lo = b;
-                                }
-                            }
-                            halving.push((lo, phi_max));
-                            let t = integrate(&halving, &options::<2>(0.0, 1e-13), f);
-                            let r = integrate(&view.phi_panels(sh, ch, kappa, phi_max), &options::<2>(0.0, 1e-9), f);
-                            let err = ((r.value[0] + r.value[1]) - (t.value[0] + t.value[1])).abs();
-                            assert!(
-                                err <= r.error + t.error,
-                                "{shadowing:?} α={alpha} μv={mu} c={c} θh at {k}/200 of π/2: off by {err:e}, estimates {:e} + {:e}",
-                                r.error,
-                                t.error
-                            );
-                        }
-                    }
+        // [0, φmax] cut at φmax(1 − 2⁻ʲ), j = 1..59.
+        let halving = |phi_max: f64| {
+            let mut out = Vec::new();
+            let mut lo = 0.0;
+            for j in 1..60 {
+                let b = phi_max - phi_max * 0.5f64.powi(j);
+                if b > lo {
+                    out.push((lo, b));
+                    lo = b;
                 }
+            }
+            out.push((lo, phi_max));
+            out
+        };
+        let views = [HC, Shadowing::Separable { k: 0.15 }].into_iter().flat_map(|shadowing| {
+            [1e-6, 1.5e-5, 1e-3].into_iter().flat_map(move |alpha| {
+                [1e-4, 0.004, 0.2, 0.7].into_iter().flat_map(move |mu| [0.0, 0.3].map(|c| (shadowing, alpha, mu, c)))
+            })
+        });
+        for (shadowing, alpha, mu, c) in views {
+            let view = View::new(alpha, mu, c, shadowing);
+            for k in 1..200 {
+                let (sh, ch) = (0.5 * PI * k as f64 / 200.0).sin_cos();
+                let kappa = view.kappa(sh, ch);
+                if !(kappa > -1.0 && kappa < 1.0) {
+                    continue;
+                }
+                let phi_max = kappa.acos();
+                let f = |phi: f64| view.integrand(sh, ch, phi.cos());
+                let t = integrate(&halving(phi_max), &options::<2>(0.0, 1e-13), f);
+                let r = integrate(&view.phi_panels(sh, ch, kappa, phi_max), &options::<2>(0.0, 1e-9), f);
+                let err = ((r.value[0] + r.value[1]) - (t.value[0] + t.value[1])).abs();
+                assert!(
+                    err <= r.error + t.error,
+                    "{shadowing:?} α={alpha} μv={mu} c={c} θh at {k}/200 of π/2: off by {err:e}, estimates {:e} + {:e}",
+                    r.error,
+                    t.error
+                );
             }
         }
     }

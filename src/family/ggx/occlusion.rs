@@ -559,13 +559,11 @@ mod tests {
         assert_eq!(readers.iter().map(|r| r.name().to_string()).collect::<Vec<_>>(), specs);
         for reader in &readers {
             let l = &reader.lut;
+            use super::super::lut::spec::RoughnessMapping as M;
+            let mapping = [M::Perceptual, M::Alpha, M::Gloss].into_iter().find(|m| m.argument() == l.row).unwrap();
             for (i, j) in [(0, 0), (5, 17), (16, 3), (31, 31), (20, 28)] {
                 let (u, t) = ((i as f64 + 0.5) / l.width as f64, (j as f64 + 0.5) / l.height as f64);
-                let alpha = match l.row.as_str() {
-                    "gloss" => crate::family::gloss::integrals::alpha_from_gloss(t),
-                    "alpha" => t,
-                    _ => t * t,
-                };
+                let alpha = mapping.alpha(t);
                 let got = reader.scale_bias(u, alpha, 0.0);
                 let want = integrals::env(alpha, u, 0.0, Shadowing::HeightCorrelated, 1e-9);
                 for (g, w) in got.iter().zip([want.scale, want.bias]) {
