@@ -391,7 +391,7 @@ fn every_emitted_function_equals_its_cpu_version_on_the_gpu() {
         }
     }
     assert!(failed.is_empty(), "{} of {runs} runs out of bound:\n\n{}", failed.len(), failed.join("\n\n"));
-    report(&format!("gpu: {functions} emitted functions + {} texture versions, {points} points, all within bound", runs - functions));
+    report(&format!("gpu: {functions} emitted functions + {} texture versions, {points} points, all within bound, the tables' within their values' range", runs - functions));
 }
 
 /// How many points of each function run in the other import styles (a pipeline each; the
