@@ -140,15 +140,6 @@ impl<'a> Fields<'a> {
             .collect()
     }
 
-    /// Split θ into the per-field free parameters.
-    pub fn split(&self, theta: &DVector<f64>) -> Vec<DVector<f64>> {
-        self.models
-            .iter()
-            .enumerate()
-            .map(|(k, m)| theta.rows(self.starts[k], m.n_free()).into_owned())
-            .collect()
-    }
-
     /// Field values c_k(x_g) at every grid point: values[g][k].
     pub fn values(&self, theta: &DVector<f64>) -> Vec<Vec<f64>> {
         let full = self.full(theta);

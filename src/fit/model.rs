@@ -90,10 +90,6 @@ impl Term {
     pub fn is_constant(&self) -> bool {
         self.monomials.len() == 1 && self.monomials[0].exps.iter().all(|&e| e == 0)
     }
-
-    pub fn degree(&self) -> u32 {
-        self.monomials.iter().map(|m| m.exps.iter().sum::<u32>()).max().unwrap_or(0)
-    }
 }
 
 impl fmt::Display for Term {
@@ -516,6 +512,54 @@ mod tests {
         for (o, s, x, want) in [(0.5, 1.0, 0.25, 0.75), (0.5, -1.0, 0.25, 0.25), (0.5, 2.0, 0.25, 1.0), (-1.0, -0.5, 3.0, -2.5)] {
             assert_eq!(affine(o, s, x), want, "{o} + {s}·{x}");
             assert_eq!(affine_f32(o as f32, s as f32, x as f32), want as f32, "{o} + {s}·{x} (f32)");
+        }
+    }
+
+    /// A derived feature's definition as the fit reports print it (`describe`) parses back to
+    /// the same feature, and its f32 evaluation (the emitted arithmetic) is its value. Values
+    /// by hand at α = 0.25, θ = π/3: 1 − α = 0.75, 0.5 + 3α = 1.25, 2α = 0.5, α, cos θ = ½,
+    /// sin θ = √3/2.
+    #[test]
+    fn derived_features_describe_themselves_and_evaluate_in_f32() {
+        let inputs = vec!["alpha".to_string(), "theta".to_string()];
+        let x = [0.25, std::f64::consts::PI / 3.0];
+        let xf = x.map(|v| v as f32);
+        let cases = [
+            ("1 - alpha", 0.75),
+            ("0.5 + 3*alpha", 1.25),
+            ("2*alpha", 0.5),
+            ("alpha", 0.25),
+            ("cos(theta)", 0.5),
+            ("sin(theta)", 3f64.sqrt() / 2.0),
+        ];
+        for (text, want) in cases {
+            let d = Derived::parse("d", text, &inputs).unwrap();
+            let described = d.describe(&inputs);
+            assert_eq!(Derived::parse("d", &described, &inputs), Ok(d.clone()), "{text} described as {described:?}");
+            // f64: exact for the affine maps (binary values), libm's cos/sin of the f64 π/3
+            // within a few ulps of 1.
+            assert!((d.eval(&x) - want).abs() <= 4.0 * f64::EPSILON, "{text}: {}", d.eval(&x));
+            // f32: θ rounded to f32 moves cos/sin by ≤ ½ ulp of π/3 (slope ≤ 1), plus the f32
+            // functions' own ulp or two; the affine maps are exact on these values.
+            let got = d.eval_f32(&xf) as f64;
+            assert!((got - want).abs() <= 3.0 * f32::EPSILON as f64, "{text}: f32 {got}, want {want}");
+        }
+    }
+
+    /// `rational(m,n)` (the CLI's `fit --model`): numerator terms 1, x, …, x^m and
+    /// denominator terms x, …, x^n (its constant fixed to 1), labelled as the reports list
+    /// the coefficients; degrees up to 12 in either place, 13 refused, malformed forms refused.
+    #[test]
+    fn rational_forms_parse_to_their_degrees() {
+        let m = RationalModel::parse_form(" rational(2, 1) ", "x").unwrap();
+        assert_eq!(m.coefficient_labels(), ["num[1]", "num[x]", "num[x^2]", "den[x]"]);
+        // (1 + 2x + 3x²)/(1 + 4x) at x = 0.5: 2.75 / 3, the coefficients in label order.
+        let full = DVector::from_vec(vec![1.0, 2.0, 3.0, 4.0]);
+        // A handful of roundings of values below 3.
+        assert!((m.eval_full(&full, &[0.5]) - 2.75 / 3.0).abs() <= 1e-15);
+        assert_eq!(RationalModel::parse_form("rational(12,12)", "x").unwrap().coefficient_labels().len(), 13 + 12);
+        for form in ["rational(13,0)", "rational(0,13)", "rational(13,13)", "rational(2)", "rational(a,1)", "poly(2,1)", "rational(2,1"] {
+            assert!(matches!(RationalModel::parse_form(form, "x"), Err(ModelError::BadForm(_))), "{form}");
         }
     }
 

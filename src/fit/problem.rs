@@ -240,6 +240,34 @@ mod tests {
         }
     }
 
+    /// argmin's cost and gradient of the residuals (for argmin's gradient solvers): the
+    /// weighted residual sum of squares, summed here, and its central differences.
+    #[test]
+    fn the_cost_is_the_weighted_sum_of_squares_and_the_gradient_its_slope() {
+        let x: Vec<Vec<f64>> = (0..25).map(|i| vec![i as f64 / 12.0]).collect();
+        let data = Data { y: x.iter().map(|p| (1.3 * p[0]).sin() + 0.2).collect(), x };
+        let m = model(vec![], None);
+        let n = m.n_free();
+        let theta = DVector::from_iterator(n, (0..n).map(|i| 0.4 * ((i as f64) * 2.3 + 0.5).cos()));
+        let mut p = Residuals::new(&m, &data, theta.clone());
+        p.set_weights(&(0..25).map(|i| 0.5 + (i % 3) as f64).collect::<Vec<_>>());
+        let cost = |t: &DVector<f64>| p.weighted(t).iter().map(|r| r * r).sum::<f64>();
+        let c = p.cost(&theta).unwrap();
+        // Two summation orders of 25 positive terms: a few ulps of the sum.
+        assert!((c - cost(&theta)).abs() <= 1e-14 * c, "{c} vs {}", cost(&theta));
+        let g = p.gradient(&theta).unwrap();
+        let h = 1e-6;
+        for k in 0..n {
+            let (mut tp, mut tm) = (theta.clone(), theta.clone());
+            tp[k] += h;
+            tm[k] -= h;
+            let fd = (cost(&tp) - cost(&tm)) / (2.0 * h);
+            // As in the Jacobian test: truncation ~h² times third derivatives of O(10^2) here
+            // (a sum of 25 squares), rounding ~1e-16·cost/h.
+            assert!((g[k] - fd).abs() <= 1e-6 * fd.abs().max(1.0), "component {k}: {} vs {fd}", g[k]);
+        }
+    }
+
     /// A sample whose model value lies exactly on a clamp limit keeps its Jacobian row: the
     /// derivative from inside the clamp, the side a descent that lowers its residual moves to.
     /// A zero row there would tell the solver that the residual cannot change. f = c₀ + c₁x

@@ -649,6 +649,19 @@ fn minimax(
 mod tests {
     use super::*;
 
+    /// The objective names `fit --objective` takes (`FromStr`) are the specs' (serde's
+    /// lowercase variant names), and each parses back to its objective; another name is
+    /// refused with the list.
+    #[test]
+    fn objective_names_parse_back() {
+        for o in [Objective::Lsq, Objective::Minimax, Objective::L4] {
+            assert_eq!(o.name().parse::<Objective>(), Ok(o));
+            assert_eq!(serde_json::to_value(o).unwrap(), o.name());
+        }
+        let e = "l2".parse::<Objective>().unwrap_err();
+        assert!(["'l2'", "lsq", "minimax", "l4"].iter().all(|w| e.contains(w)), "{e}");
+    }
+
     /// Starts stopped for stalling change nothing: the chosen fit is bit for bit the one of
     /// running every start in full. A unit step at x = 0.3 by a 2/3 rational: three of the
     /// linearised starts crawl far above the best and are left stopped.
