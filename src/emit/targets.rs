@@ -641,7 +641,7 @@ mod tests {
     #[test]
     fn the_keep_entry_point_calls_every_function_with_one_binding_per_resource_type() {
         let src = "struct P { x: f32 }\n\
-                   fn a(x: f32, n: u32, i: i32, b: bool, v: vec3<f32>, p: P) -> f32 { return x + p.x; }\n\
+                   fn a(x: f32, n: u32, i: i32, b: bool, v: vec3<f32>, p: P, m: mat2x3<f32>, r: array<f32, 4>) -> f32 { return x + p.x; }\n\
                    fn t(tex: texture_2d<f32>, s: sampler, uv: vec2<f32>) -> vec4<f32> { return textureSampleLevel(tex, s, uv, 0.0); }\n\
                    fn u(s: sampler, tex: texture_2d<f32>) -> vec4<f32> { return textureSampleLevel(tex, s, vec2<f32>(0.5), 0.0); }\n\
                    fn w() {}\n";
@@ -650,7 +650,7 @@ mod tests {
         let (all, _) = parse("k", &format!("{src}{ep}")).unwrap_or_else(|e| panic!("{e}\n{ep}"));
         assert_eq!(all.global_variables.len(), 2, "{ep}");
         assert_eq!(all.entry_points.len(), 1);
-        for call in ["_ = a(0f, 0u, 0i, false, vec3<f32>(), P());", "_ = t(k_keep_binding_0, k_keep_binding_1, vec2<f32>());", "_ = u(k_keep_binding_1, k_keep_binding_0);", "    w();"] {
+        for call in ["_ = a(0f, 0u, 0i, false, vec3<f32>(), P(), mat2x3<f32>(), array<f32, 4>());", "_ = t(k_keep_binding_0, k_keep_binding_1, vec2<f32>());", "_ = u(k_keep_binding_1, k_keep_binding_0);", "    w();"] {
             assert!(ep.contains(call), "no '{call}' in {ep}");
         }
         assert!(ep.contains("var k_keep_binding_0: texture_2d<f32>;") && ep.contains("var k_keep_binding_1: sampler;"), "{ep}");
@@ -662,13 +662,16 @@ mod tests {
     fn the_c_header_holds_every_constant() {
         let wgsl = "const K: f32 = 0.1;\nconst A: array<f32, 3> = array<f32, 3>(1.5, -2.5e-8, 3.4028235e38);\n\
                     const V: array<vec2<f32>, 2> = array<vec2<f32>, 2>(vec2<f32>(0.25, 0.5), vec2<f32>(0.75, 1.0));\n\
-                    const N: u32 = 7u;\nfn f() -> f32 { return K + A[1] + V[1].x + f32(N); }\n";
+                    const N: u32 = 7u;\nconst I: i32 = -3;\nconst B: bool = true;\n\
+                    const M: mat2x3<f32> = mat2x3<f32>(1.0, 2.0, 3.0, 4.0, 5.0, 6.0);\n\
+                    const S: vec3<f32> = vec3<f32>(0.125);\nconst R: array<f32, 2> = array<f32, 2>(K, 2.0);\n\
+                    fn f() -> f32 { return K + A[1] + V[1].x + f32(N) + f32(I) + select(0.0, 1.0, B) + M[1].x + S.y + R[0]; }\n";
         let m = naga::front::wgsl::parse_str(wgsl).unwrap();
         let h = c_header("mod_x", &["line"], "mod_x.wgsl", &m).unwrap();
         assert!(h.contains("#ifndef SHADEFIT_MOD_X_H") && h.trim_end().ends_with("#endif /* SHADEFIT_MOD_X_H */"), "{h}");
         // Every number between `= ` and `;` of each declaration, parsed back as f32.
         let values = |name: &str| -> Vec<f32> {
-            let at = h.find(&format!(" {name}")).unwrap_or_else(|| panic!("{name} missing:\n{h}"));
+            let at = h.find(&format!(" {name} =")).or_else(|| h.find(&format!(" {name}["))).unwrap_or_else(|| panic!("{name} missing:\n{h}"));
             let body = &h[at..];
             let body = &body[body.find('=').unwrap() + 1..body.find(';').unwrap()];
             body.split(|c: char| c == ',' || c == '{' || c == '}' || c.is_whitespace())
@@ -683,6 +686,16 @@ mod tests {
         assert_eq!(values("V"), vec![0.25, 0.5, 0.75, 1.0]);
         assert_eq!(values("N"), vec![7.0]);
         assert!(h.contains("static const uint32_t N ="), "{h}");
+        // A signed integer, a bool (C: int 1), a matrix (columns × rows, column-major as WGSL
+        // stores it), a splat (one value repeated) and an array naming another constant.
+        assert_eq!(values("I"), vec![-3.0]);
+        assert!(h.contains("static const int32_t I ="), "{h}");
+        assert_eq!(values("B"), vec![1.0]);
+        assert!(h.contains("static const int B ="), "{h}");
+        assert_eq!(values("M"), vec![1.0, 2.0, 3.0, 4.0, 5.0, 6.0]);
+        assert!(h.contains("static const float M[2][3] ="), "{h}");
+        assert_eq!(values("S"), vec![0.125; 3]);
+        assert_eq!(values("R"), vec![0.1, 2.0]);
     }
 
     #[test]
@@ -692,6 +705,22 @@ mod tests {
         }
         assert_eq!(parse_list(&["spirv", "hlsl", "spirv"]).unwrap(), vec![Target::Hlsl, Target::Spirv]);
         assert!(parse_list(&["hlsl", "vulkan"]).unwrap_err().contains("unknown target 'vulkan'"));
+    }
+
+    /// `--target wesl` adds the package manifest `wesl/wesl.toml` once (WeslToml: a
+    /// `[package]` whose root is the folder itself and which includes every `.wesl` file);
+    /// the other targets add no file of their own.
+    #[test]
+    fn the_wesl_target_adds_its_package_manifest() {
+        let files = package_files(&[Target::Hlsl, Target::Wesl, Target::Spirv]);
+        assert_eq!(files.len(), 1);
+        assert_eq!(files[0].path, Path::new("wesl").join("wesl.toml"));
+        let v: toml::Value = toml::from_str(std::str::from_utf8(&files[0].contents).unwrap()).unwrap();
+        assert_eq!(v["package"]["root"].as_str(), Some("."));
+        assert_eq!(v["package"]["include"].as_array().map(|a| a.iter().filter_map(|s| s.as_str()).collect::<Vec<_>>()), Some(vec!["*.wesl"]));
+        assert!(v["package"]["edition"].is_str());
+        let others: Vec<Target> = Target::ALL.into_iter().filter(|t| *t != Target::Wesl).collect();
+        assert!(package_files(&others).is_empty());
     }
 
     #[test]

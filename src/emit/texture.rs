@@ -524,10 +524,11 @@ mod tests {
 
     #[test]
     fn unorm_mip_chains_read_back_with_the_ktx2_crate() {
-        // 5×3 → 2×1 → 1×1; RG8 and RGBA16: the ktx2 crate's reader (independent) finds the
-        // format, the three levels in order and the codes (round(v · (2^bits − 1))).
-        // VkFormat enumerants from the Vulkan specification: R8G8_UNORM 16, R16G16B16A16_UNORM 91.
-        for (channels, bits, vk) in [(2usize, 8u32, 16u32), (4, 16, 91)] {
+        // 5×3 → 2×1 → 1×1; RG8, RGBA8, RG16 and RGBA16: the ktx2 crate's reader
+        // (independent) finds the format, the three levels in order and the codes
+        // (round(v · (2^bits − 1))). VkFormat enumerants from the Vulkan specification:
+        // R8G8_UNORM 16, R8G8B8A8_UNORM 37, R16G16_UNORM 77, R16G16B16A16_UNORM 91.
+        for (channels, bits, vk) in [(2usize, 8u32, 16u32), (4, 8, 37), (2, 16, 77), (4, 16, 91)] {
             let sizes = [(5u32, 3u32), (2, 1), (1, 1)];
             let levels: Vec<UnormLevel> = sizes
                 .iter()

@@ -281,6 +281,13 @@ pub fn strip_directives(src: &str) -> String {
     src.lines().filter(|l| !l.trim_start().starts_with('#')).collect::<Vec<_>>().join("\n")
 }
 
+/// The f32 interpreter of naga's IR that the runtime's GPU test takes as reference (CPU
+/// semantics: the operations the source spells out, in f32), for the tests below.
+#[cfg(test)]
+#[allow(dead_code)]
+#[path = "../../generated/tests/support/bound.rs"]
+mod interpreter;
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -333,6 +340,89 @@ mod tests {
         let names: Vec<&str> = m.functions.iter().filter_map(|(_, f)| f.name.as_deref()).collect();
         assert_eq!(names, ["m_input", "m_lut"]);
         assert!(src.contains("let x0 = m_input(x, 2.5e-1f, 2e0f);"), "{src}");
+    }
+
+    use super::interpreter as bound;
+
+    /// Emitted WGSL, interpreted, computes what the build's f32 evaluators compute, bit for bit:
+    /// a fit with a denominator and a clamp and one without either (`expr::eval_f32` of the
+    /// clamped inputs), a one- and a two-axis table (`rust::table_eval_f32`), at points inside,
+    /// on and outside the domain, at ±inf and NaN. The tables' texture forms: `_load` with each
+    /// `textureLoad` of texel (i, j) read as value i + j·n0 of the table (the KTX2 layout) gives
+    /// the table function's value; every form validates in naga; the note says what an r16float
+    /// texture changes.
+    #[test]
+    fn emitted_wgsl_computes_what_the_evaluators_compute() {
+        use crate::fit::{expr, model::RationalModel};
+        let (a1, a2) = (vec!["x".to_string()], vec!["x".to_string(), "y".to_string()]);
+        let (rat, poly) = (RationalModel::parse_form("rational(2,1)", "x").unwrap(), RationalModel::parse_form("rational(3,0)", "x").unwrap());
+        let (e_rat, e_poly) = (expr::model_expr(&rat), expr::model_expr(&poly));
+        let (rn, rd, pn) = ([0.5f32, -1.25, 3.0], [0.75f32], [1.0f32, -0.5, 0.125, 2.0]);
+        let t1: Vec<f32> = (0..7).map(|i| (i as f32).sqrt() * 0.3 - 0.4).collect();
+        let t2: Vec<f32> = (0..12).map(|i| (i as f32 * 0.7).sin()).collect();
+        let (d1, d2) = ([(0.25f32, 2.0f32)], [(0.0f32, 1.0f32), (-1.0f32, 3.0f32)]);
+        let fit = |name, expr, num, den, clamp| Function { module: name, name, args: &a1, derived: &[], domain: &d1, body: Body::Fit { expr, num, den, clamp } };
+        let fs = [
+            fit("m_rat", &e_rat, &rn[..], &rd[..], Some((0.0f32, 1.5f32))),
+            fit("m_poly", &e_poly, &pn[..], &[][..], None),
+            Function { module: "m_t1", name: "m_t1", args: &a1, derived: &[], domain: &d1, body: Body::Table { values: &t1, counts: &[7] } },
+            Function { module: "m_t2", name: "m_t2", args: &a2, derived: &[], domain: &d2, body: Body::Table { values: &t2, counts: &[3, 4] } },
+        ];
+        let xs = [-1.0f32, 0.0, 0.25, 0.3, 0.5, 1.0, 1.37, 2.0, 3.0, 5.0, f32::INFINITY, f32::NEG_INFINITY, f32::NAN];
+        let points: Vec<Vec<f32>> = xs.iter().flat_map(|&x| xs.iter().map(move |&y| vec![x, y])).collect();
+        let header = ["spec: test".to_string()];
+        for f in &fs {
+            let want = |p: &[f32]| match &f.body {
+                Body::Fit { expr, num, den, clamp } => {
+                    let x: Vec<f32> = p.iter().zip(f.domain).map(|(&v, &(lo, hi))| expr::sanitize(v, lo, hi)).collect();
+                    let v = expr::eval_f32(expr, &x, num, den);
+                    clamp.map_or(v, |(lo, hi)| v.clamp(lo, hi))
+                }
+                Body::Table { values, counts } => crate::emit::rust::table_eval_f32(values, counts, f.domain, p),
+            };
+            let arity = f.args.len();
+            let program = bound::Program::new(&strip_directives(&render_module(&header, f)));
+            let h = program.function(f.name);
+            for p in &points {
+                let p = &p[..arity];
+                assert_eq!(program.eval(h, p).0.to_bits(), want(p).to_bits(), "{}{p:?}", f.name);
+            }
+            let Body::Table { counts, .. } = f.body else { continue };
+            for (format, filterable) in [("r32float", false), ("r16float", true)] {
+                let tex = TableTexture { file: "data/t.ktx2", format, filterable, keep_const: true };
+                let src = strip_directives(&render_table_module(&header, f, Some(&tex)));
+                let note = if format == "r32float" { "the same f32 arithmetic on the same values" } else { "the values rounded to r16float as stored" };
+                assert!(src.contains(note), "{format}: no '{note}' in\n{src}");
+                let mut names: Vec<String> = vec![format!("{}_input", f.module), f.name.to_string(), format!("{}_load", f.name)];
+                if filterable {
+                    names.extend([format!("{}_uv", f.module), format!("{}_sample", f.name)]);
+                }
+                let m = naga::front::wgsl::parse_str(&src).unwrap_or_else(|e| panic!("{}", e.emit_to_string(&src)));
+                naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all())
+                    .validate(&m)
+                    .unwrap_or_else(|e| panic!("{}", e.emit_to_string(&src)));
+                let got: Vec<String> = m.functions.iter().filter_map(|(_, g)| g.name.clone()).collect();
+                assert_eq!(got, names, "{src}");
+                // The `_load` function on the const array: texel (i, j) is value i + j·n0.
+                let start = src.find(&format!("fn {}_load(", f.name)).unwrap();
+                let end = start + src[start..].find("\n}").unwrap() + 2;
+                let mut load = src[start..end].replace("lut: texture_2d<f32>, ", "").replace(&format!("fn {}_load(", f.name), "fn as_table(");
+                let table = format!("{}_TABLE", f.module.to_uppercase());
+                while let Some(at) = load.find("textureLoad(lut, vec2<u32>(") {
+                    let rest = &load[at + "textureLoad(lut, vec2<u32>(".len()..];
+                    let close = rest.find("), 0).x").unwrap();
+                    let (i, j) = rest[..close].split_once(", ").unwrap();
+                    let read = format!("{table}[({j}) * {}u + ({i})]", counts[0]);
+                    load = format!("{}{read}{}", &load[..at], &rest[close + "), 0).x".len()..]);
+                }
+                let program = bound::Program::new(&format!("{}{load}", &src[..start]));
+                let (h, g) = (program.function(f.name), program.function("as_table"));
+                for p in &points {
+                    let p = &p[..arity];
+                    assert_eq!(program.eval(g, p).0.to_bits(), program.eval(h, p).0.to_bits(), "{}_load{p:?} ({format})", f.name);
+                }
+            }
+        }
     }
 
     /// A constant array: its values read back through naga in order, six to a line.
