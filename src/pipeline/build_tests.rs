@@ -382,6 +382,94 @@ fn a_fields_spec_recovers_exact_fields_and_reads_back() {
     assert!(matches!(build_spec(&s, Mode::Committed, root, &|_| None), Err(BuildError::SpecChanged { .. })));
 }
 
+/// The committed fields read back by name (`committed::Fields::load`: fits/NAME.toml beside
+/// generated/) evaluate the exact fields, at outer points off the fitting grid too; the fit
+/// alone (`fields::fit`) gives the coefficients and the report the build wrote; a fit spec is
+/// not read as fields.
+#[test]
+fn committed_fields_evaluate_the_exact_fields() {
+    let catalog = Catalog { quantities: vec![&EXP, &FIELDS_Q], kinds: vec![] };
+    let tmp = tempfile::tempdir().unwrap();
+    let generated = tmp.path().join("generated");
+    std::fs::create_dir_all(tmp.path().join("fits")).unwrap();
+    std::fs::write(tmp.path().join("fits/quad_fields.toml"), FIELDS).unwrap();
+    let s = spec_in(FIELDS, &catalog);
+    let b = build_spec(&s, Mode::Fit, &generated, &|_| None).unwrap();
+    write_all(&generated, &b.artifacts).unwrap();
+    let f = committed::Fields::load(&generated, "quad_fields", &catalog).unwrap();
+    for o in [0.0, 0.03, 0.5, 0.97, 1.0] {
+        let c = f.eval(&[o]);
+        assert_eq!(c.len(), 3);
+        for (k, ck) in c.iter().enumerate() {
+            // Recovered to ~1e-12 (the build test above); values ≤ 3.
+            assert!((ck - field_value(k, o)).abs() < 1e-9, "field {k} at {o}: {ck} vs {}", field_value(k, o));
+        }
+    }
+    let (coefficients, report) = fields::fit(&s).unwrap();
+    let j = json_of(&b);
+    assert_eq!(coefficients.len(), 3);
+    for (k, c) in coefficients.iter().enumerate() {
+        assert_eq!(c.as_slice(), floats(&j["fields"][k]["coefficients"]), "field {k}");
+    }
+    assert_eq!(report, j["fit"]);
+    assert!(matches!(committed::Fields::of(&spec_in(FIT, &catalog), &generated), Err(BuildError::NotKind { .. })));
+}
+
+/// A table emitted as a texture too states its texture's storage error in its header: the
+/// largest |r16(v) − v| over the f32 table (rounded here with the `half` crate), 0 for
+/// r32float. The linear-sampler helper `_sample` is there for r16float (filterable in core
+/// WebGPU) and for r32float only with `float32_filterable = true`.
+#[test]
+fn a_texture_table_states_its_storage_error_and_samples_where_it_filters() {
+    let cases = [("texture_format = \"r16float\"", "r16float", true), ("texture_format = \"r32float\"", "r32float", false), ("texture_format = \"r32float\"\nfloat32_filterable = true", "r32float", true)];
+    for (extra, format, sample) in cases {
+        let s = spec(&TABLE.replace("[emit]", &format!("[emit]\nform = \"both\"\n{extra}")));
+        let tmp = tempfile::tempdir().unwrap();
+        let b = build_spec(&s, Mode::Fit, tmp.path(), &|_| None).unwrap();
+        let storage = floats(&json_of(&b)["values"])
+            .iter()
+            .map(|&v| if format == "r16float" { (half::f16::from_f32(v as f32).to_f32() - v as f32).abs() } else { 0.0 })
+            .fold(0.0f32, f32::max);
+        assert!((format == "r16float") == (storage > 1e-5), "{format}: {storage} (r16float keeps 11 bits of values in (0.13, 1])");
+        let wgsl = String::from_utf8(file(&b, "wgsl/exp_table.wgsl").to_vec()).unwrap();
+        let line = format!("; {format} texture storage <= {}", fmt_err(storage as f64));
+        assert!(wgsl.lines().next().is_some_and(|_| wgsl.contains(&line)), "{extra}: no '{line}' in\n{wgsl}");
+        assert_eq!(wgsl.contains("fn exp_table_sample("), sample, "{extra}");
+        assert!(wgsl.contains("fn exp_table_load("), "{extra}");
+    }
+}
+
+/// Each function of the runtime index is called with its arity (`Cpu::One`, `Cpu::Two`) and
+/// the domain of each argument, a spec's and a scene's alike.
+#[test]
+fn the_runtime_index_calls_each_function_with_its_arity() {
+    let catalog = Catalog { quantities: vec![&EXP, &FIELDS_Q], kinds: vec![] };
+    let two = "name = \"quad_table\"\nkind = \"table\"\nquantity = \"quadratic-fields\"\ndescription = \"a 2-D table\"\n\n\
+               [[axis]]\nname = \"o\"\nrange = [0.0, 1.0]\ncount = 5\n\n[[axis]]\nname = \"u\"\nrange = [-1.0, 1.0]\ncount = 5\n\n\
+               [emit]\nfunction = \"quad_lut\"\n";
+    let specs = [spec_in(FIT, &catalog), spec_in(two, &catalog)];
+    let scenes: Vec<SceneIndex> = vec![("scene_s".into(), vec![("s_one".into(), vec![(0.0, 0.5)]), ("s_two".into(), vec![(0.0, 0.5), (-2.0, 2.0)])])];
+    let text = String::from_utf8(runtime_index_with_scenes(&specs, &scenes).contents).unwrap();
+    for want in [
+        "name: \"exp_fit\", domain: &[[0e0, 2e0]], cpu: Cpu::One(exp_fit::exp_fit)",
+        "name: \"quad_lut\", domain: &[[0e0, 1e0], [-1e0, 1e0]], cpu: Cpu::Two(quad_table::quad_lut)",
+        "name: \"s_one\", domain: &[[0e0, 5e-1]], cpu: Cpu::One(scene_s::s_one)",
+        "name: \"s_two\", domain: &[[0e0, 5e-1], [-2e0, 2e0]], cpu: Cpu::Two(scene_s::s_two)",
+    ] {
+        assert!(text.contains(want), "no '{want}' in\n{text}");
+    }
+}
+
+/// A payload merged from shards goes to the next build of its spec once: taken, it is gone
+/// (a later build computes), and no other spec sees it.
+#[test]
+fn a_merged_payload_is_taken_once() {
+    set_merged("merged_payload_test", vec![1, 2, 3]);
+    assert_eq!(take_merged("merged_payload_test_other"), None);
+    assert_eq!(take_merged("merged_payload_test"), Some(vec![1, 2, 3]));
+    assert_eq!(take_merged("merged_payload_test"), None);
+}
+
 /// f(o, u) with a ripple 0.02·sin(7o)·u² that no rational field of this form follows: the
 /// objectives disagree.
 static RIPPLED: crate::quantity::InnerBasis = crate::quantity::InnerBasis {

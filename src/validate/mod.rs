@@ -71,6 +71,23 @@ mod tests {
     use crate::pipeline::build_tests::{fit_rational, floats, json_of, spec, uniform, EXP, FIT};
     use crate::pipeline::{build_spec, write_all, Mode};
 
+    /// `all` runs every validator on the generated folder and keeps their items in registry
+    /// order.
+    #[test]
+    fn all_keeps_every_validators_items_in_order() {
+        fn one(g: &Path) -> Vec<Item> {
+            vec![Item::measured("a", &g.display().to_string(), "x", &[vec![0.0]], &[1.0], &[1.5])]
+        }
+        fn two(_: &Path) -> Vec<Item> {
+            ["b", "c"].iter().map(|n| Item::measured(n, "s", "x", &[vec![0.0], vec![1.0]], &[1.0, 2.0], &[1.0, 2.25])).collect()
+        }
+        let items = all(Path::new("gen"), &[one, two]);
+        let names: Vec<&str> = items.iter().map(|i| i.name.as_str()).collect();
+        assert_eq!(names, ["a", "b", "c"]);
+        assert_eq!(items[0].source, "gen");
+        assert_eq!((items[0].max_abs_error, items[2].max_abs_error), (0.5, 0.25));
+    }
+
     /// A validation item beside its committed refit: `Item::add_refit` loads the refit through its
     /// spec (`fits/NAME.toml` next to the outputs), evaluates it at the item's points and adds its
     /// errors; each is re-measured here from the written coefficients against the closed form. A
