@@ -391,6 +391,41 @@ mod tests {
         assert!(r.reoptimised.max_abs_error < 0.8 * r.rounded.max_abs_error, "{r:?}");
     }
 
+    /// The search tries the moves the module documents and no others (one coefficient by ±1,
+    /// ±2, ±4, …, ±max_ulps ulps, within max_ulps of its rounded value: its evaluation count
+    /// is bounded by theirs), and where the sweeps stop before `max_sweeps`, none of those
+    /// moves lowers the score: the result is a coordinate-wise optimum over them, checked here
+    /// move by move for each objective on the cancelling quartic (no pins, no cap, no
+    /// denominator: every move admissible).
+    #[test]
+    fn the_search_stops_where_no_documented_move_improves() {
+        for objective in [Objective::Lsq, Objective::Minimax, Objective::L4] {
+            let (m, c, d) = cancelling(objective);
+            let opts = RoundOptions::new(objective, None);
+            let r = round_and_reoptimise(&m, &c, &d, &[(8.0, 9.0)], &opts, "quartic").unwrap();
+            assert!(r.sweeps < opts.max_sweeps, "{objective:?}: stopped by the sweep cap");
+            // The search's cost: the rounded vector, then at most 2·(log2(64) + 1) = 14
+            // candidates a coefficient a sweep (fewer where the cap or f32's range cuts them).
+            assert!(r.evaluations <= 1 + r.sweeps * r.num.len() * 14, "{objective:?}: {} evaluations in {} sweeps", r.evaluations, r.sweeps);
+            let f = F32Function { expr: expr::model_expr(&m), features: d.x.iter().map(|p| vec![p[0] as f32]).collect(), y: &d.y, clamp: None };
+            let best = f.score(&r.num, &[], objective, f64::INFINITY).unwrap();
+            let (start, _) = rounded(&m, &c);
+            for j in 0..r.num.len() {
+                for k in (0..=6).map(|e| 1i64 << e).flat_map(|s| [s, -s]) {
+                    let Some(v) = step_ulps(r.num[j], k) else { continue };
+                    if ulps_between(start[j], v).unsigned_abs() > MAX_ULPS as u64 {
+                        continue;
+                    }
+                    let mut num = r.num.clone();
+                    num[j] = v;
+                    // The same sums in the same order as the search: no tolerance.
+                    let s = f.score(&num, &[], objective, f64::INFINITY).unwrap();
+                    assert!(s >= best, "{objective:?}: coefficient {j} moved {k} ulps scores {s:e} < {best:e}");
+                }
+            }
+        }
+    }
+
     #[test]
     fn moves_stay_within_the_cap_and_only_free_coefficients_move() {
         let (m, c, d) = cancelling(Objective::Lsq);
