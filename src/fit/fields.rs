@@ -926,6 +926,11 @@ mod tests {
         assert!(lsq_rms < mm_rms && lsq_rms < l4_rms, "rms: lsq {lsq_rms}, minimax {mm_rms}, l4 {l4_rms}");
         assert!(l44 < lsq4 && l44 < mm4, "Σe⁴: l4 {l44}, lsq {lsq4}, minimax {mm4}");
         assert!(mm.outer_iterations > 0 && l4.outer_iterations > 0 && lsq.outer_iterations == 0);
+        // Each LM solve evaluates the cost at its start and at one trial step at least: the
+        // first solve, then one an outer iteration.
+        for (name, f) in [("lsq", &lsq), ("minimax", &mm), ("l4", &l4)] {
+            assert!(f.lm_evaluations >= 2 * (1 + f.outer_iterations), "{name}: {} evaluations, {} outer iterations", f.lm_evaluations, f.outer_iterations);
+        }
         // Stage 1: the least-squares optimum of each point alone (the floor of the basis).
         let (mut s1max, mut ss, mut n) = (0.0f64, 0.0, 0);
         for d in &data {

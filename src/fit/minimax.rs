@@ -190,6 +190,45 @@ mod tests {
         assert_eq!(working_set(&small, 40), (0..512).collect::<Vec<_>>());
     }
 
+    /// r_i = θ₀ + θ₁x_i − |x_i| on 21 points of [−1, 1]: linear in θ, minimax optimum θ =
+    /// (½, 0) with max |r| = ½ (by hand: the line must split the V evenly; at θ₁ ≠ 0 one arm's
+    /// end is farther). From θ = (0.01, 0.005) the first trust region is 1e-2·|θ_j| = (1e-4,
+    /// 5e-5); the documented growth of ρ after good steps taken at the region's edge is what
+    /// reaches the optimum within 60 iterations: held at 1e-2, the region grows only with |θ|,
+    /// by 1 % an iteration, and θ₀ would need ln 50 / ln 1.01 ≈ 390 of them.
+    struct Vee(Vec<f64>);
+
+    impl Operator for Vee {
+        type Param = DVector<f64>;
+        type Output = DVector<f64>;
+        fn apply(&self, t: &DVector<f64>) -> Result<DVector<f64>, Error> {
+            Ok(DVector::from_iterator(self.0.len(), self.0.iter().map(|x| t[0] + t[1] * x - x.abs())))
+        }
+    }
+
+    impl Jacobian for Vee {
+        type Param = DVector<f64>;
+        type Jacobian = DMatrix<f64>;
+        fn jacobian(&self, _: &DVector<f64>) -> Result<DMatrix<f64>, Error> {
+            Ok(DMatrix::from_fn(self.0.len(), 2, |i, j| if j == 0 { 1.0 } else { self.0[i] }))
+        }
+    }
+
+    #[test]
+    fn the_trust_region_grows_to_reach_a_far_optimum() {
+        let x: Vec<f64> = (0..21).map(|i| -1.0 + i as f64 / 10.0).collect();
+        let res = argmin::core::Executor::new(Vee(x), SlpMinimax::default())
+            .configure(|s| s.param(DVector::from_vec(vec![0.01, 0.005])).max_iters(60))
+            .run()
+            .unwrap();
+        let st = res.state();
+        let t = st.get_best_param().unwrap();
+        assert_eq!(st.get_termination_status(), &TerminationStatus::Terminated(TerminationReason::SolverConverged), "after {} iterations at {t:?}", st.get_iter());
+        // A linear minimax problem: the LP step lands on the optimum to its feasibility
+        // tolerance once the region holds it.
+        assert!((st.get_best_cost() - 0.5).abs() < 1e-9 && (t[0] - 0.5).abs() < 1e-9 && t[1].abs() < 1e-9, "{t:?}, max {}", st.get_best_cost());
+    }
+
     /// R̃'s form (fits/fuzz_r.toml) over α ∈ [0.15, 1], θ ∈ [0, π/2]: γ = cos θ is 6e-17 at the
     /// last grid column and γ³ is 2e-49 there, so the Jacobian's rows span ~1e49.
     fn r_form() -> RationalModel {
