@@ -760,6 +760,12 @@ mod tests {
                 assert_eq!(b.coefficients[k], a.coefficients[k] * 2f64.powi(*p), "{objective:?} coefficient {k}");
             }
             assert_eq!(b.report.max_abs_error, a.report.max_abs_error * 2f64.powi(80), "{objective:?}");
+            // The rest of the report likewise: errors times 2^80, the sum of squares times
+            // 2^160, the worst point times 2^70; relative errors unchanged.
+            let (ra, rb) = (&a.report, &b.report);
+            assert_eq!((rb.rms_error, rb.worst_residual, rb.rss), (ra.rms_error * 2f64.powi(80), ra.worst_residual * 2f64.powi(80), ra.rss * 2f64.powi(160)), "{objective:?}");
+            assert_eq!(rb.worst_point, vec![ra.worst_point[0] * 2f64.powi(70)], "{objective:?}");
+            assert_eq!(rb.max_rel_error, ra.max_rel_error, "{objective:?}");
         }
     }
 
