@@ -287,6 +287,17 @@ pub fn render_rust(header: &[String], f: &FieldsFunction<'_>, doc: &str, c64: &[
 mod tests {
     use super::*;
 
+    /// Coefficient lists as the emitted arrays hold them: six literals a line (a long array
+    /// stays readable and its diffs local), every one in order.
+    #[test]
+    fn lists_hold_six_literals_a_line() {
+        let text = list((0..14).map(|i| format!("{i}.5")));
+        let lines: Vec<&str> = text.lines().filter(|l| !l.trim().is_empty()).collect();
+        assert_eq!(lines.iter().map(|l| l.matches(',').count()).collect::<Vec<_>>(), [6, 6, 2], "{text}");
+        let read: Vec<String> = lines.iter().flat_map(|l| l.split(',').map(str::trim).filter(|v| !v.is_empty())).map(String::from).collect();
+        assert_eq!(read, (0..14).map(|i| format!("{i}.5")).collect::<Vec<_>>());
+    }
+
     /// The evaluator's sum Σ c_k b_k with b = (1, u, u²·v) at (u, v) = (0.5, 4) and c = (1, 2, 3):
     /// 1 + 2·0.5 + 3·(0.25·4) = 5, exact in f32.
     #[test]
