@@ -72,3 +72,36 @@ impl FitReport {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fit::model::RationalModel;
+
+    /// Every figure of a report, by hand: c₀ + c₁x at θ = (1, 1) on x = 0…4 against
+    /// y = (1, 2, 5, 12, 0) leaves r = f − y = (0, 0, −2, −8, 5): Σr² = 93, rms √(93/5), the
+    /// worst residual −8 (its sign kept) at x = 3, max |r/y| = 8/12 over the samples with
+    /// y ≠ 0; J = [1, x] gives JᵀJ = [[5, 10], [10, 30]], eigenvalues (35 ± √1025)/2, so
+    /// σmax/σmin = √((35 + √1025)/(35 − √1025)). A NaN residual is the worst.
+    #[test]
+    fn a_report_holds_the_figures_of_its_residuals() {
+        let model = RationalModel::rational_1d("x", 1, 0);
+        let data = Data { x: (0..5).map(|i| vec![i as f64]).collect(), y: vec![1.0, 2.0, 5.0, 12.0, 0.0] };
+        let theta = DVector::from_vec(vec![1.0, 1.0]);
+        let p = Residuals::new(&model, &data, theta.clone());
+        let opts = FitOptions::default();
+        let r = FitReport::measure(&p, &data, &theta, &opts, 7, 11);
+        assert_eq!((r.objective, r.samples, r.iterations, r.evaluations), (opts.objective, 5, 7, 11));
+        assert_eq!((r.rss, r.max_abs_error, r.worst_residual, r.worst_point.clone()), (93.0, 8.0, -8.0, vec![3.0]));
+        assert_eq!(r.rms_error, (93.0f64 / 5.0).sqrt());
+        assert_eq!(r.max_rel_error, 8.0 / 12.0);
+        let s = 1025f64.sqrt();
+        // Two ways to a condition number ~12: agreement to ~1e-14 relative.
+        let cond = ((35.0 + s) / (35.0 - s)).sqrt();
+        assert!((r.condition_number - cond).abs() <= 1e-12 * cond, "{} vs {cond}", r.condition_number);
+        let nan = Data { y: vec![1.0, f64::NAN, 5.0, 12.0, 0.0], ..data.clone() };
+        let p = Residuals::new(&model, &nan, theta.clone());
+        let r = FitReport::measure(&p, &nan, &theta, &opts, 0, 0);
+        assert!(r.worst_residual.is_nan() && r.max_abs_error.is_nan() && r.worst_point == vec![1.0], "{r:?}");
+    }
+}
