@@ -396,7 +396,8 @@ mod tests {
     /// is bounded by theirs), and where the sweeps stop before `max_sweeps`, none of those
     /// moves lowers the score: the result is a coordinate-wise optimum over them, checked here
     /// move by move for each objective on the cancelling quartic (no pins, no cap, no
-    /// denominator: every move admissible).
+    /// denominator: every move admissible). Its report's errors are those of the f64 fit, the
+    /// nearest f32 vector and the result, each re-measured here.
     #[test]
     fn the_search_stops_where_no_documented_move_improves() {
         for objective in [Objective::Lsq, Objective::Minimax, Objective::L4] {
@@ -410,6 +411,14 @@ mod tests {
             let f = F32Function { expr: expr::model_expr(&m), features: d.x.iter().map(|p| vec![p[0] as f32]).collect(), y: &d.y, clamp: None };
             let best = f.score(&r.num, &[], objective, f64::INFINITY).unwrap();
             let (start, _) = rounded(&m, &c);
+            // The report's three error sets, each of its own vector: the f64 fit (its f64
+            // evaluation), the nearest f32 vector and the result (their f32 evaluation).
+            let e = expr::model_expr(&m);
+            let of = |v: &dyn Fn(f64) -> f64| Errors::of(d.x.iter().zip(&d.y).map(|(x, y)| v(x[0]) - y), objective);
+            let (c64, r32) = (c.clone(), r.num.clone());
+            assert_eq!(r.f64, of(&|x| m.eval_clamped(&c64, &[x])), "{objective:?}");
+            assert_eq!(r.rounded, of(&|x| expr::eval_f32(&e, &[x as f32], &start, &[]) as f64), "{objective:?}");
+            assert_eq!(r.reoptimised, of(&|x| expr::eval_f32(&e, &[x as f32], &r32, &[]) as f64), "{objective:?}");
             for j in 0..r.num.len() {
                 for k in (0..=6).map(|e| 1i64 << e).flat_map(|s| [s, -s]) {
                     let Some(v) = step_ulps(r.num[j], k) else { continue };
