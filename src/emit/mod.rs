@@ -6,6 +6,8 @@
 /// The expression tree of a fitted model (it lives with the model; emit renders it).
 pub use crate::fit::expr;
 pub mod fields;
+#[cfg(test)]
+mod fixtures;
 pub mod rust;
 pub mod targets;
 pub mod texture;

@@ -169,33 +169,9 @@ mod tests {
     /// and outside the domain, at ±inf and at NaN (the lower end).
     #[test]
     fn rendered_modules_compile_and_compute_what_the_evaluators_compute() {
-        use crate::fit::{expr, model::RationalModel};
-        let (a1, a2) = (vec!["x".to_string()], vec!["x".to_string(), "y".to_string()]);
-        let (rat, poly) = (RationalModel::parse_form("rational(2,1)", "x").unwrap(), RationalModel::parse_form("rational(3,0)", "x").unwrap());
-        let (e_rat, e_poly) = (expr::model_expr(&rat), expr::model_expr(&poly));
-        let (rn, rd, pn) = ([0.5f32, -1.25, 3.0], [0.75f32], [1.0f32, -0.5, 0.125, 2.0]);
-        let t1: Vec<f32> = (0..7).map(|i| (i as f32).sqrt() * 0.3 - 0.4).collect();
-        let t2: Vec<f32> = (0..12).map(|i| (i as f32 * 0.7).sin()).collect();
-        let (d1, d2) = ([(0.25f32, 2.0f32)], [(0.0f32, 1.0f32), (-1.0f32, 3.0f32)]);
-        let fit = |name, expr, num, den, clamp| Function { module: name, name, args: &a1, derived: &[], domain: &d1, body: Body::Fit { expr, num, den, clamp } };
-        let fs = [
-            fit("m_rat", &e_rat, &rn[..], &rd[..], Some((0.0f32, 1.5f32))),
-            fit("m_poly", &e_poly, &pn[..], &[][..], None),
-            Function { module: "m_t1", name: "m_t1", args: &a1, derived: &[], domain: &d1, body: Body::Table { values: &t1, counts: &[7] } },
-            Function { module: "m_t2", name: "m_t2", args: &a2, derived: &[], domain: &d2, body: Body::Table { values: &t2, counts: &[3, 4] } },
-        ];
-        let xs = [-1.0f32, 0.0, 0.25, 0.3, 0.5, 1.0, 1.37, 2.0, 3.0, 5.0, f32::INFINITY, f32::NEG_INFINITY, f32::NAN];
-        let points = |f: &Function<'_>| -> Vec<Vec<f32>> {
-            if f.args.len() == 1 { xs.iter().map(|&x| vec![x]).collect() } else { xs.iter().flat_map(|&x| xs.iter().map(move |&y| vec![x, y])).collect() }
-        };
-        let want = |f: &Function<'_>, p: &[f32]| match &f.body {
-            Body::Fit { expr, num, den, clamp } => {
-                let x: Vec<f32> = p.iter().zip(f.domain).map(|(&v, &(lo, hi))| expr::sanitize(v, lo, hi)).collect();
-                let v = expr::eval_f32(expr, &x, num, den);
-                clamp.map_or(v, |(lo, hi)| v.clamp(lo, hi))
-            }
-            Body::Table { values, counts } => table_eval_f32(values, counts, f.domain, p),
-        };
+        use crate::emit::fixtures::{points, want, Four};
+        let four = Four::new();
+        let fs = four.functions();
         let dir = std::env::temp_dir().join(format!("shadefit-rust-emit-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let mut main = String::from("fn main() {\n");

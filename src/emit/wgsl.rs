@@ -353,39 +353,15 @@ mod tests {
     /// texture changes.
     #[test]
     fn emitted_wgsl_computes_what_the_evaluators_compute() {
-        use crate::fit::{expr, model::RationalModel};
-        let (a1, a2) = (vec!["x".to_string()], vec!["x".to_string(), "y".to_string()]);
-        let (rat, poly) = (RationalModel::parse_form("rational(2,1)", "x").unwrap(), RationalModel::parse_form("rational(3,0)", "x").unwrap());
-        let (e_rat, e_poly) = (expr::model_expr(&rat), expr::model_expr(&poly));
-        let (rn, rd, pn) = ([0.5f32, -1.25, 3.0], [0.75f32], [1.0f32, -0.5, 0.125, 2.0]);
-        let t1: Vec<f32> = (0..7).map(|i| (i as f32).sqrt() * 0.3 - 0.4).collect();
-        let t2: Vec<f32> = (0..12).map(|i| (i as f32 * 0.7).sin()).collect();
-        let (d1, d2) = ([(0.25f32, 2.0f32)], [(0.0f32, 1.0f32), (-1.0f32, 3.0f32)]);
-        let fit = |name, expr, num, den, clamp| Function { module: name, name, args: &a1, derived: &[], domain: &d1, body: Body::Fit { expr, num, den, clamp } };
-        let fs = [
-            fit("m_rat", &e_rat, &rn[..], &rd[..], Some((0.0f32, 1.5f32))),
-            fit("m_poly", &e_poly, &pn[..], &[][..], None),
-            Function { module: "m_t1", name: "m_t1", args: &a1, derived: &[], domain: &d1, body: Body::Table { values: &t1, counts: &[7] } },
-            Function { module: "m_t2", name: "m_t2", args: &a2, derived: &[], domain: &d2, body: Body::Table { values: &t2, counts: &[3, 4] } },
-        ];
-        let xs = [-1.0f32, 0.0, 0.25, 0.3, 0.5, 1.0, 1.37, 2.0, 3.0, 5.0, f32::INFINITY, f32::NEG_INFINITY, f32::NAN];
-        let points: Vec<Vec<f32>> = xs.iter().flat_map(|&x| xs.iter().map(move |&y| vec![x, y])).collect();
+        use crate::emit::fixtures::{points, want, Four};
+        let four = Four::new();
+        let fs = four.functions();
         let header = ["spec: test".to_string()];
         for f in &fs {
-            let want = |p: &[f32]| match &f.body {
-                Body::Fit { expr, num, den, clamp } => {
-                    let x: Vec<f32> = p.iter().zip(f.domain).map(|(&v, &(lo, hi))| expr::sanitize(v, lo, hi)).collect();
-                    let v = expr::eval_f32(expr, &x, num, den);
-                    clamp.map_or(v, |(lo, hi)| v.clamp(lo, hi))
-                }
-                Body::Table { values, counts } => crate::emit::rust::table_eval_f32(values, counts, f.domain, p),
-            };
-            let arity = f.args.len();
             let program = bound::Program::new(&strip_directives(&render_module(&header, f)));
             let h = program.function(f.name);
-            for p in &points {
-                let p = &p[..arity];
-                assert_eq!(program.eval(h, p).0.to_bits(), want(p).to_bits(), "{}{p:?}", f.name);
+            for p in points(f) {
+                assert_eq!(program.eval(h, &p).0.to_bits(), want(f, &p).to_bits(), "{}{p:?}", f.name);
             }
             let Body::Table { counts, .. } = f.body else { continue };
             for (format, filterable) in [("r32float", false), ("r16float", true)] {
@@ -417,9 +393,8 @@ mod tests {
                 }
                 let program = bound::Program::new(&format!("{}{load}", &src[..start]));
                 let (h, g) = (program.function(f.name), program.function("as_table"));
-                for p in &points {
-                    let p = &p[..arity];
-                    assert_eq!(program.eval(g, p).0.to_bits(), program.eval(h, p).0.to_bits(), "{}_load{p:?} ({format})", f.name);
+                for p in points(f) {
+                    assert_eq!(program.eval(g, &p).0.to_bits(), program.eval(h, &p).0.to_bits(), "{}_load{p:?} ({format})", f.name);
                 }
             }
         }

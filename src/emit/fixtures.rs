@@ -1,0 +1,74 @@
+//! Functions of every body shape, for the emitters' tests: a fit with a denominator and a
+//! clamp, one without either, a one- and a two-axis table; the points they are run at (inside,
+//! on and outside the domain, ±inf, NaN); and what the build's f32 evaluators give there.
+
+use super::rust::table_eval_f32;
+use super::wgsl::{Body, Function};
+use crate::fit::expr::{self, Expr};
+use crate::fit::model::RationalModel;
+
+/// The data the functions borrow.
+pub struct Four {
+    a1: Vec<String>,
+    a2: Vec<String>,
+    e_rat: Expr,
+    e_poly: Expr,
+    t1: Vec<f32>,
+    t2: Vec<f32>,
+}
+
+const RAT_NUM: [f32; 3] = [0.5, -1.25, 3.0];
+const RAT_DEN: [f32; 1] = [0.75];
+const POLY_NUM: [f32; 4] = [1.0, -0.5, 0.125, 2.0];
+const D1: [(f32, f32); 1] = [(0.25, 2.0)];
+const D2: [(f32, f32); 2] = [(0.0, 1.0), (-1.0, 3.0)];
+
+/// Each argument's values: inside, on and outside [0.25, 2] and [0, 1] × [−1, 3].
+const XS: [f32; 13] = [-1.0, 0.0, 0.25, 0.3, 0.5, 1.0, 1.37, 2.0, 3.0, 5.0, f32::INFINITY, f32::NEG_INFINITY, f32::NAN];
+
+impl Four {
+    pub fn new() -> Four {
+        let form = |f| expr::model_expr(&RationalModel::parse_form(f, "x").unwrap());
+        Four {
+            a1: vec!["x".to_string()],
+            a2: vec!["x".to_string(), "y".to_string()],
+            e_rat: form("rational(2,1)"),
+            e_poly: form("rational(3,0)"),
+            t1: (0..7).map(|i| (i as f32).sqrt() * 0.3 - 0.4).collect(),
+            t2: (0..12).map(|i| (i as f32 * 0.7).sin()).collect(),
+        }
+    }
+
+    /// (0.5 − 1.25x + 3x²)/(1 + 0.75x) clamped to [0, 1.5] and 1 − 0.5x + 0.125x² + 2x³, on
+    /// [0.25, 2]; a 7-point table on it and a 3 × 4 table on [0, 1] × [−1, 3].
+    pub fn functions(&self) -> [Function<'_>; 4] {
+        let fit = |name, expr, num, den, clamp| Function { module: name, name, args: &self.a1, derived: &[], domain: &D1, body: Body::Fit { expr, num, den, clamp } };
+        [
+            fit("m_rat", &self.e_rat, &RAT_NUM[..], &RAT_DEN[..], Some((0.0f32, 1.5f32))),
+            fit("m_poly", &self.e_poly, &POLY_NUM[..], &[][..], None),
+            Function { module: "m_t1", name: "m_t1", args: &self.a1, derived: &[], domain: &D1, body: Body::Table { values: &self.t1, counts: &[7] } },
+            Function { module: "m_t2", name: "m_t2", args: &self.a2, derived: &[], domain: &D2, body: Body::Table { values: &self.t2, counts: &[3, 4] } },
+        ]
+    }
+}
+
+/// The points `f` is run at: every value of [`XS`] for each argument, all combinations.
+pub fn points(f: &Function<'_>) -> Vec<Vec<f32>> {
+    match f.args.len() {
+        1 => XS.iter().map(|&x| vec![x]).collect(),
+        _ => XS.iter().flat_map(|&x| XS.iter().map(move |&y| vec![x, y])).collect(),
+    }
+}
+
+/// `f` at `p` as the build's f32 evaluators compute it: `expr::eval_f32` of the clamped inputs
+/// (NaN to the lower end), then the clamp; `table_eval_f32`.
+pub fn want(f: &Function<'_>, p: &[f32]) -> f32 {
+    match &f.body {
+        Body::Fit { expr, num, den, clamp } => {
+            let x: Vec<f32> = p.iter().zip(f.domain).map(|(&v, &(lo, hi))| expr::sanitize(v, lo, hi)).collect();
+            let v = expr::eval_f32(expr, &x, num, den);
+            clamp.map_or(v, |(lo, hi)| v.clamp(lo, hi))
+        }
+        Body::Table { values, counts } => table_eval_f32(values, counts, f.domain, p),
+    }
+}
