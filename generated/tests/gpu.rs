@@ -329,6 +329,29 @@ fn check_points(
     Ok(st)
 }
 
+/// Every GPU result of a table lookup lies within the range [lo, hi] of the table's values,
+/// less 8 ulp of |lo| below and more 8 ulp of |hi| above: a lerp `a·(1 − f) + b·f` with f in
+/// [0, 1] stays within [min(a, b), max(a, b)] but for the rounding of `1 − f`, the two products
+/// and the sum (each ≤ ½ ulp, relative), at each of at most two levels, so by at most 6·2^-24
+/// of the bound, under 8 ulp of it, whatever a GPU fuses. A weight outside [0, 1] (an index a
+/// GPU rounds past a node, the H200's −7.98e-9 below a table of values ≥ 0) leaves the range
+/// by a share of a table step, far more where the bound is 0 or small.
+fn within_table_range(t: &lut::Table, what: &str, pts: &[u32], arity: usize, gpu_bits: &[u32]) -> Result<(), String> {
+    let lo = t.values.iter().copied().fold(f32::INFINITY, f32::min) as f64;
+    let hi = t.values.iter().copied().fold(f32::NEG_INFINITY, f32::max) as f64;
+    let (lo_ok, hi_ok) = (lo - 8.0 * bound::ulp(lo.abs()), hi + 8.0 * bound::ulp(hi.abs()));
+    let outside: Vec<String> = pts
+        .chunks(arity)
+        .zip(gpu_bits)
+        .filter(|&(_, &g)| !(lo_ok..=hi_ok).contains(&(f32::from_bits(g) as f64)))
+        .map(|(p, &g)| format!("{:?} [{what}]: GPU {:e} outside the table's [{lo:e}, {hi:e}]", p.iter().map(|&b| f32::from_bits(b)).collect::<Vec<_>>(), f32::from_bits(g)))
+        .collect();
+    match outside.len() {
+        0 => Ok(()),
+        n => Err(format!("{n} of {} values outside the table's range, first ones:\n{}", gpu_bits.len(), outside[..n.min(20)].join("\n"))),
+    }
+}
+
 /// Report one run of `name` over `n` points: its deviations, or that it is out of bound (the
 /// points then go to `failed`, for the test to list every such run before it fails).
 fn outcome(name: &str, n: usize, note: &str, secs: f64, software: bool, result: Result<Stats, String>, failed: &mut Vec<String>) {
@@ -371,6 +394,9 @@ fn every_emitted_function_equals_its_cpu_version_on_the_gpu() {
         let out = runner.run(f.name, &shader, arity, 1, &pts, extra);
         let secs = t0.elapsed().as_secs_f64();
         outcome(f.name, n, note, secs, software, check(f, "const", &pts, &out, &program), &mut failed);
+        if let Some(Err(e)) = table.map(|t| within_table_range(t, "const", &pts, arity, &out)) {
+            failed.push(format!("{}: {e}", f.name));
+        }
         same_in_every_style(&runner, f, &pts, &out, moved.as_ref().map(|(_, v)| v.as_slice()));
         functions += 1;
         points += n;
@@ -386,6 +412,9 @@ fn every_emitted_function_equals_its_cpu_version_on_the_gpu() {
             let (w, h) = t.size();
             let note = format!(" (R32Float {w}x{h} texture)");
             outcome(&t.accessor_name(), n, &note, secs, software, check(f, "texture", &pts, &out, &program), &mut failed);
+            if let Err(e) = within_table_range(t, "texture", &pts, arity, &out) {
+                failed.push(format!("{}: {e}", t.accessor_name()));
+            }
             points += n;
             runs += 1;
         }
