@@ -172,8 +172,8 @@ mod tests {
         use crate::emit::fixtures::{points, want, Four};
         let four = Four::new();
         let fs = four.functions();
-        let dir = std::env::temp_dir().join(format!("shadefit-rust-emit-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path();
         let mut main = String::from("fn main() {\n");
         for f in &fs {
             std::fs::write(dir.join(format!("{}.rs", f.module)), render_module(&["spec: test".to_string()], f, "A test module.")).unwrap();
@@ -189,7 +189,6 @@ mod tests {
         let out = std::process::Command::new(rustc).args(["--edition", "2021", "-A", "warnings", "-o"]).arg(dir.join("main")).arg(dir.join("main.rs")).output().unwrap();
         assert!(out.status.success(), "rustc: {}", String::from_utf8_lossy(&out.stderr));
         let run = std::process::Command::new(dir.join("main")).output().unwrap();
-        std::fs::remove_dir_all(&dir).unwrap();
         let got: Vec<u32> = String::from_utf8(run.stdout).unwrap().lines().map(|l| l.parse().unwrap()).collect();
         let expected: Vec<(String, u32)> = fs.iter().flat_map(|f| points(f).into_iter().map(move |p| (format!("{}{p:?}", f.name), want(f, &p).to_bits()))).collect();
         assert_eq!(got.len(), expected.len());

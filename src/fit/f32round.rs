@@ -405,9 +405,11 @@ mod tests {
             let opts = RoundOptions::new(objective, None);
             let r = round_and_reoptimise(&m, &c, &d, &[(8.0, 9.0)], &opts, "quartic").unwrap();
             assert!(r.sweeps < opts.max_sweeps, "{objective:?}: stopped by the sweep cap");
-            // The search's cost: the rounded vector, then at most 2·(log2(64) + 1) = 14
-            // candidates a coefficient a sweep (fewer where the cap or f32's range cuts them).
-            assert!(r.evaluations <= 1 + r.sweeps * r.num.len() * 14, "{objective:?}: {} evaluations in {} sweeps", r.evaluations, r.sweeps);
+            // The documented moves: ±2^e ulps up to MAX_ULPS, 2·(log2(64) + 1) = 14 of them.
+            let steps: Vec<i64> = (0..=MAX_ULPS.ilog2()).map(|e| 1i64 << e).flat_map(|s| [s, -s]).collect();
+            // The search's cost: the rounded vector, then at most those candidates a
+            // coefficient a sweep (fewer where the cap or f32's range cuts them).
+            assert!(r.evaluations <= 1 + r.sweeps * r.num.len() * steps.len(), "{objective:?}: {} evaluations in {} sweeps", r.evaluations, r.sweeps);
             let f = F32Function { expr: expr::model_expr(&m), features: d.x.iter().map(|p| vec![p[0] as f32]).collect(), y: &d.y, clamp: None };
             let best = f.score(&r.num, &[], objective, f64::INFINITY).unwrap();
             let (start, _) = rounded(&m, &c);
@@ -420,7 +422,7 @@ mod tests {
             assert_eq!(r.rounded, of(&|x| expr::eval_f32(&e, &[x as f32], &start, &[]) as f64), "{objective:?}");
             assert_eq!(r.reoptimised, of(&|x| expr::eval_f32(&e, &[x as f32], &r32, &[]) as f64), "{objective:?}");
             for j in 0..r.num.len() {
-                for k in (0..=6).map(|e| 1i64 << e).flat_map(|s| [s, -s]) {
+                for &k in &steps {
                     let Some(v) = step_ulps(r.num[j], k) else { continue };
                     if ulps_between(start[j], v).unsigned_abs() > MAX_ULPS as u64 {
                         continue;
