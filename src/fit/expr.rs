@@ -236,6 +236,23 @@ mod tests {
         }
     }
 
+    /// Consecutive powers of any one feature, from a constant or not, take Horner form; other
+    /// term lists stay a sum of products. The expected renderings are written out by hand.
+    #[test]
+    fn consecutive_powers_of_either_feature_render_in_horner_form() {
+        let f = vec!["x".to_string(), "y".to_string()];
+        let terms = |ts: &[&str]| -> Vec<Term> { ts.iter().map(|s| Term::parse(s, &f).unwrap()).collect() };
+        let show = |ts: &[&str]| render(&linear_combination(&terms(ts), 0), &|i| f[i].clone(), &|_, j| format!("c{j}"), &|v| format!("{v}"));
+        assert_eq!(show(&["1", "x", "x^2"]), "c0 + x * (c1 + x * c2)");
+        assert_eq!(show(&["1", "y", "y^2"]), "c0 + y * (c1 + y * c2)");
+        assert_eq!(show(&["y", "y^2", "y^3"]), "y * (c0 + y * (c1 + y * c2))");
+        assert_eq!(show(&["x^2", "x^3"]), "x * (x * (c0 + x * c1))");
+        // Not consecutive, or not one feature: no Horner form.
+        assert_eq!(consecutive_powers(&terms(&["1", "y^2"])), None);
+        assert_eq!(consecutive_powers(&terms(&["1", "y", "x^2"])), None);
+        assert_eq!(consecutive_powers(&terms(&["y", "x*y"])), None);
+    }
+
     #[test]
     fn horner_form_matches_direct_sum() {
         let m = RationalModel::rational_1d("x", 3, 2);

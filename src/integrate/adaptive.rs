@@ -730,6 +730,19 @@ mod tests {
             let est = integrate(&[(0.0, 2.0)], &unchecked, f);
             assert_eq!(est.errors[1], 0.0);
             assert!((est.value[1] - exact[1]).abs() < 1e-6, "integrated along");
+            // Relative: the weighted error against rel·|Σ_c w_c·V_c| (≈ 1.99: the scaled first and
+            // last components are 1), which the run must meet; a target scaled by a sum of the
+            // weights and the values instead (≈ 1.6e8) would let it stop at once.
+            let opts = Options { estimate, control: Control::Weighted { weights, abs: 0.0, rel: 1e-10 }, ..Options::quadpack(weights, 0.0, 10_000) };
+            let est = integrate(&[(0.0, 2.0)], &opts, f);
+            let scaled: f64 = (0..3).map(|c| weights[c] * est.value[c]).sum();
+            let want: f64 = (0..3).map(|c| weights[c] * exact[c]).sum();
+            // Each scaled component is within its estimate (≤ 1e-10 together) of its exact value.
+            assert!((scaled - want).abs() <= 1e-9, "{scaled} vs {want}");
+            assert!(est.error <= 1e-10 * scaled, "{estimate:?}: {} > {}", est.error, 1e-10 * scaled);
+            for c in 0..3 {
+                assert!((est.value[c] - exact[c]).abs() <= est.errors[c], "{estimate:?} c={c}");
+            }
         }
     }
 
