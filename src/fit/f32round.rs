@@ -391,6 +391,25 @@ mod tests {
         assert!(r.reoptimised.max_abs_error < 0.8 * r.rounded.max_abs_error, "{r:?}");
     }
 
+    /// An rms cap constrains the search and nothing else: a cap no candidate comes near (1.0,
+    /// against errors ~1e-7) leaves the uncapped result, bit for bit; a cap of 0 (raised to the
+    /// rounded vector's rms, as documented) keeps every accepted vector's rms at or below the
+    /// rounded one's, measured by the f32 evaluation the search uses.
+    #[test]
+    fn an_rms_cap_binds_only_where_it_is_reached() {
+        let (m, c, d) = cancelling(Objective::Minimax);
+        let run = |max_rms| round_and_reoptimise(&m, &c, &d, &[(8.0, 9.0)], &RoundOptions::new(Objective::Minimax, max_rms), "quartic").unwrap();
+        let free = run(None);
+        let (start, _) = rounded(&m, &c);
+        assert_ne!(free.num, start, "the uncapped search moves");
+        let loose = run(Some(1.0));
+        assert_eq!((&loose.num, loose.sweeps, loose.evaluations), (&free.num, free.sweeps, free.evaluations));
+        let tight = run(Some(0.0));
+        let f = F32Function { expr: expr::model_expr(&m), features: d.x.iter().map(|p| vec![p[0] as f32]).collect(), y: &d.y, clamp: None };
+        assert!(f.rms(&tight.num, &[]) <= tight.rounded.rms_error, "{tight:?}");
+        assert!(tight.reoptimised.max_abs_error <= tight.rounded.max_abs_error, "{tight:?}");
+    }
+
     /// The search tries the moves the module documents and no others (one coefficient by ±1,
     /// ±2, ±4, …, ±max_ulps ulps, within max_ulps of its rounded value: its evaluation count
     /// is bounded by theirs), and where the sweeps stop before `max_sweeps`, none of those
