@@ -685,6 +685,35 @@ mod tests {
         assert_eq!(bits(&fit(&model, &data, &lsq, "step").unwrap().theta), bits(&f.theta));
     }
 
+    /// The stall rule as documented on [`Stall`], decided at one accepted step: n = 300
+    /// evaluations, rss 1, LM's cap 1300 (1000 left), the last entry ≥ WINDOW back at n0 = 0
+    /// with rss 1 + δ. At the rate δ/300 the evaluations left lower the rss by δ·1000/300, so
+    /// it stalls exactly when δ < 3e-7 (SHARE·rss·300/1000); an entry less than WINDOW back
+    /// is not a measure of progress, however large its fall.
+    #[test]
+    fn a_watched_run_stalls_where_its_rate_cannot_reach_a_share_of_its_rss() {
+        let model = RationalModel::rational_1d("x", 1, 0);
+        let x: Vec<Vec<f64>> = (0..4).map(|i| vec![i as f64]).collect();
+        let data = Data { y: x.iter().map(|p| 1.0 + p[0]).collect(), x };
+        let step = |history: Vec<(usize, f64)>| {
+            let w = Watched {
+                inner: Residuals::new(&model, &data, DVector::from_vec(vec![0.5, 0.5])),
+                max_evals: 1300,
+                evals: std::cell::Cell::new(300),
+                last: std::cell::Cell::new(1.0),
+                history: std::cell::RefCell::new(history),
+                stalled: std::cell::Cell::new(None),
+            };
+            let jacobian = w.jacobian();
+            (jacobian.is_none(), w.stalled.get(), w.history.borrow().len())
+        };
+        // Stopped: no Jacobian, REACH·rss as the lower bound, the step not recorded.
+        assert_eq!(step(vec![(0, 1.0 + 2.9e-7)]), (true, Some(0.1), 1));
+        assert_eq!(step(vec![(0, 1.0 + 3.1e-7)]), (false, None, 2));
+        assert_eq!(step(vec![(0, 1.0 + 2.9e-7), (150, 1e9)]), (true, Some(0.1), 2));
+        assert_eq!(step(vec![(150, 1.0)]), (false, None, 2));
+    }
+
     use crate::fit::model::{ModelParts, Term};
 
     fn parts_1d(num: &[&str], den: &[&str]) -> ModelParts {
