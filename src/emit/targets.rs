@@ -698,6 +698,29 @@ mod tests {
         assert_eq!(values("R"), vec![0.1, 2.0]);
     }
 
+    /// A constant whose value is another constant (`Expression::Constant`: valid IR, which the
+    /// WGSL front end folds away, so it is built here by hand) flattens to that constant's
+    /// values, through a chain of two references and inside a composite.
+    #[test]
+    fn constants_naming_constants_flatten_to_their_values() {
+        use naga::{Expression, Span, Type};
+        let mut m = naga::Module::default();
+        let f32t = m.types.insert(Type { name: None, inner: TypeInner::Scalar(Scalar::F32) }, Span::UNDEFINED);
+        let pair = m.types.insert(Type { name: None, inner: TypeInner::Vector { size: naga::VectorSize::Bi, scalar: Scalar::F32 } }, Span::UNDEFINED);
+        let constant = |m: &mut naga::Module, name: &str, ty: naga::Handle<Type>, e: Expression| {
+            let init = m.global_expressions.append(e, Span::UNDEFINED);
+            m.constants.append(naga::Constant { name: Some(name.into()), ty, init }, Span::UNDEFINED)
+        };
+        let k = constant(&mut m, "K", f32t, Expression::Literal(Literal::F32(0.5)));
+        let r = constant(&mut m, "R", f32t, Expression::Constant(k));
+        constant(&mut m, "RR", f32t, Expression::Constant(r));
+        let (ref_r, two) = (m.global_expressions.append(Expression::Constant(r), Span::UNDEFINED), m.global_expressions.append(Expression::Literal(Literal::F32(2.0)), Span::UNDEFINED));
+        constant(&mut m, "V", pair, Expression::Compose { ty: pair, components: vec![ref_r, two] });
+        let flat: Vec<(String, Vec<Literal>)> = named_constants(&m).into_iter().map(|f| f.map(|f| (f.name, f.values)).unwrap()).collect();
+        let half = Literal::F32(0.5);
+        assert_eq!(flat, [("K".into(), vec![half]), ("R".into(), vec![half]), ("RR".into(), vec![half]), ("V".into(), vec![half, Literal::F32(2.0)])]);
+    }
+
     #[test]
     fn target_names_round_trip_and_lists_are_sorted() {
         for t in Target::ALL {

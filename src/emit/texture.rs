@@ -396,6 +396,18 @@ mod tests {
         (0..w * h).map(|k| [k as f32 / 7.0, 0.25, -(k as f32), 1.0]).collect()
     }
 
+    /// The DFD's own size fields, read from the file as KDF 1.3 lays them out (the ktx2 crate
+    /// reads the samples without checking them): dfdTotalSize, the header's dfdByteLength and
+    /// the basic block's descriptorBlockSize (the high half of its second word) all follow
+    /// from a 24-byte block header and 16 bytes a sample.
+    fn dfd_sizes_follow_the_spec(bytes: &[u8], samples: u32) {
+        let hd = ktx2::Reader::new(bytes).unwrap().header();
+        let (at, len) = (hd.index.dfd_byte_offset as usize, hd.index.dfd_byte_length);
+        let word = |k: usize| u32::from_le_bytes(bytes[at + 4 * k..at + 4 * k + 4].try_into().unwrap());
+        assert_eq!((len, word(0)), (4 + 24 + 16 * samples, 4 + 24 + 16 * samples), "{samples} samples");
+        assert_eq!(word(2) >> 16, 24 + 16 * samples, "{samples} samples");
+    }
+
     #[test]
     fn ktx2_reads_back_with_the_ktx2_crate() {
         for format in [TextureFormat::Rgba16float, TextureFormat::Rgba32float] {
@@ -417,6 +429,7 @@ mod tests {
             assert_eq!(r.writer(), Some(format!("{}\0", crate::emit::GENERATOR).as_str()));
             let basic = r.basic_dfd().expect("a basic DFD block");
             assert_eq!(basic.bytes_planes[0] as u32, format.texel_size());
+            dfd_sizes_follow_the_spec(&bytes, 4);
             let samples = &basic.sample_information;
             assert_eq!(samples.len(), 4);
             for (k, s) in samples.iter().enumerate() {
@@ -471,6 +484,7 @@ mod tests {
             assert_eq!((r.header().pixel_width, r.header().pixel_height), (w, h));
             let basic = r.basic_dfd().expect("a basic DFD block");
             assert_eq!(basic.bytes_planes[0] as u32, channels as u32 * format.type_size());
+            dfd_sizes_follow_the_spec(&bytes, channels as u32);
             let ids: Vec<u8> = basic.sample_information.iter().map(|s| s.channel_type).collect();
             assert_eq!(ids, [0u8, 1][..channels]);
             let level = r.levels().next().unwrap();
