@@ -592,6 +592,41 @@ pub(super) mod tests {
         assert_eq!((be(16), be(20)), (256, 384));
     }
 
+    /// The statistics a table states (JSON and verification) are those of its cells, worked
+    /// out by hand: 24 slice cells of standard error 0.01 but cell 17 (layer 1, row 1, column 1)
+    /// at 0.05, so max 0.05, rms √((23·1e-4 + 25e-4)/24) = √2e-4, worst point (gloss 1,
+    /// θh = 1.5/4·π/2, θd = 1.5/3·π/2); 6 albedo cells of 0.002 but one at 0.004: max 0.004, rms
+    /// √((5·4e-6 + 16e-6)/6) = √6e-6.
+    #[test]
+    fn stated_statistics_are_those_of_the_cells() {
+        let s = spec(SPEC);
+        let t = Table::from_spec(&s).unwrap();
+        let (n, a) = (t.slice_cells() as usize, t.albedo_cells() as usize);
+        assert_eq!((n, a), (24, 6));
+        let mut cells: Vec<Cell> = (0..n + a).map(|k| Cell { value: 1.0, se: if k < n { 0.01 } else { 0.002 } }).collect();
+        cells[17].se = 0.05;
+        cells[n + 4].se = 0.004;
+        let built = render(&s, &t, &cells).unwrap();
+        let json = &built.artifacts.iter().find(|a| a.path.ends_with("json/msd_t.json")).unwrap().contents;
+        let v: serde_json::Value = serde_json::from_slice(json).unwrap();
+        let st = &v["statistics"];
+        let close = |got: &serde_json::Value, want: f64| {
+            // Sums of ≤ 24 squares of values ≤ 0.05, then a square root: a few ulps.
+            let g = got.as_f64().unwrap();
+            assert!((g - want).abs() <= 1e-15 * want, "{g} vs {want}");
+        };
+        close(&st["slice_max_standard_error"], 0.05);
+        close(&st["slice_rms_standard_error"], 2e-4f64.sqrt());
+        close(&st["albedo_max_standard_error"], 0.004);
+        close(&st["albedo_rms_standard_error"], 6e-6f64.sqrt());
+        let worst: Vec<f64> = st["slice_worst_cell"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
+        let want = [1.0, 1.5 / 4.0 * FRAC_PI_2, 1.5 / 3.0 * FRAC_PI_2];
+        assert!(worst.iter().zip(want).all(|(g, w)| (g - w).abs() <= 1e-15), "{worst:?}");
+        let ver = &built.verification;
+        assert_eq!((ver.points, ver.max_abs_error, ver.worst_point.clone()), (24, 0.05, worst));
+        assert!((ver.rms_error - 2e-4f64.sqrt()).abs() <= 1e-15 * ver.rms_error, "{ver:?}");
+    }
+
     #[test]
     fn merl_files_hold_the_walk_at_the_cell_centres() {
         // merl_paths = 2 (1.46M cells a layer, the smallest run): a cell of the file is the
