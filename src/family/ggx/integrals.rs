@@ -628,6 +628,29 @@ mod tests {
 
     const HC: Shadowing = Shadowing::HeightCorrelated;
 
+    /// κ is where the integrand's own cut μl ≥ c falls in cos φ: just above it the integrand
+    /// is on, just below off. Where s·sin θh = 0, μl does not depend on φ and κ is −∞ (every φ)
+    /// when μl ≥ c holds, including μl = c exactly (view 0.5 and cone 0.5 at θh = 0, where
+    /// the integrand is on), and +∞ (no φ) when it fails.
+    #[test]
+    fn kappa_is_the_integrands_own_cut_in_cos_phi() {
+        let view = View::new(0.5, 0.5, 0.5, HC);
+        assert_eq!(view.kappa(0.0, 1.0), f64::NEG_INFINITY);
+        assert_ne!(view.integrand(0.0, 1.0, 0.3), [0.0, 0.0]);
+        assert_eq!(View::new(0.5, 0.5, 0.4, HC).kappa(0.0, 1.0), f64::NEG_INFINITY);
+        assert_eq!(View::new(0.5, 0.5, 0.6, HC).kappa(0.0, 1.0), f64::INFINITY);
+        assert_eq!(View::new(0.5, 0.5, 0.6, HC).integrand(0.0, 1.0, 0.3), [0.0, 0.0]);
+        // s·sin θh > 0: a cut inside (−1, 1), tested 1e-9 either side of it.
+        for (mu_v, cone, theta_h) in [(0.5, 0.5, 0.3), (0.8, 0.2, 0.9), (0.3, 0.7, 0.6)] {
+            let view = View::new(0.5, mu_v, cone, HC);
+            let (sh, ch) = f64::sin_cos(theta_h);
+            let k = view.kappa(sh, ch);
+            assert!(k.abs() < 1.0 - 1e-6, "{k}");
+            assert_ne!(view.integrand(sh, ch, k + 1e-9), [0.0, 0.0], "{mu_v} {cone} {theta_h}: above κ = {k}");
+            assert_eq!(view.integrand(sh, ch, k - 1e-9), [0.0, 0.0], "{mu_v} {cone} {theta_h}: below κ = {k}");
+        }
+    }
+
     /// The φ integrand's pole just below μl = 0 (see `phi_panels`) at small α: on the initial
     /// panels of `phi_panels` the inner integral lies within its own error estimate (plus the
     /// reference's) of a reference on panels halving towards φmax down to 2⁻⁵⁹ of it, which

@@ -625,6 +625,22 @@ mod tests {
         assert!(cos_s < cos_v, "the first case's specular cone is the wider");
     }
 
+    /// The validators' grid is the one their items state (DOMAIN): r = 0.05, 0.10, …, 1 (20),
+    /// n·v at the 32 texel centres (j + ½)/32, V = 1/32, …, 1 (32), r slowest and V fastest.
+    #[test]
+    fn the_grid_is_the_stated_domain() {
+        let g = grid();
+        assert_eq!(g.len(), 20 * 32 * 32);
+        assert!(DOMAIN.ends_with(&format!("{} points", g.len())), "{DOMAIN}");
+        for (n, p) in g.iter().enumerate() {
+            let (i, j, k) = (n / 1024, (n / 32) % 32, n % 32);
+            let want = [0.05 * (i + 1) as f64, (j as f64 + 0.5) / 32.0, (k + 1) as f64 / 32.0];
+            // 0.05·(i + 1) in f64 either way: equal to an ulp.
+            assert!(p.iter().zip(want).all(|(a, b)| (a - b).abs() <= 1e-15), "{n}: {p:?} vs {want:?}");
+        }
+        assert_eq!((g[0][0], g[g.len() - 1]), (0.05, [1.0, 31.5 / 32.0, 1.0]));
+    }
+
     #[test]
     fn max_error_is_the_largest_absolute_deviation() {
         // Hand-worked: so(r, μ, v) = r at r = 0.1, 0.2, 0.3 against references 0, 0.5, 0.1:
