@@ -278,6 +278,49 @@ mod tests {
         assert!(floor > 0.0 && floor <= extra("rows_3_4_swapped_rms_error") && floor <= ps.rms_error, "floor {floor}");
         assert!(extra("rows_3_4_swapped_max_abs_error") < ps.max_abs_error, "the exchange is the finding");
         assert_eq!(ps.points, 17 * 17 * 256);
+        // The floor re-measured: at each (α, θf) the least-squares fit of the six Eq. 1 terms
+        // 1, u·n, u·t, (u·n)², (u·n)(u·t), (u·t)², u·t = sin θu cos φu sin θf + cos θu cos θf,
+        // solved here by the normal equations (Cholesky) rather than the item's SVD. At the
+        // optimum the residuals move only to second order in the coefficients' solver error
+        // (~1e-10 relative here), so both measures agree to 1e-9 of themselves.
+        let (alphas, thetas, dirs) = (fuzz::linspace(0.15, 1.0, 17), fuzz::linspace(0.1, std::f64::consts::FRAC_PI_2, 17), fuzz::fitting_directions(16, 16));
+        let (mut max, mut ss, mut n) = (0.0f64, 0.0, 0usize);
+        // And the table's own errors, as printed and with rows 3 and 4 exchanged: (max, Σ r²).
+        let (mut printed, mut swapped) = ((0.0f64, 0.0), (0.0f64, 0.0));
+        for (k, row) in fuzz::ps_grid(&alphas, &thetas, &dirs, 1e-9).iter().enumerate() {
+            let (a, tf) = (alphas[k / thetas.len()], thetas[k % thetas.len()]);
+            let table = published_ps_coeffs(a, tf);
+            let terms = |tu: f64, pu: f64| {
+                let (un, ut) = (tu.cos(), tu.sin() * pu.cos() * tf.sin() + tu.cos() * tf.cos());
+                nalgebra::DVector::from_vec(vec![1.0, un, ut, un * un, un * ut, ut * ut])
+            };
+            let (mut gram, mut rhs) = (nalgebra::DMatrix::<f64>::zeros(6, 6), nalgebra::DVector::<f64>::zeros(6));
+            for (&(tu, pu), e) in dirs.iter().zip(row) {
+                let t = terms(tu, pu);
+                gram += &t * t.transpose();
+                rhs += &t * e.value;
+            }
+            let c = gram.cholesky().expect("six independent terms").solve(&rhs);
+            for (&(tu, pu), e) in dirs.iter().zip(row) {
+                let t = terms(tu, pu);
+                let r = t.dot(&c) - e.value;
+                (max, ss, n) = (max.max(r.abs()), ss + r * r, n + 1);
+                for (acc, v) in [(&mut printed, ps_from_coeffs(&table, t[1], t[2])), (&mut swapped, ps_from_coeffs_swapped(&table, t[1], t[2]))] {
+                    let r = v - e.value;
+                    *acc = (acc.0.max(r.abs()), acc.1 + r * r);
+                }
+            }
+        }
+        // The same residuals summed in the same order as the item: to rounding (1e-12).
+        let close = |what: &str, reported: f64, want: f64| assert!((reported - want).abs() <= 1e-12 * want, "{what}: reported {reported:e}, re-measured {want:e}");
+        close("printed max", ps.max_abs_error, printed.0);
+        close("printed rms", ps.rms_error, (printed.1 / n as f64).sqrt());
+        close("swapped max", extra("rows_3_4_swapped_max_abs_error"), swapped.0);
+        close("swapped rms", extra("rows_3_4_swapped_rms_error"), (swapped.1 / n as f64).sqrt());
+        let rms = (ss / n as f64).sqrt();
+        assert!((floor - rms).abs() <= 1e-9 * rms, "floor: reported {floor:e}, re-measured {rms:e}");
+        let bmax = extra("best_6_term_fit_max_abs_error");
+        assert!((bmax - max).abs() <= 1e-9 * max, "floor max: reported {bmax:e}, re-measured {max:e}");
     }
 
     /// R̃ (Listing 5) follows the integral R it was fitted to: on a 5×5 (α, θf) grid, R

@@ -392,6 +392,18 @@ fn energy_finding(scheme: Scheme, f1_max_dev: f64, (g, gp): (f64, &str), (l, lp)
 mod tests {
     use super::*;
 
+    /// The n·v samples are the stated domain's: MU_COUNT uniform values from 0 to 1, both
+    /// ends included (the grazing end is where the schemes differ most).
+    #[test]
+    fn mu_grid_spans_the_stated_domain() {
+        let mu = mu_grid();
+        assert_eq!(mu.len(), MU_COUNT);
+        assert!(domain().contains(&format!("n·v ∈ [0, 1] ({MU_COUNT})")), "{}", domain());
+        assert_eq!((mu[0], mu[MU_COUNT - 1]), (0.0, 1.0));
+        // Uniform: each the same quotient i/(MU_COUNT − 1), to the bit.
+        assert!(mu.iter().enumerate().all(|(i, &m)| m == i as f64 / (MU_COUNT - 1) as f64), "{mu:?}");
+    }
+
     /// The grid is roughness-major: point (j, i) is input j·len(μ) + i.
     #[test]
     fn grid_points_are_roughness_major() {
