@@ -621,6 +621,24 @@ pub fn figures(out: &Path, _generated: &Path) -> Result<Vec<PathBuf>, PlotError>
 mod tests {
     use super::*;
 
+    /// A pair form's per-channel maxima, by hand: scale errors 0.1, −0.3, 0.2 and bias errors
+    /// −0.05, 0.04, 0.5 (truth minus approximation either way round) give 0.3 and 0.5.
+    #[test]
+    fn channel_max_takes_each_channels_largest_absolute_error() {
+        let errors = [[0.1, -0.05], [-0.3, 0.04], [0.2, 0.5]];
+        let mut p = PairMeasure { points: vec![], truth: vec![], approx: vec![] };
+        for (k, e) in errors.iter().enumerate() {
+            for ch in 0..2 {
+                p.points.push(vec![k as f64 / 4.0, 0.5, ch as f64]);
+                p.truth.push(1.0 + k as f64);
+                p.approx.push(1.0 + k as f64 + e[ch]);
+            }
+        }
+        let (scale, bias) = (channel_max(&p, 0), channel_max(&p, 1));
+        // Each |(1 + k + e) − (1 + k)| is e to an ulp of 1 + k (≤ 3): 1e-15.
+        assert!((scale - 0.3).abs() < 1e-15 && (bias - 0.5).abs() < 1e-15, "{scale} {bias}");
+    }
+
     /// The Filament measures sit where the shader reads: column c of the grid at the texel
     /// centre n·v = (cols[c] + ½)/128, grid row k at perceptual roughness (k + ½)/128 (row 128:
     /// 1); each against the height-correlated integral computed directly at that point, and
