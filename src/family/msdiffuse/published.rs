@@ -469,16 +469,22 @@ mod tests {
         assert!((got - want).abs() <= 1e-14 * want, "reported {got}, re-measured {want}");
     }
 
+    /// The committed F0 = 0 slices (gloss 0 first) and their θh, θd cell counts.
+    fn lambert_slices() -> (Value, usize, usize) {
+        let generated = Path::new(env!("CARGO_MANIFEST_DIR")).join("generated");
+        let v: Value = serde_json::from_str(&std::fs::read_to_string(generated.join("json/ms_diffuse_slices_lambert.json")).unwrap()).unwrap();
+        assert_eq!(v["gloss"][0].as_f64(), Some(0.0));
+        let (w, h) = (v["axes"][0]["count"].as_u64().unwrap() as usize, v["axes"][1]["count"].as_u64().unwrap() as usize);
+        (v, w, h)
+    }
+
     #[test]
     fn talk_rational_against_the_lambert_slice_times_0_9216_is_re_measured() {
         // The talk's F0 = 0.04 with a constant (1 − F0) at entry and exit scales the F0 = 0 walk
         // by (1 − 0.04)² = 0.9216. Re-measured here from the committed JSON alone: the gloss-0
         // layer's cells at θh = (i + ½)/w·π/2, θd = (j + ½)/h·π/2, where the rational's
         // arguments are n·h = cos θh and l·h = cos θd. 1e-12: the same f64 sums in another order.
-        let generated = Path::new(env!("CARGO_MANIFEST_DIR")).join("generated");
-        let v: Value = serde_json::from_str(&std::fs::read_to_string(generated.join("json/ms_diffuse_slices_lambert.json")).unwrap()).unwrap();
-        assert_eq!(v["gloss"][0].as_f64(), Some(0.0));
-        let (w, h) = (v["axes"][0]["count"].as_u64().unwrap() as usize, v["axes"][1]["count"].as_u64().unwrap() as usize);
+        let (v, w, h) = lambert_slices();
         let mut want = 0.0f64;
         for j in 0..h {
             for i in 0..w {
@@ -501,10 +507,7 @@ mod tests {
     /// transcription wrong moves whole regions of the slice by tens of percent.
     #[test]
     fn the_transcribed_rational_follows_the_lambert_walk_times_0_9216() {
-        let generated = Path::new(env!("CARGO_MANIFEST_DIR")).join("generated");
-        let v: Value = serde_json::from_str(&std::fs::read_to_string(generated.join("json/ms_diffuse_slices_lambert.json")).unwrap()).unwrap();
-        assert_eq!(v["gloss"][0].as_f64(), Some(0.0));
-        let (w, h) = (v["axes"][0]["count"].as_u64().unwrap() as usize, v["axes"][1]["count"].as_u64().unwrap() as usize);
+        let (v, w, h) = lambert_slices();
         let mut ratio: Vec<f64> = (0..w * h)
             .map(|k| {
                 let (th, td) = (((k % w) as f64 + 0.5) / w as f64 * FRAC_PI_2, ((k / w) as f64 + 0.5) / h as f64 * FRAC_PI_2);
