@@ -325,7 +325,7 @@ mod tests {
         let model = RationalModel::rational_1d("x", 1, 1);
         let x: Vec<Vec<f64>> = (0..5).map(|i| vec![i as f64 / 4.0]).collect();
         let y: Vec<f64> = x.iter().map(|p| 0.3 + 0.9 * p[0] * p[0]).collect();
-        let f = F32Function { expr: expr::model_expr(&model), features: x.iter().map(|p| vec![p[0] as f32]).collect(), y: &y, clamp: None };
+        let f = f32_function_1d(&model, &x, &y);
         let (num, den) = ([0.25f32, 1.0], [0.5f32]);
         let r: Vec<f64> = x.iter().zip(&y).map(|(p, y)| expr::eval_f32(&f.expr, &[p[0] as f32], &num, &den) as f64 - y).collect();
         assert!(r.iter().all(|v| v.abs() > 1e-3), "residuals away from 0: {r:?}");
@@ -339,6 +339,11 @@ mod tests {
             assert_eq!(f.score(&num, &den, objective, want * (1.0 - 1e-9)), None, "{objective:?} reaches its bound");
         }
         assert!((f.rms(&num, &den) - (s2 / 5.0).sqrt()).abs() <= 1e-15, "rms");
+    }
+
+    /// The emitted f32 function of a one-input model on samples `x` (no clamp).
+    fn f32_function_1d<'a>(model: &RationalModel, x: &[Vec<f64>], y: &'a [f64]) -> F32Function<'a> {
+        F32Function { expr: expr::model_expr(model), features: x.iter().map(|p| vec![p[0] as f32]).collect(), y, clamp: None }
     }
 
     fn samples(lo: f64, hi: f64, n: usize, f: impl Fn(f64) -> f64) -> Data {
@@ -405,7 +410,7 @@ mod tests {
         let loose = run(Some(1.0));
         assert_eq!((&loose.num, loose.sweeps, loose.evaluations), (&free.num, free.sweeps, free.evaluations));
         let tight = run(Some(0.0));
-        let f = F32Function { expr: expr::model_expr(&m), features: d.x.iter().map(|p| vec![p[0] as f32]).collect(), y: &d.y, clamp: None };
+        let f = f32_function_1d(&m, &d.x, &d.y);
         assert!(f.rms(&tight.num, &[]) <= tight.rounded.rms_error, "{tight:?}");
         assert!(tight.reoptimised.max_abs_error <= tight.rounded.max_abs_error, "{tight:?}");
     }
@@ -429,7 +434,7 @@ mod tests {
             // The search's cost: the rounded vector, then at most those candidates a
             // coefficient a sweep (fewer where the cap or f32's range cuts them).
             assert!(r.evaluations <= 1 + r.sweeps * r.num.len() * steps.len(), "{objective:?}: {} evaluations in {} sweeps", r.evaluations, r.sweeps);
-            let f = F32Function { expr: expr::model_expr(&m), features: d.x.iter().map(|p| vec![p[0] as f32]).collect(), y: &d.y, clamp: None };
+            let f = f32_function_1d(&m, &d.x, &d.y);
             let best = f.score(&r.num, &[], objective, f64::INFINITY).unwrap();
             let (start, _) = rounded(&m, &c);
             // The report's three error sets, each of its own vector: the f64 fit (its f64
