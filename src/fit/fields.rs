@@ -527,6 +527,13 @@ fn solve_joint(fields: &mut Fields<'_>, max_iters: usize, what: &str) -> Result<
     Ok(evals)
 }
 
+/// The joint start of index `c`: every field's candidate `c`, or its last one when it has fewer
+/// (a start whose solve was not finite is dropped, so fields can have different counts),
+/// concatenated in field order. Every field has at least one candidate.
+fn start_set(per_field: &[Vec<DVector<f64>>], c: usize) -> DVector<f64> {
+    DVector::from_vec(per_field.iter().flat_map(|s| s[c.min(s.len() - 1)].iter().copied()).collect())
+}
+
 /// Fit the fields `models` (one per basis function) over the grid points `x` to the samples
 /// `data` (one [`PointData`] per grid point, same order).
 pub fn fit_fields(
@@ -569,8 +576,7 @@ pub fn fit_fields(
     let mut theta = DVector::zeros(0);
     let mut best_cost = f64::INFINITY;
     for c in 0..n_cand {
-        let t: Vec<f64> = per_field.iter().flat_map(|s| s[c.min(s.len() - 1)].iter().copied()).collect();
-        let t = DVector::from_vec(t);
+        let t = start_set(&per_field, c);
         let cost = probe.cost(&t);
         if cost < best_cost {
             best_cost = cost;
@@ -746,6 +752,17 @@ mod tests {
             })
             .collect();
         (xs.iter().map(|&x| vec![x]).collect(), data)
+    }
+
+    /// Start set c takes candidate c of every field that has one and the last candidate of
+    /// each field that has fewer, in field order.
+    #[test]
+    fn a_field_with_fewer_candidates_lends_its_last_to_later_start_sets() {
+        let v = |s: &[f64]| DVector::from_row_slice(s);
+        let per_field = vec![vec![v(&[1.0, 2.0]), v(&[3.0, 4.0]), v(&[5.0, 6.0])], vec![v(&[-1.0])], vec![v(&[7.0]), v(&[8.0])]];
+        assert_eq!(start_set(&per_field, 0).as_slice(), [1.0, 2.0, -1.0, 7.0]);
+        assert_eq!(start_set(&per_field, 1).as_slice(), [3.0, 4.0, -1.0, 8.0]);
+        assert_eq!(start_set(&per_field, 2).as_slice(), [5.0, 6.0, -1.0, 8.0]);
     }
 
     #[test]

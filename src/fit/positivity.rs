@@ -215,6 +215,10 @@ fn bound(model: &RationalModel, c: &DVector<f64>, region: &[(f64, f64)], max_exp
     q.0.max(mean_value_bound(model, c, max_exp, sc))
 }
 
+/// The boxes a proof may take: it gives up (not proven) at a bisection where the boxes visited
+/// and those waiting on the stack reach it.
+const BUDGET: usize = 200_000;
+
 /// Prove Q > 0 on the box `domain` (one (min, max) per feature).
 ///
 /// Depth first, the lower half of a bisected box before the upper; the boxes live on one flat
@@ -224,7 +228,11 @@ pub fn prove_denominator_positive(
     c: &DVector<f64>,
     domain: &[(f64, f64)],
 ) -> Positivity {
-    const BUDGET: usize = 200_000;
+    prove_within(model, c, domain, BUDGET)
+}
+
+/// [`prove_denominator_positive`] with a budget of `budget` boxes (see [`BUDGET`]).
+fn prove_within(model: &RationalModel, c: &DVector<f64>, domain: &[(f64, f64)], budget: usize) -> Positivity {
     // The highest power of each feature in the denominator's terms (the powers a box needs).
     let mut max_exp = vec![0u32; model.features.len()];
     for t in model.lead.iter().chain(&model.denominator) {
@@ -270,7 +278,7 @@ pub fn prove_denominator_positive(
             .map(|(i, _)| i)
             .unwrap_or(0);
         let w = region[widest].1 - region[widest].0;
-        if sample <= MIN_BOUND || boxes + stack.len() / dim >= BUDGET || w < 1e-9 {
+        if sample <= MIN_BOUND || boxes + stack.len() / dim >= budget || w < 1e-9 {
             return Positivity::NotProven { lower: lo, region, sample };
         }
         let mid = 0.5 * (region[widest].0 + region[widest].1);
@@ -475,8 +483,9 @@ mod tests {
         assert!(yes > 30 && no > 30, "{yes} proven, {no} not");
     }
 
-    /// Q = 1 + b₁x + b₂x² + 0·y on `domain` (x, y): the 2-D model of the bisection tests.
-    fn prove_xy(b: [f64; 2], domain: [(f64, f64); 2]) -> Positivity {
+    /// Q = 1 + b₁x + b₂x² + 0·y (x, y): the 2-D model of the bisection tests, and its
+    /// coefficients.
+    fn model_xy(b: [f64; 2]) -> (RationalModel, DVector<f64>) {
         use crate::fit::model::{ModelParts, Term};
         let features = vec!["x".to_string(), "y".to_string()];
         let term = |t: &str| Term::parse(t, &features).unwrap();
@@ -487,7 +496,34 @@ mod tests {
             ..ModelParts::default()
         })
         .unwrap();
-        prove_denominator_positive(&model, &DVector::from_vec(vec![1.0, b[0], b[1], 0.0]), &domain)
+        (model, DVector::from_vec(vec![1.0, b[0], b[1], 0.0]))
+    }
+
+    /// [`model_xy`]'s Q proven on `domain`.
+    fn prove_xy(b: [f64; 2], domain: [(f64, f64); 2]) -> Positivity {
+        let (model, c) = model_xy(b);
+        prove_denominator_positive(&model, &c, &domain)
+    }
+
+    /// The budget counts the boxes visited and those waiting. Each bisection adds one to that
+    /// count (one box taken off the stack, two put on) and a proven box none, so it is largest
+    /// at the last bisection, where it is N − 2 for a proof of N boxes (everything waiting, and
+    /// the two halves, is then proven without bisection): the proof holds within a budget of
+    /// N − 1 and stops at N − 2. In two dimensions, with boxes waiting at the last bisection,
+    /// counting each waiting box's two (min, max) pairs as two boxes would stop it at N − 1.
+    #[test]
+    fn the_budget_counts_the_boxes_visited_and_waiting() {
+        // Q = 4(x − ¼)² + ε scaled to Q(0) = 1 (ε = 1e-4) on [0, 1]²: bisected in x about ¼
+        // and in y wherever y is the widest side, the upper halves waiting meanwhile.
+        let eps = 1e-4;
+        let k = 1.0 / (0.25 + eps);
+        let (model, c) = model_xy([-2.0 * k, 4.0 * k]);
+        let dom = [(0.0, 1.0), (0.0, 1.0)];
+        let Positivity::Proven { boxes: n, lower } = prove_within(&model, &c, &dom, usize::MAX) else { panic!("not proven") };
+        assert!(n > 20 && lower > 1e-12, "{n} boxes, lower {lower}");
+        assert_eq!(prove_denominator_positive(&model, &c, &dom), Positivity::Proven { boxes: n, lower });
+        assert_eq!(prove_within(&model, &c, &dom, n - 1), Positivity::Proven { boxes: n, lower });
+        assert!(matches!(prove_within(&model, &c, &dom, n - 2), Positivity::NotProven { .. }));
     }
 
     #[test]

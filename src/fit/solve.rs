@@ -942,27 +942,33 @@ mod tests {
         assert!(f.report.max_abs_error < 1e-12, "{:?}", f.report);
     }
 
-    /// A pin given in the data's own units (x = 2^70 · 0.5) holds after the input is rescaled:
-    /// the fitted rational takes the pinned value there, to the rounding of the scaled problem.
+    /// A pin given in the data's own units (x = 2^70 · 0.5, values of order 1, 2^-90 and 2^90)
+    /// holds after the inputs and the values are rescaled: the fitted rational takes the pinned
+    /// value there, to the rounding of the scaled problem.
     #[test]
     fn pins_far_from_one_hold_in_the_datas_units() {
         use crate::fit::model::Pin;
         let xs = 2f64.powi(70);
-        let target = |x: f64| {
-            let t = x / xs;
-            (1.0 + 2.0 * t) / (1.0 + 0.5 * t) + 0.02 * (5.0 * t).sin()
-        };
-        let at = 0.5 * xs;
-        let pinned = target(at) + 0.01;
-        let model =
-            RationalModel::new(ModelParts { pins: vec![Pin { at: vec![at], value: pinned, eliminate: 0 }], ..parts_1d(&["1", "x", "x^2"], &["x"]) })
-                .unwrap();
-        let x: Vec<Vec<f64>> = (0..=40).map(|i| vec![xs * i as f64 / 20.0]).collect();
-        let data = Data { y: x.iter().map(|p| target(p[0])).collect(), x };
-        let f = fit_rescaled(&model, &data, &FitOptions::default(), "pinned").unwrap();
-        let v = model.eval_full(&f.coefficients, &[at]);
-        // The pin eliminates a coefficient exactly; evaluation rounding of terms ~10: 1e-13.
-        assert!((v - pinned).abs() < 1e-13, "f({at:e}) = {v} vs pin {pinned}");
+        for ys in [1.0, 2f64.powi(-90), 2f64.powi(90)] {
+            let target = |x: f64| {
+                let t = x / xs;
+                ys * ((1.0 + 2.0 * t) / (1.0 + 0.5 * t) + 0.02 * (5.0 * t).sin())
+            };
+            let at = 0.5 * xs;
+            let pinned = target(at) + 0.01 * ys;
+            let model = RationalModel::new(ModelParts {
+                pins: vec![Pin { at: vec![at], value: pinned, eliminate: 0 }],
+                ..parts_1d(&["1", "x", "x^2"], &["x"])
+            })
+            .unwrap();
+            let x: Vec<Vec<f64>> = (0..=40).map(|i| vec![xs * i as f64 / 20.0]).collect();
+            let data = Data { y: x.iter().map(|p| target(p[0])).collect(), x };
+            let f = fit_rescaled(&model, &data, &FitOptions::default(), "pinned").unwrap();
+            let v = model.eval_full(&f.coefficients, &[at]);
+            // The pin eliminates a coefficient exactly; evaluation rounding of terms ~10 (times
+            // the values' scale, a power of two): 1e-13.
+            assert!((v - pinned).abs() < 1e-13 * ys, "values × {ys:e}: f({at:e}) = {v:e} vs pin {pinned:e}");
+        }
     }
 
     /// With an rms cap the minimax iterates are kept only while their rms (√(Σr²/n)) is within
