@@ -627,6 +627,27 @@ pub(super) mod tests {
         assert!((ver.rms_error - 2e-4f64.sqrt()).abs() <= 1e-15 * ver.rms_error, "{ver:?}");
     }
 
+    /// A table's axes, as its docs state them: gloss k/(layers − 1) at layer k (0 for one
+    /// layer), θh and θd at the cell centres (i + ½)/n·π/2, n·v at (a + ½)/n; the JSON lists the
+    /// glosses of its layers. Five layers: 0, ¼, ½, ¾, 1, each exact in f64.
+    #[test]
+    fn the_axes_are_the_stated_layers_and_cell_centres() {
+        let s = spec(&SPEC.replace("[4, 3, 2]", "[4, 3, 5]"));
+        let t = Table::from_spec(&s).unwrap();
+        assert_eq!((0..5).map(|k| t.gloss(k)).collect::<Vec<_>>(), [0.0, 0.25, 0.5, 0.75, 1.0]);
+        assert_eq!((0..4).map(|i| t.theta_h(i)).collect::<Vec<_>>(), [0.5, 1.5, 2.5, 3.5].map(|c| c / 4.0 * FRAC_PI_2));
+        assert_eq!((0..3).map(|j| t.theta_d(j)).collect::<Vec<_>>(), [0.5, 1.5, 2.5].map(|c| c / 3.0 * FRAC_PI_2));
+        assert_eq!((0..3).map(|a| t.n_dot_v(a)).collect::<Vec<_>>(), [0.5, 1.5, 2.5].map(|c| c / 3.0));
+        let n = (t.slice_cells() + t.albedo_cells()) as usize;
+        let cells = vec![Cell { value: 1.0, se: 0.01 }; n];
+        let built = render(&s, &t, &cells).unwrap();
+        let json = &built.artifacts.iter().find(|a| a.path.ends_with("json/msd_t.json")).unwrap().contents;
+        let v: serde_json::Value = serde_json::from_slice(json).unwrap();
+        assert_eq!(v["gloss"], serde_json::json!([0.0, 0.25, 0.5, 0.75, 1.0]));
+        let one = Table::from_spec(&spec(&SPEC.replace("[4, 3, 2]", "[4, 3, 1]"))).unwrap();
+        assert_eq!(one.gloss(0), 0.0);
+    }
+
     #[test]
     fn merl_files_hold_the_walk_at_the_cell_centres() {
         // merl_paths = 2 (1.46M cells a layer, the smallest run): a cell of the file is the
