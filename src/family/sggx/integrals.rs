@@ -620,6 +620,30 @@ mod tests {
         assert!(worst_iters > 3, "the test footprints never needed iterating");
     }
 
+    /// The eigenvector is oriented to z ≥ 0 even where the iterates alternate in sign: a
+    /// symmetric S whose dominant eigenvalue is negative (−3, its axis v = (1, 1, 1)/√3; 1 and
+    /// 0.5 on the axes across it), turned a little each time so that the iteration ends on
+    /// either parity. The result is +v to the residual.
+    #[test]
+    fn the_eigenvector_is_oriented_up_even_when_the_iterates_alternate() {
+        let v = V3::new(1.0, 1.0, 1.0).normalize();
+        let mut flipped = 0;
+        for k in 0..8 {
+            // Two unit axes across v, turned by 0.1·k about it.
+            let u0 = V3::new(1.0, -1.0, 0.0).normalize();
+            let w0 = v.cross(&u0);
+            let (sn, cs) = (0.1 * k as f64).sin_cos();
+            let (u, w) = (u0 * cs + w0 * sn, w0 * cs - u0 * sn);
+            let s = -3.0 * v * v.transpose() + u * u.transpose() + 0.5 * w * w.transpose();
+            let p = power_iteration(&s);
+            assert!(p.converged, "turn {k}: {p:?}");
+            assert!(p.n.z >= 0.0 && (p.n - v).norm() < 1e-12, "turn {k}: n = {}", p.n);
+            // The raw iterate's sign: odd iteration counts end on −v (its z below 0).
+            flipped += p.iterations % 2;
+        }
+        assert!(flipped > 0, "no turn ended on an odd iteration");
+    }
+
     #[test]
     fn power_iteration_counts_follow_the_eigenvalue_ratio() {
         // The residual shrinks by λ₂/λ₁ per step: from 1 to 1e-14 takes ≈ ln(1e-14)/ln(λ₂/λ₁)

@@ -263,6 +263,39 @@ mod tests {
     }
     use crate::family::sggx::integrals::{Aniso, direction, sggx_from};
 
+    /// A PNG written here with the png crate: `data` is its samples in row order (big-endian
+    /// pairs at 16 bits).
+    fn write_png(path: &Path, (w, h): (u32, u32), color: png::ColorType, depth: png::BitDepth, data: &[u8]) {
+        let mut enc = png::Encoder::new(std::fs::File::create(path).unwrap(), w, h);
+        enc.set_color(color);
+        enc.set_depth(depth);
+        enc.write_header().unwrap().write_image_data(data).unwrap();
+    }
+
+    /// The maps are read as (width, height, channels, samples as UNORM values in row order):
+    /// v/255 at 8 bits, v/65535 at 16; a grey map is refused, naming the file and the field.
+    #[test]
+    fn maps_read_back_as_unorm_samples() {
+        let dir = tempfile::tempdir().unwrap();
+        let rgb8 = dir.path().join("rgb8.png");
+        let bytes = [0u8, 51, 255, 128, 1, 2];
+        write_png(&rgb8, (2, 1), png::ColorType::Rgb, png::BitDepth::Eight, &bytes);
+        let (w, h, c, v) = read_png(&rgb8, "normal map").unwrap();
+        assert_eq!((w, h, c), (2, 1, 3));
+        assert_eq!(v, bytes.map(|b| b as f64 / 255.0));
+        let rgba16 = dir.path().join("rgba16.png");
+        let words = [0u16, 65535, 32768, 1, 258, 4660, 65534, 7];
+        let be: Vec<u8> = words.iter().flat_map(|w| w.to_be_bytes()).collect();
+        write_png(&rgba16, (1, 2), png::ColorType::Rgba, png::BitDepth::Sixteen, &be);
+        let (w, h, c, v) = read_png(&rgba16, "aniso map").unwrap();
+        assert_eq!((w, h, c), (1, 2, 4));
+        assert_eq!(v, words.map(|x| x as f64 / 65535.0));
+        let grey = dir.path().join("grey.png");
+        write_png(&grey, (1, 1), png::ColorType::Grayscale, png::BitDepth::Eight, &[9]);
+        let e = read_png(&grey, "aniso map").unwrap_err().to_string();
+        assert!(e.contains("grey.png") && e.contains("color type") && e.contains("(aniso map)"), "{e}");
+    }
+
     #[test]
     fn a_uniform_texture_keeps_its_texel_at_every_level() {
         // Every level's S is the mean of equal matrices, so every texel is the input's to the
