@@ -302,6 +302,31 @@ mod tests {
         }
     }
 
+    /// `ggx-kc-fms`'s error is the first-order propagation of its three integrals' errors:
+    /// Σ |∂f_ms/∂x|·error(x) over E(μo), E(μi) and E_avg, the partials here by central
+    /// differences of the lobe formula (linear in E(μo) and E(μi), so exact there; in E_avg
+    /// their truncation is h²/(1 − E_avg)² ≈ 3e-9 relative at h = 1e-5, their rounding ~ε/h ≈
+    /// 2e-11: well inside 1e-6).
+    #[test]
+    fn kc_fms_error_propagates_each_integrals_error() {
+        let (alpha, mo, mi, tol) = (0.5, 0.3, 0.8, 1e-7);
+        let (eo, ei, ea) = (integrals::albedo(alpha, mo, tol), integrals::albedo(alpha, mi, tol), integrals::albedo_avg(alpha, tol));
+        let x = [eo.value, ei.value, ea.value];
+        let h = 1e-5;
+        let partial = |k: usize| {
+            let (mut up, mut down) = (x, x);
+            up[k] += h;
+            down[k] -= h;
+            (kc_f_ms_lobe(up[0], up[1], up[2]) - kc_f_ms_lobe(down[0], down[1], down[2])) / (2.0 * h)
+        };
+        let want: f64 = [eo.error, ei.error, ea.error].iter().enumerate().map(|(k, e)| partial(k).abs() * e).sum();
+        let got = eval_kc_fms(&[alpha, mo, mi], tol);
+        assert_eq!(got.value, kc_f_ms_lobe(x[0], x[1], x[2]));
+        assert!(want > 0.0 && (got.error - want).abs() <= 1e-6 * want, "error {} vs {want}", got.error);
+        // E_avg's share is a large part of the sum (measured 0.63), so its term is checked too.
+        assert!(partial(2).abs() * ea.error > 0.3 * want, "{} of {want}", partial(2).abs() * ea.error);
+    }
+
     #[test]
     fn kulla_conty_lobe_is_symmetric() {
         let p = [0.5, 0.2, 0.9];
