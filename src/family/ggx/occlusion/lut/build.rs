@@ -263,6 +263,25 @@ pub fn build(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> 
 mod tests {
     use super::*;
 
+    /// The verification samples the cone cosine between the slices, at the centres of
+    /// VERIFY_DENSITY (2) intervals in each: 0.25 and 0.75 on a 2 × 2 × 2 LUT. With slice 1's
+    /// texels (c = 1) raised by 100 in both channels, the texture's error is 100·c plus the
+    /// table's own (its values are in [0, 1], so it is below 1, f16 rounding at 100 included):
+    /// largest at c = 0.75, ≈ 75.
+    #[test]
+    fn the_verification_samples_the_cone_cosine_between_the_slices() {
+        let text = "name = \"ggx_c\"\nkind = \"ggx-cone-lut\"\nquantity = \"ggx-env\"\nresolution = [2, 2, 2]\n\n[emit]\nfunction = \"ggx_c\"\n";
+        let lut = ConeLut::parse(Path::new("fits/ggx_c.toml"), text).unwrap();
+        let (mut values, _) = tabulate(&lut);
+        for v in &mut values[4..] {
+            *v = v.map(|x| x + 100.0);
+        }
+        let m = verify(&lut, &values).unwrap();
+        assert_eq!(m.points, 4 * 4 * 2);
+        assert_eq!(m.texture.worst_point[2], 0.75, "{:?}", m.texture);
+        assert!((m.texture.max_abs_error - 75.0).abs() < 1.0, "{:?}", m.texture);
+    }
+
     #[test]
     fn trilinear_reproduces_a_linear_field_with_slices_at_k_over_d_minus_1() {
         // Texels holding channel 0 = k (the slice index) and channel 1 = i + 10 j on a
