@@ -526,6 +526,26 @@ mod tests {
         assert!(matches!(prove_within(&model, &c, &dom, n - 2), Positivity::NotProven { .. }));
     }
 
+    /// The budget counts the waiting boxes too where the last bisection leaves some: Q =
+    /// (x − 0.3)² + 2.5e-5 scaled to Q(0) = 1 on [0, 1], bisected down to 0.3 (lower halves
+    /// first), then across [0.5, 1], whose last bisection, of [0.5, 0.75], leaves [0.75, 1]
+    /// waiting (41 boxes, traced). Every budget above N − 2 proves it and none at or below it
+    /// does: the count is N − 2 at the last bisection whatever waits then. A count of the
+    /// visited boxes less the waiting ones is N − 4 there.
+    #[test]
+    fn every_budget_above_the_last_count_proves_and_none_below() {
+        let k = 1.0 / (0.09 + 2.5e-5);
+        let model = RationalModel::rational_1d("x", 0, 2);
+        let c = DVector::from_vec(vec![1.0, -0.6 * k, k]);
+        let dom = [(0.0, 1.0)];
+        let Positivity::Proven { boxes: n, .. } = prove_within(&model, &c, &dom, usize::MAX) else { panic!("not proven") };
+        assert!(n > 10, "{n} boxes");
+        for budget in 1..=n + 1 {
+            let p = prove_within(&model, &c, &dom, budget);
+            assert_eq!(matches!(p, Positivity::Proven { .. }), budget > n - 2, "budget {budget} of {n} boxes: {p:?}");
+        }
+    }
+
     #[test]
     fn a_constant_denominator_is_one_box() {
         // No feature in the box (dim 0): Q = 1, proven at once with the bound 1.
