@@ -627,11 +627,11 @@ mod tests {
     #[test]
     fn the_eigenvector_is_oriented_up_even_when_the_iterates_alternate() {
         let v = V3::new(1.0, 1.0, 1.0).normalize();
+        // Two unit axes across v, turned by 0.1·k about it at turn k.
+        let u0 = V3::new(1.0, -1.0, 0.0).normalize();
+        let w0 = v.cross(&u0);
         let mut flipped = 0;
         for k in 0..8 {
-            // Two unit axes across v, turned by 0.1·k about it.
-            let u0 = V3::new(1.0, -1.0, 0.0).normalize();
-            let w0 = v.cross(&u0);
             let (sn, cs) = (0.1 * k as f64).sin_cos();
             let (u, w) = (u0 * cs + w0 * sn, w0 * cs - u0 * sn);
             let s = -3.0 * v * v.transpose() + u * u.transpose() + 0.5 * w * w.transpose();

@@ -270,8 +270,8 @@ mod tests {
     /// largest at c = 0.75, ≈ 75.
     #[test]
     fn the_verification_samples_the_cone_cosine_between_the_slices() {
-        let text = "name = \"ggx_c\"\nkind = \"ggx-cone-lut\"\nquantity = \"ggx-env\"\nresolution = [2, 2, 2]\n\n[emit]\nfunction = \"ggx_c\"\n";
-        let lut = ConeLut::parse(Path::new("fits/ggx_c.toml"), text).unwrap();
+        let text = super::super::spec::tests::SPEC.replace("[8, 4, 3]", "[2, 2, 2]");
+        let lut = ConeLut::parse(Path::new("fits/ggx_c.toml"), &text).unwrap();
         let (mut values, _) = tabulate(&lut);
         for v in &mut values[4..] {
             *v = v.map(|x| x + 100.0);

@@ -161,10 +161,11 @@ pub fn spec_file(path: &Path, text: &str) -> Result<Option<SpecFile>, SpecError>
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
 
-    const SPEC: &str = "name = \"ggx_c\"\nkind = \"ggx-cone-lut\"\nquantity = \"ggx-env\"\n\
+    /// An 8 × 4 × 3 cone LUT spec, the least a spec names.
+    pub(in crate::family::ggx::occlusion::lut) const SPEC: &str = "name = \"ggx_c\"\nkind = \"ggx-cone-lut\"\nquantity = \"ggx-env\"\n\
         resolution = [8, 4, 3]\n\n[emit]\nfunction = \"ggx_c\"\n";
 
     #[test]
