@@ -883,6 +883,41 @@ mod tests {
         }
     }
 
+    /// Sanathanan–Koerner: start k ≥ 2 minimises Σ ((P − y·Q)/|Q_{k−1}|)², the linearised
+    /// residual weighted by the previous start's denominator. On data no [1/1] rational fits
+    /// (exp on [0, 2]) the weights matter, so the test checks that start's normal equations with
+    /// the weights computed here: the weighted residual is orthogonal to every weighted column.
+    #[test]
+    fn each_reweighted_start_solves_the_linearisation_weighted_by_the_last_denominator() {
+        let model = RationalModel::rational_1d("x", 1, 1);
+        let x: Vec<Vec<f64>> = (0..=40).map(|i| vec![0.05 * i as f64]).collect();
+        let data = Data { y: x.iter().map(|p| p[0].exp()).collect(), x };
+        let starts = linearised_starts(&model, &data, "exp").unwrap();
+        assert_eq!(starts.len(), 7);
+        for k in 2..starts.len() {
+            let (prev, c) = (model.full(&starts[k - 1]), model.full(&starts[k]));
+            let mut rows = Vec::new();
+            for (p, &y) in data.x.iter().zip(&data.y) {
+                let w = 1.0 / model.denominator_at(&prev, p).abs();
+                // Columns: ∂(P − y·Q)/∂(a0, a1, b1), weighted; Q = 1 + b1·x.
+                let col = [w, w * p[0], -w * y * p[0]];
+                let (num, den) = model.basis(p).pq(&c);
+                rows.push((col, w * (num - y * den)));
+            }
+            let e_norm = rows.iter().map(|r| r.1 * r.1).sum::<f64>().sqrt();
+            // exp is no [1/1] rational: the residual cannot vanish (it is ~1e-2 here).
+            assert!(e_norm > 1e-4, "start {k}: residual {e_norm}");
+            for j in 0..3 {
+                let dot: f64 = rows.iter().map(|r| r.0[j] * r.1).sum();
+                let col_norm = rows.iter().map(|r| r.0[j] * r.0[j]).sum::<f64>().sqrt();
+                // An SVD least-squares solve of a 41×3 system (condition ~1e3 after column
+                // scaling) leaves Jᵀe at rounding, ~1e-13 of ‖J_j‖·‖e‖; weights other than
+                // 1/|Q_{k−1}| leave it O(1e-1).
+                assert!(dot.abs() < 1e-9 * col_norm * e_norm, "start {k}, column {j}: Jᵀe {dot:e} vs {:e}", col_norm * e_norm);
+            }
+        }
+    }
+
     /// The linearised starts do not depend on the feature's units: x times 2³⁰ scales the
     /// columns of x^k by 2^(30k) exactly, the column scaling takes that out, and every start's
     /// coefficient of x^k comes back times 2^(−30k), bit for bit. Unscaled, the columns' norms
