@@ -563,7 +563,8 @@ fn c_literal(l: Literal) -> Option<String> {
     })
 }
 
-/// The C/C++ header: every named constant as `static const` (arrays of vectors as 2-D arrays).
+/// The C/C++ header: every named constant as `static const` (arrays of vectors as 2-D arrays);
+/// a 1-D array six values to a line, so a long table diffs line by line.
 fn c_header(module: &str, header: &[&str], from: &str, m: &naga::Module) -> Result<String, TargetError> {
     let guard = format!("SHADEFIT_{}_H", module.to_uppercase());
     let mut s = comment_header(
@@ -696,6 +697,22 @@ mod tests {
         assert!(h.contains("static const float M[2][3] ="), "{h}");
         assert_eq!(values("S"), vec![0.125; 3]);
         assert_eq!(values("R"), vec![0.1, 2.0]);
+    }
+
+    /// A 1-D array of 13 values is laid out six to a line, each line indented four spaces: lines
+    /// of 6, 6 and 1 values between the braces.
+    #[test]
+    fn a_c_header_array_holds_six_values_to_a_line() {
+        let wgsl = "const T: array<f32, 13> = array<f32, 13>(0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0, 10.0, 11.0, 12.0);\n\
+                    fn f() -> f32 { return T[3]; }\n";
+        let m = naga::front::wgsl::parse_str(wgsl).unwrap();
+        let h = c_header("mod_t", &["line"], "mod_t.wgsl", &m).unwrap();
+        let at = h.find("static const float T[13] = {\n").unwrap_or_else(|| panic!("{h}"));
+        let body = &h[at..];
+        let body = &body[body.find('{').unwrap() + 2..body.find("\n};").unwrap_or_else(|| panic!("{h}"))];
+        let lines: Vec<&str> = body.split('\n').collect();
+        assert!(lines.iter().all(|l| l.starts_with("    ") && !l.starts_with("     ")), "{body}");
+        assert_eq!(lines.iter().map(|l| l.split(',').filter(|t| !t.trim().is_empty()).count()).collect::<Vec<_>>(), [6, 6, 1], "{body}");
     }
 
     /// A constant whose value is another constant (`Expression::Constant`: valid IR, which the

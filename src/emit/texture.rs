@@ -576,4 +576,31 @@ mod tests {
             }
         }
     }
+
+    /// KTX 2.0 §3.9.7 (Level Index): without supercompression every level's byteOffset is a
+    /// multiple of lcm(texel block size, 4), e.g. 8 for R16G16B16A16 (libktx's
+    /// `ktxTexture2_calcRequiredLevelAlignment` checks the same). Key/value data of every length
+    /// mod 8 puts the end of the header on both sides of an 8-byte boundary, so an alignment of
+    /// 4 is caught wherever it lands.
+    #[test]
+    fn level_offsets_are_multiples_of_the_lcm_of_the_texel_size_and_4() {
+        fn lcm4(b: usize) -> usize {
+            if b.is_multiple_of(4) { b } else { b * 4 / if b.is_multiple_of(2) { 2 } else { 1 } }
+        }
+        let sizes = [(3u32, 3u32), (1, 2), (1, 1)];
+        for (channels, bits) in [(2usize, 8u32), (4, 8), (2, 16), (4, 16)] {
+            let levels: Vec<UnormLevel> =
+                sizes.iter().map(|&(w, h)| UnormLevel { width: w, height: h, values: vec![0.5; (w * h) as usize * channels] }).collect();
+            let block = channels * bits as usize / 8;
+            for pad in 0..8 {
+                let text = "x".repeat(pad);
+                let bytes = ktx2_unorm_mips(&levels, channels, bits, &[("pad", &text)]);
+                for k in 0..sizes.len() {
+                    let at = 80 + 24 * k;
+                    let offset = u64::from_le_bytes(bytes[at..at + 8].try_into().unwrap()) as usize;
+                    assert!(offset.is_multiple_of(lcm4(block)), "{channels} × {bits} bits, pad {pad}, level {k}: offset {offset}");
+                }
+            }
+        }
+    }
 }
