@@ -905,14 +905,14 @@ mod tests {
                 rows.push((col, w * (num - y * den)));
             }
             let e_norm = rows.iter().map(|r| r.1 * r.1).sum::<f64>().sqrt();
-            // exp is no [1/1] rational: the residual cannot vanish (it is ~1e-2 here).
+            // exp is no [1/1] rational: the weighted residual cannot vanish (‖e‖ ≈ 0.24 here).
             assert!(e_norm > 1e-4, "start {k}: residual {e_norm}");
             for j in 0..3 {
                 let dot: f64 = rows.iter().map(|r| r.0[j] * r.1).sum();
                 let col_norm = rows.iter().map(|r| r.0[j] * r.0[j]).sum::<f64>().sqrt();
-                // An SVD least-squares solve of a 41×3 system (condition ~1e3 after column
-                // scaling) leaves Jᵀe at rounding, ~1e-13 of ‖J_j‖·‖e‖; weights other than
-                // 1/|Q_{k−1}| leave it O(1e-1).
+                // An SVD least-squares solve of a 41×3 system (condition ≈ 16 after column
+                // scaling) leaves Jᵀe at rounding, of order ε·16 ≈ 4e-15 of ‖J_j‖·‖e‖; weights
+                // other than 1/|Q_{k−1}| leave it O(1e-1).
                 assert!(dot.abs() < 1e-9 * col_norm * e_norm, "start {k}, column {j}: Jᵀe {dot:e} vs {:e}", col_norm * e_norm);
             }
         }
