@@ -596,8 +596,10 @@ mod tests {
                 let text = "x".repeat(pad);
                 let bytes = ktx2_unorm_mips(&levels, channels, bits, &[("pad", &text)]);
                 for k in 0..sizes.len() {
-                    let at = 80 + 24 * k;
-                    let offset = u64::from_le_bytes(bytes[at..at + 8].try_into().unwrap()) as usize;
+                    // The level index follows the 80-byte header (KTX 2.0 §3.9.7).
+                    let at = 80 + ktx2::LevelIndex::LENGTH * k;
+                    let entry = ktx2::LevelIndex::from_bytes(bytes[at..at + ktx2::LevelIndex::LENGTH].try_into().unwrap());
+                    let offset = entry.byte_offset as usize;
                     assert!(offset.is_multiple_of(lcm4(block)), "{channels} × {bits} bits, pad {pad}, level {k}: offset {offset}");
                 }
             }

@@ -898,10 +898,11 @@ mod tests {
             let (prev, c) = (model.full(&starts[k - 1]), model.full(&starts[k]));
             let mut rows = Vec::new();
             for (p, &y) in data.x.iter().zip(&data.y) {
-                let w = 1.0 / model.denominator_at(&prev, p).abs();
-                // Columns: ∂(P − y·Q)/∂(a0, a1, b1), weighted; Q = 1 + b1·x.
-                let col = [w, w * p[0], -w * y * p[0]];
-                let (num, den) = model.basis(p).pq(&c);
+                let b = model.basis(p);
+                let w = 1.0 / b.pq(&prev).1.abs();
+                // Columns: ∂(P − y·Q)/∂(a0, a1, b1) = (φ0, φ1, −y·ψ1), weighted.
+                let col = [w * b.phi[0], w * b.phi[1], -w * y * b.psi[0]];
+                let (num, den) = b.pq(&c);
                 rows.push((col, w * (num - y * den)));
             }
             let e_norm = rows.iter().map(|r| r.1 * r.1).sum::<f64>().sqrt();
