@@ -94,6 +94,16 @@ fn put_u64(out: &mut Vec<u8>, v: u64) {
     out.extend_from_slice(&v.to_le_bytes());
 }
 
+/// The alignment of every level's data: lcm(texel block size, 4) (KTX 2.0 §3.9.7, the
+/// level index, without supercompression).
+fn level_alignment(texel_size: usize) -> usize {
+    let (mut a, mut b) = (texel_size, 4);
+    while b != 0 {
+        (a, b) = (b, a % b);
+    }
+    texel_size / a * 4
+}
+
 fn pad_to(out: &mut Vec<u8>, align: usize) {
     while !out.len().is_multiple_of(align) {
         out.push(0);
@@ -230,8 +240,7 @@ pub fn ktx2_volume(
     for &c in values {
         format.push(&mut level, c);
     }
-    // lcm(texel size, 4): the texel size for RGBA (8, 16), RG32F (8) and R32F (4); 4 for RG16F and R16F.
-    let align = texel_size.max(4);
+    let align = level_alignment(texel_size);
     let level_offset = (kvd_offset + kvd.len()).next_multiple_of(align);
 
     let mut out = Vec::with_capacity(level_offset + level.len());
@@ -309,7 +318,7 @@ pub fn ktx2_unorm_mips(levels: &[UnormLevel], channels: usize, bits: u32, metada
     let index_end = 80 + 24 * levels.len();
     let dfd_offset = index_end;
     let kvd_offset = dfd_offset + dfd.len();
-    let align = (channels * type_size as usize).max(4);
+    let align = level_alignment(channels * type_size as usize);
     // Offsets: smallest level first in the file.
     let mut offsets = vec![0usize; levels.len()];
     let mut at = kvd_offset + kvd.len();
@@ -584,9 +593,6 @@ mod tests {
     /// 4 is caught wherever it lands.
     #[test]
     fn level_offsets_are_multiples_of_the_lcm_of_the_texel_size_and_4() {
-        fn lcm4(b: usize) -> usize {
-            if b.is_multiple_of(4) { b } else { b * 4 / if b.is_multiple_of(2) { 2 } else { 1 } }
-        }
         let sizes = [(3u32, 3u32), (1, 2), (1, 1)];
         for (channels, bits) in [(2usize, 8u32), (4, 8), (2, 16), (4, 16)] {
             let levels: Vec<UnormLevel> =
@@ -601,6 +607,43 @@ mod tests {
                     let entry = ktx2::LevelIndex::from_bytes(bytes[at..at + ktx2::LevelIndex::LENGTH].try_into().unwrap());
                     let offset = entry.byte_offset as usize;
                     assert!(offset.is_multiple_of(lcm4(block)), "{channels} × {bits} bits, pad {pad}, level {k}: offset {offset}");
+                }
+            }
+        }
+    }
+
+    /// lcm(b, 4) by search: the least positive multiple of both.
+    fn lcm4(b: usize) -> usize {
+        (1..).map(|m| m * b).find(|m| m.is_multiple_of(4)).unwrap()
+    }
+
+    #[test]
+    fn level_alignment_is_the_least_common_multiple_of_the_texel_size_and_4() {
+        // Every texel size up to 48 bytes: odd (3, 5: lcm 4b), 2 mod 4 (6: 12, which max(b, 4)
+        // would get wrong), multiples of 4 (b itself).
+        for b in 1..=48 {
+            assert_eq!(level_alignment(b), lcm4(b), "texel size {b}");
+        }
+    }
+
+    /// The float writer's level, as the UNORM mips' above: at a multiple of lcm(texel size, 4)
+    /// for each channel count and precision, whatever the key/value data's length mod 16.
+    #[test]
+    fn a_float_level_lies_at_a_multiple_of_the_lcm_of_the_texel_size_and_4() {
+        for format in [TextureFormat::Rgba16float, TextureFormat::Rgba32float] {
+            for channels in [1usize, 2, 4] {
+                let values = vec![0.25f32; 3 * 2 * channels];
+                let block = channels * format.type_size() as usize;
+                for pad in 0..16 {
+                    let text = "x".repeat(pad);
+                    let bytes = ktx2_texels(3, 2, channels, &values, format, &[("pad", &text)]);
+                    let entry = ktx2::LevelIndex::from_bytes(bytes[80..80 + ktx2::LevelIndex::LENGTH].try_into().unwrap());
+                    let offset = entry.byte_offset as usize;
+                    assert!(offset.is_multiple_of(lcm4(block)), "{} × {channels}, pad {pad}: offset {offset}", format.name());
+                    // No more padding than the alignment needs: the level follows the key/value data.
+                    let kvd_end = u32::from_le_bytes(bytes[56..60].try_into().unwrap()) as usize
+                        + u32::from_le_bytes(bytes[60..64].try_into().unwrap()) as usize;
+                    assert!(offset >= kvd_end && offset - kvd_end < lcm4(block), "{} × {channels}, pad {pad}: {kvd_end} → {offset}", format.name());
                 }
             }
         }
