@@ -832,6 +832,30 @@ mod tests {
     }
 
     #[test]
+    fn without_stop_when_exhausted_error_free_panels_are_bisected_leftmost_first_to_the_limit() {
+        // The contract (Options::stop_when_exhausted): a run whose error is all stuck keeps
+        // bisecting, leftmost first, until the panel limit. Intervals: [0, 1/4], where the
+        // integrand is 0 (every estimate exactly 0), and [1, 1 + ε], one ulp wide, where it is
+        // 1/3 + x (an estimate above 0 that gets stuck). Tolerance 0 is never met, so after the
+        // stuck panel every bisection falls on the left interval's leftmost panel, which stays
+        // splittable (its width halves from 1/4, far above the smallest subnormal).
+        let f = |x: f64| [if x >= 1.0 { 1.0 / 3.0 + x } else { 0.0 }];
+        let intervals = [(0.0, 0.25), (1.0, 1.0 + f64::EPSILON)];
+        for (name, opts) in variants(0.0, 0) {
+            for max_panels in [2usize, 3, 10, 40] {
+                let opts = Options { max_panels, stop_when_exhausted: false, ..opts };
+                let est = integrate(&intervals, &opts, f);
+                assert!(est.error > 0.0, "{name}: the one-ulp panel's estimate is stuck, not 0");
+                // Two initial panels, then max_panels − 2 bisections of 42 evaluations each.
+                assert_eq!(est.evals, 42 + 42 * (max_panels as u64 - 2), "{name} max_panels={max_panels}");
+                // The error is the stuck panel's alone: bisecting zeros adds none.
+                let alone = integrate(&intervals[1..], &Options { max_panels: 1, ..opts }, f);
+                assert_eq!(est.error.to_bits(), alone.error.to_bits(), "{name} max_panels={max_panels}");
+            }
+        }
+    }
+
+    #[test]
     fn degenerate_stops() {
         // An infinite value at the centre node: stop_when_non_finite ends the run at once; the
         // scalar rule bisects it (the halves do not evaluate x = 0.5 and are exact).
