@@ -602,8 +602,8 @@ mod tests {
                 let text = "x".repeat(pad);
                 let bytes = ktx2_unorm_mips(&levels, channels, bits, &[("pad", &text)]);
                 for k in 0..sizes.len() {
-                    // The level index follows the 80-byte header (KTX 2.0 §3.9.7).
-                    let at = 80 + ktx2::LevelIndex::LENGTH * k;
+                    // The level index follows the header (KTX 2.0 §3.9.7).
+                    let at = ktx2::Header::LENGTH + ktx2::LevelIndex::LENGTH * k;
                     let entry = ktx2::LevelIndex::from_bytes(bytes[at..at + ktx2::LevelIndex::LENGTH].try_into().unwrap());
                     let offset = entry.byte_offset as usize;
                     assert!(offset.is_multiple_of(lcm4(block)), "{channels} × {bits} bits, pad {pad}, level {k}: offset {offset}");
@@ -637,12 +637,12 @@ mod tests {
                 for pad in 0..16 {
                     let text = "x".repeat(pad);
                     let bytes = ktx2_texels(3, 2, channels, &values, format, &[("pad", &text)]);
-                    let entry = ktx2::LevelIndex::from_bytes(bytes[80..80 + ktx2::LevelIndex::LENGTH].try_into().unwrap());
-                    let offset = entry.byte_offset as usize;
+                    let (h, l) = (ktx2::Header::LENGTH, ktx2::LevelIndex::LENGTH);
+                    let header = ktx2::Header::from_bytes(bytes[..h].try_into().unwrap()).unwrap();
+                    let offset = ktx2::LevelIndex::from_bytes(bytes[h..h + l].try_into().unwrap()).byte_offset as usize;
                     assert!(offset.is_multiple_of(lcm4(block)), "{} × {channels}, pad {pad}: offset {offset}", format.name());
                     // No more padding than the alignment needs: the level follows the key/value data.
-                    let kvd_end = u32::from_le_bytes(bytes[56..60].try_into().unwrap()) as usize
-                        + u32::from_le_bytes(bytes[60..64].try_into().unwrap()) as usize;
+                    let kvd_end = (header.index.kvd_byte_offset + header.index.kvd_byte_length) as usize;
                     assert!(offset >= kvd_end && offset - kvd_end < lcm4(block), "{} × {channels}, pad {pad}: {kvd_end} → {offset}", format.name());
                 }
             }
