@@ -834,6 +834,43 @@ mod tests {
         assert_eq!(one.0.as_slice(), a.as_slice());
     }
 
+    /// A joint solve whose damped normal matrix cannot be factored at any damping stops and
+    /// keeps its start: the damping grows until it gives up, without evaluating a trial.
+    /// The systems are the exact problem's scaled by s = 1e160, so the cost at the true
+    /// coefficients (rounding residuals ~1e-15·s, squared) is finite while RᵀR (~s²) and so
+    /// JᵀJ overflow.
+    #[test]
+    fn a_normal_matrix_that_cannot_be_factored_leaves_the_start_unchanged() {
+        let (tx, rx) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            let (x, data) = problem();
+            let models: Vec<RationalModel> = OFFSETS.iter().map(|&o| field(o)).collect();
+            let s = 1e160;
+            let systems: Vec<Reduced> = data
+                .iter()
+                .map(|d| {
+                    let e = reduce(&d.design, &d.y, None);
+                    let r = &e.r * s;
+                    Reduced { rtr: r.tr_mul(&r), r, z: &e.z * s, floor: e.floor * s * s }
+                })
+                .collect();
+            let theta = DVector::from_iterator(12, TRUE.iter().flatten().copied());
+            let mut f = Fields::new(&models, &x, systems, theta.clone());
+            let cost = f.cost(&theta);
+            let (a, _, _) = f.normal_equations(&theta);
+            let evals = solve_joint(&mut f, 500, "overflowing");
+            tx.send((cost, a.iter().all(|v| v.is_finite()), evals.ok(), f.theta == theta)).unwrap();
+        });
+        // The solve takes microseconds; this bound only turns a damping loop that never ends
+        // (one that shrinks λ on a failed factorisation) into a failure instead of a hang.
+        let (cost, a_finite, evals, unchanged) =
+            rx.recv_timeout(std::time::Duration::from_secs(120)).expect("the solve did not return");
+        assert!(cost.is_finite(), "the start's cost must be finite for the solve to begin: {cost}");
+        assert!(!a_finite, "JᵀJ was expected to overflow");
+        assert_eq!(evals, Some(1), "no trial can be evaluated without a factorisation");
+        assert!(unchanged, "the start must be kept");
+    }
+
     /// With a denominator driven below Q_MIN the barrier residuals join the normal equations:
     /// (JᵀJ, Jᵀr, cost) equal the dense products of the residuals extended by
     /// Q_PENALTY·(Q_MIN − Q) at the points where Q = 1 + b·x < Q_MIN, Q written out here from

@@ -611,3 +611,50 @@ fn committed_texels_read_back_each_texel_or_say_why_not() {
         assert!(err(bad.clone(), 3).starts_with(no_array), "{bad}: {}", err(bad.clone(), 3));
     }
 }
+
+/// The sentence that heads an emitted fit's documentation states the form the spec asks for,
+/// read back from the spec's own text: the plain P/Q of FIT, and an offset, a factor, a clamp
+/// and a denominator lead, each where the form puts it. It is the Rust module's doc line.
+#[test]
+fn a_fit_is_described_by_the_form_its_spec_gives() {
+    let plain = spec(FIT);
+    assert_eq!(
+        describe_fit(&plain, plain.model.as_ref().unwrap()),
+        "e^-x by a 2/2 rational: `exp_fit` ≈ P/Q of quantity `exp-decay`, P = NUM · [(1), (x), (x^2)], Q = 1 + DEN · [(x), (x^2)]."
+    );
+    let full = spec(
+        r#"
+name = "exp_described"
+kind = "fit"
+quantity = "exp-decay"
+description = "e^-x in every part of the form"
+
+[[axis]]
+name = "x"
+range = [0.0, 2.0]
+count = 16
+
+[model]
+offset = 0.25
+factor = "x"
+clamp = [0.0, 1.0]
+numerator = ["1", "x"]
+denominator_lead = "x^2"
+denominator = ["1"]
+
+[fit]
+objective = "lsq"
+
+[emit]
+function = "exp_described"
+"#,
+    );
+    assert_eq!(
+        describe_fit(&full, full.model.as_ref().unwrap()),
+        "e^-x in every part of the form: `exp_described` ≈ clamp(0.25 + (x)·P/Q) of quantity `exp-decay`, P = NUM · [(1), (x)], Q = (x^2) + DEN · [(1)]."
+    );
+    let tmp = tempfile::tempdir().unwrap();
+    let b = build_spec(&plain, Mode::Fit, tmp.path(), &|_| None).unwrap();
+    let module = String::from_utf8_lossy(file(&b, "src/exp_fit.rs")).into_owned();
+    assert!(module.contains("//! e^-x by a 2/2 rational: `exp_fit` ≈ P/Q of quantity `exp-decay`"), "{module}");
+}
