@@ -658,3 +658,76 @@ function = "exp_described"
     let module = String::from_utf8_lossy(file(&b, "src/exp_fit.rs")).into_owned();
     assert!(module.contains("//! e^-x by a 2/2 rational: `exp_fit` ≈ P/Q of quantity `exp-decay`"), "{module}");
 }
+
+/// A fit's JSON records the spec it came from (path, kind, quantity, description, function,
+/// axes with both grids) and a model complete enough to evaluate: offset, factor, derived
+/// feature, clamp and coefficients, read back here and evaluated by the form the JSON states,
+/// reproduce the verification's error on its grid.
+#[test]
+fn a_fit_json_records_its_spec_and_a_model_that_evaluates() {
+    let s = spec(
+        r#"
+name = "exp_recorded"
+kind = "fit"
+quantity = "exp-decay"
+description = "e^-x through a derived feature"
+
+[[axis]]
+name = "x"
+range = [0.0, 2.0]
+count = 24
+verify = 33
+
+[model]
+derived = { u = "2 - x" }
+offset = 0.125
+factor = "u"
+clamp = [0.0, 1.0]
+numerator = ["1", "u"]
+denominator = ["u"]
+
+[fit]
+objective = "lsq"
+
+[emit]
+function = "exp_recorded"
+"#,
+    );
+    let tmp = tempfile::tempdir().unwrap();
+    let b = build_spec(&s, Mode::Fit, tmp.path(), &|_| None).unwrap();
+    let j = json_of(&b);
+    assert_eq!(j["spec"], json!("fits/exp_recorded.toml"));
+    assert_eq!(j["kind"], json!("fit"));
+    assert_eq!(j["quantity"], json!("exp-decay"));
+    assert_eq!(j["description"], json!("e^-x through a derived feature"));
+    assert_eq!(j["function"], json!("exp_recorded"));
+    assert_eq!(j["axes"], json!([{"name": "x", "range": [0.0, 2.0], "count": 24, "verify": 33}]));
+    let m = &j["model"];
+    assert_eq!(m["features"], json!(["x", "u"]));
+    assert_eq!(m["numerator"], json!(["1", "u"]));
+    assert_eq!(m["denominator"], json!(["u"]));
+    assert_eq!(m["denominator_lead"], json!("1"));
+    assert_eq!(m["derived"][0]["name"], json!("u"));
+    assert_eq!((m["offset"].as_f64(), m["factor"].as_str()), (Some(0.125), Some("u")));
+    assert_eq!(m["clamp"], json!([0.0, 1.0]));
+    assert_eq!(m["objective"], json!("lsq"));
+    let c = floats(&m["coefficients"]);
+    assert_eq!(c.len(), 3);
+    // offset + factor · P/Q, P = c0 + c1 u, Q = 1 + c2 u, u = 2 − x, clamped to [0, 1].
+    let f = |x: f64| {
+        let u = 2.0 - x;
+        (0.125 + u * (c[0] + c[1] * u) / (1.0 + c[2] * u)).clamp(0.0, 1.0)
+    };
+    let (mut worst, mut ss) = (0.0f64, 0.0);
+    for i in 0..33 {
+        let x = if i == 32 { 2.0 } else { 2.0 * i as f64 / 32.0 };
+        let e = (f(x) - (-x).exp()).abs();
+        worst = worst.max(e);
+        ss += e * e;
+    }
+    let v = &b.verification;
+    // The same residuals in another operation order: 1e-15 of values ~1.
+    assert_eq!(v.points, 33);
+    assert!((v.max_abs_error - worst).abs() < 1e-15, "{} vs {worst}", v.max_abs_error);
+    assert!((v.rms_error - (ss / 33.0).sqrt()).abs() < 1e-15, "{} vs {}", v.rms_error, (ss / 33.0).sqrt());
+}
