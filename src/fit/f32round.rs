@@ -547,4 +547,37 @@ mod tests {
         assert_ne!((r.num.clone(), r.den.clone()), rounded(&m, &f.coefficients));
         assert!(matches!(prove_denominator_positive(&m, &widen(&r.num, &r.den), &[(0.0, 1.0)]), Positivity::Proven { .. }));
     }
+
+    /// A pin the data pull against holds to one ulp of its value. The line c0 + c1 x pinned to
+    /// f(0) = 1.001 over samples of 1 + x: the least-squares fit keeps the pin and leaves a
+    /// positive mean residual (0.001 − 0.0015·x averages 2.5e-4), so lowering c0 lowers the
+    /// objective for hundreds of ulps. The search may move c0 only as far as the pin allows:
+    /// max(the rounded vector's error there, one ulp of 1.001 in f32, 2^-23).
+    #[test]
+    fn a_pin_against_the_data_holds_to_one_ulp() {
+        let feats = vec!["x".to_string()];
+        let terms = |ts: &[&str]| ts.iter().map(|t| Term::parse(t, &feats).unwrap()).collect::<Vec<_>>();
+        let m = RationalModel::new(ModelParts {
+            inputs: feats.clone(),
+            numerator: terms(&["1", "x"]),
+            pins: vec![Pin { at: vec![0.0], value: 1.001, eliminate: 0 }],
+            ..ModelParts::default()
+        })
+        .unwrap();
+        let d = samples(0.0, 1.0, 129, |x| 1.0 + x);
+        let f = fit(&m, &d, &FitOptions { objective: Objective::Lsq, ..FitOptions::default() }, "against").unwrap();
+        let r = round_and_reoptimise(&m, &f.coefficients, &d, &[(0.0, 1.0)], &RoundOptions::new(Objective::Lsq, None), "against")
+            .unwrap();
+        let (n0, _) = rounded(&m, &f.coefficients);
+        let ulp = 2f64.powi(-23);
+        let start = (n0[0] as f64 - 1.001).abs();
+        assert!((r.num[0] as f64 - 1.001).abs() <= start.max(ulp), "c0 = {} moved off the pin (rounded {})", r.num[0], n0[0]);
+        // Not vacuous: the rms with c0 lowered by 64 ulps (the move cap) is below that of the
+        // rounded vector, so an unpinned search would take it.
+        let rms = |c0: f32| {
+            let s: f64 = d.x.iter().zip(&d.y).map(|(x, y)| (c0 as f64 + n0[1] as f64 * x[0] - y).powi(2)).sum();
+            (s / d.y.len() as f64).sqrt()
+        };
+        assert!(rms(step_ulps(n0[0], -64).unwrap()) < rms(n0[0]));
+    }
 }
