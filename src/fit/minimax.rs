@@ -229,6 +229,44 @@ mod tests {
         assert!((st.get_best_cost() - 0.5).abs() < 1e-9 && (t[0] - 0.5).abs() < 1e-9 && t[1].abs() < 1e-9, "{t:?}, max {}", st.get_best_cost());
     }
 
+    /// Vee's residuals with the Jacobian's sign flipped: every LP step predicts a descent the
+    /// residuals answer with a climb.
+    struct Misled(Vee);
+
+    impl Operator for Misled {
+        type Param = DVector<f64>;
+        type Output = DVector<f64>;
+        fn apply(&self, t: &DVector<f64>) -> Result<DVector<f64>, Error> {
+            self.0.apply(t)
+        }
+    }
+
+    impl Jacobian for Misled {
+        type Param = DVector<f64>;
+        type Jacobian = DMatrix<f64>;
+        fn jacobian(&self, t: &DVector<f64>) -> Result<DMatrix<f64>, Error> {
+            Ok(-self.0.jacobian(t)?)
+        }
+    }
+
+    /// A step is taken only when the max residual falls by at least a tenth of what the LP
+    /// predicted. With a Jacobian that points the wrong way every step climbs, so the trust
+    /// region shrinks until the solver gives up, where it started, its max residual unchanged.
+    #[test]
+    fn a_step_the_linearisation_mispredicts_is_refused() {
+        let x: Vec<f64> = (0..21).map(|i| -1.0 + i as f64 / 10.0).collect();
+        let start = DVector::from_vec(vec![0.01, 0.005]);
+        let m0 = max_abs(&Vee(x.clone()).apply(&start).unwrap());
+        let res = argmin::core::Executor::new(Misled(Vee(x)), SlpMinimax::default())
+            .configure(|s| s.param(start.clone()).max_iters(20))
+            .run()
+            .unwrap();
+        let st = res.state();
+        assert_eq!(st.get_termination_status(), &TerminationStatus::Terminated(TerminationReason::SolverConverged));
+        assert_eq!(st.get_param(), Some(&start), "the solver moved to {:?}", st.get_param());
+        assert_eq!(st.get_cost(), m0);
+    }
+
     /// R̃'s form (fits/fuzz_r.toml) over α ∈ [0.15, 1], θ ∈ [0, π/2]: γ = cos θ is 6e-17 at the
     /// last grid column and γ³ is 2e-49 there, so the Jacobian's rows span ~1e49.
     fn r_form() -> RationalModel {
