@@ -49,6 +49,11 @@ pub const WEIGHT_FLOOR: f64 = 1e-2;
 pub const Q_MIN: f64 = 0.05;
 pub const Q_PENALTY: f64 = 100.0;
 
+/// Outer (reweighting) iterations in a row without a proven improvement that end the search.
+/// An iterate that improves on the best but whose denominators are not proven positive counts
+/// as one: it is skipped, and the search goes on from it.
+pub const PATIENCE: usize = 6;
+
 /// The stage-1 system of one grid point reduced to k equations (see the module doc).
 #[derive(Debug, Clone)]
 pub struct Reduced {
@@ -607,6 +612,8 @@ pub fn fit_fields(
         // lowest Σe⁴: plain IRLS for p = 4 need not descend, and may end above its least-squares
         // start) is kept; with an rms cap, only iterates under it qualify.
         //
+        // PATIENCE iterations in a row without a proven improvement end the search.
+        //
         // An iterate that qualifies by its errors still needs its denominators proven; that
         // proof runs beside the next iteration, which does not depend on it. When the proof's
         // answer ends the loop, the next iteration is dropped uncounted, so the iterates,
@@ -641,7 +648,7 @@ pub fn fit_fields(
                     since_best = 0;
                 } else {
                     since_best += 1;
-                    if since_best >= 6 {
+                    if since_best >= PATIENCE {
                         break;
                     }
                 }
@@ -656,7 +663,7 @@ pub fn fit_fields(
                 pending = Some((s, fields.theta.clone(), fields.full(&fields.theta)));
             } else {
                 since_best += 1;
-                if since_best >= 6 {
+                if since_best >= PATIENCE {
                     break;
                 }
             }
@@ -832,6 +839,65 @@ mod tests {
         let two = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap().install(|| f.normal_equations(&theta));
         assert_eq!(one.0.as_slice(), two.0.as_slice());
         assert_eq!(one.0.as_slice(), a.as_slice());
+    }
+
+    /// A peaked first field, (ε/((x − 0.35)² + ε) with ε = 1.5e-3) plus small noise, on a
+    /// seven-point grid of [0, 1], by P2/Q2 over [1, x, x²] / [1, x, x²] (13 parameters with the other two fields): the reweighted
+    /// iterates that fit the peak better dip their denominator below zero between grid points,
+    /// so none is proven. The search must count each as a miss and go on to PATIENCE of them,
+    /// and keep the least-squares start.
+    #[test]
+    fn unproven_iterates_count_against_the_patience_and_do_not_end_the_search() {
+        let f = vec!["x".to_string()];
+        let t = |s: &str| Term::parse(s, &f).unwrap();
+        let xs: Vec<f64> = (0..=6).map(|i| i as f64 / 6.0).collect();
+        let inner: Vec<(f64, f64)> =
+            (0..6).flat_map(|i| (0..6).map(move |j| (i as f64 / 5.0 - 0.5, (j as f64 * 0.37).sin()))).collect();
+        let data: Vec<PointData> = xs
+            .iter()
+            .map(|&x| {
+                let mut b = DMatrix::zeros(inner.len(), 3);
+                let mut y = DVector::zeros(inner.len());
+                for (r, &(u, w)) in inner.iter().enumerate() {
+                    let v = x * w + (1.0 - x) * u;
+                    b[(r, 0)] = 1.0;
+                    b[(r, 1)] = u;
+                    b[(r, 2)] = v;
+                    let peak = 1.5e-3 / ((x - 0.35).powi(2) + 1.5e-3);
+                    y[r] = peak + truth(1, x) * u + truth(2, x) * v + 0.01 * (r as f64 * 1.3 + x * 7.0).sin();
+                }
+                PointData { design: b, y }
+            })
+            .collect();
+        let x: Vec<Vec<f64>> = xs.iter().map(|&x| vec![x]).collect();
+        let peaked = RationalModel::new(ModelParts {
+            inputs: f.clone(),
+            numerator: vec![t("1"), t("x"), t("x^2")],
+            denominator: vec![t("x"), t("x^2")],
+            ..ModelParts::default()
+        })
+        .unwrap();
+        let models = vec![peaked, field(0.0), field(0.0)];
+        let lsq = fit_fields(&models, &x, &data, &FieldOptions::default(), "peaked").unwrap();
+        let opts = FieldOptions { objective: Objective::Minimax, ..FieldOptions::default() };
+        let mm = fit_fields(&models, &x, &data, &opts, "peaked").unwrap();
+        assert_eq!(mm.max_abs_error, lsq.max_abs_error, "a proven iterate improved on the start");
+        assert_eq!(mm.outer_iterations, PATIENCE);
+        // Not vacuous: of the reweighted steps from the start, replayed, one improves the max
+        // error with a first denominator that is not proven positive on [0, 1].
+        let theta = DVector::from_iterator(13, lsq.coefficients.iter().flat_map(|c| c.iter().copied()));
+        let systems: Vec<Reduced> = data.iter().map(|d| reduce(&d.design, &d.y, None)).collect();
+        let mut fields = Fields::new(&models, &x, systems, theta.clone());
+        assert_eq!(fields.full(&theta), lsq.coefficients);
+        let (_, _, mut res) = sample_errors(&fields, &theta, &data);
+        let mut w: Vec<Vec<f64>> = data.iter().map(|d| vec![1.0; d.y.len()]).collect();
+        let unproven_improvement = (0..PATIENCE).any(|_| {
+            let (_, m, _, r) = outer_step(&mut fields, &mut w, &res, &data, &opts, "peaked").unwrap();
+            res = r;
+            let full = fields.full(&fields.theta);
+            m < lsq.max_abs_error && matches!(prove_denominator_positive(&models[0], &full[0], &[(0.0, 1.0)]), Positivity::NotProven { .. })
+        });
+        assert!(unproven_improvement);
     }
 
     /// A joint solve whose damped normal matrix cannot be factored at any damping stops and
