@@ -740,7 +740,13 @@ mod tests {
     /// Basis [1, u, v] with v = x·w + (1 − x)·u over inner samples (u, w): at x = 0 the
     /// columns u and v coincide (rank 2), like u·t → u·n as θf → 0.
     fn problem() -> (Vec<Vec<f64>>, Vec<PointData>) {
-        let xs: Vec<f64> = (0..=20).map(|i| i as f64 / 20.0).collect();
+        problem_on(20, |x| truth(0, x), |_, _| 0.0)
+    }
+
+    /// The basis of [`problem`] on n + 1 uniform points of [0, 1], with `first(x)` as the first
+    /// field and `noise(x, r)` added to sample r.
+    fn problem_on(n: usize, first: impl Fn(f64) -> f64, noise: impl Fn(f64, usize) -> f64) -> (Vec<Vec<f64>>, Vec<PointData>) {
+        let xs: Vec<f64> = (0..=n).map(|i| i as f64 / n as f64).collect();
         let inner: Vec<(f64, f64)> =
             (0..6).flat_map(|i| (0..6).map(move |j| (i as f64 / 5.0 - 0.5, (j as f64 * 0.37).sin()))).collect();
         let data = xs
@@ -753,7 +759,7 @@ mod tests {
                     b[(r, 0)] = 1.0;
                     b[(r, 1)] = u;
                     b[(r, 2)] = v;
-                    y[r] = truth(0, x) + truth(1, x) * u + truth(2, x) * v;
+                    y[r] = first(x) + truth(1, x) * u + truth(2, x) * v + noise(x, r);
                 }
                 PointData { design: b, y }
             })
@@ -850,26 +856,11 @@ mod tests {
     fn unproven_iterates_count_against_the_patience_and_do_not_end_the_search() {
         let f = vec!["x".to_string()];
         let t = |s: &str| Term::parse(s, &f).unwrap();
-        let xs: Vec<f64> = (0..=6).map(|i| i as f64 / 6.0).collect();
-        let inner: Vec<(f64, f64)> =
-            (0..6).flat_map(|i| (0..6).map(move |j| (i as f64 / 5.0 - 0.5, (j as f64 * 0.37).sin()))).collect();
-        let data: Vec<PointData> = xs
-            .iter()
-            .map(|&x| {
-                let mut b = DMatrix::zeros(inner.len(), 3);
-                let mut y = DVector::zeros(inner.len());
-                for (r, &(u, w)) in inner.iter().enumerate() {
-                    let v = x * w + (1.0 - x) * u;
-                    b[(r, 0)] = 1.0;
-                    b[(r, 1)] = u;
-                    b[(r, 2)] = v;
-                    let peak = 1.5e-3 / ((x - 0.35).powi(2) + 1.5e-3);
-                    y[r] = peak + truth(1, x) * u + truth(2, x) * v + 0.01 * (r as f64 * 1.3 + x * 7.0).sin();
-                }
-                PointData { design: b, y }
-            })
-            .collect();
-        let x: Vec<Vec<f64>> = xs.iter().map(|&x| vec![x]).collect();
+        let (x, data) = problem_on(
+            6,
+            |x| 1.5e-3 / ((x - 0.35).powi(2) + 1.5e-3),
+            |x, r| 0.01 * (r as f64 * 1.3 + x * 7.0).sin(),
+        );
         let peaked = RationalModel::new(ModelParts {
             inputs: f.clone(),
             numerator: vec![t("1"), t("x"), t("x^2")],
