@@ -848,7 +848,7 @@ mod tests {
     }
 
     /// A peaked first field, (ε/((x − 0.35)² + ε) with ε = 1.5e-3) plus small noise, on a
-    /// seven-point grid of [0, 1], by P2/Q2 over [1, x, x²] / [1, x, x²] (13 parameters with the other two fields): the reweighted
+    /// seven-point grid of [0, 1], by P2/Q2 over [1, x, x²] / [1, x, x²]: the reweighted
     /// iterates that fit the peak better dip their denominator below zero between grid points,
     /// so none is proven. The search must count each as a miss and go on to PATIENCE of them,
     /// and keep the least-squares start.
@@ -876,7 +876,7 @@ mod tests {
         assert_eq!(mm.outer_iterations, PATIENCE);
         // Not vacuous: of the reweighted steps from the start, replayed, one improves the max
         // error with a first denominator that is not proven positive on [0, 1].
-        let theta = DVector::from_iterator(13, lsq.coefficients.iter().flat_map(|c| c.iter().copied()));
+        let theta = DVector::from_vec(lsq.coefficients.iter().flat_map(|c| c.iter().copied()).collect());
         let systems: Vec<Reduced> = data.iter().map(|d| reduce(&d.design, &d.y, None)).collect();
         let mut fields = Fields::new(&models, &x, systems, theta.clone());
         assert_eq!(fields.full(&theta), lsq.coefficients);
@@ -911,7 +911,7 @@ mod tests {
                     Reduced { rtr: r.tr_mul(&r), r, z: &e.z * s, floor: e.floor * s * s }
                 })
                 .collect();
-            let theta = DVector::from_iterator(12, TRUE.iter().flatten().copied());
+            let theta = DVector::from_vec(TRUE.iter().flatten().copied().collect());
             let mut f = Fields::new(&models, &x, systems, theta.clone());
             let cost = f.cost(&theta);
             let (a, _, _) = f.normal_equations(&theta);

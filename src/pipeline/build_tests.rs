@@ -119,6 +119,9 @@ fn a_fit_spec_reports_the_errors_of_what_it_writes() {
     for f in ["wgsl/exp_fit.wgsl", "src/exp_fit.rs"] {
         assert!(String::from_utf8_lossy(file(&b, f)).contains(&header), "{f} lacks '{header}'");
     }
+    // The Rust module's doc opens with the sentence describing the fit's form.
+    let module = String::from_utf8_lossy(file(&b, "src/exp_fit.rs")).into_owned();
+    assert!(module.contains("//! e^-x by a 2/2 rational: `exp_fit` ≈ P/Q of quantity `exp-decay`"), "{module}");
     // A 2/2 rational of e^−x on [0, 2]: its minimax error is 3.2e-5 (measured; Padé [2/2] alone
     // is 4e-3 at x = 2); the f32 code adds rounding ~1e-7.
     assert!(m64 < 1e-4 && m32 < m64 + 1e-6, "{m64} {m32}");
@@ -614,7 +617,8 @@ fn committed_texels_read_back_each_texel_or_say_why_not() {
 
 /// The sentence that heads an emitted fit's documentation states the form the spec asks for,
 /// read back from the spec's own text: the plain P/Q of FIT, and an offset, a factor, a clamp
-/// and a denominator lead, each where the form puts it. It is the Rust module's doc line.
+/// and a denominator lead, each where the form puts it (the Rust module's doc line: see
+/// `a_fit_spec_reports_the_errors_of_what_it_writes`).
 #[test]
 fn a_fit_is_described_by_the_form_its_spec_gives() {
     let plain = spec(FIT);
@@ -653,10 +657,6 @@ function = "exp_described"
         describe_fit(&full, full.model.as_ref().unwrap()),
         "e^-x in every part of the form: `exp_described` ≈ clamp(0.25 + (x)·P/Q) of quantity `exp-decay`, P = NUM · [(1), (x)], Q = (x^2) + DEN · [(1)]."
     );
-    let tmp = tempfile::tempdir().unwrap();
-    let b = build_spec(&plain, Mode::Fit, tmp.path(), &|_| None).unwrap();
-    let module = String::from_utf8_lossy(file(&b, "src/exp_fit.rs")).into_owned();
-    assert!(module.contains("//! e^-x by a 2/2 rational: `exp_fit` ≈ P/Q of quantity `exp-decay`"), "{module}");
 }
 
 /// A fit's JSON records the spec it came from (path, kind, quantity, description, function,
@@ -719,8 +719,7 @@ function = "exp_recorded"
         (0.125 + u * (c[0] + c[1] * u) / (1.0 + c[2] * u)).clamp(0.0, 1.0)
     };
     let (mut worst, mut ss) = (0.0f64, 0.0);
-    for i in 0..33 {
-        let x = if i == 32 { 2.0 } else { 2.0 * i as f64 / 32.0 };
+    for x in uniform(33) {
         let e = (f(x) - (-x).exp()).abs();
         worst = worst.max(e);
         ss += e * e;
