@@ -1,7 +1,7 @@
 //! The DFG LUT modules: the CPU lookups read the KTX2 texels they ship (f16, exact) and hit them
 //! at the texel centres, clamp beyond the outer centres, and decode both layouts to (scale, bias).
 
-use shadefit_runtime::{ggx_dfg_lut as sb, ggx_dfg_lut_filament as fil};
+use shadefit_runtime::{ggx_dfg_lut as sb, ggx_dfg_lut_filament as fil, skin};
 
 #[test]
 fn ktx2_headers_name_rg16f_and_the_size() {
@@ -10,6 +10,27 @@ fn ktx2_headers_name_rg16f_and_the_size() {
         assert_eq!(&bytes[1..4], b"KTX");
         assert_eq!(u32_at(12), 83, "VK_FORMAT_R16G16_SFLOAT");
         assert_eq!([u32_at(20), u32_at(24)], size);
+    }
+}
+
+#[test]
+fn the_runtime_ktx2_reader_gives_the_emitted_texels() {
+    // Two readers of the same bytes: the runtime's `Ktx2Image` (header and level index, what the
+    // GPU upload uses) and the emitted module's fixed offset; every texel equal, bit for bit.
+    for (bytes, [w, h], texel) in [
+        (sb::GGX_DFG_LUT_KTX2, sb::GGX_DFG_LUT_SIZE, sb::ggx_dfg_texel as fn(u32, u32) -> [f32; 2]),
+        (fil::GGX_DFG_LUT_FILAMENT_KTX2, fil::GGX_DFG_LUT_FILAMENT_SIZE, fil::ggx_dfg_filament_texel),
+    ] {
+        let img = skin::Ktx2Image::parse(bytes).expect("an RG16F KTX2");
+        assert_eq!((img.width, img.height, img.depth, img.format), (w, h, 0, skin::LutFormat::Rg16Float));
+        for y in 0..h {
+            for x in 0..w {
+                let [r, g] = texel(x, y);
+                let got = img.texel(x, y);
+                // The missing channels read as WGSL reads an RG texture: (r, g, 0, 1).
+                assert_eq!(got.map(f32::to_bits), [r, g, 0.0, 1.0].map(f32::to_bits), "texel ({x}, {y})");
+            }
+        }
     }
 }
 
@@ -57,6 +78,21 @@ mod cone {
         // pixelWidth, pixelHeight, pixelDepth, layerCount (0: not an array).
         assert_eq!([u32_at(20), u32_at(24), u32_at(28)], cone::GGX_CONE_LUT_SIZE);
         assert_eq!(u32_at(32), 0);
+    }
+
+    #[test]
+    fn the_runtime_ktx2_reader_gives_the_emitted_texels_of_every_slice() {
+        let [w, h, d] = cone::GGX_CONE_LUT_SIZE;
+        let img = shadefit_runtime::skin::Ktx2Image::parse(cone::GGX_CONE_LUT_KTX2).expect("a 3-D RG16F KTX2");
+        assert_eq!((img.width, img.height, img.depth, img.format), (w, h, d, shadefit_runtime::skin::LutFormat::Rg16Float));
+        for z in 0..d {
+            for y in 0..h {
+                for x in 0..w {
+                    let [r, g] = cone::ggx_cone_dfg_texel(x, y, z);
+                    assert_eq!(img.texel_3d(x, y, z).map(f32::to_bits), [r, g, 0.0, 1.0].map(f32::to_bits), "texel ({x}, {y}, {z})");
+                }
+            }
+        }
     }
 
     #[test]

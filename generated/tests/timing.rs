@@ -3,11 +3,19 @@
 //!
 //!     cargo test --release -p shadefit-runtime --test timing -- --ignored --nocapture
 //!
+//! Two times per function, each the best of five dispatches after a warm-up: the GPU's own, from
+//! timestamps written at the start and the end of the compute pass (where the adapter offers
+//! `TIMESTAMP_QUERY`; the launch and the submission excluded), and submit to completion as the
+//! host sees it (the launch included: on a fast GPU the floor every cheap function reads).
+//! Textures are bound from the modules' KTX2 bytes (skin LUTs, split-sum DFG and cone LUTs,
+//! tables); a linear sampler on a 32-bit float texture needs `FLOAT32_FILTERABLE`, requested where
+//! the adapter offers it.
+//!
 //! Operation counts of the same functions, next to their measured errors, are the shadefit
 //! crate's `tests/op_counts.rs` (`cargo test --release --test op_counts -- --nocapture`);
 //! `shadefit bench` ranks approximation forms by cost and error.
 
-use shadefit_runtime::{compose, lut, wgsl};
+use shadefit_runtime::{compose, lut, skin, wgsl};
 
 /// What a timed function needs: its library (self-contained WGSL) and what to bind.
 struct Target {
@@ -41,7 +49,9 @@ fn reads_const_array(m: &naga::Module, f: &naga::Function) -> bool {
 }
 
 /// Every emitted function and every table's texture accessor.
-fn targets() -> Vec<Target> {
+/// `features`: those the device was granted (a 32-bit float table sampled linearly needs
+/// `FLOAT32_FILTERABLE`).
+fn targets(features: wgpu::Features) -> Vec<Target> {
     let mut out = Vec::new();
     for &module in wgsl::NAMES {
         let library = compose(&[module]).unwrap();
@@ -54,9 +64,13 @@ fn targets() -> Vec<Target> {
             let sampled = f.arguments.iter().any(|a| matches!(m.types[a.ty].inner, naga::TypeInner::Image { .. }));
             let sampler = f.arguments.iter().any(|a| matches!(m.types[a.ty].inner, naga::TypeInner::Sampler { .. }));
             let table = lut::table(module).filter(|t| t.ktx2.is_some());
+            let float32 = |t: &lut::Table| skin::Ktx2Image::parse(t.ktx2.expect("a KTX2 table")).expect("the table's KTX2").format.needs_float32_filterable();
             let bind = match (sampled, table, timing::ktx2(module)) {
-                (true, Some(t), _) if !sampler => Ok(timing::Bind::TableKtx2(t)),
-                (true, Some(_), _) => Err("a table's R32Float texture through a linear sampler"),
+                (true, Some(t), _) if !sampler => Ok(timing::Bind::TableKtx2 { table: t, linear: false }),
+                (true, Some(t), _) if float32(t) && !features.contains(wgpu::Features::FLOAT32_FILTERABLE) => {
+                    Err("a 32-bit float texture through a linear sampler; the adapter lacks FLOAT32_FILTERABLE")
+                }
+                (true, Some(t), _) => Ok(timing::Bind::TableKtx2 { table: t, linear: true }),
                 (true, None, Some(k)) => Ok(timing::Bind::Ktx2(k)),
                 (true, None, None) => Err("a texture this harness does not upload"),
                 (false, ..) => Ok(timing::Bind::None),
@@ -79,7 +93,8 @@ fn targets() -> Vec<Target> {
 #[test]
 #[ignore = "timing: run with --ignored --nocapture"]
 fn timing_over_a_4k_dispatch() {
-    let g = match pollster::block_on(shadefit_runtime::gpu::headless("shader timing")) {
+    let optional = wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::FLOAT32_FILTERABLE;
+    let g = match pollster::block_on(shadefit_runtime::gpu::headless_with("shader timing", optional)) {
         Ok(g) => g,
         Err(e) => {
             println!("timing SKIPPED: {e}");
@@ -88,20 +103,35 @@ fn timing_over_a_4k_dispatch() {
     };
     let info = g.adapter.get_info();
     let software = info.device_type == wgpu::DeviceType::Cpu;
+    let features = g.device.features();
     println!("adapter: {}{}", shadefit_runtime::gpu::describe(&info), if software { " -- SOFTWARE RENDERING: CPU time, trend only" } else { "" });
+    println!(
+        "timestamp queries: {}; FLOAT32_FILTERABLE: {}",
+        if features.contains(wgpu::Features::TIMESTAMP_QUERY) { "yes (GPU column: end-of-pass minus start-of-pass timestamp)" } else { "no (GPU column empty)" },
+        if features.contains(wgpu::Features::FLOAT32_FILTERABLE) { "yes" } else { "no" }
+    );
     let baseline = || timing::run(&g, "baseline", &timing::kernel("", "", "", "c0 + c1 + c2"), timing::Bind::None);
     let before = baseline();
-    println!("\n| module | function | ms per 3840x2160 dispatch |\n|---|---|---:|");
-    for t in targets() {
-        let ms = match &t.bind {
-            Err(why) => format!("- ({why})"),
-            Ok(_) if software && t.const_array => "- (const array)".to_string(),
-            Ok(bind) => format!("{:.3}", timing::time(&g, &t, bind)),
+    println!("\n| module | function | GPU ms (timestamps) | ms submit to completion |\n|---|---|---:|---:|");
+    for t in targets(features) {
+        let (gpu_ms, host_ms) = match &t.bind {
+            Err(why) => ("-".to_string(), format!("- ({why})")),
+            Ok(_) if software && t.const_array => ("-".to_string(), "- (const array)".to_string()),
+            Ok(bind) => {
+                let times = timing::time(&g, &t, bind);
+                (times.gpu_text(), format!("{:.3}", times.host_ms))
+            }
         };
-        println!("| {} | {} | {ms} |", t.module, t.function);
+        println!("| {} | {} | {gpu_ms} | {host_ms} |", t.module, t.function);
     }
     let after = baseline();
-    println!("\nbaseline kernel (arguments and write only): {before:.3} ms before, {after:.3} ms after the functions, per 3840x2160 dispatch");
+    println!(
+        "\nbaseline kernel (arguments and write only), per 3840x2160 dispatch: GPU {} ms before, {} ms after the functions; submit to completion {:.3} ms before, {:.3} ms after",
+        before.gpu_text(),
+        after.gpu_text(),
+        before.host_ms,
+        after.host_ms
+    );
 }
 
 mod timing {
@@ -117,11 +147,25 @@ mod timing {
         None,
         /// A table's R32Float texture at binding 2 (declared by `lut::Table::wgsl`).
         Table(&'static lut::Table),
-        /// A skin LUT's KTX2 texture and a linear sampler, at 2 and 3.
+        /// A LUT module's KTX2 texture (2-D or 3-D) and a linear sampler, at 2 and 3.
         Ktx2(&'static [u8]),
         /// A table's own KTX2 texture at 2 (`lut::Table::upload_ktx2`), read by its
-        /// `FUNCTION_load`.
-        TableKtx2(&'static lut::Table),
+        /// `FUNCTION_load`, or with `linear` by its `FUNCTION_sample` through the sampler at 3.
+        TableKtx2 { table: &'static lut::Table, linear: bool },
+    }
+
+    /// One function's times per dispatch, each the best of five.
+    pub struct Times {
+        /// Submit to completion, as the host sees it.
+        pub host_ms: f64,
+        /// Between the pass's start and end timestamps; None without `TIMESTAMP_QUERY`.
+        pub gpu_ms: Option<f64>,
+    }
+
+    impl Times {
+        pub fn gpu_text(&self) -> String {
+            self.gpu_ms.map_or("-".to_string(), |ms| format!("{ms:.4}"))
+        }
     }
 
     /// `library`, extra declarations, and an entry point that runs the statement `call` and
@@ -141,9 +185,15 @@ mod timing {
         )
     }
 
-    /// The skin LUT texture a module's `_sample` function reads.
+    /// The LUT texture a module's `_sample` functions read.
     pub fn ktx2(module: &str) -> Option<&'static [u8]> {
         match module {
+            #[cfg(feature = "ggx")]
+            "ggx_dfg_lut" => Some(shadefit_runtime::ggx_dfg_lut::GGX_DFG_LUT_KTX2),
+            #[cfg(feature = "ggx")]
+            "ggx_dfg_lut_filament" => Some(shadefit_runtime::ggx_dfg_lut_filament::GGX_DFG_LUT_FILAMENT_KTX2),
+            #[cfg(feature = "ggx")]
+            "ggx_cone_lut" => Some(shadefit_runtime::ggx_cone_lut::GGX_CONE_LUT_KTX2),
             #[cfg(feature = "skin")]
             "skin_punctual_lut" => Some(shadefit_runtime::skin_punctual_lut::SKIN_PUNCTUAL_LUT_KTX2),
             #[cfg(feature = "skin")]
@@ -152,12 +202,16 @@ mod timing {
         }
     }
 
-    /// Milliseconds for the target's function, with `bind` bound.
-    pub fn time(g: &gpu::Gpu, t: &Target, bind: &Bind) -> f64 {
+    /// Times of the target's function, with `bind` bound.
+    pub fn time(g: &gpu::Gpu, t: &Target, bind: &Bind) -> Times {
+        let sampler = "@group(0) @binding(3) var shadefit_smp: sampler;\n";
         let decls = match bind {
-            Bind::Ktx2(_) => "@group(0) @binding(2) var shadefit_tex: texture_2d<f32>;\n@group(0) @binding(3) var shadefit_smp: sampler;\n",
-            Bind::TableKtx2(_) => "@group(0) @binding(2) var shadefit_tex: texture_2d<f32>;\n",
-            _ => "",
+            Bind::Ktx2(bytes) => {
+                let dims = if skin::Ktx2Image::parse(bytes).expect("the module's KTX2").depth == 0 { 2 } else { 3 };
+                format!("@group(0) @binding(2) var shadefit_tex: texture_{dims}d<f32>;\n{sampler}")
+            }
+            Bind::TableKtx2 { linear, .. } => format!("@group(0) @binding(2) var shadefit_tex: texture_2d<f32>;\n{}", if *linear { sampler } else { "" }),
+            _ => String::new(),
         };
         let m = super::parse(&t.library);
         let f = m.functions.iter().map(|(_, f)| f).find(|f| f.name.as_deref() == Some(t.function.as_str())).expect("the target's function");
@@ -201,11 +255,11 @@ mod timing {
             other => panic!("{}: no reduction of {other:?}", t.function),
         };
         let call = format!("let r = {}({});", t.function, args.join(", "));
-        run(g, &t.function, &kernel(&t.library, decls, &call, &reduce), bind.clone())
+        run(g, &t.function, &kernel(&t.library, &decls, &call, &reduce), bind.clone())
     }
 
-    /// Compile, warm up, then the best of five timed dispatches (submit to completion), in ms.
-    pub fn run(g: &gpu::Gpu, label: &str, shader: &str, bind: Bind) -> f64 {
+    /// Compile, warm up, then five timed dispatches: the best of each time.
+    pub fn run(g: &gpu::Gpu, label: &str, shader: &str, bind: Bind) -> Times {
         let device = &g.device;
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some(label),
@@ -237,9 +291,12 @@ mod timing {
                 table = t.create_texture(device, &g.queue);
                 entries.push(wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&table.view) });
             }
-            Bind::TableKtx2(t) => {
-                table_ktx2 = t.upload_ktx2(device, &g.queue, false).expect("the table's KTX2").expect("KTX2");
+            Bind::TableKtx2 { table: t, linear } => {
+                table_ktx2 = t.upload_ktx2(device, &g.queue, linear).expect("the table's KTX2").expect("KTX2");
                 entries.push(wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&table_ktx2.view) });
+                if linear {
+                    entries.push(wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::Sampler(&table_ktx2.sampler) });
+                }
             }
             Bind::Ktx2(bytes) => {
                 ktx = skin::create_lut_texture(device, &g.queue, label, bytes).expect("KTX2");
@@ -254,20 +311,62 @@ mod timing {
             layout: &pipeline.get_bind_group_layout(0),
             entries: &entries,
         });
-        let dispatch = || {
+        // Two timestamps a dispatch (start and end of the pass), resolved into a buffer and
+        // copied to one the host maps; ticks × `get_timestamp_period()` ns.
+        let stamps = device.features().contains(wgpu::Features::TIMESTAMP_QUERY).then(|| {
+            let set = device.create_query_set(&wgpu::QuerySetDescriptor { label: Some(label), ty: wgpu::QueryType::Timestamp, count: 2 });
+            let resolve = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("timestamps"),
+                size: 16,
+                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            });
+            let read = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("timestamps read back"),
+                size: 16,
+                usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+                mapped_at_creation: false,
+            });
+            (set, resolve, read)
+        });
+        let period_ns = g.queue.get_timestamp_period() as f64;
+        let dispatch = || -> (f64, Option<f64>) {
             let mut encoder = device.create_command_encoder(&Default::default());
             {
-                let mut pass = encoder.begin_compute_pass(&Default::default());
+                let timestamp_writes = stamps.as_ref().map(|(set, ..)| wgpu::ComputePassTimestampWrites {
+                    query_set: set,
+                    beginning_of_pass_write_index: Some(0),
+                    end_of_pass_write_index: Some(1),
+                });
+                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(label), timestamp_writes });
                 pass.set_pipeline(&pipeline);
                 pass.set_bind_group(0, &bind_group, &[]);
                 pass.dispatch_workgroups(W / 8, H / 8, 1);
             }
+            if let Some((set, resolve, read)) = &stamps {
+                encoder.resolve_query_set(set, 0..2, resolve, 0);
+                encoder.copy_buffer_to_buffer(resolve, 0, read, 0, 16);
+            }
             let t0 = std::time::Instant::now();
             g.queue.submit([encoder.finish()]);
             device.poll(wgpu::PollType::wait_indefinitely()).expect("poll");
-            t0.elapsed().as_secs_f64() * 1e3
+            let host = t0.elapsed().as_secs_f64() * 1e3;
+            let gpu = stamps.as_ref().map(|(_, _, read)| {
+                let (tx, rx) = std::sync::mpsc::channel();
+                read.slice(..).map_async(wgpu::MapMode::Read, move |r| tx.send(r).unwrap());
+                device.poll(wgpu::PollType::wait_indefinitely()).expect("poll");
+                rx.recv().unwrap().expect("map the timestamps");
+                let ticks: [u64; 2] = bytemuck::pod_read_unaligned(&read.slice(..).get_mapped_range().expect("mapped")[..16]);
+                read.unmap();
+                ticks[1].wrapping_sub(ticks[0]) as f64 * period_ns * 1e-6
+            });
+            (host, gpu)
         };
         dispatch();
-        (0..5).map(|_| dispatch()).fold(f64::INFINITY, f64::min)
+        let runs: Vec<(f64, Option<f64>)> = (0..5).map(|_| dispatch()).collect();
+        Times {
+            host_ms: runs.iter().map(|r| r.0).fold(f64::INFINITY, f64::min),
+            gpu_ms: runs.iter().map(|r| r.1).collect::<Option<Vec<f64>>>().map(|v| v.into_iter().fold(f64::INFINITY, f64::min)),
+        }
     }
 }

@@ -49,6 +49,13 @@ pub fn instance() -> wgpu::Instance {
 /// Adapter (from the environment, see the module documentation) and a device with default
 /// limits and no optional features.
 pub async fn headless(label: &str) -> Result<Gpu, GpuError> {
+    headless_with(label, wgpu::Features::empty()).await
+}
+
+/// [`headless`], with those of the `optional` features the adapter offers (e.g.
+/// `TIMESTAMP_QUERY` for GPU-side timing, `FLOAT32_FILTERABLE` for a linear sampler on a 32-bit
+/// float LUT): `device.features()` says which were granted (one the adapter lacks is left out, not an error).
+pub async fn headless_with(label: &str, optional: wgpu::Features) -> Result<Gpu, GpuError> {
     let instance = instance();
     let adapter = wgpu::util::initialize_adapter_from_env_or_default(&instance, None)
         .await
@@ -56,6 +63,7 @@ pub async fn headless(label: &str) -> Result<Gpu, GpuError> {
     let (device, queue) = adapter
         .request_device(&wgpu::DeviceDescriptor {
             label: Some(label),
+            required_features: optional & adapter.features(),
             required_limits: wgpu::Limits::default().using_resolution(adapter.limits()),
             ..Default::default()
         })

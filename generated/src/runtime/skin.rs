@@ -24,8 +24,9 @@
 //!
 //! # Textures
 //! Each skin LUT module carries its texture as KTX2 bytes (`NAME_KTX2`: linear RGBA16F or
-//! RGBA32F, alpha 1, one level). [`Ktx2Image::parse`] reads the header this crate's generator
-//! writes (no supercompression, one 2-D level); with the `gpu` feature [`create_lut_texture`]
+//! RGBA32F, alpha 1, one level), as do the split-sum DFG LUTs (RG16F, 2-D) and the cone LUT
+//! (RG16F, 3-D). [`Ktx2Image::parse`] reads the header this crate's generator writes (no
+//! supercompression, one 2-D or 3-D level); with the `gpu` feature [`create_lut_texture`]
 //! uploads it and [`lut_sampler`] makes the linear, clamp-to-edge sampler the emitted
 //! `NAME_sample` functions expect. RGBA16F is filterable in core WebGPU; RGBA32F needs the
 //! `FLOAT32_FILTERABLE` feature for a linear sampler, so [`create_lut_texture`] refuses an
@@ -69,9 +70,10 @@ pub fn skin_curvature_from_light_normalized(
 pub enum Ktx2Error {
     /// Not a KTX2 file, or shorter than its header says.
     Malformed(&'static str),
-    /// A `VkFormat` other than R16F (76), R32F (100), RGBA16F (97) and RGBA32F (109).
+    /// A `VkFormat` other than R16F (76), R32F (100), RG16F (83), RG32F (103), RGBA16F (97)
+    /// and RGBA32F (109).
     Format(u32),
-    /// Supercompressed, layered, cube, 3-D or mipmapped: not what shadefit writes.
+    /// Supercompressed, layered, cube or mipmapped: not what shadefit writes.
     Unsupported(&'static str),
     /// A 32-bit float texture for a linear sampler on a device without `FLOAT32_FILTERABLE`.
     NeedsFloat32Filterable,
@@ -81,7 +83,9 @@ impl std::fmt::Display for Ktx2Error {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             Ktx2Error::Malformed(why) => write!(f, "malformed KTX2: {why}"),
-            Ktx2Error::Format(v) => write!(f, "KTX2 VkFormat {v} is not R16F (76), R32F (100), RGBA16F (97) or RGBA32F (109)"),
+            Ktx2Error::Format(v) => {
+                write!(f, "KTX2 VkFormat {v} is not R16F (76), R32F (100), RG16F (83), RG32F (103), RGBA16F (97) or RGBA32F (109)")
+            }
             Ktx2Error::Unsupported(what) => write!(f, "unsupported KTX2: {what}"),
             Ktx2Error::NeedsFloat32Filterable => write!(
                 f,
@@ -93,12 +97,14 @@ impl std::fmt::Display for Ktx2Error {
 
 impl std::error::Error for Ktx2Error {}
 
-/// Texel format of a LUT texture: RGBA for the skin LUTs, one channel for the table modules
-/// (`crate::lut`).
+/// Texel format of a LUT texture: RGBA for the skin LUTs, RG for the split-sum (DFG) and cone
+/// LUTs (scale, bias), one channel for the table modules (`crate::lut`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum LutFormat {
     Rgba16Float,
     Rgba32Float,
+    Rg16Float,
+    Rg32Float,
     R16Float,
     R32Float,
 }
@@ -107,13 +113,14 @@ impl LutFormat {
     /// Whether a linear sampler on this format needs the optional `float32-filterable`
     /// feature (WebGPU: 32-bit float formats are unfilterable in core).
     pub fn needs_float32_filterable(self) -> bool {
-        matches!(self, LutFormat::Rgba32Float | LutFormat::R32Float)
+        matches!(self, LutFormat::Rgba32Float | LutFormat::Rg32Float | LutFormat::R32Float)
     }
 
     /// Channels per texel.
     pub fn channels(self) -> usize {
         match self {
             LutFormat::Rgba16Float | LutFormat::Rgba32Float => 4,
+            LutFormat::Rg16Float | LutFormat::Rg32Float => 2,
             LutFormat::R16Float | LutFormat::R32Float => 1,
         }
     }
@@ -121,8 +128,8 @@ impl LutFormat {
     /// Bytes per channel.
     pub fn channel_size(self) -> usize {
         match self {
-            LutFormat::Rgba16Float | LutFormat::R16Float => 2,
-            LutFormat::Rgba32Float | LutFormat::R32Float => 4,
+            LutFormat::Rgba16Float | LutFormat::Rg16Float | LutFormat::R16Float => 2,
+            LutFormat::Rgba32Float | LutFormat::Rg32Float | LutFormat::R32Float => 4,
         }
     }
 
@@ -131,23 +138,30 @@ impl LutFormat {
         match self {
             LutFormat::Rgba16Float => wgpu::TextureFormat::Rgba16Float,
             LutFormat::Rgba32Float => wgpu::TextureFormat::Rgba32Float,
+            LutFormat::Rg16Float => wgpu::TextureFormat::Rg16Float,
+            LutFormat::Rg32Float => wgpu::TextureFormat::Rg32Float,
             LutFormat::R16Float => wgpu::TextureFormat::R16Float,
             LutFormat::R32Float => wgpu::TextureFormat::R32Float,
         }
     }
 }
 
-/// One 2-D level of a KTX2 file: size, format and the texels (little-endian, row 0 first).
+/// The one level of a KTX2 file: size, format and the texels (little-endian, row 0 of slice 0
+/// first).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Ktx2Image<'a> {
     pub width: u32,
     pub height: u32,
+    /// The file's `pixelDepth`: 0 for a 2-D image, the slice count of a 3-D one (the cone LUT).
+    pub depth: u32,
     pub format: LutFormat,
     pub data: &'a [u8],
 }
 
 impl<'a> Ktx2Image<'a> {
-    /// Read the header and the level index of an uncompressed, single-level 2-D KTX2 file.
+    /// Read the header and the level index of an uncompressed, single-level 2-D or 3-D KTX2 file
+    /// (KTX 2.0 §3: the identifier, `vkFormat` at byte 12, `pixelWidth`/`Height`/`Depth` at 20,
+    /// 24, 28, the level index at 80).
     pub fn parse(bytes: &'a [u8]) -> Result<Ktx2Image<'a>, Ktx2Error> {
         const ID: [u8; 12] = [0xAB, 0x4B, 0x54, 0x58, 0x20, 0x32, 0x30, 0xBB, 0x0D, 0x0A, 0x1A, 0x0A];
         if bytes.len() < 104 || bytes[..12] != ID {
@@ -158,6 +172,8 @@ impl<'a> Ktx2Image<'a> {
         let format = match u32_at(12) {
             97 => LutFormat::Rgba16Float,
             109 => LutFormat::Rgba32Float,
+            83 => LutFormat::Rg16Float,
+            103 => LutFormat::Rg32Float,
             76 => LutFormat::R16Float,
             100 => LutFormat::R32Float,
             other => return Err(Ktx2Error::Format(other)),
@@ -167,22 +183,29 @@ impl<'a> Ktx2Image<'a> {
         if scheme != 0 {
             return Err(Ktx2Error::Unsupported("supercompression"));
         }
-        if depth != 0 || layers > 1 || faces != 1 || levels > 1 || height == 0 {
-            return Err(Ktx2Error::Unsupported("not a single-level 2-D image"));
+        if layers > 1 || faces != 1 || levels > 1 || height == 0 || width == 0 {
+            return Err(Ktx2Error::Unsupported("not a single-level 2-D or 3-D image"));
         }
         let (offset, length) = (u64_at(80) as usize, u64_at(88) as usize);
         let texel = format.channels() * format.channel_size();
-        if length != width as usize * height as usize * texel {
-            return Err(Ktx2Error::Malformed("level length differs from width × height × texel size"));
+        let expected = (width as usize).checked_mul(height as usize).and_then(|n| n.checked_mul(depth.max(1) as usize)).and_then(|n| n.checked_mul(texel));
+        if Some(length) != expected {
+            return Err(Ktx2Error::Malformed("level length differs from width × height × depth × texel size"));
         }
-        let data = bytes.get(offset..offset + length).ok_or(Ktx2Error::Malformed("level data beyond the end"))?;
-        Ok(Ktx2Image { width, height, format, data })
+        let data = offset.checked_add(length).and_then(|end| bytes.get(offset..end)).ok_or(Ktx2Error::Malformed("level data beyond the end"))?;
+        Ok(Ktx2Image { width, height, depth, format, data })
     }
 
-    /// Texel (x, y) as f32 RGBA (f16 widened exactly; a one-channel texel is (r, 0, 0, 1), as
-    /// WGSL reads it).
+    /// Texel (x, y) of a 2-D image (of slice 0 of a 3-D one) as f32 RGBA: [`Ktx2Image::texel_3d`]
+    /// at z = 0.
     pub fn texel(&self, x: u32, y: u32) -> [f32; 4] {
-        let k = (y * self.width + x) as usize;
+        self.texel_3d(x, y, 0)
+    }
+
+    /// Texel (x, y, z) as f32 RGBA (f16 widened exactly; missing channels as WGSL reads them:
+    /// a one-channel texel is (r, 0, 0, 1), a two-channel one (r, g, 0, 1)).
+    pub fn texel_3d(&self, x: u32, y: u32, z: u32) -> [f32; 4] {
+        let k = ((z as usize * self.height as usize + y as usize) * self.width as usize) + x as usize;
         let (n, size) = (self.format.channels(), self.format.channel_size());
         std::array::from_fn(|c| {
             if c >= n {
@@ -215,9 +238,11 @@ mod gpu {
     use super::{Ktx2Error, Ktx2Image};
     use wgpu::util::DeviceExt;
 
-    /// Upload a skin LUT's KTX2 bytes (`NAME_KTX2`) as a 2-D texture (`Rgba16Float` or
-    /// `Rgba32Float`, one level, `TEXTURE_BINDING | COPY_DST`). An `Rgba32Float` texture is
-    /// refused unless the device has `FLOAT32_FILTERABLE`: [`lut_sampler`] filters linearly.
+    /// Upload a LUT's KTX2 bytes (`NAME_KTX2`: the skin LUTs, RGBA; the split-sum DFG LUTs, RG
+    /// 2-D; the cone LUT, RG 3-D) as a texture of its format, one level, `TEXTURE_BINDING |
+    /// COPY_DST`, 3-D where the file's `pixelDepth` is non-zero (bind a `texture_3d` view). A
+    /// 32-bit float texture is refused unless the device has `FLOAT32_FILTERABLE`:
+    /// [`lut_sampler`] filters linearly.
     pub fn create_lut_texture(
         device: &wgpu::Device,
         queue: &wgpu::Queue,
@@ -227,7 +252,7 @@ mod gpu {
         upload(device, queue, label, ktx2, true)
     }
 
-    /// Upload KTX2 bytes of any [`LutFormat`] as a 2-D texture; `linear`: the texture is to be
+    /// Upload KTX2 bytes of any [`LutFormat`] as a 2-D or 3-D texture; `linear`: the texture is to be
     /// read through a linear sampler, so a 32-bit float format needs `FLOAT32_FILTERABLE`.
     pub(crate) fn upload(
         device: &wgpu::Device,
@@ -245,10 +270,10 @@ mod gpu {
             queue,
             &wgpu::TextureDescriptor {
                 label: Some(label),
-                size: wgpu::Extent3d { width: img.width, height: img.height, depth_or_array_layers: 1 },
+                size: wgpu::Extent3d { width: img.width, height: img.height, depth_or_array_layers: img.depth.max(1) },
                 mip_level_count: 1,
                 sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
+                dimension: if img.depth == 0 { wgpu::TextureDimension::D2 } else { wgpu::TextureDimension::D3 },
                 format,
                 usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
                 view_formats: &[],
