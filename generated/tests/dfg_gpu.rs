@@ -243,9 +243,13 @@ fn judge(l: &Lut, pts: &[f32], out: &[f32]) -> Judged {
     // storage can round 1 up by at most half an ulp of 1, 2^-11); 1 + 2^-10 bounds them.
     let vmax = 1.0 + 2f32.powi(-10);
     // The filter's lerps, one per texel pair merged (2-D: 3, 3-D: 7), each a product and a sum
-    // rounded on either side: 2 ulps of vmax a lerp.
+    // rounded. Vulkan leaves the filter's arithmetic precision to the implementation, and
+    // NVIDIA's driver filters these 16-bit float textures at about the texels' own precision (an
+    // H100, driver 580.159.04, came within 2.9e-4 of the exact-weight f32 filter of the same
+    // texels, 16 times an f32 rounding bound): each rounding taken in binary16, half an ulp, at
+    // most 2^-11 of vmax.
     let lerps = if dims == 2 { 3.0 } else { 7.0 };
-    let rounding = 2.0 * lerps * 2f32.powi(-24) * vmax;
+    let rounding = 2.0 * lerps * 2f32.powi(-11) * vmax;
     let mut j = Judged { ratio: [0.0; 2], worst: [0.0; 2] };
     for (p, o) in pts.chunks(dims).zip(out.chunks(OUTS)) {
         assert!(o.iter().all(|v| v.is_finite()), "{} at {p:?}: {o:?}", l.module);
@@ -269,6 +273,8 @@ fn judge(l: &Lut, pts: &[f32], out: &[f32]) -> Judged {
 #[test]
 fn split_sum_lut_textures_sample_as_the_cpu_lookups_interpolate() {
     let Some(g) = harness::device("shadefit split-sum LUT texture test") else { return };
+    // Every LUT is measured and reported before any assertion.
+    let mut failures = Vec::new();
     for l in luts() {
         let dims = l.size.len();
         let img = skin::Ktx2Image::parse(l.ktx2).expect("the module's KTX2");
@@ -289,14 +295,19 @@ fn split_sum_lut_textures_sample_as_the_cpu_lookups_interpolate() {
             j.worst[1],
             j.ratio[1]
         ));
-        assert!(j.ratio[0] <= 1.0 && j.ratio[1] <= 1.0, "{}: out of bound", l.module);
+        if j.ratio[0] > 1.0 || j.ratio[1] > 1.0 {
+            failures.push(format!("{}: out of bound", l.module));
+        }
         // Coordinates half a texel off on one axis: caught on every axis.
         for a in 0..dims {
             let shift: Vec<f32> = (0..dims).map(|b| if a == b { 0.5 / l.size[a] as f32 } else { 0.0 }).collect();
             let moved = shifted(&library, l.uv, &shift);
             let j = judge(&l, &pts, &run_on_gpu(&g, &l, &view, &sampler, &moved, &pts));
             report(&format!("{}: coordinates half a texel off on axis {a}: largest deviation/bound {:.1}", l.module, j.ratio[0]));
-            assert!(j.ratio[0] > 1.0, "{}: half a texel off on axis {a} passes the bound", l.module);
+            if j.ratio[0] <= 1.0 {
+                failures.push(format!("{}: half a texel off on axis {a} passes the bound", l.module));
+            }
         }
     }
+    assert!(failures.is_empty(), "{}", failures.join("; "));
 }

@@ -3,10 +3,17 @@
 //!
 //!     cargo test --release -p shadefit-runtime --test timing -- --ignored --nocapture
 //!
-//! Two times per function, each the best of five dispatches after a warm-up: the GPU's own, from
-//! timestamps written at the start and the end of the compute pass (where the adapter offers
-//! `TIMESTAMP_QUERY`; the launch and the submission excluded), and submit to completion as the
-//! host sees it (the launch included: on a fast GPU the floor every cheap function reads).
+//! Each invocation (one a pixel) calls the function `reps` times in a loop, on inputs that move
+//! with the iteration (so no call can be hoisted), and writes the sum of the results; `reps` is
+//! `SHADEFIT_TIMING_REPS` (default 64 on a GPU, 1 on a software adapter), except for a function
+//! reading a `const` array at a computed index whose one call a pixel takes over 1 ms (tens of
+//! ms for a large table: naga copies the array at each such read), timed at one. Two times per kernel, each the
+//! best of five dispatches after a warm-up: the GPU's own, from timestamps written at the start
+//! and the end of the compute pass (where the adapter offers `TIMESTAMP_QUERY`; the launch and
+//! the submission excluded), and submit to completion as the host sees it. The cost of one call
+//! over the 3840×2160 pixels is the GPU time less that of the baseline kernel with the same
+//! loop (inputs and sum only), divided by `reps`: with one call a pixel an H100 reads about
+//! 0.083 ms for every kernel, the loop's floor, and a single call hides under it.
 //! Textures are bound from the modules' KTX2 bytes (skin LUTs, split-sum DFG and cone LUTs,
 //! tables); a linear sampler on a 32-bit float texture needs `FLOAT32_FILTERABLE`, requested where
 //! the adapter offers it.
@@ -110,28 +117,49 @@ fn timing_over_a_4k_dispatch() {
         if features.contains(wgpu::Features::TIMESTAMP_QUERY) { "yes (GPU column: end-of-pass minus start-of-pass timestamp)" } else { "no (GPU column empty)" },
         if features.contains(wgpu::Features::FLOAT32_FILTERABLE) { "yes" } else { "no" }
     );
-    let baseline = || timing::run(&g, "baseline", &timing::kernel("", "", "", "c0 + c1 + c2"), timing::Bind::None);
-    let before = baseline();
-    println!("\n| module | function | GPU ms (timestamps) | ms submit to completion |\n|---|---|---:|---:|");
+    let reps: u32 = match std::env::var("SHADEFIT_TIMING_REPS") {
+        Ok(v) => v.parse().ok().filter(|&r| r >= 1).expect("SHADEFIT_TIMING_REPS: a whole number >= 1"),
+        Err(_) if software => 1,
+        Err(_) => 64,
+    };
+    let baseline = |reps: u32| timing::run(&g, "baseline", &timing::kernel("", "", "", "c0 + c1 + c2", reps), timing::Bind::None);
+    let before = [baseline(1), baseline(reps)];
+    println!(
+        "\n| module | function | calls a pixel | GPU ms (timestamps) | GPU ms a call, baseline loop subtracted | ms submit to completion |\n|---|---|---:|---:|---:|---:|"
+    );
     for t in targets(features) {
-        let (gpu_ms, host_ms) = match &t.bind {
-            Err(why) => ("-".to_string(), format!("- ({why})")),
-            Ok(_) if software && t.const_array => ("-".to_string(), "- (const array)".to_string()),
+        let mut r = reps;
+        let (gpu_ms, per_call, host_ms) = match &t.bind {
+            Err(why) => ("-".to_string(), "-".to_string(), format!("- ({why})")),
+            Ok(_) if software && t.const_array => ("-".to_string(), "-".to_string(), "- (const array)".to_string()),
             Ok(bind) => {
-                let times = timing::time(&g, &t, bind);
-                (times.gpu_text(), format!("{:.3}", times.host_ms))
+                // A const-array read: one call a pixel first, the loop only if that is cheap.
+                let once = (t.const_array && reps > 1).then(|| timing::time(&g, &t, bind, 1));
+                let times = match once {
+                    Some(once) if once.gpu_ms.unwrap_or(once.host_ms) > 1.0 => {
+                        r = 1;
+                        once
+                    }
+                    _ => timing::time(&g, &t, bind, reps),
+                };
+                let base = if r == 1 { &before[0] } else { &before[1] };
+                let per_call = times.gpu_ms.zip(base.gpu_ms).map_or("-".to_string(), |(f, b)| format!("{:.4}", (f - b) / r as f64));
+                (times.gpu_text(), per_call, format!("{:.3}", times.host_ms))
             }
         };
-        println!("| {} | {} | {gpu_ms} | {host_ms} |", t.module, t.function);
+        let calls = if host_ms.starts_with('-') { "-".to_string() } else { r.to_string() };
+        println!("| {} | {} | {calls} | {gpu_ms} | {per_call} | {host_ms} |", t.module, t.function);
     }
-    let after = baseline();
-    println!(
-        "\nbaseline kernel (arguments and write only), per 3840x2160 dispatch: GPU {} ms before, {} ms after the functions; submit to completion {:.3} ms before, {:.3} ms after",
-        before.gpu_text(),
-        after.gpu_text(),
-        before.host_ms,
-        after.host_ms
-    );
+    let after = [baseline(1), baseline(reps)];
+    for (k, r) in [1, reps].into_iter().enumerate() {
+        println!(
+            "\nbaseline kernel (inputs and sum only, {r} a pixel), per 3840x2160 dispatch: GPU {} ms before, {} ms after the functions; submit to completion {:.3} ms before, {:.3} ms after",
+            before[k].gpu_text(),
+            after[k].gpu_text(),
+            before[k].host_ms,
+            after[k].host_ms
+        );
+    }
 }
 
 mod timing {
@@ -168,18 +196,26 @@ mod timing {
         }
     }
 
-    /// `library`, extra declarations, and an entry point that runs the statement `call` and
-    /// writes `reduce` (an f32 expression of c0, c1, c2 and what `call` defines).
-    pub fn kernel(library: &str, decls: &str, call: &str, reduce: &str) -> String {
+    /// `library`, extra declarations, and an entry point that runs the statement `call` `reps`
+    /// times and writes the sum of `reduce` (an f32 expression of c0, c1, c2 and what `call`
+    /// defines); c0 and c1 start at the pixel's position in [0, 1] and move by irrational steps
+    /// with the iteration, c2 mixes them.
+    pub fn kernel(library: &str, decls: &str, call: &str, reduce: &str, reps: u32) -> String {
         format!(
             "{library}\n{decls}\n@group(0) @binding(1) var<storage, read_write> shadefit_out: array<f32>;\n\n\
              @compute @workgroup_size(8, 8)\n\
              fn shadefit_main(@builtin(global_invocation_id) id: vec3<u32>) {{\n    \
-                 let c0 = f32(id.x) / {w}.0;\n    \
-                 let c1 = f32(id.y) / {h}.0;\n    \
-                 let c2 = fract(c0 * 7.0 + c1 * 3.0);\n    \
-                 {call}\n    \
-                 shadefit_out[id.y * {W}u + id.x] = {reduce};\n}}\n",
+                 let shadefit_b0 = f32(id.x) / {w}.0;\n    \
+                 let shadefit_b1 = f32(id.y) / {h}.0;\n    \
+                 var shadefit_sum = 0.0;\n    \
+                 for (var shadefit_k = 0u; shadefit_k < {reps}u; shadefit_k++) {{\n        \
+                     let c0 = select(fract(shadefit_b0 + f32(shadefit_k) * 0.618034), shadefit_b0, shadefit_k == 0u);\n        \
+                     let c1 = select(fract(shadefit_b1 + f32(shadefit_k) * 0.414214), shadefit_b1, shadefit_k == 0u);\n        \
+                     let c2 = fract(c0 * 7.0 + c1 * 3.0);\n        \
+                     {call}\n        \
+                     shadefit_sum += {reduce};\n    \
+                 }}\n    \
+                 shadefit_out[id.y * {W}u + id.x] = shadefit_sum;\n}}\n",
             w = W - 1,
             h = H - 1,
         )
@@ -202,8 +238,8 @@ mod timing {
         }
     }
 
-    /// Times of the target's function, with `bind` bound.
-    pub fn time(g: &gpu::Gpu, t: &Target, bind: &Bind) -> Times {
+    /// Times of the target's function, `reps` calls a pixel, with `bind` bound.
+    pub fn time(g: &gpu::Gpu, t: &Target, bind: &Bind, reps: u32) -> Times {
         let sampler = "@group(0) @binding(3) var shadefit_smp: sampler;\n";
         let decls = match bind {
             Bind::Ktx2(bytes) => {
@@ -255,7 +291,7 @@ mod timing {
             other => panic!("{}: no reduction of {other:?}", t.function),
         };
         let call = format!("let r = {}({});", t.function, args.join(", "));
-        run(g, &t.function, &kernel(&t.library, &decls, &call, &reduce), bind.clone())
+        run(g, &t.function, &kernel(&t.library, &decls, &call, &reduce, reps), bind.clone())
     }
 
     /// Compile, warm up, then five timed dispatches: the best of each time.
