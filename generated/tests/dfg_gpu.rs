@@ -210,22 +210,8 @@ fn run_on_gpu(g: &gpu::Gpu, l: &Lut, view: &wgpu::TextureView, sampler: &wgpu::S
             wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::Sampler(sampler) },
         ],
     });
-    let mut encoder = device.create_command_encoder(&Default::default());
-    {
-        let mut pass = encoder.begin_compute_pass(&Default::default());
-        pass.set_pipeline(&pipeline);
-        pass.set_bind_group(0, &bind_group, &[]);
-        pass.dispatch_workgroups((padded / WORKGROUP) as u32, 1, 1);
-    }
-    encoder.copy_buffer_to_buffer(&output, 0, &readback, 0, size);
-    g.queue.submit([encoder.finish()]);
-    let (tx, rx) = std::sync::mpsc::channel();
-    readback.slice(..).map_async(wgpu::MapMode::Read, move |r| tx.send(r).unwrap());
-    device.poll(wgpu::PollType::wait_indefinitely()).expect("device poll");
-    rx.recv().unwrap().expect("map readback buffer");
-    let out = bytemuck::cast_slice::<u8, f32>(&readback.slice(..).get_mapped_range().expect("mapped range")).to_vec();
-    readback.unmap();
-    out
+    let bytes = gpu::dispatch_and_read(g, l.module, &pipeline, &bind_group, (padded / WORKGROUP) as u32, &output, &readback);
+    bytemuck::pod_collect_to_vec(&bytes)
 }
 
 /// Per point: the largest |GPU − CPU| of the sample and of the specular over their bounds, and

@@ -199,21 +199,8 @@ impl Runner {
             _ => {}
         }
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(label), layout: &bgl, entries: &bind });
-        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
-        {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(label), timestamp_writes: None });
-            pass.set_pipeline(&pipeline);
-            pass.set_bind_group(0, &bind_group, &[]);
-            pass.dispatch_workgroups(padded as u32 / WORKGROUP, 1, 1);
-        }
-        encoder.copy_buffer_to_buffer(&output, 0, &readback, 0, size);
-        self.gpu.queue.submit([encoder.finish()]);
-        let (tx, rx) = std::sync::mpsc::channel();
-        readback.slice(..).map_async(wgpu::MapMode::Read, move |r| tx.send(r).unwrap());
-        self.gpu.device.poll(wgpu::PollType::wait_indefinitely()).expect("device poll");
-        rx.recv().unwrap().expect("map readback buffer");
-        let out = bytemuck::cast_slice::<u8, u32>(&readback.slice(..).get_mapped_range().expect("mapped range")).to_vec();
-        readback.unmap();
+        let bytes = gpu::dispatch_and_read(&self.gpu, label, &pipeline, &bind_group, padded as u32 / WORKGROUP, &output, &readback);
+        let out: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
         out[..n * outputs].to_vec()
     }
 }

@@ -155,21 +155,8 @@ fn table_textures_agree_with_the_const_arrays_on_the_gpu() {
             bind.push(wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::Sampler(&texture.sampler) });
         }
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(t.module), layout: &bgl, entries: &bind });
-        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(t.module) });
-        {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(t.module), timestamp_writes: None });
-            pass.set_pipeline(&pipeline);
-            pass.set_bind_group(0, &bind_group, &[]);
-            pass.dispatch_workgroups((padded / WORKGROUP) as u32, 1, 1);
-        }
-        encoder.copy_buffer_to_buffer(&output, 0, &readback, 0, size);
-        g.queue.submit([encoder.finish()]);
-        let (tx, rx) = std::sync::mpsc::channel();
-        readback.slice(..).map_async(wgpu::MapMode::Read, move |r| tx.send(r).unwrap());
-        device.poll(wgpu::PollType::wait_indefinitely()).expect("device poll");
-        rx.recv().unwrap().expect("map readback buffer");
-        let out = bytemuck::cast_slice::<u8, f32>(&readback.slice(..).get_mapped_range().expect("mapped range")).to_vec();
-        readback.unmap();
+        let bytes = gpu::dispatch_and_read(&g, t.module, &pipeline, &bind_group, (padded / WORKGROUP) as u32, &output, &readback);
+        let out: Vec<f32> = bytemuck::pod_collect_to_vec(&bytes);
 
         let vmax = t.values.iter().fold(0.0f32, |m, v| m.max(v.abs()));
         let step = max_step(t);

@@ -124,6 +124,35 @@ pub fn compute_pipeline(
     (bgl, pipeline)
 }
 
+/// Run `pipeline` with `bind_group` over `workgroups` × 1 × 1 workgroups, copy `output` into
+/// `readback` (both of the size [`output_and_readback`] made them) and return its bytes.
+pub fn dispatch_and_read(
+    g: &Gpu,
+    label: &str,
+    pipeline: &wgpu::ComputePipeline,
+    bind_group: &wgpu::BindGroup,
+    workgroups: u32,
+    output: &wgpu::Buffer,
+    readback: &wgpu::Buffer,
+) -> Vec<u8> {
+    let mut encoder = g.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
+    {
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(label), timestamp_writes: None });
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, bind_group, &[]);
+        pass.dispatch_workgroups(workgroups, 1, 1);
+    }
+    encoder.copy_buffer_to_buffer(output, 0, readback, 0, output.size());
+    g.queue.submit([encoder.finish()]);
+    let (tx, rx) = std::sync::mpsc::channel();
+    readback.slice(..).map_async(wgpu::MapMode::Read, move |r| tx.send(r).expect("the receiver waits"));
+    g.device.poll(wgpu::PollType::wait_indefinitely()).expect("device poll");
+    rx.recv().expect("the map callback ran").expect("map the readback buffer");
+    let bytes = readback.slice(..).get_mapped_range().expect("mapped range").to_vec();
+    readback.unmap();
+    bytes
+}
+
 /// A storage buffer a shader writes `size` bytes to, and the mappable buffer to copy it into.
 pub fn output_and_readback(device: &wgpu::Device, size: u64) -> (wgpu::Buffer, wgpu::Buffer) {
     let output = device.create_buffer(&wgpu::BufferDescriptor {
