@@ -323,4 +323,64 @@ mod tests {
     fn malformed_ktx2_is_refused() {
         assert!(matches!(Ktx2Image::parse(b"not a texture"), Err(Ktx2Error::Malformed(_))));
     }
+
+    /// A KTX 2.0 file by its header fields (KTX 2.0 §3: vkFormat, typeSize, pixel width, height,
+    /// depth, layerCount, faceCount, levelCount, supercompressionScheme; then one level's offset
+    /// and length) and its level bytes, placed at byte 104.
+    fn ktx2(format: u32, [w, h, d]: [u32; 3], layers: u32, levels: u32, level: (u64, u64), data: &[u8]) -> Vec<u8> {
+        let mut b = vec![0xAB, 0x4B, 0x54, 0x58, 0x20, 0x32, 0x30, 0xBB, 0x0D, 0x0A, 0x1A, 0x0A];
+        for v in [format, 4, w, h, d, layers, 1, levels, 0] {
+            b.extend_from_slice(&v.to_le_bytes());
+        }
+        b.resize(80, 0);
+        for v in [level.0, level.1, level.1] {
+            b.extend_from_slice(&v.to_le_bytes());
+        }
+        b.extend_from_slice(data);
+        b
+    }
+
+    #[test]
+    fn a_3d_rg_image_reads_slice_major() {
+        // 2×2×3 RG32F, texel (x, y, z) = (x + 10y + 100z, −that), stored slice by slice, each
+        // row by row (KTX 2.0 §4: z, then y, then x, the fastest).
+        let mut data = Vec::new();
+        for z in 0..3 {
+            for y in 0..2 {
+                for x in 0..2 {
+                    let v = (x + 10 * y + 100 * z) as f32;
+                    data.extend_from_slice(&v.to_le_bytes());
+                    data.extend_from_slice(&(-v).to_le_bytes());
+                }
+            }
+        }
+        let bytes = ktx2(103, [2, 2, 3], 0, 1, (104, data.len() as u64), &data);
+        let img = Ktx2Image::parse(&bytes).expect("well-formed");
+        assert_eq!((img.width, img.height, img.depth, img.format), (2, 2, 3, LutFormat::Rg32Float));
+        for (x, y, z) in [(0, 0, 0), (1, 0, 0), (0, 1, 0), (1, 1, 2), (0, 1, 1)] {
+            let v = (x + 10 * y + 100 * z) as f32;
+            assert_eq!(img.texel_3d(x, y, z), [v, -v, 0.0, 1.0], "({x}, {y}, {z})");
+        }
+        assert_eq!(img.texel(1, 1), img.texel_3d(1, 1, 0));
+    }
+
+    #[test]
+    fn inconsistent_or_unsupported_ktx2_headers_are_refused_without_panicking() {
+        let data = [0u8; 16];
+        let rg16 = |size: [u32; 3], layers: u32, levels: u32, level: (u64, u64)| Ktx2Image::parse(&ktx2(83, size, layers, levels, level, &data)).map(|i| i.depth);
+        // 2×2 RG16F is 16 bytes: well-formed; as 2×2×2 it would need 32.
+        assert_eq!(rg16([2, 2, 0], 0, 1, (104, 16)), Ok(0));
+        assert!(matches!(rg16([2, 2, 2], 0, 1, (104, 16)), Err(Ktx2Error::Malformed(_))));
+        // A size whose byte count overflows, and a level beyond the end or at an offset that
+        // overflows: refused, not a panic.
+        assert!(matches!(rg16([u32::MAX, u32::MAX, u32::MAX], 0, 1, (104, 16)), Err(Ktx2Error::Malformed(_))));
+        assert!(matches!(rg16([2, 2, 0], 0, 1, (112, 16)), Err(Ktx2Error::Malformed(_))));
+        assert!(matches!(rg16([2, 2, 0], 0, 1, (u64::MAX, 16)), Err(Ktx2Error::Malformed(_))));
+        // Arrays, mip chains and empty images are not what the generator writes.
+        assert!(matches!(rg16([2, 2, 0], 2, 1, (104, 16)), Err(Ktx2Error::Unsupported(_))));
+        assert!(matches!(rg16([2, 2, 0], 0, 2, (104, 16)), Err(Ktx2Error::Unsupported(_))));
+        assert!(matches!(rg16([0, 2, 0], 0, 1, (104, 0)), Err(Ktx2Error::Unsupported(_))));
+        // A format it does not read (R8G8_UNORM, 16) is named.
+        assert_eq!(Ktx2Image::parse(&ktx2(16, [2, 2, 0], 0, 1, (104, 16), &data)), Err(Ktx2Error::Format(16)));
+    }
 }
