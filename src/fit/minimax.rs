@@ -229,6 +229,31 @@ mod tests {
         assert!((st.get_best_cost() - 0.5).abs() < 1e-9 && (t[0] - 0.5).abs() < 1e-9 && t[1].abs() < 1e-9, "{t:?}, max {}", st.get_best_cost());
     }
 
+    /// The LP is posed in its own units (steps relative to their bounds, rows divided by the
+    /// largest reach) and its reductions are relative to each row's size (a term below
+    /// ε·(|r_i| + Σ_j |a_ij|) is left out), so residuals and a Jacobian scaled by a power of two
+    /// give the same step bit for bit and the linearised max scaled by it, whatever the units
+    /// of the fitted quantity: every product, sum and quotient scales exactly (no overflow or
+    /// subnormal at 2^±40 here). A reduction taken against an absolute size would leave out
+    /// every term of the 2^-30 problem (|a_ij| ≈ 1e-11 against residuals ≈ 1e-9).
+    #[test]
+    fn the_lp_step_is_the_same_in_any_units() {
+        let vee = Vee((0..21).map(|i| -1.0 + i as f64 / 10.0).collect());
+        let theta = DVector::from_vec(vec![0.2, 0.1]);
+        let (r, j) = (vee.apply(&theta).unwrap(), vee.jacobian(&theta).unwrap());
+        let bounds = [0.05, 0.02];
+        let rows: Vec<usize> = (0..r.len()).collect();
+        let (delta, linearised) = lp_step(&r, &j, &bounds, &rows).expect("the LP solves");
+        // Not a stationary point: the step descends (θ moves toward (½, 0)).
+        assert!(linearised < max_abs(&r), "{linearised} at max {}", max_abs(&r));
+        for k in [-40, -30, 30, 40] {
+            let c = 2f64.powi(k);
+            let (d, l) = lp_step(&(&r * c), &(&j * c), &bounds, &rows).unwrap_or_else(|| panic!("the LP scaled by 2^{k} solves"));
+            assert_eq!(d, delta, "step at 2^{k}");
+            assert_eq!(l, linearised * c, "linearised max at 2^{k}");
+        }
+    }
+
     /// Vee's residuals with the Jacobian's sign flipped: every LP step predicts a descent the
     /// residuals answer with a climb.
     struct Misled(Vee);
