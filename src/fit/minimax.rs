@@ -235,7 +235,7 @@ mod tests {
     /// give the same step bit for bit and the linearised max scaled by it, whatever the units
     /// of the fitted quantity: every product, sum and quotient scales exactly (no overflow or
     /// subnormal at 2^±40 here). A reduction taken against an absolute size would leave out
-    /// every term of the 2^-30 problem (|a_ij| ≤ 5e-11 against ε/size ≈ 4e-7).
+    /// every term of the 2^-30 problem (|a_ij| ≤ 5e-11 against ε/size ≥ 2e-7).
     #[test]
     fn the_lp_step_is_the_same_in_any_units() {
         let vee = Vee((0..21).map(|i| -1.0 + i as f64 / 10.0).collect());
