@@ -385,7 +385,51 @@ fn a_fields_spec_recovers_exact_fields_and_reads_back() {
     assert!(matches!(build_spec(&s, Mode::Committed, root, &|_| None), Err(BuildError::SpecChanged { .. })));
 }
 
-/// The committed fields read back by name (`committed::Fields::load`: fits/NAME.toml beside
+/// A fields build's `f32_rounding` reports its errors on the fitting samples (17 × 9): the f64
+/// ones are the JSON's fields' residuals there, re-measured here from their coefficients in the
+/// documented form; the f32 ones are the emitted f32 code's at those samples, which the
+/// verification grid (33 × 17 here, holding every fitting sample: o = i/16, u = −1 + l/4 are
+/// on it exactly) evaluates too, so their max is at most the verification's f32 max.
+#[test]
+fn a_fields_builds_rounding_report_is_its_errors_on_the_fitting_samples() {
+    let text = FIELDS.replace("count = 9\nverify = 11", "count = 9\nverify = 17");
+    assert_ne!(text, FIELDS);
+    let s = spec_in(&text, &Catalog { quantities: vec![&FIELDS_Q], kinds: vec![] });
+    let tmp = tempfile::tempdir().unwrap();
+    let b = build_spec(&s, Mode::Fit, tmp.path(), &|_| None).unwrap();
+    let j = json_of(&b);
+    let fr = &j["f32_rounding"];
+    assert_eq!(fr["fitting_samples"].as_u64(), Some(17 * 9));
+    assert_eq!(fr["reoptimised"], json!(false));
+    let fields: Vec<(f64, Vec<f64>)> =
+        j["fields"].as_array().unwrap().iter().map(|f| (f["offset"].as_f64().unwrap(), floats(&f["coefficients"]))).collect();
+    let (mut max, mut ss) = (0.0f64, 0.0f64);
+    for i in 0..17 {
+        for l in 0..9 {
+            let (o, u) = (i as f64 / 16.0, -1.0 + l as f64 / 4.0);
+            let c: Vec<f64> = fields.iter().map(|(off, c)| off + (c[0] + c[1] * o) / (1.0 + c[2] * o)).collect();
+            let r = c[0] + c[1] * u + c[2] * u * u - fields_value(o, u);
+            max = max.max(r.abs());
+            ss += r * r;
+        }
+    }
+    // The residuals are ~1e-12 (exact data, a recovered fit); evaluated in another order here,
+    // each moves by a few ulps of values ≤ 4 (~1e-15).
+    let e64 = &fr["f64"];
+    assert!((e64["max_abs_error"].as_f64().unwrap() - max).abs() < 1e-14, "{e64} vs max {max}");
+    assert!((e64["rms_error"].as_f64().unwrap() - (ss / 153.0).sqrt()).abs() < 1e-14, "{e64} vs rms {}", (ss / 153.0).sqrt());
+    // The spec's objective is least squares: the reported objective is the rms.
+    assert_eq!(e64["objective"], e64["rms_error"]);
+    let (e32, v) = (fr["rounded_f32"]["max_abs_error"].as_f64().unwrap(), &b.verification);
+    assert_eq!(v.points, 33 * 17);
+    assert!(e32 <= v.max_abs_error_f32, "fitting samples {e32} > verification {}", v.max_abs_error_f32);
+    // f32 arithmetic on values ≤ ~4 (ulps of 2^-22 at most): above the f64 fit's 1e-12, far
+    // below 1e-5; the truth at most samples is no f32 (its denominators 1 + d·o are not powers
+    // of two), so the f32 code cannot be within 1e-9 of it at every sample.
+    assert!(e32 > 1e-9 && e32 < 1e-5, "{e32}");
+}
+
+
 /// generated/) evaluate the exact fields, at outer points off the fitting grid too; the fit
 /// alone (`fields::fit`) gives the coefficients and the report the build wrote; a fit spec is
 /// not read as fields.
