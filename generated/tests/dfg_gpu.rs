@@ -29,12 +29,9 @@ struct Lut {
     /// The WGSL (and CPU) texture-coordinate function.
     uv: &'static str,
     ktx2: &'static [u8],
-    /// Texels per axis (x, y[, z]).
-    size: Vec<u32>,
     cpu_uv: fn(&[f32]) -> Vec<f32>,
     cpu_sample: fn(&[f32]) -> [f32; 2],
     cpu_specular: fn(&[f32]) -> [f32; 3],
-    texel: fn(u32, u32, u32) -> [f32; 2],
     /// `scale = G − R` (Filament's layout): the specular's error triples.
     difference: bool,
 }
@@ -46,11 +43,9 @@ fn luts() -> Vec<Lut> {
             function: "ggx_dfg",
             uv: "ggx_dfg_uv",
             ktx2: sb::GGX_DFG_LUT_KTX2,
-            size: sb::GGX_DFG_LUT_SIZE.to_vec(),
             cpu_uv: |p| sb::ggx_dfg_uv(p[0], p[1]).to_vec(),
             cpu_sample: |p| sb::ggx_dfg(p[0], p[1]),
             cpu_specular: |p| sb::ggx_dfg_specular(F0, p[0], p[1]),
-            texel: |x, y, _| sb::ggx_dfg_texel(x, y),
             difference: false,
         },
         Lut {
@@ -58,11 +53,9 @@ fn luts() -> Vec<Lut> {
             function: "ggx_dfg_filament",
             uv: "ggx_dfg_filament_uv",
             ktx2: fil::GGX_DFG_LUT_FILAMENT_KTX2,
-            size: fil::GGX_DFG_LUT_FILAMENT_SIZE.to_vec(),
             cpu_uv: |p| fil::ggx_dfg_filament_uv(p[0], p[1]).to_vec(),
             cpu_sample: |p| fil::ggx_dfg_filament(p[0], p[1]),
             cpu_specular: |p| fil::ggx_dfg_filament_specular(F0, p[0], p[1]),
-            texel: |x, y, _| fil::ggx_dfg_filament_texel(x, y),
             difference: true,
         },
         Lut {
@@ -70,25 +63,30 @@ fn luts() -> Vec<Lut> {
             function: "ggx_cone_dfg",
             uv: "ggx_cone_dfg_uvw",
             ktx2: cone::GGX_CONE_LUT_KTX2,
-            size: cone::GGX_CONE_LUT_SIZE.to_vec(),
             cpu_uv: |p| cone::ggx_cone_dfg_uvw(p[0], p[1], p[2]).to_vec(),
             cpu_sample: |p| cone::ggx_cone_dfg(p[0], p[1], p[2]),
             cpu_specular: |p| cone::ggx_cone_dfg_specular(F0, p[0], p[1], p[2]),
-            texel: cone::ggx_cone_dfg_texel,
             difference: false,
         },
     ]
 }
 
+/// Texels per axis of the image: (width, height) or (width, height, depth).
+fn size(img: &skin::Ktx2Image) -> Vec<u32> {
+    if img.depth == 0 { vec![img.width, img.height] } else { vec![img.width, img.height, img.depth] }
+}
+
 /// The largest difference between neighbouring texels along each axis, over both channels,
 /// among the texels a linear filter at texture coordinates `uv` reads and one more on each side
-/// (so a coordinate that rounds across a texel centre on the GPU is covered too).
-fn local_steps(l: &Lut, uv: &[f32]) -> Vec<f32> {
-    let dims = l.size.len();
+/// (so a coordinate that rounds across a texel centre on the GPU is covered too). The texels are
+/// read by the runtime's KTX2 reader, which `tests/ggx.rs` checks against the emitted ones.
+fn local_steps(img: &skin::Ktx2Image, uv: &[f32]) -> Vec<f32> {
+    let size = size(img);
+    let dims = size.len();
     // Per axis: the filter's pair i0, i0 + 1 at x = u·n − 0.5, widened by one texel each way.
     let span: Vec<(u32, u32)> = (0..dims)
         .map(|a| {
-            let n = l.size[a] as i64;
+            let n = size[a] as i64;
             let i0 = (uv[a] * n as f32 - 0.5).floor() as i64;
             ((i0 - 1).clamp(0, n - 1) as u32, (i0 + 2).clamp(0, n - 1) as u32)
         })
@@ -98,13 +96,13 @@ fn local_steps(l: &Lut, uv: &[f32]) -> Vec<f32> {
     for z in range(2) {
         for y in range(1) {
             for x in range(0) {
-                let here = (l.texel)(x, y, z);
+                let here = img.texel_3d(x, y, z);
                 let at = [x, y, z];
                 for (a, s) in steps.iter_mut().enumerate() {
                     if at[a] < span[a].1 {
                         let mut next = at;
                         next[a] += 1;
-                        let t = (l.texel)(next[0], next[1], next[2]);
+                        let t = img.texel_3d(next[0], next[1], next[2]);
                         *s = s.max((t[0] - here[0]).abs()).max((t[1] - here[1]).abs());
                     }
                 }
@@ -149,9 +147,8 @@ fn shifted(library: &str, uv: &str, shift: &[f32]) -> String {
 }
 
 /// Run `_sample` and `_specular` of `library` on the GPU at `pts`: OUTS values a point.
-fn run_on_gpu(g: &gpu::Gpu, l: &Lut, view: &wgpu::TextureView, sampler: &wgpu::Sampler, library: &str, pts: &[f32]) -> Vec<f32> {
+fn run_on_gpu(g: &gpu::Gpu, l: &Lut, dims: usize, view: &wgpu::TextureView, sampler: &wgpu::Sampler, library: &str, pts: &[f32]) -> Vec<f32> {
     let device = &g.device;
-    let dims = l.size.len();
     let args: Vec<String> = (0..dims).map(|k| format!("inp[{dims}u * i + {k}u]")).collect();
     let args = args.join(", ");
     let shader = format!(
@@ -214,17 +211,17 @@ fn run_on_gpu(g: &gpu::Gpu, l: &Lut, view: &wgpu::TextureView, sampler: &wgpu::S
     bytemuck::pod_collect_to_vec(&bytes)
 }
 
-/// Per point: the largest |GPU − CPU| of the sample and of the specular over their bounds, and
-/// the two deviations.
-struct Judged {
-    /// Largest deviation / bound, sample and specular.
-    ratio: [f32; 2],
-    /// Largest deviation, sample and specular.
-    worst: [f32; 2],
+/// What the GPU's outputs at a point are judged against: the CPU lookups and their bounds.
+struct Reference {
+    sample: [f32; 2],
+    specular: [f32; 3],
+    sample_bound: f32,
+    specular_bound: f32,
 }
 
-fn judge(l: &Lut, pts: &[f32], out: &[f32]) -> Judged {
-    let dims = l.size.len();
+/// The references at `pts`, computed once for the shader and its shifted versions.
+fn references(l: &Lut, img: &skin::Ktx2Image, pts: &[f32]) -> Vec<Reference> {
+    let dims = size(img).len();
     // Texel magnitudes: scale, bias and scale + bias of a split sum all lie in [0, 1] (the f16
     // storage can round 1 up by at most half an ulp of 1, 2^-11); 1 + 2^-10 bounds them.
     let vmax = 1.0 + 2f32.powi(-10);
@@ -236,22 +233,38 @@ fn judge(l: &Lut, pts: &[f32], out: &[f32]) -> Judged {
     // most 2^-11 of vmax.
     let lerps = if dims == 2 { 3.0 } else { 7.0 };
     let rounding = 2.0 * lerps * 2f32.powi(-11) * vmax;
+    pts.chunks(dims)
+        .map(|p| {
+            // The sampler's weights quantised to the sub-texel precision Vulkan guarantees (>= 4
+            // bits: each weight within 2^-5 of exact) on each axis, times that axis's texel step
+            // here.
+            let steps = local_steps(img, &(l.cpu_uv)(p));
+            let sample_bound = rounding + steps.iter().map(|s| 2f32.powi(-5) * s).sum::<f32>();
+            // specular = f0·scale + bias with |f0| <= 1: both channels' errors (Filament's scale =
+            // G − R: three), and the product, the sum and the difference's roundings, 2 ulps of 2.
+            let specular_bound = if l.difference { 3.0 } else { 2.0 } * sample_bound + 3.0 * 2f32.powi(-23);
+            Reference { sample: (l.cpu_sample)(p), specular: (l.cpu_specular)(p), sample_bound, specular_bound }
+        })
+        .collect()
+}
+
+/// The largest |GPU − CPU| of the sample and of the specular over the points, and the largest
+/// ratio of each to its bound.
+struct Judged {
+    /// Largest deviation / bound, sample and specular.
+    ratio: [f32; 2],
+    /// Largest deviation, sample and specular.
+    worst: [f32; 2],
+}
+
+fn judge(module: &str, refs: &[Reference], out: &[f32]) -> Judged {
     let mut j = Judged { ratio: [0.0; 2], worst: [0.0; 2] };
-    for (p, o) in pts.chunks(dims).zip(out.chunks(OUTS)) {
-        assert!(o.iter().all(|v| v.is_finite()), "{} at {p:?}: {o:?}", l.module);
-        // The sampler's weights quantised to the sub-texel precision Vulkan guarantees (>= 4
-        // bits: each weight within 2^-5 of exact) on each axis, times that axis's texel step
-        // here.
-        let steps = local_steps(l, &(l.cpu_uv)(p));
-        let sample_bound = rounding + steps.iter().map(|s| 2f32.powi(-5) * s).sum::<f32>();
-        // specular = f0·scale + bias with |f0| <= 1: both channels' errors (Filament's scale =
-        // G − R: three), and the product, the sum and the difference's roundings, 2 ulps of 2.
-        let specular_bound = if l.difference { 3.0 } else { 2.0 } * sample_bound + 3.0 * 2f32.powi(-23);
-        let (t, s) = ((l.cpu_sample)(p), (l.cpu_specular)(p));
-        let ds = (0..2).map(|c| (o[c] - t[c]).abs()).fold(0.0f32, f32::max);
-        let dp = (0..3).map(|c| (o[2 + c] - s[c]).abs()).fold(0.0f32, f32::max);
+    for (k, (r, o)) in refs.iter().zip(out.chunks(OUTS)).enumerate() {
+        assert!(o.iter().all(|v| v.is_finite()), "{module} at point {k}: {o:?}");
+        let ds = (0..2).map(|c| (o[c] - r.sample[c]).abs()).fold(0.0f32, f32::max);
+        let dp = (0..3).map(|c| (o[2 + c] - r.specular[c]).abs()).fold(0.0f32, f32::max);
         j.worst = [j.worst[0].max(ds), j.worst[1].max(dp)];
-        j.ratio = [j.ratio[0].max(ds / sample_bound), j.ratio[1].max(dp / specular_bound)];
+        j.ratio = [j.ratio[0].max(ds / r.sample_bound), j.ratio[1].max(dp / r.specular_bound)];
     }
     j
 }
@@ -262,20 +275,22 @@ fn split_sum_lut_textures_sample_as_the_cpu_lookups_interpolate() {
     // Every LUT is measured and reported before any assertion.
     let mut failures = Vec::new();
     for l in luts() {
-        let dims = l.size.len();
         let img = skin::Ktx2Image::parse(l.ktx2).expect("the module's KTX2");
+        let size = size(&img);
+        let dims = size.len();
         assert_eq!(img.format, skin::LutFormat::Rg16Float, "{}", l.module);
         let texture = skin::create_lut_texture(&g.device, &g.queue, l.module, l.ktx2).expect("an RG16F texture uploads");
         let view = texture.create_view(&Default::default());
         let sampler = skin::lut_sampler(&g.device);
         let library = compose(&[l.module]).unwrap();
         let pts = points(dims);
-        let j = judge(&l, &pts, &run_on_gpu(&g, &l, &view, &sampler, &library, &pts));
+        let refs = references(&l, &img, &pts);
+        let j = judge(l.module, &refs, &run_on_gpu(&g, &l, dims, &view, &sampler, &library, &pts));
         report(&format!(
             "{} ({dims}-D RG16F {:?}, {} points): |sample - CPU| max {:.3e} (largest deviation/bound {:.3}); |specular - CPU| max {:.3e} ({:.3})",
             l.module,
-            l.size,
-            pts.len() / dims,
+            size,
+            refs.len(),
             j.worst[0],
             j.ratio[0],
             j.worst[1],
@@ -286,9 +301,9 @@ fn split_sum_lut_textures_sample_as_the_cpu_lookups_interpolate() {
         }
         // Coordinates half a texel off on one axis: caught on every axis.
         for a in 0..dims {
-            let shift: Vec<f32> = (0..dims).map(|b| if a == b { 0.5 / l.size[a] as f32 } else { 0.0 }).collect();
+            let shift: Vec<f32> = (0..dims).map(|b| if a == b { 0.5 / size[a] as f32 } else { 0.0 }).collect();
             let moved = shifted(&library, l.uv, &shift);
-            let j = judge(&l, &pts, &run_on_gpu(&g, &l, &view, &sampler, &moved, &pts));
+            let j = judge(l.module, &refs, &run_on_gpu(&g, &l, dims, &view, &sampler, &moved, &pts));
             report(&format!("{}: coordinates half a texel off on axis {a}: largest deviation/bound {:.1}", l.module, j.ratio[0]));
             if j.ratio[0] <= 1.0 {
                 failures.push(format!("{}: half a texel off on axis {a} passes the bound", l.module));
