@@ -629,12 +629,29 @@ mod tests {
     /// 100001 points of the interval, and its ends are reached within the sampling's error
     /// (spacing ≤ 1.5e-4, so cos/sin at the nearest sample lie within (7.5e-5)²/2 ≈ 2.8e-9 of
     /// an interior extremum; affine ends are sampled exactly). Intervals inside one period, across one
-    /// or both extrema, over several periods, and negative.
+    /// or both extrema, over several periods, and negative; and intervals in periods other than
+    /// the first, where the extremum's position is the period index k ≠ 0 times 2π (plus π for
+    /// cos's −1): cos −1 at −3π in [−10, −9], 1 at 2π in [6, 6.5], neither in [4, 5], [10.5,
+    /// 11.5] or [20, 21]; sin −1 at 3π/2 in [4, 5] and 7π/2 in [10.5, 11.5], 1 at 13π/2 in
+    /// [20, 21].
     #[test]
     fn derived_ranges_are_tight_against_dense_sampling() {
         let inputs = vec!["x".to_string()];
         let features = ["cos(x)", "sin(x)", "1 - 2*x", "0.5 + 3*x", "x"];
-        let intervals = [(0.5, 5.5), (0.1, 1.5), (-0.5, 4.0), (2.0, 9.0), (-7.0, -6.0), (1.0, 1.0 + 1e-3), (-3.0, 12.0)];
+        let intervals = [
+            (0.5, 5.5),
+            (0.1, 1.5),
+            (-0.5, 4.0),
+            (2.0, 9.0),
+            (-7.0, -6.0),
+            (1.0, 1.0 + 1e-3),
+            (-3.0, 12.0),
+            (4.0, 5.0),
+            (-10.0, -9.0),
+            (6.0, 6.5),
+            (10.5, 11.5),
+            (20.0, 21.0),
+        ];
         for text in features {
             let d = Derived::parse("d", text, &inputs).unwrap();
             for &(lo, hi) in &intervals {
