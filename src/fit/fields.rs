@@ -485,8 +485,10 @@ fn outer_step(
 /// Levenberg–Marquardt on the normal equations (JᵀJ + λ·diag(JᵀJ)) δ = −Jᵀr, solved by
 /// Cholesky. The joint system is small in parameters (a few hundred) and tall in residuals;
 /// forming JᵀJ with a blocked product is far cheaper than a column-pivoted QR of J each
-/// iteration, and the Marquardt scaling keeps the solve well-posed. Returns the number of
-/// residual evaluations.
+/// iteration, and the Marquardt scaling keeps the solve well-posed. A trial is taken only when
+/// it lowers the cost; each refused trial multiplies λ (from 1e-4) by 4, and a point no trial
+/// improves before λ reaches 1e16 ends the solve. Returns the number of residual evaluations
+/// (the start's and every trial's).
 fn solve_joint(fields: &mut Fields<'_>, max_iters: usize, what: &str) -> Result<usize, FitError> {
     let mut theta = fields.theta.clone();
     let mut cost = fields.cost(&theta);
@@ -926,6 +928,33 @@ mod tests {
         assert!(!a_finite, "JᵀJ was expected to overflow");
         assert_eq!(evals, Some(1), "no trial can be evaluated without a factorisation");
         assert!(unchanged, "the start must be kept");
+    }
+
+    /// A trial is taken only when it lowers the cost. With every system zero (the exact
+    /// problem's scaled by 0) the cost at the true coefficients is exactly 0 (no denominator is
+    /// near Q_MIN) and so is the gradient: every trial is the start itself, at the same cost, and
+    /// is refused. λ grows from 1e-4 by 4 a refusal; the solve ends when it reaches 1e16, having
+    /// evaluated the start and each trial below that (counted here from the documented
+    /// schedule), with the start kept bit for bit. A solver that took equal-cost trials as
+    /// progress would stop after a few "steps" of gain 0 instead.
+    #[test]
+    fn a_trial_that_does_not_lower_the_cost_is_refused() {
+        let (x, data) = problem();
+        let models: Vec<RationalModel> = OFFSETS.iter().map(|&o| field(o)).collect();
+        let systems: Vec<Reduced> = data
+            .iter()
+            .map(|d| {
+                let e = reduce(&d.design, &d.y, None);
+                let r = &e.r * 0.0;
+                Reduced { rtr: r.tr_mul(&r), r, z: &e.z * 0.0, floor: 0.0 }
+            })
+            .collect();
+        let theta = DVector::from_vec(TRUE.iter().flatten().copied().collect());
+        let mut f = Fields::new(&models, &x, systems, theta.clone());
+        assert_eq!(f.cost(&theta), 0.0);
+        let trials = std::iter::successors(Some(1e-4f64), |l| Some(l * 4.0)).take_while(|&l| l < 1e16).count();
+        assert_eq!(solve_joint(&mut f, 500, "flat").unwrap(), 1 + trials);
+        assert_eq!(f.theta, theta);
     }
 
     /// With a denominator driven below Q_MIN the barrier residuals join the normal equations:
