@@ -415,6 +415,31 @@ mod tests {
         assert!(tight.reoptimised.max_abs_error <= tight.rounded.max_abs_error, "{tight:?}");
     }
 
+    /// `max_sweeps` caps the sweeps exactly: 0 keeps the nearest f32 vector (no sweep, the one
+    /// evaluation of the start), and a cap of k below the uncapped run's sweep count stops after
+    /// k sweeps, with a result no worse than the start's and no better than the uncapped one's
+    /// (the same first k sweeps; each sweep only accepts improvements).
+    #[test]
+    fn the_sweep_cap_is_held_exactly() {
+        let (m, c, d) = cancelling(Objective::Minimax);
+        let run = |max_sweeps| {
+            let opts = RoundOptions { max_sweeps, ..RoundOptions::new(Objective::Minimax, None) };
+            round_and_reoptimise(&m, &c, &d, &[(8.0, 9.0)], &opts, "quartic").unwrap()
+        };
+        let free = run(100);
+        assert!(free.sweeps >= 2, "the uncapped search needs more than one sweep here: {free:?}");
+        let none = run(0);
+        let (start, _) = rounded(&m, &c);
+        assert_eq!((none.num.as_slice(), none.sweeps, none.evaluations), (start.as_slice(), 0, 1));
+        assert_eq!(none.reoptimised, none.rounded);
+        for k in 1..free.sweeps {
+            let capped = run(k);
+            assert_eq!(capped.sweeps, k);
+            let e = capped.reoptimised.max_abs_error;
+            assert!(e <= none.rounded.max_abs_error && e >= free.reoptimised.max_abs_error, "{k} sweeps: {capped:?}");
+        }
+    }
+
     /// The search tries the moves the module documents and no others (one coefficient by ±1,
     /// ±2, ±4, …, ±max_ulps ulps, within max_ulps of its rounded value: its evaluation count
     /// is bounded by theirs), and where the sweeps stop before `max_sweeps`, none of those
