@@ -771,6 +771,21 @@ mod tests {
 
     /// Start set c takes candidate c of every field that has one and the last candidate of
     /// each field that has fewer, in field order.
+    /// A least-squares fields fit is returned only with every denominator proven positive on
+    /// the data's domain. Exact fields whose first denominator is 1 − 1.5x, zero at x = 2/3
+    /// inside [0, 1] (between the samples 0.65 and 0.7), are refused with a pole in field 0:
+    /// whatever the fit found, its first denominator was not proven positive.
+    #[test]
+    fn a_least_squares_fit_with_a_pole_in_the_domain_is_refused() {
+        let a = TRUE[0];
+        let (x, data) = problem_on(20, |x| OFFSETS[0] + x * (a[0] + a[1] * x + a[2] * x * x) / (1.0 - 1.5 * x), |_, _| 0.0);
+        let models: Vec<RationalModel> = OFFSETS.iter().map(|&o| field(o)).collect();
+        match fit_fields(&models, &x, &data, &FieldOptions::default(), "pole") {
+            Err(FitError::PoleInDomain { what, lower, .. }) => assert!(what == "pole (field 0)" && !(lower > 1e-12), "{what}: lower {lower}"),
+            other => panic!("expected a pole in field 0, got {other:?}"),
+        }
+    }
+
     #[test]
     fn a_field_with_fewer_candidates_lends_its_last_to_later_start_sets() {
         let v = |s: &[f64]| DVector::from_row_slice(s);

@@ -292,6 +292,41 @@ mod tests {
         assert_eq!(st.get_cost(), m0);
     }
 
+    /// One residual with a cliff: t itself from 0.5 up, 10 below (the Jacobian 1 everywhere).
+    struct Cliff;
+
+    impl Operator for Cliff {
+        type Param = DVector<f64>;
+        type Output = DVector<f64>;
+        fn apply(&self, t: &DVector<f64>) -> Result<DVector<f64>, Error> {
+            Ok(DVector::from_element(1, if t[0] >= 0.5 { t[0] } else { 10.0 }))
+        }
+    }
+
+    impl Jacobian for Cliff {
+        type Param = DVector<f64>;
+        type Jacobian = DMatrix<f64>;
+        fn jacobian(&self, _: &DVector<f64>) -> Result<DMatrix<f64>, Error> {
+            Ok(DMatrix::from_element(1, 1, 1.0))
+        }
+    }
+
+    /// A refused step shrinks the trust region by 4 and the step is tried again within one
+    /// iteration. From t = 1 with the region at 1 (its bound ρ·|t| = 1), the LP steps to 0,
+    /// over the cliff (max 10 against the predicted 0): refused. Within ρ = 1/4 it steps to
+    /// 0.75 exactly, the max falling as predicted: taken, at the bound with a ratio above 3/4,
+    /// so the region doubles to 1/2.
+    #[test]
+    fn a_refused_step_is_retried_in_a_smaller_region() {
+        let res = argmin::core::Executor::new(Cliff, SlpMinimax { rho: 1.0, converged: false })
+            .configure(|s| s.param(DVector::from_element(1, 1.0)).max_iters(1))
+            .run()
+            .unwrap();
+        let st = res.state();
+        assert_eq!((st.get_param().map(|t| t[0]), st.get_cost()), (Some(0.75), 0.75));
+        assert_eq!(res.solver().rho, 0.5);
+    }
+
     /// R̃'s form (fits/fuzz_r.toml) over α ∈ [0.15, 1], θ ∈ [0, π/2]: γ = cos θ is 6e-17 at the
     /// last grid column and γ³ is 2e-49 there, so the Jacobian's rows span ~1e49.
     fn r_form() -> RationalModel {
