@@ -769,8 +769,6 @@ mod tests {
         (xs.iter().map(|&x| vec![x]).collect(), data)
     }
 
-    /// Start set c takes candidate c of every field that has one and the last candidate of
-    /// each field that has fewer, in field order.
     /// A least-squares fields fit is returned only with every denominator proven positive on
     /// the data's domain. Exact fields whose first denominator is 1 − 1.5x, zero at x = 2/3
     /// inside [0, 1] (between the samples 0.65 and 0.7), are refused with a pole in field 0:
@@ -786,6 +784,8 @@ mod tests {
         }
     }
 
+    /// Start set c takes candidate c of every field that has one and the last candidate of
+    /// each field that has fewer, in field order.
     #[test]
     fn a_field_with_fewer_candidates_lends_its_last_to_later_start_sets() {
         let v = |s: &[f64]| DVector::from_row_slice(s);
@@ -908,6 +908,17 @@ mod tests {
         assert!(unproven_improvement);
     }
 
+    /// Each point's reduced system with its residuals scaled by s (R and z by s, the floor by s²).
+    fn scaled_systems(data: &[PointData], s: f64) -> Vec<Reduced> {
+        data.iter()
+            .map(|d| {
+                let e = reduce(&d.design, &d.y, None);
+                let r = &e.r * s;
+                Reduced { rtr: r.tr_mul(&r), r, z: &e.z * s, floor: e.floor * s * s }
+            })
+            .collect()
+    }
+
     /// A joint solve whose damped normal matrix cannot be factored at any damping stops and
     /// keeps its start: the damping grows until it gives up, without evaluating a trial.
     /// The systems are the exact problem's scaled by s = 1e160, so the cost at the true
@@ -919,15 +930,7 @@ mod tests {
         std::thread::spawn(move || {
             let (x, data) = problem();
             let models: Vec<RationalModel> = OFFSETS.iter().map(|&o| field(o)).collect();
-            let s = 1e160;
-            let systems: Vec<Reduced> = data
-                .iter()
-                .map(|d| {
-                    let e = reduce(&d.design, &d.y, None);
-                    let r = &e.r * s;
-                    Reduced { rtr: r.tr_mul(&r), r, z: &e.z * s, floor: e.floor * s * s }
-                })
-                .collect();
+            let systems = scaled_systems(&data, 1e160);
             let theta = DVector::from_vec(TRUE.iter().flatten().copied().collect());
             let mut f = Fields::new(&models, &x, systems, theta.clone());
             let cost = f.cost(&theta);
@@ -956,14 +959,7 @@ mod tests {
     fn a_trial_that_does_not_lower_the_cost_is_refused() {
         let (x, data) = problem();
         let models: Vec<RationalModel> = OFFSETS.iter().map(|&o| field(o)).collect();
-        let systems: Vec<Reduced> = data
-            .iter()
-            .map(|d| {
-                let e = reduce(&d.design, &d.y, None);
-                let r = &e.r * 0.0;
-                Reduced { rtr: r.tr_mul(&r), r, z: &e.z * 0.0, floor: 0.0 }
-            })
-            .collect();
+        let systems = scaled_systems(&data, 0.0);
         let theta = DVector::from_vec(TRUE.iter().flatten().copied().collect());
         let mut f = Fields::new(&models, &x, systems, theta.clone());
         assert_eq!(f.cost(&theta), 0.0);

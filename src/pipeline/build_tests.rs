@@ -429,7 +429,7 @@ fn a_fields_builds_rounding_report_is_its_errors_on_the_fitting_samples() {
     assert!(e32 > 1e-9 && e32 < 1e-5, "{e32}");
 }
 
-
+/// The committed fields read back by name (`committed::Fields::load`: fits/NAME.toml beside
 /// generated/) evaluate the exact fields, at outer points off the fitting grid too; the fit
 /// alone (`fields::fit`) gives the coefficients and the report the build wrote; a fit spec is
 /// not read as fields.
