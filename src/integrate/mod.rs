@@ -140,4 +140,75 @@ mod tests {
             assert!((wsum - 2.0).abs() < 1e-14 * n as f64);
         }
     }
+
+    /// The rules of up to five nodes against their closed forms (Abramowitz & Stegun 25.4.29,
+    /// Table 25.4): n = 4's nodes √(3/7 ∓ (2/7)√(6/5)) with weights (18 ± √30)/36, n = 5's
+    /// (1/3)√(5 ∓ 2√(10/7)) with (322 ± 13√70)/900 and 0 with 128/225.
+    #[test]
+    fn the_small_rules_are_their_closed_forms() {
+        let s = f64::sqrt;
+        let n4_in = s(3.0 / 7.0 - 2.0 / 7.0 * s(6.0 / 5.0));
+        let n4_out = s(3.0 / 7.0 + 2.0 / 7.0 * s(6.0 / 5.0));
+        let n5_in = s(5.0 - 2.0 * s(10.0 / 7.0)) / 3.0;
+        let n5_out = s(5.0 + 2.0 * s(10.0 / 7.0)) / 3.0;
+        let (w4_in, w4_out) = ((18.0 + s(30.0)) / 36.0, (18.0 - s(30.0)) / 36.0);
+        let (w5_in, w5_out) = ((322.0 + 13.0 * s(70.0)) / 900.0, (322.0 - 13.0 * s(70.0)) / 900.0);
+        let cases: [(Vec<f64>, Vec<f64>); 5] = [
+            (vec![0.0], vec![2.0]),
+            (vec![-1.0 / s(3.0), 1.0 / s(3.0)], vec![1.0, 1.0]),
+            (vec![-s(0.6), 0.0, s(0.6)], vec![5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0]),
+            (vec![-n4_out, -n4_in, n4_in, n4_out], vec![w4_out, w4_in, w4_in, w4_out]),
+            (
+                vec![-n5_out, -n5_in, 0.0, n5_in, n5_out],
+                vec![w5_out, w5_in, 128.0 / 225.0, w5_in, w5_out],
+            ),
+        ];
+        for (i, (xs, ws)) in cases.iter().enumerate() {
+            let (x, w) = gauss_legendre(i + 1);
+            // Each closed form is a few correctly rounded operations (≤ 4 ulps) and the rule
+            // is within a few ε of the roots at this size (module doc): 8 ε relative holds both.
+            for (got, want) in x.iter().zip(xs).chain(w.iter().zip(ws)) {
+                let tol = 8.0 * f64::EPSILON * want.abs().max(f64::MIN_POSITIVE);
+                assert!((got - want).abs() <= tol, "n={}: {got:e} vs closed form {want:e}", i + 1);
+            }
+        }
+    }
+
+    /// Every monomial up to the rule's degree 2n − 1 is integrated to the accuracy the module
+    /// doc claims for the weights, at the sizes the integrals and the benchmarks use.
+    #[test]
+    fn the_rules_are_exact_to_their_degree_within_the_documented_accuracy() {
+        // (n, the documented relative error of the weights, in ε)
+        for (n, weight_eps) in [(16usize, 10.0), (48, 4e2), (64, 4e2)] {
+            let (x, w) = gauss_legendre(n);
+            assert!(x.windows(2).all(|p| p[0] < p[1]), "n={n}: nodes not ascending");
+            for k in 0..2 * n {
+                let got: f64 = x.iter().zip(&w).map(|(x, w)| w * x.powi(k as i32)).sum();
+                let exact = if k % 2 == 1 { 0.0 } else { 2.0 / (k as f64 + 1.0) };
+                // Σ w|x^k| ≤ 2: the weights' relative error moves the sum by at most 2·that,
+                // and the n-term sum's rounding by at most 2·n·ε.
+                let tol = 2.0 * (weight_eps + n as f64) * f64::EPSILON;
+                assert!((got - exact).abs() <= tol, "n={n}, x^{k}: {got:e} vs {exact:e}");
+            }
+        }
+    }
+
+    /// One degree past exactness the rule's error is the Gauss remainder, in closed form for
+    /// x^{2n}: ∫ − Q = 2^{2n+1} (n!)⁴ / ((2n + 1) ((2n)!)²) = 2^{2n+1} / ((2n + 1) C(2n, n)²)
+    /// (Abramowitz & Stegun 25.4.30 with f^{(2n)} = (2n)!).
+    #[test]
+    fn one_degree_past_exactness_the_error_is_the_gauss_remainder() {
+        for n in [1usize, 2, 3, 5, 8, 12, 16] {
+            let (x, w) = gauss_legendre(n);
+            let q: f64 = x.iter().zip(&w).map(|(x, w)| w * x.powi(2 * n as i32)).sum();
+            let got = 2.0 / (2.0 * n as f64 + 1.0) - q;
+            // C(2n, n) by the exact product C(2j, j) = C(2j − 2, j − 1)·(2j)(2j − 1)/j² (an
+            // integer below 2^53 for n ≤ 16, each step exact).
+            let c = (1..=n).fold(1.0, |c: f64, j| c * (2 * j * (2 * j - 1)) as f64 / (j * j) as f64);
+            let want = 2f64.powi(2 * n as i32 + 1) / ((2.0 * n as f64 + 1.0) * c * c);
+            // The remainder at n = 16 is 7e-10; the difference of two O(1) sums carries
+            // ~n ε ≈ 4e-15 of rounding, so 1e-4 relative holds every n here.
+            assert!((got - want).abs() <= 1e-4 * want, "n={n}: remainder {got:e}, closed form {want:e}");
+        }
+    }
 }
