@@ -90,21 +90,32 @@ fn lp_step(r: &DVector<f64>, j: &DMatrix<f64>, bounds: &[f64], rows: &[usize]) -
     let mut lp = Lp::new(OptimizationDirection::Minimize);
     let units: Vec<_> = bounds.iter().map(|_| lp.add_var(0.0, (-1.0, 1.0))).collect();
     let sigma = lp.add_var(1.0, (-m / s, f64::INFINITY));
-    for ((&i, row), &reach) in rows.iter().zip(&a).zip(&reach) {
-        for sign in [1.0, -1.0] {
-            if sign * r[i] + reach < m - s {
-                continue;
-            }
-            let mut c: Vec<(microlp::Variable, f64)> = row.iter().map(|&(k, v)| (units[k], sign * v / s)).collect();
-            c.push((sigma, -1.0));
-            lp.add_constraint(&c, ComparisonOp::Le, (m - sign * r[i]) / s);
-        }
+    let r_rows: Vec<f64> = rows.iter().map(|&i| r[i]).collect();
+    for (k, sign) in sides_that_can_bind(&r_rows, &reach, m, s) {
+        let mut c: Vec<(microlp::Variable, f64)> = a[k].iter().map(|&(col, v)| (units[col], sign * v / s)).collect();
+        c.push((sigma, -1.0));
+        lp.add_constraint(&c, ComparisonOp::Le, (m - sign * r_rows[k]) / s);
     }
     let outcome = lp.solve().ok()?;
     let sol = outcome.solution()?;
     let delta = DVector::from_iterator(units.len(), units.iter().zip(bounds).map(|(&u, &b)| sol[u].clamp(-1.0, 1.0) * b));
     let linearised = rows.iter().fold(0.0_f64, |x, &i| x.max((r[i] + j.row(i).dot(&delta.transpose())).abs()));
     Some((delta, linearised))
+}
+
+/// The sides ±(r_k + a_k·u) ≤ t of the LP that can bind, as (row, sign) in row order, + before
+/// −: a side with ±r_k + reach_k < m − S is left out ([`lp_step`]'s first reduction), where
+/// reach_k = Σ_j |a_kj|, m = max |r_k| and S = max reach_k.
+fn sides_that_can_bind(r: &[f64], reach: &[f64], m: f64, s: f64) -> Vec<(usize, f64)> {
+    let mut sides = Vec::with_capacity(2 * r.len());
+    for (k, (&rk, &reach)) in r.iter().zip(reach).enumerate() {
+        for sign in [1.0, -1.0] {
+            if sign * rk + reach >= m - s {
+                sides.push((k, sign));
+            }
+        }
+    }
+    sides
 }
 
 impl<O> Solver<O, St> for SlpMinimax
@@ -212,6 +223,18 @@ mod tests {
         fn jacobian(&self, _: &DVector<f64>) -> Result<DMatrix<f64>, Error> {
             Ok(DMatrix::from_fn(self.0.len(), 2, |i, j| if j == 0 { 1.0 } else { self.0[i] }))
         }
+    }
+
+    /// The LP keeps every side that can bind and only those: with m = 1 and S = ½, a side binds
+    /// at most where ±r + reach reaches m − S = ½ (all values dyadic, so every sum is exact):
+    /// r = (1, −¼, ⅝, −¼), reach = (¼, ½, ⅛, ¼) give +: 1¼, ¼, ¾, 0 and −: −¾, ¾, −½, ½ (the
+    /// last exactly at the bound, kept).
+    #[test]
+    fn the_lp_keeps_exactly_the_sides_that_can_bind() {
+        let sides = sides_that_can_bind(&[1.0, -0.25, 0.625, -0.25], &[0.25, 0.5, 0.125, 0.25], 1.0, 0.5);
+        assert_eq!(sides, [(0, 1.0), (1, -1.0), (2, 1.0), (3, -1.0)]);
+        // Nothing within reach of the largest residual is left out: with S ≥ m every side stays.
+        assert_eq!(sides_that_can_bind(&[0.5, -1.0], &[1.0, 1.0], 1.0, 1.0).len(), 4);
     }
 
     #[test]
