@@ -1178,6 +1178,17 @@ mod tests {
         assert!(text.ends_with("}\n"));
     }
 
+    /// Arrays that are not all numbers are left as serde_json's pretty printer writes them:
+    /// numbers before a string, an array or an object in the same array are not gathered.
+    #[test]
+    fn arrays_not_all_numbers_stay_pretty() {
+        let v = json!({"mixed": [1.0, "x", 2.0], "ragged": [0.5, [1.0, 2.0]], "records": [3, {"k": 4}], "words": ["a", "b"]});
+        let text = compact_json(&v);
+        // Only the inner all-number array [1.0, 2.0] is gathered onto one line.
+        assert_eq!(text, json_text(&v).replace("[\n      1.0,\n      2.0\n    ]", "[1.0, 2.0]"), "{text}");
+        assert_eq!(serde_json::from_str::<Value>(&text).unwrap(), v);
+    }
+
     /// Max abs, rms and worst point worked out by hand; errors of either sign count.
     #[test]
     fn measure_is_max_rms_and_worst_point() {
