@@ -964,6 +964,25 @@ mod tests {
         }
     }
 
+    /// As many samples as free parameters are enough: the fit interpolates them (here the
+    /// rational (1 + x)/(1 + x/2) through three of its points, [1/1] having three free
+    /// coefficients); one sample fewer is refused as underdetermined, naming both counts.
+    #[test]
+    fn as_many_samples_as_parameters_are_interpolated_and_fewer_refused() {
+        let model = RationalModel::rational_1d("x", 1, 1);
+        assert_eq!(model.n_free(), 3);
+        let data = |xs: &[f64]| Data { x: xs.iter().map(|&x| vec![x]).collect(), y: xs.iter().map(|&x| (1.0 + x) / (1.0 + 0.5 * x)).collect() };
+        let f = fit(&model, &data(&[0.0, 1.0, 2.0]), &FitOptions::default(), "three").unwrap();
+        // Three equations in three unknowns, consistent: solved to rounding (condition ~10).
+        for (got, want) in f.coefficients.iter().zip([1.0, 1.0, 0.5]) {
+            assert!((got - want).abs() < 1e-12, "{:?}", f.coefficients);
+        }
+        match fit(&model, &data(&[0.0, 1.0]), &FitOptions::default(), "two") {
+            Err(FitError::Underdetermined { what, n: 2, p: 3 }) => assert_eq!(what, "two"),
+            other => panic!("{other:?}"),
+        }
+    }
+
     /// Data that is all zero has no scale to take out: the fit is the zero rational (the
     /// numerator 0, the denominator free but finite), and the report says zero error.
     #[test]
