@@ -73,12 +73,14 @@ fn working_set(r: &DVector<f64>, n_params: usize) -> Vec<usize> {
 ///   kept, they make rows span 1e49 and most LPs then fail (a stalled or cycling dual simplex
 ///   after thousands of pivots), each failure shrinking the trust region.
 fn lp_step(r: &DVector<f64>, j: &DMatrix<f64>, bounds: &[f64], rows: &[usize]) -> Option<(DVector<f64>, f64)> {
-    let m = rows.iter().fold(0.0_f64, |a, &i| a.max(r[i].abs()));
+    let r_rows: Vec<f64> = rows.iter().map(|&i| r[i]).collect();
+    let m = r_rows.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
     let a: Vec<Vec<(usize, f64)>> = rows
         .iter()
-        .map(|&i| {
+        .zip(&r_rows)
+        .map(|(&i, ri)| {
             let row: Vec<(usize, f64)> = bounds.iter().enumerate().map(|(k, &b)| (k, j[(i, k)] * b)).filter(|(_, v)| *v != 0.0).collect();
-            let size = r[i].abs() + row.iter().map(|(_, v)| v.abs()).sum::<f64>();
+            let size = ri.abs() + row.iter().map(|(_, v)| v.abs()).sum::<f64>();
             row.into_iter().filter(|(_, v)| v.abs() > f64::EPSILON * size).collect()
         })
         .collect();
@@ -90,7 +92,6 @@ fn lp_step(r: &DVector<f64>, j: &DMatrix<f64>, bounds: &[f64], rows: &[usize]) -
     let mut lp = Lp::new(OptimizationDirection::Minimize);
     let units: Vec<_> = bounds.iter().map(|_| lp.add_var(0.0, (-1.0, 1.0))).collect();
     let sigma = lp.add_var(1.0, (-m / s, f64::INFINITY));
-    let r_rows: Vec<f64> = rows.iter().map(|&i| r[i]).collect();
     for (k, sign) in sides_that_can_bind(&r_rows, &reach, m, s) {
         let mut c: Vec<(microlp::Variable, f64)> = a[k].iter().map(|&(col, v)| (units[col], sign * v / s)).collect();
         c.push((sigma, -1.0));

@@ -126,13 +126,18 @@ pub fn adaptive(a: f64, b: f64, tol: Tolerance, mut f: impl FnMut(f64) -> f64) -
 mod tests {
     use super::*;
 
+    /// The rule (x, w) applied to the monomial x^k: Σ w_i x_i^k, in node order.
+    fn rule_sum(x: &[f64], w: &[f64], k: usize) -> f64 {
+        x.iter().zip(w).map(|(x, w)| w * x.powi(k as i32)).sum()
+    }
+
     #[test]
     fn gauss_legendre_integrates_polynomials_exactly() {
         // An n-point rule is exact for degree 2n-1; the bound is f64 rounding of an n-term sum.
         for n in [1usize, 2, 5, 16, 64, 200] {
             let (x, w) = gauss_legendre(n);
             let deg = 2 * n - 1;
-            let got: f64 = x.iter().zip(&w).map(|(x, w)| w * x.powi(deg as i32 - 1)).sum();
+            let got = rule_sum(&x, &w, deg - 1);
             // ∫_{-1}^{1} x^{2n-2} dx = 2/(2n-1)
             let exact = 2.0 / (deg as f64);
             assert!((got - exact).abs() < 1e-14 * n as f64, "n={n}: {got} vs {exact}");
@@ -183,7 +188,7 @@ mod tests {
             let (x, w) = gauss_legendre(n);
             assert!(x.windows(2).all(|p| p[0] < p[1]), "n={n}: nodes not ascending");
             for k in 0..2 * n {
-                let got: f64 = x.iter().zip(&w).map(|(x, w)| w * x.powi(k as i32)).sum();
+                let got = rule_sum(&x, &w, k);
                 let exact = if k % 2 == 1 { 0.0 } else { 2.0 / (k as f64 + 1.0) };
                 // Σ w|x^k| ≤ 2: the weights' relative error moves the sum by at most 2·that;
                 // the n-term sum's rounding and powi's (≤ 2·log2(k) ≤ 14 ε relative, within
@@ -201,7 +206,7 @@ mod tests {
     fn one_degree_past_exactness_the_error_is_the_gauss_remainder() {
         for n in [1usize, 2, 3, 5, 8, 12, 16] {
             let (x, w) = gauss_legendre(n);
-            let q: f64 = x.iter().zip(&w).map(|(x, w)| w * x.powi(2 * n as i32)).sum();
+            let q = rule_sum(&x, &w, 2 * n);
             let got = 2.0 / (2.0 * n as f64 + 1.0) - q;
             // C(2n, n) by the exact product C(2j, j) = C(2j − 2, j − 1)·(2j)(2j − 1)/j² (an
             // integer below 2^53 for n ≤ 16, each step exact).
