@@ -738,6 +738,21 @@ mod tests {
         assert_eq!(flat, [("K".into(), vec![half]), ("R".into(), vec![half]), ("RR".into(), vec![half]), ("V".into(), vec![half, Literal::F32(2.0)])]);
     }
 
+    /// A splat inside a composite (`vec3<f32>(1.0)` in an array of vectors, kept as
+    /// `Expression::Splat` by the WGSL front end) flattens to its value repeated once per
+    /// component of its own vector, not of the whole array: the composite's count divided
+    /// among its components.
+    #[test]
+    fn splats_inside_composites_fill_their_own_vector() {
+        let wgsl = "const T = array<vec3<f32>, 2>(vec3<f32>(1.0), vec3<f32>(2.0, 3.0, 4.0));\n";
+        let m = naga::front::wgsl::parse_str(wgsl).unwrap();
+        let splats = m.global_expressions.iter().filter(|(_, e)| matches!(e, naga::Expression::Splat { .. })).count();
+        assert_eq!(splats, 1, "the front end no longer keeps the splat: the test does not reach it");
+        let flat: Vec<_> = named_constants(&m).into_iter().map(|f| f.map(|f| (f.name, f.dims, f.values))).collect();
+        let v = [1.0, 1.0, 1.0, 2.0, 3.0, 4.0].map(Literal::F32).to_vec();
+        assert_eq!(flat, [Some(("T".to_string(), vec![2, 3], v))]);
+    }
+
     #[test]
     fn target_names_round_trip_and_lists_are_sorted() {
         for t in Target::ALL {
