@@ -1083,6 +1083,32 @@ mod tests {
         }
     }
 
+    /// Inputs far from one are rescaled only where every monomial of a term scales alike: a
+    /// term x + x² (one coefficient, the monomials scaling by 2^70 and 2^140) is not, so data
+    /// 2^70 in input is fitted as given, bit for bit [`fit`]'s fit, and an exact rational
+    /// (1 + 2^-141·(x + x²))/(1 + 0.3·2^-70·x) is recovered in the data's units. Scaling x
+    /// there would fit (1 + 2^-71·t + ½t²)/(1 + 0.3t) of t = x/2^70 by a single coefficient on
+    /// t + t², which it cannot represent.
+    #[test]
+    fn a_term_whose_monomials_scale_unlike_is_fitted_unscaled() {
+        let xs = 2f64.powi(70);
+        let want = [1.0, 0.5 / (xs * xs), 0.3 / xs];
+        let model = RationalModel::new(parts_1d(&["1", "x + x^2"], &["x"])).unwrap();
+        let x: Vec<Vec<f64>> = (0..=40).map(|i| vec![xs * i as f64 / 20.0]).collect();
+        let y = |x: f64| (want[0] + want[1] * (x + x * x)) / (1.0 + want[2] * x);
+        let data = Data { y: x.iter().map(|p| y(p[0])).collect(), x };
+        let opts = FitOptions::default();
+        let f = fit_rescaled(&model, &data, &opts, "unlike").unwrap();
+        let g = fit(&model, &data, &opts, "unlike").unwrap();
+        let bits = |c: &DVector<f64>| c.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&f.coefficients), bits(&g.coefficients));
+        for (c, w) in f.coefficients.iter().zip(&want) {
+            // Exact data; LM scales its columns, so the raw units cost it little: 1e-9 relative
+            // is far inside the misfit of the scaled model (order one in the values).
+            assert!((c - w).abs() <= 1e-9 * w.abs(), "{c:e} vs {w:e}");
+        }
+    }
+
     /// A fixed numerator coefficient of data far from one (values ~2⁻⁵⁰) holds in the data's
     /// units: the scaled problem fixes it divided by the same power of two as the data, so the
     /// fit of an exact rational reports the fixed value and recovers the others.
