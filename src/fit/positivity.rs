@@ -362,6 +362,34 @@ mod tests {
         }
     }
 
+    /// The threshold is strict where the bound lands on it exactly: Q = x (a lead term x, and
+    /// x² at coefficient 0) on [a, 1], with a a few ulps above 1e-12, has the rigorous bound
+    /// a rounded down a few times, so one a in the first 64 ulps gives a bound equal to the
+    /// f64 1e-12. That bound is not above the threshold, and the box is bisected on towards its
+    /// width limit: not proven. The next a whose bound is above it is proven. (Without a lead
+    /// term Q's bound is 1 + Σ…, a multiple of 2⁻⁵³, which 1e-12 is not.)
+    #[test]
+    fn a_bound_exactly_at_the_threshold_is_no_proof() {
+        use crate::fit::model::{ModelParts, Term};
+        let f = vec!["x".to_string()];
+        let m = RationalModel::new(ModelParts {
+            inputs: f.clone(),
+            numerator: vec![Term::parse("1", &f).unwrap()],
+            denominator: vec![Term::parse("x^2", &f).unwrap()],
+            lead: Some(Term::parse("x", &f).unwrap()),
+            ..ModelParts::default()
+        })
+        .unwrap();
+        let c = DVector::from_vec(vec![1.0, 0.0]);
+        let whole_box = |a: f64| bound(&m, &c, &[(a, 1.0)], &[2], &mut Scratch::new(&[2]));
+        let ends: Vec<f64> = std::iter::successors(Some(MIN_BOUND), |a| Some(a.next_up())).take(64).collect();
+        let at = ends.iter().position(|&a| whole_box(a) == MIN_BOUND).expect("no a in 64 ulps bounds Q at exactly 1e-12: the test does not reach the threshold");
+        assert!(proven(&prove_denominator_positive(&m, &c, &[(ends[at], 1.0)])).is_none(), "a bound of exactly 1e-12 proven");
+        let above = ends[at..].iter().find(|&&a| whole_box(a) > MIN_BOUND).expect("a bound above 1e-12 within 64 ulps");
+        let lower = proven(&prove_denominator_positive(&m, &c, &[(*above, 1.0)])).expect("a bound above 1e-12 is a proof");
+        assert!(lower > MIN_BOUND && lower <= *above, "{lower:e}");
+    }
+
     #[test]
     fn tangent_roots_and_near_tangents() {
         // Q = (4(x − ½)² + ε)/(1 + ε) = 1 − 4x/(1+ε) + 4x²/(1+ε): minimum ε/(1+ε) at x = ½.
