@@ -891,6 +891,33 @@ mod tests {
         }
     }
 
+    /// Fixed coefficients enter the linearisation as a known part: with the numerator's
+    /// constant and the denominator's x² fixed at their true values (nonzero, so the model's
+    /// constant map is not zero), P − y·Q = 0 is still consistent in the free coefficients and
+    /// every reweighted start is the exact rational, its fixed coefficients exactly.
+    #[test]
+    fn reweighted_starts_with_fixed_coefficients_recover_an_exact_rational() {
+        let want = [1.0, 2.0, -0.05, 0.5, 0.01];
+        let model = RationalModel::new(ModelParts { fixed: vec![(0, want[0]), (4, want[4])], ..parts_1d(&["1", "x", "x^2"], &["x", "x^2"]) }).unwrap();
+        assert_eq!(model.n_free(), 3);
+        let x: Vec<Vec<f64>> = (0..=40).map(|i| vec![0.75 * i as f64]).collect();
+        let y = x.iter().map(|p| {
+            let t = p[0];
+            (want[0] + want[1] * t + want[2] * t * t) / (1.0 + want[3] * t + want[4] * t * t)
+        });
+        let data = Data { y: y.collect(), x };
+        let starts = linearised_starts(&model, &data, "fixed").unwrap();
+        assert_eq!(starts.len(), 7);
+        for (k, s) in starts.iter().enumerate().skip(1) {
+            let c = model.full(s);
+            assert_eq!((c[0], c[4]), (want[0], want[4]), "start {k}: the fixed coefficients");
+            // As in the free case above: a consistent system, condition ~1e5 after scaling.
+            for (j, (got, w)) in c.iter().zip(want).enumerate() {
+                assert!((got - w).abs() < 1e-8 * w.abs().max(1.0), "start {k}, coefficient {j}: {got} vs {w}");
+            }
+        }
+    }
+
     /// Sanathanan–Koerner: start k ≥ 2 minimises Σ ((P − y·Q)/|Q_{k−1}|)², the linearised
     /// residual weighted by the previous start's denominator. On data no [1/1] rational fits
     /// (exp on [0, 2]) the weights matter, so the test checks that start's normal equations with
