@@ -869,10 +869,12 @@ mod tests {
     /// On samples of an exact rational the linearised problem P − y·Q = 0 is consistent, so
     /// every reweighted (Loeb, Sanathanan–Koerner) start is the rational itself, whatever the
     /// weights: x over [0, 30] makes the columns' norms span ~1e5, so the column scaling and
-    /// its undoing are exercised too.
+    /// its undoing are exercised too. Fixed coefficients enter the linearisation as a known
+    /// part: with the numerator's constant and the denominator's x² fixed at their true values
+    /// (nonzero, so the model's constant map is not zero) the system is still consistent in the
+    /// free coefficients, and every start has the fixed ones exactly.
     #[test]
     fn every_reweighted_start_recovers_an_exact_rational() {
-        let model = RationalModel::rational_1d("x", 2, 2);
         let want = [1.0, 2.0, -0.05, 0.5, 0.01];
         let x: Vec<Vec<f64>> = (0..=40).map(|i| vec![0.75 * i as f64]).collect();
         let y = x.iter().map(|p| {
@@ -880,40 +882,21 @@ mod tests {
             (want[0] + want[1] * t + want[2] * t * t) / (1.0 + want[3] * t + want[4] * t * t)
         });
         let data = Data { y: y.collect(), x };
-        let starts = linearised_starts(&model, &data, "exact").unwrap();
-        assert_eq!(starts.len(), 7, "the polynomial start and six reweighted ones");
-        for (k, s) in starts.iter().enumerate().skip(1) {
-            let c = model.full(s);
-            // SVD solves of a 41×5 consistent system, condition ~1e5 after scaling: ~1e-11.
-            for (j, (got, w)) in c.iter().zip(want).enumerate() {
-                assert!((got - w).abs() < 1e-8 * w.abs().max(1.0), "start {k}, coefficient {j}: {got} vs {w}");
-            }
-        }
-    }
-
-    /// Fixed coefficients enter the linearisation as a known part: with the numerator's
-    /// constant and the denominator's x² fixed at their true values (nonzero, so the model's
-    /// constant map is not zero), P − y·Q = 0 is still consistent in the free coefficients and
-    /// every reweighted start is the exact rational, its fixed coefficients exactly.
-    #[test]
-    fn reweighted_starts_with_fixed_coefficients_recover_an_exact_rational() {
-        let want = [1.0, 2.0, -0.05, 0.5, 0.01];
-        let model = RationalModel::new(ModelParts { fixed: vec![(0, want[0]), (4, want[4])], ..parts_1d(&["1", "x", "x^2"], &["x", "x^2"]) }).unwrap();
-        assert_eq!(model.n_free(), 3);
-        let x: Vec<Vec<f64>> = (0..=40).map(|i| vec![0.75 * i as f64]).collect();
-        let y = x.iter().map(|p| {
-            let t = p[0];
-            (want[0] + want[1] * t + want[2] * t * t) / (1.0 + want[3] * t + want[4] * t * t)
-        });
-        let data = Data { y: y.collect(), x };
-        let starts = linearised_starts(&model, &data, "fixed").unwrap();
-        assert_eq!(starts.len(), 7);
-        for (k, s) in starts.iter().enumerate().skip(1) {
-            let c = model.full(s);
-            assert_eq!((c[0], c[4]), (want[0], want[4]), "start {k}: the fixed coefficients");
-            // As in the free case above: a consistent system, condition ~1e5 after scaling.
-            for (j, (got, w)) in c.iter().zip(want).enumerate() {
-                assert!((got - w).abs() < 1e-8 * w.abs().max(1.0), "start {k}, coefficient {j}: {got} vs {w}");
+        let free = RationalModel::rational_1d("x", 2, 2);
+        let fixed = RationalModel::new(ModelParts { fixed: vec![(0, want[0]), (4, want[4])], ..parts_1d(&["1", "x", "x^2"], &["x", "x^2"]) }).unwrap();
+        assert_eq!((free.n_free(), fixed.n_free()), (5, 3));
+        for (model, what) in [(&free, "exact"), (&fixed, "fixed")] {
+            let starts = linearised_starts(model, &data, what).unwrap();
+            assert_eq!(starts.len(), 7, "{what}: the polynomial start and six reweighted ones");
+            for (k, s) in starts.iter().enumerate().skip(1) {
+                let c = model.full(s);
+                if what == "fixed" {
+                    assert_eq!((c[0], c[4]), (want[0], want[4]), "start {k}: the fixed coefficients");
+                }
+                // SVD solves of a 41×5 consistent system, condition ~1e5 after scaling: ~1e-11.
+                for (j, (got, w)) in c.iter().zip(want).enumerate() {
+                    assert!((got - w).abs() < 1e-8 * w.abs().max(1.0), "{what} start {k}, coefficient {j}: {got} vs {w}");
+                }
             }
         }
     }
