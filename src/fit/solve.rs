@@ -678,7 +678,6 @@ mod tests {
         assert_eq!(none, 0);
         let ((wv, w), (fv, f)) = (watched.unwrap(), full.unwrap());
         assert_eq!(wv, fv);
-        let bits = |t: &DVector<f64>| t.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
         assert_eq!(bits(&w.theta), bits(&f.theta));
         assert_eq!(w.report.rss.to_bits(), f.report.rss.to_bits());
         // The public entry point is the watched multi-start, and for least squares its answer
@@ -723,6 +722,11 @@ mod tests {
     }
 
     use crate::fit::model::{ModelParts, Term};
+
+    /// A vector's bit patterns, to compare results bit for bit.
+    fn bits(v: &DVector<f64>) -> Vec<u64> {
+        v.iter().map(|x| x.to_bits()).collect()
+    }
 
     fn parts_1d(num: &[&str], den: &[&str]) -> ModelParts {
         let f = vec!["x".to_string()];
@@ -890,8 +894,8 @@ mod tests {
             assert_eq!(starts.len(), 7, "{what}: the polynomial start and six reweighted ones");
             for (k, s) in starts.iter().enumerate().skip(1) {
                 let c = model.full(s);
-                if what == "fixed" {
-                    assert_eq!((c[0], c[4]), (want[0], want[4]), "start {k}: the fixed coefficients");
+                for &(i, v) in &model.fixed {
+                    assert_eq!(c[i], v, "{what} start {k}: the fixed coefficient {i}");
                 }
                 // SVD solves of a 41×5 consistent system, condition ~1e5 after scaling: ~1e-11.
                 for (j, (got, w)) in c.iter().zip(want).enumerate() {
@@ -1110,7 +1114,6 @@ mod tests {
         let opts = FitOptions::default();
         let f = fit_rescaled(&model, &data, &opts, "unlike").unwrap();
         let g = fit(&model, &data, &opts, "unlike").unwrap();
-        let bits = |c: &DVector<f64>| c.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
         assert_eq!(bits(&f.coefficients), bits(&g.coefficients));
         for (c, w) in f.coefficients.iter().zip(&want) {
             // Exact data; LM scales its columns, so the raw units cost it little: 1e-9 relative
