@@ -738,6 +738,33 @@ mod tests {
         assert_eq!(flat, [("K".into(), vec![half]), ("R".into(), vec![half]), ("RR".into(), vec![half]), ("V".into(), vec![half, Literal::F32(2.0)])]);
     }
 
+    /// A non-finite f32 constant has no C literal (`inf` and `NaN` are not C tokens, and
+    /// `INFINITY` would need <math.h>): the header is refused, naming the module, rather than
+    /// written with a token a C compiler rejects or reads as an identifier. The WGSL front end
+    /// refuses such a constant, so the module is built here by hand; the same module with a
+    /// finite value gives its header.
+    #[test]
+    fn a_non_finite_constant_has_no_c_form() {
+        use naga::{Expression, Span, Type};
+        let module = |v: f32| {
+            let mut m = naga::Module::default();
+            let ty = m.types.insert(Type { name: None, inner: TypeInner::Scalar(Scalar::F32) }, Span::UNDEFINED);
+            let init = m.global_expressions.append(Expression::Literal(Literal::F32(v)), Span::UNDEFINED);
+            m.constants.append(naga::Constant { name: Some("K".into()), ty, init }, Span::UNDEFINED);
+            m
+        };
+        let h = c_header("mod_k", &["line"], "mod_k.wgsl", &module(0.5)).unwrap();
+        assert!(h.contains("static const float K = 5e-1f;"), "{h}");
+        for v in [f32::INFINITY, f32::NEG_INFINITY, f32::NAN] {
+            match c_header("mod_k", &["line"], "mod_k.wgsl", &module(v)) {
+                Err(TargetError::Unsupported { module, what }) => {
+                    assert_eq!((module.as_str(), what.as_str()), ("mod_k", "a constant with no C form"))
+                }
+                other => panic!("{v}: {other:?}"),
+            }
+        }
+    }
+
     /// A splat inside a composite (`vec3<f32>(1.0)` in an array of vectors, kept as
     /// `Expression::Splat` by the WGSL front end) flattens to its value repeated once per
     /// component of its own vector, not of the whole array: the composite's count divided
