@@ -663,33 +663,50 @@ mod tests {
     }
 
     /// Starts stopped for stalling change nothing: the chosen fit is bit for bit the one of
-    /// running every start in full. A unit step at x = 0.3 by a 2/3 rational: three of the
-    /// linearised starts crawl far above the best and are left stopped.
+    /// running every start in full. A unit step at x = 0.3 by a 2/3 and a 3/3 rational: some of
+    /// the linearised starts crawl and are stopped. A stopped start is run again in full unless
+    /// the chosen valid fit already beats the lower bound its own stopped run gives: the starts
+    /// left stopped are exactly those whose bound is above the chosen rss (each start's watched
+    /// run, alone, gives its bound). At 2/3 every stopped start is left so; at 3/3 three bounds
+    /// (~0.26–0.29) are under the chosen rss (~1.02), so those starts must have been rerun.
     #[test]
     fn stalled_starts_do_not_change_the_choice() {
-        let model = RationalModel::rational_1d("x", 2, 3);
         let x: Vec<Vec<f64>> = (0..200).map(|i| vec![i as f64 / 199.0]).collect();
         let data = Data { y: x.iter().map(|p| if p[0] < 0.3 { 0.0 } else { 1.0 }).collect(), x };
         let lsq = FitOptions::default();
-        let starts = linearised_starts(&model, &data, "step").unwrap();
-        let (watched, left) = multi_start(&model, &data, &lsq, "step", &starts, true);
-        let (full, none) = multi_start(&model, &data, &lsq, "step", &starts, false);
-        assert!(left >= 1, "no start was left stopped: the test does not exercise the stop");
-        assert_eq!(none, 0);
-        let ((wv, w), (fv, f)) = (watched.unwrap(), full.unwrap());
-        assert_eq!(wv, fv);
-        assert_eq!(bits(&w.theta), bits(&f.theta));
-        assert_eq!(w.report.rss.to_bits(), f.report.rss.to_bits());
-        // The public entry point is the watched multi-start, and for least squares its answer
-        // is the chosen run itself, no further run from it: the same parameters, and the report
-        // counts that run's iterations and evaluations (a run restarted at the optimum would
-        // report its own few).
-        let public = fit(&model, &data, &lsq, "step").unwrap();
-        assert_eq!(bits(&public.theta), bits(&f.theta));
-        assert_eq!(
-            (public.report.iterations, public.report.evaluations, public.report.rss.to_bits()),
-            (w.report.iterations, w.report.evaluations, w.report.rss.to_bits())
-        );
+        let (mut left_seen, mut rerun_seen) = (0, 0);
+        for (m, n) in [(2, 3), (3, 3)] {
+            let model = RationalModel::rational_1d("x", m, n);
+            let starts = linearised_starts(&model, &data, "step").unwrap();
+            let (watched, left) = multi_start(&model, &data, &lsq, "step", &starts, true);
+            let (full, none) = multi_start(&model, &data, &lsq, "step", &starts, false);
+            assert_eq!(none, 0);
+            let ((wv, w), (fv, f)) = (watched.unwrap(), full.unwrap());
+            assert!(wv, "[{m}/{n}]: the chosen fit is not proven valid: the bound rule below does not apply");
+            assert_eq!(wv, fv);
+            assert_eq!(bits(&w.theta), bits(&f.theta));
+            assert_eq!(w.report.rss.to_bits(), f.report.rss.to_bits());
+            let bounds: Vec<f64> = starts
+                .iter()
+                .filter_map(|t| fit_start(&model, &data, t.clone(), &lsq, "step", true).ok().and_then(|(_, lower)| lower))
+                .collect();
+            let above = bounds.iter().filter(|&&b| b > w.report.rss).count();
+            assert_eq!(left, above, "[{m}/{n}]: stopped starts' bounds {bounds:?}, chosen rss {}", w.report.rss);
+            left_seen += left;
+            rerun_seen += bounds.len() - above;
+            // The public entry point is the watched multi-start, and for least squares its
+            // answer is the chosen run itself, no further run from it: the same parameters, and
+            // the report counts that run's iterations and evaluations (a run restarted at the
+            // optimum would report its own few).
+            let public = fit(&model, &data, &lsq, "step").unwrap();
+            assert_eq!(bits(&public.theta), bits(&f.theta));
+            assert_eq!(
+                (public.report.iterations, public.report.evaluations, public.report.rss.to_bits()),
+                (w.report.iterations, w.report.evaluations, w.report.rss.to_bits())
+            );
+        }
+        assert!(left_seen >= 1, "no start was left stopped: the test does not exercise the stop");
+        assert!(rerun_seen >= 1, "no stopped start was rerun: the test does not exercise the rerun");
     }
 
     /// The stall rule as documented on [`Stall`], decided at one accepted step: n = 300
