@@ -237,7 +237,8 @@ mod tests {
     }
 
     /// Consecutive powers of any one feature, from a constant or not, take Horner form; other
-    /// term lists stay a sum of products. The expected renderings are written out by hand.
+    /// term lists stay a sum of products, with no product by a literal 1 for a constant term.
+    /// The expected renderings are written out by hand.
     #[test]
     fn consecutive_powers_of_either_feature_render_in_horner_form() {
         let f = vec!["x".to_string(), "y".to_string()];
@@ -247,10 +248,14 @@ mod tests {
         assert_eq!(show(&["1", "y", "y^2"]), "c0 + y * (c1 + y * c2)");
         assert_eq!(show(&["y", "y^2", "y^3"]), "y * (c0 + y * (c1 + y * c2))");
         assert_eq!(show(&["x^2", "x^3"]), "x * (x * (c0 + x * c1))");
-        // Not consecutive, or not one feature: no Horner form.
+        // Not consecutive, or not one feature: no Horner form, but a sum of coefficient times
+        // monomial, a constant term its coefficient alone.
         assert_eq!(consecutive_powers(&terms(&["1", "y^2"])), None);
         assert_eq!(consecutive_powers(&terms(&["1", "y", "x^2"])), None);
         assert_eq!(consecutive_powers(&terms(&["y", "x*y"])), None);
+        assert_eq!(show(&["1", "y^2"]), "c0 + c1 * (y * y)");
+        assert_eq!(show(&["1", "y", "x^2"]), "c0 + c1 * y + c2 * (x * x)");
+        assert_eq!(show(&["y", "x*y"]), "c0 * y + c1 * (x * y)");
     }
 
     #[test]
