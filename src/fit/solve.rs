@@ -713,7 +713,7 @@ mod tests {
     /// evaluations, rss 1, LM's cap 1300 (1000 left), the last entry ≥ WINDOW back at n0 = 0
     /// with rss 1 + δ. At the rate δ/300 the evaluations left lower the rss by δ·1000/300, so
     /// it stalls exactly when δ < 3e-7 (SHARE·rss·300/1000); an entry less than WINDOW back
-    /// is not a measure of progress, however large its fall.
+    /// is not a measure of progress, however large its fall, and one exactly WINDOW back is.
     #[test]
     fn a_watched_run_stalls_where_its_rate_cannot_reach_a_share_of_its_rss() {
         let model = RationalModel::rational_1d("x", 1, 0);
@@ -736,6 +736,10 @@ mod tests {
         assert_eq!(step(vec![(0, 1.0 + 3.1e-7)]), (false, None, 2));
         assert_eq!(step(vec![(0, 1.0 + 2.9e-7), (150, 1e9)]), (true, Some(0.1), 2));
         assert_eq!(step(vec![(150, 1.0)]), (false, None, 2));
+        // An entry exactly WINDOW back (n0 = 100) is a measure: over 200 evaluations the
+        // threshold is δ < 2e-7 (SHARE·rss·200/1000).
+        assert_eq!(step(vec![(100, 1.0 + 1.9e-7)]), (true, Some(0.1), 1));
+        assert_eq!(step(vec![(100, 1.0 + 2.1e-7)]), (false, None, 2));
     }
 
     use crate::fit::model::{ModelParts, Term};
