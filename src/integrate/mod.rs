@@ -5,7 +5,8 @@
 //! independent integrals and collect in order).
 //!
 //! - [`gauss_legendre`]: n-point Gauss–Legendre nodes and weights on [-1, 1] (Newton on the
-//!   Legendre recurrence). The nodes lie within an ulp of the roots; the weights' relative
+//!   Legendre recurrence). The nodes lie within 0.51 ε of the roots (n ≤ 100, against roots
+//!   to 50 digits; a node near 0 is then up to 2.6 of its own ulps off); the weights' relative
 //!   error grows with n, through the cancellation in 1 − z² and P_n' near ±1: about 10 ε at
 //!   n = 16, 4e2 ε at n = 64 and 4e4 ε (1e-11) at n = 1000, against roots to 40 digits. The
 //!   rules the integrals use (n ≤ 48) stay within 1e-13, far under their tolerances; the
