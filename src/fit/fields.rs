@@ -810,6 +810,18 @@ mod tests {
         assert!(stage1(&d.design, &d.y).condition > 1e12, "x = 0 must be reported singular");
     }
 
+    /// A grid point where every basis value is 0 (all of σ zero) is rank-deficient like any
+    /// other: its condition is ∞, as documented on [`Stage1`], not σmax/σmin = 0/0, and its
+    /// minimum-norm coefficients are 0. A zero column alone (σmin = 0 < σmax) is ∞ as well.
+    #[test]
+    fn a_basis_of_zeros_is_infinitely_conditioned() {
+        let y = DVector::from_vec(vec![1.0, -2.0, 3.0, 0.5]);
+        let s = stage1(&DMatrix::zeros(4, 3), &y);
+        assert_eq!((s.condition, s.coefficients.as_slice()), (f64::INFINITY, [0.0; 3].as_slice()));
+        let one_zero_column = DMatrix::from_row_slice(4, 2, &[1.0, 0.0, 2.0, 0.0, 0.5, 0.0, -1.0, 0.0]);
+        assert_eq!(stage1(&one_zero_column, &y).condition, f64::INFINITY);
+    }
+
     #[test]
     fn joint_fit_recovers_exact_fields_through_a_singular_point() {
         let (x, data) = problem();
