@@ -715,6 +715,13 @@ mod tests {
         assert_eq!(lines.iter().map(|l| l.split(',').filter(|t| !t.trim().is_empty()).count()).collect::<Vec<_>>(), [6, 6, 1], "{body}");
     }
 
+    /// Appends the named constant `name: ty = e` to a module built by hand (the WGSL front end
+    /// folds or refuses what these tests need).
+    fn constant(m: &mut naga::Module, name: &str, ty: naga::Handle<naga::Type>, e: naga::Expression) -> naga::Handle<naga::Constant> {
+        let init = m.global_expressions.append(e, naga::Span::UNDEFINED);
+        m.constants.append(naga::Constant { name: Some(name.into()), ty, init }, naga::Span::UNDEFINED)
+    }
+
     /// A constant whose value is another constant (`Expression::Constant`: valid IR, which the
     /// WGSL front end folds away, so it is built here by hand) flattens to that constant's
     /// values, through a chain of two references and inside a composite.
@@ -724,10 +731,6 @@ mod tests {
         let mut m = naga::Module::default();
         let f32t = m.types.insert(Type { name: None, inner: TypeInner::Scalar(Scalar::F32) }, Span::UNDEFINED);
         let pair = m.types.insert(Type { name: None, inner: TypeInner::Vector { size: naga::VectorSize::Bi, scalar: Scalar::F32 } }, Span::UNDEFINED);
-        let constant = |m: &mut naga::Module, name: &str, ty: naga::Handle<Type>, e: Expression| {
-            let init = m.global_expressions.append(e, Span::UNDEFINED);
-            m.constants.append(naga::Constant { name: Some(name.into()), ty, init }, Span::UNDEFINED)
-        };
         let k = constant(&mut m, "K", f32t, Expression::Literal(Literal::F32(0.5)));
         let r = constant(&mut m, "R", f32t, Expression::Constant(k));
         constant(&mut m, "RR", f32t, Expression::Constant(r));
@@ -749,8 +752,7 @@ mod tests {
         let module = |v: f32| {
             let mut m = naga::Module::default();
             let ty = m.types.insert(Type { name: None, inner: TypeInner::Scalar(Scalar::F32) }, Span::UNDEFINED);
-            let init = m.global_expressions.append(Expression::Literal(Literal::F32(v)), Span::UNDEFINED);
-            m.constants.append(naga::Constant { name: Some("K".into()), ty, init }, Span::UNDEFINED);
+            constant(&mut m, "K", ty, Expression::Literal(Literal::F32(v)));
             m
         };
         let h = c_header("mod_k", &["line"], "mod_k.wgsl", &module(0.5)).unwrap();
