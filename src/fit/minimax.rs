@@ -314,6 +314,42 @@ mod tests {
         assert_eq!(st.get_termination_status(), &TerminationStatus::Terminated(TerminationReason::SolverConverged));
         assert_eq!(st.get_param(), Some(&start), "the solver moved to {:?}", st.get_param());
         assert_eq!(st.get_cost(), m0);
+        // It stops when the predicted fall is below 1e-15 of m = 0.995 (at x = −1). The bounds
+        // are ρ·(0.01, 0.005) and the LP's predicted fall lies between the first and their
+        // sum: 1.5e-15 to 2.2e-15 at ρ = 1e-2/4^18, 3.6e-16 to 5.5e-16 at 1e-2/4^19. So it
+        // stops after 19 refusals, each dividing ρ by 4 exactly (a power of two).
+        assert_eq!(res.solver().rho, 1e-2 * 0.25f64.powi(19));
+    }
+
+    /// One steep residual r = 1e6·t − (1e6 − 1), max 1 at t = 1, with the Jacobian's sign
+    /// flipped: the predicted fall is ρ·1e6 of m, above 1e-15 of it down to ρ = 1e-21, so what
+    /// ends the refusals is ρ itself falling below 1e-15 ("ρ underflows"): 1e-2/4^k first does
+    /// at k = 22 (4^22 ≈ 1.8e13). The solver stops where it started.
+    #[test]
+    fn refusals_end_when_the_trust_region_underflows() {
+        struct Steep;
+        impl Operator for Steep {
+            type Param = DVector<f64>;
+            type Output = DVector<f64>;
+            fn apply(&self, t: &DVector<f64>) -> Result<DVector<f64>, Error> {
+                Ok(DVector::from_element(1, 1e6 * t[0] - (1e6 - 1.0)))
+            }
+        }
+        impl Jacobian for Steep {
+            type Param = DVector<f64>;
+            type Jacobian = DMatrix<f64>;
+            fn jacobian(&self, _: &DVector<f64>) -> Result<DMatrix<f64>, Error> {
+                Ok(DMatrix::from_element(1, 1, -1e6))
+            }
+        }
+        let res = argmin::core::Executor::new(Steep, SlpMinimax::default())
+            .configure(|s| s.param(DVector::from_element(1, 1.0)).max_iters(5))
+            .run()
+            .unwrap();
+        let st = res.state();
+        assert_eq!(st.get_termination_status(), &TerminationStatus::Terminated(TerminationReason::SolverConverged));
+        assert_eq!((st.get_param().map(|t| t[0]), st.get_cost(), st.get_iter()), (Some(1.0), 1.0, 1));
+        assert_eq!(res.solver().rho, 1e-2 * 0.25f64.powi(22));
     }
 
     /// One residual with a cliff: t itself from 0.5 up, 10 below (the Jacobian 1 everywhere).
@@ -349,6 +385,119 @@ mod tests {
         let st = res.state();
         assert_eq!((st.get_param().map(|t| t[0]), st.get_cost()), (Some(0.75), 0.75));
         assert_eq!(res.solver().rho, 0.5);
+    }
+
+    /// One residual r = t with its Jacobian 1: the minimax optimum is t = 0, reached by one
+    /// step from any start whose trust region holds it.
+    struct Line;
+
+    impl Operator for Line {
+        type Param = DVector<f64>;
+        type Output = DVector<f64>;
+        fn apply(&self, t: &DVector<f64>) -> Result<DVector<f64>, Error> {
+            Ok(t.clone())
+        }
+    }
+
+    impl Jacobian for Line {
+        type Param = DVector<f64>;
+        type Jacobian = DMatrix<f64>;
+        fn jacobian(&self, _: &DVector<f64>) -> Result<DMatrix<f64>, Error> {
+            Ok(DMatrix::from_element(1, 1, 1.0))
+        }
+    }
+
+    /// ρ doubles after a good step at the region's edge, but never past 1 (a step at most as
+    /// large as each parameter's own scale): from t = 4 with ρ = 1 the LP steps by −4 to the
+    /// optimum exactly (ratio 1, at the bound), and ρ stays 1.
+    #[test]
+    fn the_trust_region_never_grows_past_one() {
+        let res = argmin::core::Executor::new(Line, SlpMinimax { rho: 1.0, converged: false })
+            .configure(|s| s.param(DVector::from_element(1, 4.0)).max_iters(1))
+            .run()
+            .unwrap();
+        let st = res.state();
+        assert_eq!((st.get_param().map(|t| t[0]), st.get_cost()), (Some(0.0), 0.0));
+        assert_eq!(res.solver().rho, 1.0);
+    }
+
+    /// max|r| counts a NaN residual as infinite (f64::max would skip it), so a step into a
+    /// region where the model is undefined is never taken as an improvement.
+    #[test]
+    fn a_nan_residual_is_an_infinite_max() {
+        assert_eq!(max_abs(&DVector::from_vec(vec![-2.0, 1.0])), 2.0);
+        assert_eq!(max_abs(&DVector::from_vec(vec![1.0, f64::NAN, -2.0])), f64::INFINITY);
+        assert_eq!(max_abs(&DVector::from_vec(vec![f64::NAN])), f64::INFINITY);
+    }
+
+    /// A Jacobian of zeros gives no LP (every row's reach is 0): each failure shrinks ρ by 4,
+    /// and after the 40 tries of one iteration the solver stops where it started, converged.
+    #[test]
+    fn a_flat_problem_stops_where_it_started() {
+        struct Flat;
+        impl Operator for Flat {
+            type Param = DVector<f64>;
+            type Output = DVector<f64>;
+            fn apply(&self, t: &DVector<f64>) -> Result<DVector<f64>, Error> {
+                Ok(DVector::from_vec(vec![t[0] * 0.0 + 3.0, -1.0]))
+            }
+        }
+        impl Jacobian for Flat {
+            type Param = DVector<f64>;
+            type Jacobian = DMatrix<f64>;
+            fn jacobian(&self, _: &DVector<f64>) -> Result<DMatrix<f64>, Error> {
+                Ok(DMatrix::zeros(2, 1))
+            }
+        }
+        let res = argmin::core::Executor::new(Flat, SlpMinimax::default())
+            .configure(|s| s.param(DVector::from_element(1, 0.5)).max_iters(5))
+            .run()
+            .unwrap();
+        let st = res.state();
+        assert_eq!(st.get_termination_status(), &TerminationStatus::Terminated(TerminationReason::SolverConverged));
+        assert_eq!((st.get_param().map(|t| t[0]), st.get_cost(), st.get_iter()), (Some(0.5), 3.0, 1));
+        assert_eq!(res.solver().rho, 1e-2 * 0.25f64.powi(40));
+    }
+
+    /// The solver needs a start, and says so.
+    #[test]
+    fn the_solver_needs_a_start() {
+        let Err(err) = argmin::core::Executor::new(Line, SlpMinimax::default()).configure(|s| s.max_iters(1)).run() else {
+            panic!("ran without a start")
+        };
+        assert!(err.to_string().contains("SLP minimax needs a start"), "{err}");
+    }
+
+    /// A parameter at 0 still moves: its trust region is 1e-3 of the largest |θ|, not of its
+    /// own 0. r_i = θ₀ + θ₁x_i − x_i on 11 points of [0, 1] has its optimum θ = (0, 1) with
+    /// max 0; from (0.5, 0) the solver reaches it.
+    #[test]
+    fn a_parameter_at_zero_has_a_trust_region() {
+        struct Ramp(Vec<f64>);
+        impl Operator for Ramp {
+            type Param = DVector<f64>;
+            type Output = DVector<f64>;
+            fn apply(&self, t: &DVector<f64>) -> Result<DVector<f64>, Error> {
+                Ok(DVector::from_iterator(self.0.len(), self.0.iter().map(|x| t[0] + t[1] * x - x)))
+            }
+        }
+        impl Jacobian for Ramp {
+            type Param = DVector<f64>;
+            type Jacobian = DMatrix<f64>;
+            fn jacobian(&self, _: &DVector<f64>) -> Result<DMatrix<f64>, Error> {
+                Ok(DMatrix::from_fn(self.0.len(), 2, |i, j| if j == 0 { 1.0 } else { self.0[i] }))
+            }
+        }
+        let x: Vec<f64> = (0..11).map(|i| i as f64 / 10.0).collect();
+        let res = argmin::core::Executor::new(Ramp(x), SlpMinimax::default())
+            .configure(|s| s.param(DVector::from_vec(vec![0.5, 0.0])).max_iters(200))
+            .run()
+            .unwrap();
+        let st = res.state();
+        let t = st.get_best_param().unwrap();
+        // A linear problem: once the region holds the optimum, the LP lands on it to its
+        // feasibility tolerance (1e-7 absolute on data of order one; 1e-9 has not been needed).
+        assert!(st.get_best_cost() < 1e-9 && t[0].abs() < 1e-9 && (t[1] - 1.0).abs() < 1e-9, "{t:?} after {} iterations, max {}", st.get_iter(), st.get_best_cost());
     }
 
     /// R̃'s form (fits/fuzz_r.toml) over α ∈ [0.15, 1], θ ∈ [0, π/2]: γ = cos θ is 6e-17 at the
