@@ -852,6 +852,74 @@ mod tests {
         assert!(out.contains("SamplerState nagaSamplerHeap[2048]") && !out.contains("nagaComparisonSamplerHeap"));
     }
 
+    /// The WGSL of each argument type the keep entry point can make a value of is the type
+    /// itself: each type, declared as a function argument and parsed, is written back as it was
+    /// declared. Types it cannot make (a depth or multisampled texture, an integer texture, a
+    /// pointer) have none.
+    #[test]
+    fn argument_types_are_written_back_as_declared() {
+        let made = [
+            "f32", "u32", "i32", "bool", "vec2<f32>", "vec3<u32>", "vec4<i32>", "vec2<bool>", "mat2x3<f32>", "mat4x4<f32>",
+            "array<f32, 4>", "array<vec3<f32>, 2>", "P", "texture_1d<f32>", "texture_2d<f32>", "texture_3d<f32>",
+            "texture_cube<f32>", "texture_2d_array<f32>", "texture_cube_array<f32>", "sampler", "sampler_comparison",
+        ];
+        let unmade = ["texture_depth_2d", "texture_multisampled_2d<f32>", "texture_2d<i32>", "ptr<function, f32>"];
+        for (ty, want) in made.iter().map(|t| (t, Some(t.to_string()))).chain(unmade.iter().map(|t| (t, None))) {
+            let m = naga::front::wgsl::parse_str(&format!("struct P {{ x: f32 }}\nfn f(a: {ty}) {{}}\n")).unwrap_or_else(|e| panic!("{ty}: {e}"));
+            let (_, f) = m.functions.iter().next().unwrap();
+            assert_eq!(wgsl_type(&m, f.arguments[0].ty), want, "{ty}");
+        }
+    }
+
+    /// Every text target begins with the module's header lines, then one line of its own
+    /// naming the target and the file it came from; GLSL's come right after `#version`, which
+    /// must be first. The WGSL without its directive keeps the module's code as it was.
+    #[test]
+    fn every_text_target_carries_the_header_and_its_provenance() {
+        let code = "fn emitted_f(x: f32) -> f32 { return x * 2.0; }\n";
+        let src = format!("// first line\n// second line\n#define_import_path shadefit::m\n{code}");
+        let targets = [Target::WgslPlain, Target::Hlsl, Target::Glsl, Target::GlslEs, Target::Msl, Target::C, Target::Wesl];
+        let out = translate("m", &src, &targets).unwrap();
+        assert_eq!(out.len(), targets.len());
+        for (t, a) in targets.iter().zip(&out) {
+            assert_eq!(a.path, t.path("m"));
+            let text = String::from_utf8(a.contents.clone()).unwrap();
+            let body = if matches!(t, Target::Glsl | Target::GlslEs) {
+                let (version, rest) = text.split_once('\n').unwrap();
+                assert!(version.starts_with("#version "), "{t:?}: {version}");
+                rest
+            } else {
+                &text
+            };
+            let mut lines = body.lines();
+            assert_eq!((lines.next(), lines.next()), (Some("// first line"), Some("// second line")), "{t:?}:\n{text}");
+            let own = lines.next().unwrap();
+            assert!(own.starts_with("// ") && own.contains("wgsl/m.wgsl"), "{t:?}: {own}");
+            if !matches!(t, Target::WgslPlain | Target::Wesl | Target::C) {
+                assert!(own.starts_with(&format!("// {} translated from wgsl/m.wgsl", t.name())), "{t:?}: {own}");
+            }
+            if matches!(t, Target::WgslPlain | Target::Wesl) {
+                assert_eq!(lines.collect::<Vec<_>>().join("\n") + "\n", code, "{t:?}");
+            }
+        }
+    }
+
+    /// Text that is not a module file is refused for what it lacks or adds: no
+    /// `#define_import_path` after the header, or a directive line in the code.
+    #[test]
+    fn a_module_file_needs_its_import_path_and_no_other_directive() {
+        let why = |src: &str| match translate("x", src, &[Target::Hlsl]) {
+            Err(TargetError::Unsupported { module, what }) => {
+                assert_eq!(module, "x");
+                what
+            }
+            other => panic!("{src:?}: {other:?}"),
+        };
+        assert_eq!(why("// h\nfn f() {}\n"), "no `#define_import_path` line after the header");
+        assert_eq!(why("// h\n#define_import_path shadefit::x\nfn f() {}\n  #ifdef X\n"), "it has a directive line `#ifdef X`");
+        assert!(translate("x", "#define_import_path shadefit::x\nfn f() {}\n", &[Target::Hlsl]).is_ok(), "no header lines at all is fine");
+    }
+
     #[test]
     fn imports_are_refused() {
         let src = "// h\n#define_import_path shadefit::x\n#import shadefit::y\nfn f() {}\n";
