@@ -206,25 +206,15 @@ impl Derived {
     }
 }
 
-/// offset + scale·x, with the operation order the emitted code uses.
+/// offset + scale·x, rounded as the emitted code rounds it: the code writes `offset + x` for
+/// a scale of 1 and `offset - x` for −1, and these are the same bits as offset + scale·x in
+/// IEEE 754 (a product by ±1 is exact, and a − b is a + (−b), signed zeros included).
 pub fn affine(offset: f64, scale: f64, x: f64) -> f64 {
-    if scale == 1.0 {
-        offset + x
-    } else if scale == -1.0 {
-        offset - x
-    } else {
-        offset + scale * x
-    }
+    offset + scale * x
 }
 
 fn affine_f32(offset: f32, scale: f32, x: f32) -> f32 {
-    if scale == 1.0 {
-        offset + x
-    } else if scale == -1.0 {
-        offset - x
-    } else {
-        offset + scale * x
-    }
+    offset + scale * x
 }
 
 /// Everything that defines a model, before its constraints are resolved.
@@ -505,13 +495,21 @@ impl Basis {
 mod tests {
     use super::*;
 
-    /// offset + scale·x in each of its three branches, on values exact in binary (so the
-    /// expected sums are exact in f64 and f32 alike).
+    /// offset + scale·x, on values exact in binary (so the expected sums are exact in f64 and
+    /// f32 alike); and for scales ±1, the bits of the emitted forms `offset + x` and
+    /// `offset - x` on values whose sums round, signed zeros included.
     #[test]
     fn affine_is_offset_plus_scale_times_x() {
         for (o, s, x, want) in [(0.5, 1.0, 0.25, 0.75), (0.5, -1.0, 0.25, 0.25), (0.5, 2.0, 0.25, 1.0), (-1.0, -0.5, 3.0, -2.5)] {
             assert_eq!(affine(o, s, x), want, "{o} + {s}·{x}");
             assert_eq!(affine_f32(o as f32, s as f32, x as f32), want as f32, "{o} + {s}·{x} (f32)");
+        }
+        for (o, x) in [(1.0, 0.1), (0.3, 1e-17), (-0.0, 0.0), (0.0, 0.0), (-0.0, -0.0), (1e300, -1e300), (0.7, 2f64.powi(-1074))] {
+            assert_eq!(affine(o, 1.0, x).to_bits(), (o + x).to_bits(), "{o} + {x}");
+            assert_eq!(affine(o, -1.0, x).to_bits(), (o - x).to_bits(), "{o} - {x}");
+            let (of, xf) = (o as f32, x as f32);
+            assert_eq!(affine_f32(of, 1.0, xf).to_bits(), (of + xf).to_bits(), "{of} + {xf} (f32)");
+            assert_eq!(affine_f32(of, -1.0, xf).to_bits(), (of - xf).to_bits(), "{of} - {xf} (f32)");
         }
     }
 
