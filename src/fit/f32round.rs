@@ -302,6 +302,10 @@ mod tests {
         assert_eq!(ulps_between(-tiny, tiny), 2);
         assert_eq!(step_ulps(f32::MAX, 1), None);
         assert_eq!(step_ulps(f32::MIN, -1), None);
+        // The largest finite floats themselves are reachable, from either side.
+        let below_max = f32::from_bits(f32::MAX.to_bits() - 1);
+        assert_eq!((step_ulps(below_max, 1), step_ulps(-below_max, -1)), (Some(f32::MAX), Some(f32::MIN)));
+        assert_eq!((step_ulps(f32::MAX, 0), step_ulps(f32::MIN, 0)), (Some(f32::MAX), Some(f32::MIN)));
     }
 
     /// Residuals (3, −4, 0, 12): max 12; Σr² = 169, rms = √(169/4) = 6.5; Σr⁴ =

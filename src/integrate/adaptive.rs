@@ -866,6 +866,17 @@ mod tests {
         let s = integrate(&[(0.0, 1.0)], &Options::scalar(Tolerance { rel: 0.0, ..Tolerance::default() }), f);
         assert_eq!(s.evals, 63);
         assert!((s.value[0] - 1.0).abs() < 1e-15 && s.error < 1e-15);
+        // Per component: one infinite component's error ends the run at once with
+        // stop_when_non_finite (the other is finite), and is bisected away without it.
+        let g = |x: f64| [if x == 0.5 { f64::INFINITY } else { 1.0 }, x];
+        let c = Options::per_component([1e-12; 2], 0.0, 100);
+        let stopped = integrate(&[(0.0, 1.0)], &Options { stop_when_non_finite: true, ..c }, g);
+        assert_eq!((stopped.evals, stopped.error, stopped.errors[0]), (21, f64::INFINITY, f64::INFINITY));
+        assert!(stopped.errors[1].is_finite(), "{stopped:?}");
+        let bisected = integrate(&[(0.0, 1.0)], &c, g);
+        assert_eq!(bisected.evals, 63);
+        // K21 is exact for constants and x: the halves' value to rounding, error 0 or rounding.
+        assert!((bisected.value[0] - 1.0).abs() < 1e-15 && (bisected.value[1] - 0.5).abs() < 1e-15 && bisected.error < 1e-15, "{bisected:?}");
         // The sign of a sum of −0.0 panels.
         let s = integrate(&[(0.0, 1.0)], &Options::scalar(Tolerance::default()), |_| [-0.0]);
         assert!(s.value[0] == 0.0 && s.value[0].is_sign_negative());
