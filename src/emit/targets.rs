@@ -782,6 +782,26 @@ mod tests {
         assert_eq!(flat, [Some(("T".to_string(), vec![2, 3], v))]);
     }
 
+    /// Each target's file is the one the README's target table names, written out here.
+    #[test]
+    fn each_target_writes_the_file_the_readme_names() {
+        let want = [
+            (Target::Wgsl, "wgsl/NAME.wgsl"),
+            (Target::WgslPlain, "wgsl-plain/NAME.wgsl"),
+            (Target::Hlsl, "hlsl/NAME.hlsl"),
+            (Target::Glsl, "glsl/NAME.glsl"),
+            (Target::GlslEs, "glsl-es/NAME.glsl"),
+            (Target::Msl, "msl/NAME.metal"),
+            (Target::Spirv, "spirv/NAME.spv"),
+            (Target::C, "c/NAME.h"),
+            (Target::Wesl, "wesl/NAME.wesl"),
+        ];
+        assert_eq!(want.map(|(t, _)| t), Target::ALL);
+        for (t, path) in want {
+            assert_eq!(t.path("NAME"), PathBuf::from(path), "{t:?}");
+        }
+    }
+
     #[test]
     fn target_names_round_trip_and_lists_are_sorted() {
         for t in Target::ALL {
