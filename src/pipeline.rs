@@ -1029,6 +1029,27 @@ pub fn take_merged(name: &str) -> Option<Vec<u8>> {
 mod tests {
     use super::*;
 
+    /// Orphans are the files directly under the output folders that no artifact is, sorted
+    /// within each folder, folders in the order given: not the runtime crate's hand-written
+    /// `src/lib.rs`, not a folder (its own code), not a file in a folder not listed, and a
+    /// missing folder is skipped. Stale are the artifacts whose file differs or is missing.
+    #[test]
+    fn orphans_are_the_unproduced_files_of_the_output_folders_and_stale_the_changed_ones() {
+        let tmp = tempfile::tempdir().unwrap();
+        let root = tmp.path();
+        for d in ["wgsl", "src/nested", "json", "hlsl"] {
+            std::fs::create_dir_all(root.join(d)).unwrap();
+        }
+        for f in ["wgsl/b.wgsl", "wgsl/a.wgsl", "wgsl/kept.wgsl", "src/lib.rs", "src/x.rs", "src/nested/y.rs", "json/z.json", "hlsl/h.hlsl"] {
+            std::fs::write(root.join(f), "old").unwrap();
+        }
+        let artifact = |p: &str, c: &str| Artifact { path: p.into(), contents: c.as_bytes().to_vec() };
+        let artifacts = [artifact("wgsl/kept.wgsl", "old"), artifact("json/z.json", "new"), artifact("data/t.bin", "old")];
+        assert_eq!(orphans(root, &artifacts), ["wgsl/a.wgsl", "wgsl/b.wgsl", "src/x.rs"]);
+        assert_eq!(orphans_in(root, &artifacts, &["hlsl", "wgsl"]), ["hlsl/h.hlsl", "wgsl/a.wgsl", "wgsl/b.wgsl"]);
+        assert_eq!(stale(root, &artifacts), ["json/z.json", "data/t.bin"]);
+    }
+
     /// `x` moved `k` f32 steps away from zero (k < 0: towards it), by its bit pattern: for a
     /// finite non-zero f32 of either sign, consecutive bit patterns are consecutive floats.
     fn away_from_zero(x: f32, k: i32) -> f32 {
