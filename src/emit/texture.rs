@@ -510,6 +510,62 @@ mod tests {
         }
     }
 
+    /// A 3-D image reads back as one: its depth in the header, `KTXorientation` `rdi`, and the
+    /// level holding the slices one after the other, z = 0 first, each row by row: the value at
+    /// (x, y, z, c) is at ((z·h + y)·w + x)·channels + c. Values are chosen exact in f16 (k/8,
+    /// |k| < 2048) so each one read back is the value written.
+    #[test]
+    fn a_volume_reads_back_slice_by_slice() {
+        let (w, h, d, channels) = (3u32, 2u32, 4u32, 2usize);
+        let value = |x: u32, y: u32, z: u32, c: usize| (x + 10 * y + 100 * z) as f32 / 8.0 - c as f32;
+        let mut v = Vec::new();
+        for z in 0..d {
+            for y in 0..h {
+                for x in 0..w {
+                    for c in 0..channels {
+                        v.push(value(x, y, z, c));
+                    }
+                }
+            }
+        }
+        for format in [TextureFormat::Rgba16float, TextureFormat::Rgba32float] {
+            let bytes = ktx2_volume(w, h, d, channels, &v, format, &[]);
+            let r = ktx2::Reader::new(&bytes[..]).expect("a valid KTX2 file");
+            let hd = r.header();
+            assert_eq!((hd.pixel_width, hd.pixel_height, hd.pixel_depth, hd.level_count), (w, h, d, 1));
+            let kv: Vec<(&str, &[u8])> = r.key_value_data().collect();
+            assert_eq!(kv[0], ("KTXorientation", &b"rdi\0"[..]));
+            let level = r.levels().next().unwrap();
+            let ts = format.type_size() as usize;
+            assert_eq!(level.data.len(), (w * h * d) as usize * channels * ts);
+            for z in 0..d {
+                for y in 0..h {
+                    for x in 0..w {
+                        for c in 0..channels {
+                            let k = (((z * h + y) * w + x) as usize) * channels + c;
+                            let b = &level.data[k * ts..(k + 1) * ts];
+                            let got = match format {
+                                TextureFormat::Rgba16float => half::f16::from_le_bytes([b[0], b[1]]).to_f32(),
+                                TextureFormat::Rgba32float => f32::from_le_bytes([b[0], b[1], b[2], b[3]]),
+                            };
+                            assert_eq!(got, value(x, y, z, c), "{format:?} at ({x}, {y}, {z}, {c})");
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// Key/value entries are sorted by key bytes whatever their order given (KTX 2.0 §3.11:
+    /// uppercase sorts before lowercase), and each value is NUL-terminated.
+    #[test]
+    fn key_value_entries_are_sorted_by_key() {
+        let bytes = ktx2_texels(1, 1, 1, &[0.5], TextureFormat::Rgba32float, &[("zeta", "1"), ("Beta", "2"), ("alpha", "3")]);
+        let r = ktx2::Reader::new(&bytes[..]).expect("a valid KTX2 file");
+        let kv: Vec<(&str, &[u8])> = r.key_value_data().collect();
+        assert_eq!(kv, [("Beta", &b"2\0"[..]), ("KTXorientation", b"rd\0"), ("KTXwriter", format!("{}\0", crate::emit::GENERATOR).as_bytes()), ("alpha", b"3\0"), ("zeta", b"1\0")]);
+    }
+
     #[test]
     fn srgb_encoding_matches_the_standard() {
         // IEC 61966-2-1 reference points: 0 → 0, 1 → 255, 0.5 → 0.7354 → 188, 0.0031308 (the
