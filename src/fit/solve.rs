@@ -995,6 +995,26 @@ mod tests {
         }
     }
 
+    /// An LM run's parameters come back only when every one is finite; one NaN or infinite
+    /// parameter among finite ones is a divergence, reported with the run's evaluations and
+    /// its last objective.
+    #[test]
+    fn a_non_finite_lm_result_is_a_divergence() {
+        let report = |objective_function: f64| levenberg_marquardt::MinimizationReport {
+            termination: levenberg_marquardt::TerminationReason::Converged { ftol: true, xtol: false },
+            number_of_evaluations: 17,
+            objective_function,
+        };
+        let ok = DVector::from_vec(vec![1.0, -2.0, 0.0]);
+        assert_eq!(finite_lm_result(ok.clone(), &report(0.5), "ok").unwrap(), ok);
+        for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+            match finite_lm_result(DVector::from_vec(vec![1.0, bad, 0.0]), &report(3.0), "run") {
+                Err(FitError::Diverged { what, iters, residual }) => assert_eq!((what.as_str(), iters, residual), ("run", 17, 3.0)),
+                other => panic!("{bad}: {other:?}"),
+            }
+        }
+    }
+
     /// An L4 fit is a least-squares solve followed by a solve of Σr⁴ from its optimum: it
     /// reports both stages' iterations and evaluations, each stage re-run here on its own, and
     /// its Σr⁴ is no higher than the least-squares optimum's.
