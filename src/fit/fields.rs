@@ -850,6 +850,15 @@ mod tests {
         assert!(s.condition > START_COND, "{}", s.condition);
         // The SVD's rounding (ε-relative) bounds the distance from (½, ½).
         assert!(s.coefficients.iter().all(|c| (c - 0.5).abs() < 1e-14), "{:?}", s.coefficients);
+        // The cut is relative to σmax: columns of norms 1e3 and 1e-12 (σ ratio 1e-15, below
+        // RCOND = 1e-12) leave the second out, whatever σmax's own size, so y = (1, 1, 0, 0)
+        // gives (1e-3, 0), not the 1e12 that solving along σ = 1e-12 would (an absolute or
+        // inverted cut, 1e-12 or 1e-15, keeps it). Its condition is the ratio, 1e15.
+        let b = DMatrix::from_row_slice(4, 2, &[1e3, 0.0, 0.0, 1e-12, 0.0, 0.0, 0.0, 0.0]);
+        let s = stage1(&b, &DVector::from_vec(vec![1.0, 1.0, 0.0, 0.0]));
+        // (1/σ to rounding on the kept direction; exactly 0 on the cut one.)
+        assert!((s.coefficients[0] - 1e-3).abs() < 1e-18 && s.coefficients[1] == 0.0, "the direction of σ = 1e-12 is not cut: {:?}", s.coefficients);
+        assert!((s.condition / 1e15 - 1.0).abs() < 1e-14, "{}", s.condition);
     }
 
     /// A grid point where every basis value is 0 (all of σ zero) is rank-deficient like any
