@@ -810,6 +810,21 @@ mod tests {
         assert!(stage1(&d.design, &d.y).condition > 1e12, "x = 0 must be reported singular");
     }
 
+    /// A fields fit needs grid points, and one point of data per grid point: none, or a count
+    /// that differs from the grid's, is refused as no data.
+    #[test]
+    fn a_fields_fit_needs_one_point_of_data_per_grid_point() {
+        let (x, data) = problem();
+        let models: Vec<RationalModel> = OFFSETS.iter().map(|&o| field(o)).collect();
+        let opts = FieldOptions::default();
+        for (xs, ds) in [(&x[..0], &data[..0]), (&x[..], &data[..x.len() - 1]), (&x[..x.len() - 1], &data[..])] {
+            match fit_fields(&models, xs, ds, &opts, "grid") {
+                Err(FitError::NoData { what }) => assert_eq!(what, "grid"),
+                other => panic!("{} points, {} data: {:?}", xs.len(), ds.len(), other.err()),
+            }
+        }
+    }
+
     /// Weighted, the reduction is exact for the weighted sum: Σ w_i (B_i c − y_i)² =
     /// ‖R c − z‖² + floor for every c, with √w given per row (a rank-deficient point, whose
     /// reduction rests on no inverse).

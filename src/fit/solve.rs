@@ -995,6 +995,17 @@ mod tests {
         }
     }
 
+    /// No samples at all is its own error, not an underdetermined fit, for every objective.
+    #[test]
+    fn no_data_is_refused_as_such() {
+        let model = RationalModel::rational_1d("x", 1, 1);
+        for objective in [Objective::Lsq, Objective::Minimax, Objective::L4] {
+            let e = fit(&model, &Data { x: vec![], y: vec![] }, &FitOptions { objective, ..FitOptions::default() }, "empty").unwrap_err();
+            assert!(matches!(e, FitError::NoData { .. }), "{objective:?}: {e}");
+            assert_eq!(e.to_string(), "empty: no data to fit");
+        }
+    }
+
     /// An LM run's parameters come back only when every one is finite; one NaN or infinite
     /// parameter among finite ones is a divergence, reported with the run's evaluations and
     /// its last objective.
