@@ -137,8 +137,11 @@ impl Derived {
         } else if let Some(arg) = t.strip_prefix("sin(").and_then(|r| r.strip_suffix(')')) {
             DerivedExpr::Sin(input(arg)?)
         } else {
-            // offset ± [scale *] input, or [scale *] input.
-            let (offset, sign, rest) = match t.find(['+', '-']).filter(|&i| i > 0) {
+            // offset ± [scale *] input, or [scale *] input. The operator is the first + or −
+            // after the first character (a leading one is the number's sign) that is not an
+            // exponent's sign (`1e-3 + x`, `-0.5 - 2e+1*x`).
+            let operator = t.char_indices().skip(1).find(|&(i, c)| (c == '+' || c == '-') && !t[..i].ends_with(['e', 'E'])).map(|(i, _)| i);
+            let (offset, sign, rest) = match operator {
                 Some(i) => {
                     let off: f64 = t[..i].trim().parse().map_err(|_| bad("offset is not a number"))?;
                     (off, if &t[i..i + 1] == "-" { -1.0 } else { 1.0 }, t[i + 1..].trim())
@@ -677,5 +680,32 @@ mod tests {
         let e = Derived::parse("e", "2 + 3*alpha", &inputs).unwrap();
         assert_eq!(e.eval(&[1.0, 0.0]), 5.0);
         assert!(Derived::parse("z", "cos(phi)", &inputs).is_err());
+    }
+
+    /// Signed numbers parse in every place a number stands: a negative offset, a negative
+    /// scale with no offset, exponents with either sign; and each such feature's description
+    /// parses back to it. Values written out by hand.
+    #[test]
+    fn signed_and_exponent_numbers_parse_in_affine_features() {
+        let inputs = vec!["alpha".to_string()];
+        let affine = |input, offset, scale| DerivedExpr::Affine { input, offset, scale };
+        for (text, want) in [
+            ("-0.5 + alpha", affine(0, -0.5, 1.0)),
+            ("-2*alpha", affine(0, 0.0, -2.0)),
+            ("-2 * alpha", affine(0, 0.0, -2.0)),
+            ("1e-3 + alpha", affine(0, 1e-3, 1.0)),
+            ("1e-3*alpha", affine(0, 0.0, 1e-3)),
+            ("2.5E-1 - 3e+0*alpha", affine(0, 0.25, -3.0)),
+            ("-1 - alpha", affine(0, -1.0, -1.0)),
+            ("1 + -4*alpha", affine(0, 1.0, -4.0)),
+        ] {
+            let d = Derived::parse("d", text, &inputs).unwrap_or_else(|e| panic!("{text}: {e}"));
+            assert_eq!(d.expr, want, "{text}");
+            let described = d.describe(&inputs);
+            assert_eq!(Derived::parse("d", &described, &inputs), Ok(d.clone()), "{text} described as {described:?}");
+        }
+        for bad in ["-alpha", "1e + alpha", "alpha - 1"] {
+            assert!(Derived::parse("d", bad, &inputs).is_err(), "{bad} parsed");
+        }
     }
 }
