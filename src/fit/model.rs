@@ -122,7 +122,8 @@ pub struct Derived {
 }
 
 impl Derived {
-    /// Parse `cos(x)`, `sin(x)`, `x`, `a - x`, `a + x`, `b*x`, `a + b*x`, `a - b*x` over `inputs`.
+    /// Parse `cos(x)`, `sin(x)`, `x`, `a - x`, `a + x`, `b*x`, `a + b*x`, `a - b*x` over `inputs`;
+    /// the numbers a and b may be signed and carry exponents (`-0.5 + x`, `1e-3 - 2e+1*x`).
     pub fn parse(name: &str, text: &str, inputs: &[String]) -> Result<Derived, ModelError> {
         let bad = |why: &str| ModelError::BadTerm { term: format!("{name} = {text}"), why: why.into() };
         let input = |s: &str| {
