@@ -327,22 +327,8 @@ mod tests {
     /// at k = 22 (4^22 ≈ 1.8e13). The solver stops where it started.
     #[test]
     fn refusals_end_when_the_trust_region_underflows() {
-        struct Steep;
-        impl Operator for Steep {
-            type Param = DVector<f64>;
-            type Output = DVector<f64>;
-            fn apply(&self, t: &DVector<f64>) -> Result<DVector<f64>, Error> {
-                Ok(DVector::from_element(1, 1e6 * t[0] - (1e6 - 1.0)))
-            }
-        }
-        impl Jacobian for Steep {
-            type Param = DVector<f64>;
-            type Jacobian = DMatrix<f64>;
-            fn jacobian(&self, _: &DVector<f64>) -> Result<DMatrix<f64>, Error> {
-                Ok(DMatrix::from_element(1, 1, -1e6))
-            }
-        }
-        let res = argmin::core::Executor::new(Steep, SlpMinimax::default())
+        let steep = Toy(|t: &DVector<f64>| DVector::from_element(1, 1e6 * t[0] - (1e6 - 1.0)), |_: &DVector<f64>| DMatrix::from_element(1, 1, -1e6));
+        let res = argmin::core::Executor::new(steep, SlpMinimax::default())
             .configure(|s| s.param(DVector::from_element(1, 1.0)).max_iters(5))
             .run()
             .unwrap();
@@ -352,23 +338,33 @@ mod tests {
         assert_eq!(res.solver().rho, 1e-2 * 0.25f64.powi(22));
     }
 
-    /// One residual with a cliff: t itself from 0.5 up, 10 below (the Jacobian 1 everywhere).
-    struct Cliff;
+    /// A residual function and its Jacobian, as closures: a test problem for the solver.
+    struct Toy<F, J>(F, J);
 
-    impl Operator for Cliff {
+    impl<F: Fn(&DVector<f64>) -> DVector<f64>, J> Operator for Toy<F, J> {
         type Param = DVector<f64>;
         type Output = DVector<f64>;
         fn apply(&self, t: &DVector<f64>) -> Result<DVector<f64>, Error> {
-            Ok(DVector::from_element(1, if t[0] >= 0.5 { t[0] } else { 10.0 }))
+            Ok((self.0)(t))
         }
     }
 
-    impl Jacobian for Cliff {
+    impl<F, J: Fn(&DVector<f64>) -> DMatrix<f64>> Jacobian for Toy<F, J> {
         type Param = DVector<f64>;
         type Jacobian = DMatrix<f64>;
-        fn jacobian(&self, _: &DVector<f64>) -> Result<DMatrix<f64>, Error> {
-            Ok(DMatrix::from_element(1, 1, 1.0))
+        fn jacobian(&self, t: &DVector<f64>) -> Result<DMatrix<f64>, Error> {
+            Ok((self.1)(t))
         }
+    }
+
+    /// The Jacobian 1 of one residual.
+    fn unit(_: &DVector<f64>) -> DMatrix<f64> {
+        DMatrix::from_element(1, 1, 1.0)
+    }
+
+    /// One residual with a cliff: t itself from 0.5 up, 10 below (the Jacobian 1 everywhere).
+    fn cliff(t: &DVector<f64>) -> DVector<f64> {
+        DVector::from_element(1, if t[0] >= 0.5 { t[0] } else { 10.0 })
     }
 
     /// A refused step shrinks the trust region by 4 and the step is tried again within one
@@ -378,7 +374,7 @@ mod tests {
     /// so the region doubles to 1/2.
     #[test]
     fn a_refused_step_is_retried_in_a_smaller_region() {
-        let res = argmin::core::Executor::new(Cliff, SlpMinimax { rho: 1.0, converged: false })
+        let res = argmin::core::Executor::new(Toy(cliff, unit), SlpMinimax { rho: 1.0, converged: false })
             .configure(|s| s.param(DVector::from_element(1, 1.0)).max_iters(1))
             .run()
             .unwrap();
@@ -389,22 +385,8 @@ mod tests {
 
     /// One residual r = t with its Jacobian 1: the minimax optimum is t = 0, reached by one
     /// step from any start whose trust region holds it.
-    struct Line;
-
-    impl Operator for Line {
-        type Param = DVector<f64>;
-        type Output = DVector<f64>;
-        fn apply(&self, t: &DVector<f64>) -> Result<DVector<f64>, Error> {
-            Ok(t.clone())
-        }
-    }
-
-    impl Jacobian for Line {
-        type Param = DVector<f64>;
-        type Jacobian = DMatrix<f64>;
-        fn jacobian(&self, _: &DVector<f64>) -> Result<DMatrix<f64>, Error> {
-            Ok(DMatrix::from_element(1, 1, 1.0))
-        }
+    fn line(t: &DVector<f64>) -> DVector<f64> {
+        t.clone()
     }
 
     /// ρ doubles after a good step at the region's edge, but never past 1 (a step at most as
@@ -412,7 +394,7 @@ mod tests {
     /// optimum exactly (ratio 1, at the bound), and ρ stays 1.
     #[test]
     fn the_trust_region_never_grows_past_one() {
-        let res = argmin::core::Executor::new(Line, SlpMinimax { rho: 1.0, converged: false })
+        let res = argmin::core::Executor::new(Toy(line, unit), SlpMinimax { rho: 1.0, converged: false })
             .configure(|s| s.param(DVector::from_element(1, 4.0)).max_iters(1))
             .run()
             .unwrap();
@@ -434,22 +416,8 @@ mod tests {
     /// and after the 40 tries of one iteration the solver stops where it started, converged.
     #[test]
     fn a_flat_problem_stops_where_it_started() {
-        struct Flat;
-        impl Operator for Flat {
-            type Param = DVector<f64>;
-            type Output = DVector<f64>;
-            fn apply(&self, t: &DVector<f64>) -> Result<DVector<f64>, Error> {
-                Ok(DVector::from_vec(vec![t[0] * 0.0 + 3.0, -1.0]))
-            }
-        }
-        impl Jacobian for Flat {
-            type Param = DVector<f64>;
-            type Jacobian = DMatrix<f64>;
-            fn jacobian(&self, _: &DVector<f64>) -> Result<DMatrix<f64>, Error> {
-                Ok(DMatrix::zeros(2, 1))
-            }
-        }
-        let res = argmin::core::Executor::new(Flat, SlpMinimax::default())
+        let flat = Toy(|_: &DVector<f64>| DVector::from_vec(vec![3.0, -1.0]), |_: &DVector<f64>| DMatrix::zeros(2, 1));
+        let res = argmin::core::Executor::new(flat, SlpMinimax::default())
             .configure(|s| s.param(DVector::from_element(1, 0.5)).max_iters(5))
             .run()
             .unwrap();
@@ -462,7 +430,7 @@ mod tests {
     /// The solver needs a start, and says so.
     #[test]
     fn the_solver_needs_a_start() {
-        let Err(err) = argmin::core::Executor::new(Line, SlpMinimax::default()).configure(|s| s.max_iters(1)).run() else {
+        let Err(err) = argmin::core::Executor::new(Toy(line, unit), SlpMinimax::default()).configure(|s| s.max_iters(1)).run() else {
             panic!("ran without a start")
         };
         assert!(err.to_string().contains("SLP minimax needs a start"), "{err}");
@@ -473,23 +441,12 @@ mod tests {
     /// max 0; from (0.5, 0) the solver reaches it.
     #[test]
     fn a_parameter_at_zero_has_a_trust_region() {
-        struct Ramp(Vec<f64>);
-        impl Operator for Ramp {
-            type Param = DVector<f64>;
-            type Output = DVector<f64>;
-            fn apply(&self, t: &DVector<f64>) -> Result<DVector<f64>, Error> {
-                Ok(DVector::from_iterator(self.0.len(), self.0.iter().map(|x| t[0] + t[1] * x - x)))
-            }
-        }
-        impl Jacobian for Ramp {
-            type Param = DVector<f64>;
-            type Jacobian = DMatrix<f64>;
-            fn jacobian(&self, _: &DVector<f64>) -> Result<DMatrix<f64>, Error> {
-                Ok(DMatrix::from_fn(self.0.len(), 2, |i, j| if j == 0 { 1.0 } else { self.0[i] }))
-            }
-        }
         let x: Vec<f64> = (0..11).map(|i| i as f64 / 10.0).collect();
-        let res = argmin::core::Executor::new(Ramp(x), SlpMinimax::default())
+        let ramp = Toy(
+            |t: &DVector<f64>| DVector::from_iterator(x.len(), x.iter().map(|x| t[0] + t[1] * x - x)),
+            |_: &DVector<f64>| DMatrix::from_fn(x.len(), 2, |i, j| if j == 0 { 1.0 } else { x[i] }),
+        );
+        let res = argmin::core::Executor::new(ramp, SlpMinimax::default())
             .configure(|s| s.param(DVector::from_vec(vec![0.5, 0.0])).max_iters(200))
             .run()
             .unwrap();
