@@ -995,6 +995,29 @@ mod tests {
         }
     }
 
+    /// A minimax fit's report counts the polish among its evaluations, one per iteration of the
+    /// sequential-LP solver, and not among its iterations (Lawson's least-squares solves): the
+    /// fit with the polish reports the evaluations of the fit without it (the same Lawson
+    /// iterates, which do not depend on the polish) plus the iterations of the polish run again
+    /// here on its own from Lawson's best iterate.
+    #[test]
+    fn a_minimax_fit_counts_the_polish_among_its_evaluations() {
+        let model = RationalModel::rational_1d("x", 2, 1);
+        let x: Vec<Vec<f64>> = (0..=30).map(|i| vec![i as f64 / 10.0]).collect();
+        let data = Data { y: x.iter().map(|p| (0.7 * p[0]).exp()).collect(), x };
+        let minimax = |polish_iters| FitOptions { objective: Objective::Minimax, polish_iters, ..FitOptions::default() };
+        let lawson = fit(&model, &data, &minimax(0), "exp").unwrap();
+        let polished = fit(&model, &data, &minimax(200), "exp").unwrap();
+        let run = Executor::new(Residuals::new(&model, &data, lawson.theta.clone()), SlpMinimax::default())
+            .configure(|s| s.param(lawson.theta.clone()).max_iters(200))
+            .run()
+            .unwrap();
+        let k = run.state().get_iter() as usize;
+        assert!(k >= 2 && lawson.report.evaluations > 2, "{k} polish iterations after {} evaluations", lawson.report.evaluations);
+        assert_eq!(polished.report.iterations, lawson.report.iterations);
+        assert_eq!(polished.report.evaluations, lawson.report.evaluations + k);
+    }
+
     /// No samples at all is its own error, not an underdetermined fit, for every objective.
     #[test]
     fn no_data_is_refused_as_such() {
