@@ -826,8 +826,8 @@ mod tests {
     }
 
     /// Weighted, the reduction is exact for the weighted sum: Σ w_i (B_i c − y_i)² =
-    /// ‖R c − z‖² + floor for every c, with √w given per row (a rank-deficient point, whose
-    /// reduction rests on no inverse).
+    /// ‖R c − z‖² + floor for every c, with √w given per row, at a rank-deficient point (x = 0)
+    /// and a full-rank one alike (the reduction rests on no inverse).
     #[test]
     fn a_weighted_reduction_is_exact_for_the_weighted_sum() {
         let (_, data) = problem();
