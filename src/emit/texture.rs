@@ -405,6 +405,14 @@ mod tests {
         (0..w * h).map(|k| [k as f32 / 7.0, 0.25, -(k as f32), 1.0]).collect()
     }
 
+    /// One channel value decoded from its little-endian bytes in `format`.
+    fn channel(format: TextureFormat, b: &[u8]) -> f32 {
+        match format {
+            TextureFormat::Rgba16float => half::f16::from_le_bytes([b[0], b[1]]).to_f32(),
+            TextureFormat::Rgba32float => f32::from_le_bytes([b[0], b[1], b[2], b[3]]),
+        }
+    }
+
     /// The DFD's own size fields, read from the file as KDF 1.3 lays them out (the ktx2 crate
     /// reads the samples without checking them): dfdTotalSize, the header's dfdByteLength and
     /// the basic block's descriptorBlockSize (the high half of its second word) all follow
@@ -465,10 +473,7 @@ mod tests {
             for (k, texel) in t.iter().enumerate() {
                 for c in 0..4 {
                     let b = &data[(4 * k + c) * ts..(4 * k + c + 1) * ts];
-                    let v = match format {
-                        TextureFormat::Rgba16float => half::f16::from_le_bytes([b[0], b[1]]).to_f32(),
-                        TextureFormat::Rgba32float => f32::from_le_bytes([b[0], b[1], b[2], b[3]]),
-                    };
+                    let v = channel(format, b);
                     assert_eq!(v.to_bits(), format.stored(texel[c]).to_bits());
                 }
             }
@@ -501,10 +506,7 @@ mod tests {
             let ts = format.type_size() as usize;
             for (k, &x) in v.iter().enumerate() {
                 let b = &level.data[k * ts..(k + 1) * ts];
-                let got = match format {
-                    TextureFormat::Rgba16float => half::f16::from_le_bytes([b[0], b[1]]).to_f32(),
-                    TextureFormat::Rgba32float => f32::from_le_bytes([b[0], b[1], b[2], b[3]]),
-                };
+                let got = channel(format, b);
                 assert_eq!(got.to_bits(), format.stored(x).to_bits());
             }
         }
@@ -544,10 +546,7 @@ mod tests {
                         for c in 0..channels {
                             let k = (((z * h + y) * w + x) as usize) * channels + c;
                             let b = &level.data[k * ts..(k + 1) * ts];
-                            let got = match format {
-                                TextureFormat::Rgba16float => half::f16::from_le_bytes([b[0], b[1]]).to_f32(),
-                                TextureFormat::Rgba32float => f32::from_le_bytes([b[0], b[1], b[2], b[3]]),
-                            };
+                            let got = channel(format, b);
                             assert_eq!(got, value(x, y, z, c), "{format:?} at ({x}, {y}, {z}, {c})");
                         }
                     }
