@@ -709,4 +709,77 @@ mod tests {
             assert!(Derived::parse("d", bad, &inputs).is_err(), "{bad} parsed");
         }
     }
+
+    /// `RationalModel::new` refuses each model it cannot resolve, with the error its docs
+    /// name, and accepts the neighbours of each refused one:
+    /// - a constant denominator term beside the implicit lead 1 (also when the lead is
+    ///   written as `"1"`); beside a lead that is not 1 (`"1 + x^2"`, or `"x"`, one monomial
+    ///   that is not constant) the constant term is a coefficient like any other, and that
+    ///   lead is kept;
+    /// - no free coefficient left, by fixing or by pinning;
+    /// - a pin that eliminates a fixed coefficient or a denominator one, a pin where the
+    ///   factor is 0 or overflows, and two pins at one point (a singular system).
+    #[test]
+    fn the_constructor_refuses_what_it_cannot_resolve() {
+        let feats = vec!["x".to_string()];
+        let terms = |ts: &[&str]| ts.iter().map(|t| Term::parse(t, &feats).unwrap()).collect::<Vec<_>>();
+        let parts = |num: &[&str], den: &[&str]| ModelParts {
+            inputs: feats.clone(),
+            numerator: terms(num),
+            denominator: terms(den),
+            ..ModelParts::default()
+        };
+        let pin = |at: f64, eliminate| Pin { at: vec![at], value: 0.5, eliminate };
+        assert!(Term::parse("1", &feats).unwrap().is_constant());
+        assert!(!Term::parse("x", &feats).unwrap().is_constant());
+        assert!(!Term::parse("1 + x", &feats).unwrap().is_constant());
+
+        // The denominator's constant.
+        for lead in [None, Some(terms(&["1"]).remove(0))] {
+            let err = RationalModel::new(ModelParts { lead: lead.clone(), ..parts(&["1"], &["1", "x"]) }).unwrap_err();
+            assert!(matches!(&err, ModelError::BadTerm { term, .. } if term == "1"), "lead {lead:?}: {err}");
+        }
+        let one = RationalModel::new(ModelParts { lead: Some(terms(&["1"]).remove(0)), ..parts(&["1"], &["x"]) }).unwrap();
+        assert_eq!((one.lead.clone(), one.lead_at(&[3.0])), (None, 1.0), "a lead of 1 is the implicit one");
+        for lead in ["1 + x^2", "x"] {
+            let m = RationalModel::new(ModelParts { lead: Some(terms(&[lead]).remove(0)), ..parts(&["1"], &["1", "x"]) })
+                .unwrap_or_else(|e| panic!("lead {lead}: {e}"));
+            assert_eq!(m.lead.as_ref().map(|t| t.label.as_str()), Some(lead));
+            // (1 + x²) or x, plus 1·b0 + x·b1, at x = 3 with b = (2, 0.5): 10 + 3.5, 3 + 3.5.
+            let c = DVector::from_vec(vec![7.0, 2.0, 0.5]);
+            let want_q = if lead == "x" { 6.5 } else { 13.5 };
+            assert_eq!(m.denominator_at(&c, &[3.0]), want_q, "lead {lead}");
+        }
+
+        // No free coefficient.
+        let all_fixed = RationalModel::new(ModelParts { fixed: vec![(0, 1.0), (1, 2.0)], ..parts(&["1"], &["x"]) });
+        assert_eq!(all_fixed.unwrap_err(), ModelError::NoFreeParameter);
+        let fixed_and_pinned = ModelParts { fixed: vec![(1, 2.0)], pins: vec![pin(0.5, 0)], ..parts(&["1", "x"], &[]) };
+        assert_eq!(RationalModel::new(fixed_and_pinned).unwrap_err(), ModelError::NoFreeParameter);
+        let one_left = ModelParts { fixed: vec![(1, 2.0)], pins: vec![pin(0.5, 0)], ..parts(&["1", "x"], &["x"]) };
+        assert_eq!(RationalModel::new(one_left).unwrap().n_free(), 1);
+
+        // Pins that cannot be resolved.
+        let bad_pin = |p: ModelParts, why: &str| {
+            let err = RationalModel::new(p).unwrap_err();
+            assert!(matches!(&err, ModelError::BadPin { why: w, .. } if w.contains(why)), "{err} (want '{why}')");
+        };
+        bad_pin(ModelParts { fixed: vec![(0, 1.0)], pins: vec![pin(0.5, 0)], ..parts(&["1", "x"], &["x"]) }, "not fixed");
+        bad_pin(ModelParts { pins: vec![pin(0.5, 2)], ..parts(&["1", "x"], &["x"]) }, "numerator coefficient");
+        let with_factor = |at: f64| ModelParts { factor: Some(terms(&["x^2"]).remove(0)), pins: vec![pin(at, 0)], ..parts(&["1", "x"], &[]) };
+        bad_pin(with_factor(0.0), "factor is zero");
+        bad_pin(with_factor(1e200), "factor is zero");
+        assert!(RationalModel::new(with_factor(2.0)).is_ok());
+        bad_pin(ModelParts { pins: vec![pin(0.5, 0), pin(0.5, 1)], ..parts(&["1", "x", "x^2"], &[]) }, "singular");
+        // The same pins at two points determine both coefficients: c0 + c1·x + c2·x² = 0.5 at
+        // x = 0.5 and 2 for every c2.
+        let two = RationalModel::new(ModelParts { pins: vec![pin(0.5, 0), pin(2.0, 1)], ..parts(&["1", "x", "x^2"], &[]) }).unwrap();
+        for c2 in [0.0, 3.0] {
+            let c = two.full(&DVector::from_vec(vec![c2]));
+            for x in [0.5, 2.0] {
+                // Rounding of a 2×2 solve on numbers below 12.
+                assert!((two.eval_full(&c, &[x]) - 0.5).abs() <= 1e-14, "c2 = {c2}, x = {x}");
+            }
+        }
+    }
 }
