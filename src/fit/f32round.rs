@@ -105,6 +105,7 @@ fn ordinal(x: f32) -> i64 {
     if b & 0x8000_0000 != 0 { -((b & 0x7fff_ffff) as i64) } else { b as i64 }
 }
 
+/// The f32 at position `k` of [`ordinal`]'s line; position 0 is +0.
 fn from_ordinal(k: i64) -> f32 {
     if k < 0 { f32::from_bits((-k) as u32 | 0x8000_0000) } else { f32::from_bits(k as u32) }
 }
@@ -300,6 +301,11 @@ mod tests {
         assert_eq!(step_ulps(0.0, 1), Some(tiny));
         assert_eq!(step_ulps(-0.0, -1), Some(-tiny));
         assert_eq!(ulps_between(-tiny, tiny), 2);
+        // Zero's one position is +0, reached from either side: a coefficient stepped onto zero
+        // is printed `0.0` in emitted code, never `-0.0` (bits, since -0.0 == 0.0).
+        for (from, k) in [(tiny, -1), (-tiny, 1), (-0.0, 0), (0.0, 0)] {
+            assert_eq!(step_ulps(from, k).map(f32::to_bits), Some(0), "{from:e} stepped {k}");
+        }
         assert_eq!(step_ulps(f32::MAX, 1), None);
         assert_eq!(step_ulps(f32::MIN, -1), None);
         // The largest finite floats themselves are reachable, from either side.
