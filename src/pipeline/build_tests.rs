@@ -429,6 +429,68 @@ fn a_fields_builds_rounding_report_is_its_errors_on_the_fitting_samples() {
     assert!(e32 > 1e-9 && e32 < 1e-5, "{e32}");
 }
 
+/// The inner variable v = (1 + 3o)·u: the stage-1 design [1, v, v²] on the 9 inner samples
+/// changes with o, so its condition number does.
+static SCALED: crate::quantity::InnerBasis = crate::quantity::InnerBasis {
+    inner: 1,
+    args: &["v"],
+    arg_domain: &[(-4.0, 4.0)],
+    terms: &["1", "v", "v^2"],
+    to_args: |o, i| vec![(1.0 + 3.0 * o[0]) * i[0]],
+    sample: |o, inner, _| {
+        inner
+            .iter()
+            .map(|i| {
+                let v = (1.0 + 3.0 * o[0]) * i[0];
+                Estimate { value: field_value(0, o[0]) + field_value(1, o[0]) * v + field_value(2, o[0]) * v * v, error: 0.0, evals: 1 }
+            })
+            .collect()
+    },
+    range: (-100.0, 100.0),
+};
+
+static SCALED_Q: QuantityDef = QuantityDef { name: "scaled-fields", basis: Some(&SCALED), ..FIELDS_Q };
+
+/// A fields build reports the stage-1 condition numbers of its outer points as their min,
+/// median and max, worked out here in closed form: at o = i/16 the design's columns are
+/// 1, s·u, s²·u² with s = 1 + 3o on u = −1 + l/4 (l = 0…8), whose Gram matrix is
+/// [[9, 0, 3.75 s²], [0, 3.75 s², 0], [3.75 s², 0, 2.765625 s⁴]] (Σu² = 3.75, Σu⁴ = 2.765625):
+/// eigenvalues 3.75 s² and those of the 2×2 block, and the condition is √(λmax/λmin). None is
+/// above 1e8. The rest of the fit's report: its grids, objective (least squares: no outer
+/// iterations), no rms cap, and LM evaluations.
+#[test]
+fn a_fields_build_reports_its_stage1_conditions() {
+    let text = FIELDS.replace("quadratic-fields", "scaled-fields");
+    let b = build_spec(&spec_in(&text, &Catalog { quantities: vec![&SCALED_Q], kinds: vec![] }), Mode::Fit, tempfile::tempdir().unwrap().path(), &|_| None)
+        .unwrap();
+    let fit = &json_of(&b)["fit"];
+    let mut conds: Vec<f64> = (0..17)
+        .map(|i| {
+            let s2 = (1.0 + 3.0 * i as f64 / 16.0).powi(2);
+            let (a, bb, d) = (9.0, 3.75 * s2, 2.765625 * s2 * s2);
+            let hi = 0.5 * (a + d) + (0.25 * (a - d) * (a - d) + bb * bb).sqrt();
+            // The smaller eigenvalue as det / λmax, free of the cancellation in (a + d)/2 − √….
+            let lo = (a * d - bb * bb) / hi;
+            let eig = [hi, lo, 3.75 * s2];
+            let (max, min) = (eig.iter().copied().fold(0.0, f64::max), eig.iter().copied().fold(f64::INFINITY, f64::min));
+            (max / min).sqrt()
+        })
+        .collect();
+    conds.sort_by(f64::total_cmp);
+    assert!(conds[16] > 2.0 * conds[0], "the conditions differ across o: {conds:?}");
+    let c = &fit["stage1_condition"];
+    // The SVD of a 9 × 3 matrix and the closed form above agree to a few ulps of the
+    // condition (≤ 30 here) times its size: 1e-12 relative.
+    for (key, want) in [("min", conds[0]), ("median", conds[8]), ("max_up_to_1e8", conds[16]), ("max", conds[16])] {
+        let got = c[key].as_f64().unwrap_or_else(|| panic!("{key}: {c}"));
+        assert!((got - want).abs() <= 1e-12 * want, "{key}: {got} vs {want}");
+    }
+    assert_eq!(c["points_above_1e8"].as_u64(), Some(0));
+    assert_eq!((fit["grid_points"].as_u64(), fit["inner_samples"].as_u64()), (Some(17), Some(9)));
+    assert_eq!((&fit["objective"], &fit["max_rms"], fit["outer_iterations"].as_u64()), (&json!("lsq"), &Value::Null, Some(0)));
+    assert!(fit["lm_evaluations"].as_u64().is_some_and(|n| n > 0), "{fit}");
+}
+
 /// The committed fields read back by name (`committed::Fields::load`: fits/NAME.toml beside
 /// generated/) evaluate the exact fields, at outer points off the fitting grid too; the fit
 /// alone (`fields::fit`) gives the coefficients and the report the build wrote; a fit spec is
