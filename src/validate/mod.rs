@@ -123,6 +123,16 @@ mod tests {
         // The Taylor form's own error (at x = 2: 1 − e⁻² ≈ 0.865) is far above the refit's.
         assert!(item.max_abs_error > 0.8 && max < 1e-3, "taylor {}, refit {max}", item.max_abs_error);
         assert_eq!(item.findings.len(), 1, "{:?}", item.findings);
+        // The finding names the spec and its objective, and sets the refit's errors beside the
+        // published form's as ratios: for a form with twice the refit's error at every point,
+        // 0.50 and 0.50 (to 2 decimals; the doubling rounds by an ulp).
+        let doubled: Vec<f64> = xs.iter().zip(&truth).map(|(&x, t)| t + 2.0 * (r64(x) - t)).collect();
+        let mut half = Item::measured("doubled", "a test", "x ∈ [0, 2]", &points, &truth, &doubled);
+        half.add_refit(&generated, "exp_fit", &catalog, &points, &truth).unwrap();
+        let f = &half.findings[0];
+        for part in ["(fits/exp_fit.toml, same form, minimax)", "(0.50× the published)", "(0.50×)."] {
+            assert!(f.contains(part), "{f:?} lacks {part:?}");
+        }
         let mut bare = Item::measured("taylor", "a test", "x ∈ [0, 2]", &points, &truth, &taylor);
         assert!(bare.add_refit(&generated, "no_such_fit", &catalog, &points, &truth).is_none());
         assert!(bare.extra.is_empty() && bare.findings.is_empty());
