@@ -343,7 +343,7 @@ impl RationalModel {
             }
             let fac = model.factor.as_ref().map_or(1.0, |t| t.eval(&model.extend(&p.at)));
             if fac == 0.0 || !fac.is_finite() {
-                return Err(ModelError::BadPin { at: p.at.clone(), why: "the factor is zero there".into() });
+                return Err(ModelError::BadPin { at: p.at.clone(), why: "the factor is zero or not finite there".into() });
             }
         }
         let theta0 = DVector::zeros(model.free.len());
@@ -768,7 +768,7 @@ mod tests {
         bad_pin(ModelParts { pins: vec![pin(0.5, 2)], ..parts(&["1", "x"], &["x"]) }, "numerator coefficient");
         let with_factor = |at: f64| ModelParts { factor: Some(terms(&["x^2"]).remove(0)), pins: vec![pin(at, 0)], ..parts(&["1", "x"], &[]) };
         bad_pin(with_factor(0.0), "factor is zero");
-        bad_pin(with_factor(1e200), "factor is zero");
+        bad_pin(with_factor(1e200), "not finite");
         assert!(RationalModel::new(with_factor(2.0)).is_ok());
         bad_pin(ModelParts { pins: vec![pin(0.5, 0), pin(0.5, 1)], ..parts(&["1", "x", "x^2"], &[]) }, "singular");
         // The same pins at two points determine both coefficients: c0 + c1·x + c2·x² = 0.5 at
