@@ -151,6 +151,37 @@ fn a_fit_spec_reports_the_errors_of_what_it_writes() {
     assert_eq!(fr["fitting_samples"].as_u64(), Some(64));
     let (rounded, reopt) = (fr["rounded_f32"]["max_abs_error"].as_f64().unwrap(), fr["reoptimised_f32"]["max_abs_error"].as_f64().unwrap());
     assert!(reopt <= rounded, "{reopt} > {rounded}");
+    // The f32 coefficients' own denominator bound: positive and below Q of the f32
+    // coefficients (in f64) sampled densely.
+    let q32 = (0..=20000).map(|i| 2.0 * i as f64 / 20000.0).map(|x| 1.0 + den[0] * x + den[1] * x * x).fold(f64::MAX, f64::min);
+    let lower32 = fr["denominator_lower_bound"].as_f64().unwrap();
+    assert!(lower32 > 0.0 && lower32 <= q32, "f32 bound {lower32}, sampled min {q32}");
+}
+
+/// A quartic on the narrow [1.75, 2]: its monomial terms cancel, so rounding each coefficient
+/// to f32 costs more than the fit's error and the search moves coefficients. The report's
+/// moves are each f32 coefficient's distance from the nearest f32 to its f64 coefficient,
+/// counted here on the ordered line of f32 bit patterns; the count of those that moved, the
+/// largest, and the documented cap of 64 ulps.
+#[test]
+fn a_fits_rounding_report_counts_the_moves_of_its_coefficients() {
+    let text = FIT
+        .replace("range = [0.0, 2.0]", "range = [1.75, 2.0]")
+        .replace("numerator = [\"1\", \"x\", \"x^2\"]\ndenominator = [\"x\", \"x^2\"]", "numerator = [\"1\", \"x\", \"x^2\", \"x^3\", \"x^4\"]");
+    assert!(text.contains("x^4") && text.contains("1.75"), "{text}");
+    let b = build_spec(&spec(&text), Mode::Fit, tempfile::tempdir().unwrap().path(), &|_| None).unwrap();
+    let j = json_of(&b);
+    let (c, num) = (floats(&j["model"]["coefficients"]), floats(&j["model"]["numerator_f32"]));
+    let ord = |v: f32| if v.is_sign_negative() { -((v.to_bits() & 0x7fff_ffff) as i64) } else { v.to_bits() as i64 };
+    let moves: Vec<i64> = num.iter().zip(&c).map(|(&a, &b)| ord(a as f32) - ord(b as f32)).collect();
+    let fr = &j["f32_rounding"];
+    let reported: Vec<i64> = fr["moves_ulps"].as_array().unwrap().iter().map(|v| v.as_i64().unwrap()).collect();
+    assert_eq!(reported, moves);
+    let moved = moves.iter().filter(|m| **m != 0).count() as u64;
+    assert!(moved > 0 && moved < 5, "some coefficients move, not all: {moves:?}");
+    assert_eq!(fr["coefficients_moved"].as_u64(), Some(moved));
+    assert_eq!(fr["max_move_ulps"].as_u64(), moves.iter().map(|m| m.unsigned_abs()).max());
+    assert_eq!(fr["max_ulps_allowed"].as_u64(), Some(64));
 }
 
 #[test]
