@@ -158,8 +158,8 @@ fn a_fit_spec_reports_the_errors_of_what_it_writes() {
     assert!(lower32 > 0.0 && lower32 <= q32, "f32 bound {lower32}, sampled min {q32}");
 }
 
-/// A quartic on the narrow [1.75, 2]: its monomial terms cancel, so rounding each coefficient
-/// to f32 costs more than the fit's error and the search moves coefficients. The report's
+/// A quartic on the narrow [1.75, 2], whose monomial terms cancel (like `fit::f32round`'s
+/// quartic on [8, 9]): the f32 search moves some of its coefficients, not all. The report's
 /// moves are each f32 coefficient's distance from the nearest f32 to its f64 coefficient,
 /// counted here on the ordered line of f32 bit patterns; the count of those that moved, the
 /// largest, and the documented cap of 64 ulps.
