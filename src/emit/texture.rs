@@ -430,6 +430,7 @@ mod tests {
         // The VkFormat of each, as the ktx2 crate names Vulkan's enumerants (97 and 109), and
         // its bytes a channel (a half, a float).
         for (format, vk, size) in [(TextureFormat::Rgba16float, ktx2::Format::R16G16B16A16_SFLOAT, 2), (TextureFormat::Rgba32float, ktx2::Format::R32G32B32A32_SFLOAT, 4)] {
+            let texel = 4 * size;
             let (w, h) = (5, 3);
             let t = texels(w, h);
             let bytes = ktx2_rgba(w, h, &t, format, &[("shadefit", "spec: fits/x.toml")]);
@@ -447,7 +448,7 @@ mod tests {
             // KTX2 string values are NUL-terminated.
             assert_eq!(r.writer(), Some(format!("{}\0", crate::emit::GENERATOR).as_str()));
             let basic = r.basic_dfd().expect("a basic DFD block");
-            assert_eq!(basic.bytes_planes[0] as u32, 4 * size);
+            assert_eq!(basic.bytes_planes[0] as u32, texel);
             dfd_sizes_follow_the_spec(&bytes, 4);
             let samples = &basic.sample_information;
             assert_eq!(samples.len(), 4);
@@ -467,10 +468,10 @@ mod tests {
             let levels: Vec<_> = r.levels().collect();
             assert_eq!(levels.len(), 1);
             let data = levels[0].data;
-            assert_eq!(data.len(), t.len() * 4 * size as usize);
+            assert_eq!(data.len(), t.len() * texel as usize);
             // The level starts at a multiple of the texel size.
             let at = data.as_ptr() as usize - bytes.as_ptr() as usize;
-            assert_eq!(at % (4 * size) as usize, 0);
+            assert_eq!(at % texel as usize, 0);
             let ts = size as usize;
             for (k, texel) in t.iter().enumerate() {
                 for c in 0..4 {

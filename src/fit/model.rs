@@ -722,7 +722,8 @@ mod tests {
     #[test]
     fn the_constructor_refuses_what_it_cannot_resolve() {
         let feats = vec!["x".to_string()];
-        let terms = |ts: &[&str]| ts.iter().map(|t| Term::parse(t, &feats).unwrap()).collect::<Vec<_>>();
+        let term = |t: &str| Term::parse(t, &feats).unwrap();
+        let terms = |ts: &[&str]| ts.iter().map(|t| term(t)).collect::<Vec<_>>();
         let parts = |num: &[&str], den: &[&str]| ModelParts {
             inputs: feats.clone(),
             numerator: terms(num),
@@ -730,19 +731,19 @@ mod tests {
             ..ModelParts::default()
         };
         let pin = |at: f64, eliminate| Pin { at: vec![at], value: 0.5, eliminate };
-        assert!(Term::parse("1", &feats).unwrap().is_constant());
-        assert!(!Term::parse("x", &feats).unwrap().is_constant());
-        assert!(!Term::parse("1 + x", &feats).unwrap().is_constant());
+        assert!(term("1").is_constant());
+        assert!(!term("x").is_constant());
+        assert!(!term("1 + x").is_constant());
 
         // The denominator's constant.
-        for lead in [None, Some(terms(&["1"]).remove(0))] {
+        for lead in [None, Some(term("1"))] {
             let err = RationalModel::new(ModelParts { lead: lead.clone(), ..parts(&["1"], &["1", "x"]) }).unwrap_err();
             assert!(matches!(&err, ModelError::BadTerm { term, .. } if term == "1"), "lead {lead:?}: {err}");
         }
-        let one = RationalModel::new(ModelParts { lead: Some(terms(&["1"]).remove(0)), ..parts(&["1"], &["x"]) }).unwrap();
+        let one = RationalModel::new(ModelParts { lead: Some(term("1")), ..parts(&["1"], &["x"]) }).unwrap();
         assert_eq!((one.lead.clone(), one.lead_at(&[3.0])), (None, 1.0), "a lead of 1 is the implicit one");
         for lead in ["1 + x^2", "x"] {
-            let m = RationalModel::new(ModelParts { lead: Some(terms(&[lead]).remove(0)), ..parts(&["1"], &["1", "x"]) })
+            let m = RationalModel::new(ModelParts { lead: Some(term(lead)), ..parts(&["1"], &["1", "x"]) })
                 .unwrap_or_else(|e| panic!("lead {lead}: {e}"));
             assert_eq!(m.lead.as_ref().map(|t| t.label.as_str()), Some(lead));
             // (1 + x²) or x, plus 1·b0 + x·b1, at x = 3 with b = (2, 0.5): 10 + 3.5, 3 + 3.5.
@@ -766,7 +767,7 @@ mod tests {
         };
         bad_pin(ModelParts { fixed: vec![(0, 1.0)], pins: vec![pin(0.5, 0)], ..parts(&["1", "x"], &["x"]) }, "not fixed");
         bad_pin(ModelParts { pins: vec![pin(0.5, 2)], ..parts(&["1", "x"], &["x"]) }, "numerator coefficient");
-        let with_factor = |at: f64| ModelParts { factor: Some(terms(&["x^2"]).remove(0)), pins: vec![pin(at, 0)], ..parts(&["1", "x"], &[]) };
+        let with_factor = |at: f64| ModelParts { factor: Some(term("x^2")), pins: vec![pin(at, 0)], ..parts(&["1", "x"], &[]) };
         bad_pin(with_factor(0.0), "factor is zero");
         bad_pin(with_factor(1e200), "not finite");
         assert!(RationalModel::new(with_factor(2.0)).is_ok());
