@@ -122,8 +122,9 @@ pub struct Derived {
 }
 
 impl Derived {
-    /// Parse `cos(x)`, `sin(x)`, `x`, `a - x`, `a + x`, `b*x`, `a + b*x`, `a - b*x` over `inputs`;
-    /// the numbers a and b may be signed and carry exponents (`-0.5 + x`, `1e-3 - 2e+1*x`).
+    /// Parse `cos(x)`, `sin(x)`, `x`, `-x`, `a - x`, `a + x`, `b*x`, `a + b*x`, `a - b*x` over
+    /// `inputs`; the numbers a and b may be signed and carry exponents (`-0.5 + x`,
+    /// `1e-3 - 2e+1*x`).
     pub fn parse(name: &str, text: &str, inputs: &[String]) -> Result<Derived, ModelError> {
         let bad = |why: &str| ModelError::BadTerm { term: format!("{name} = {text}"), why: why.into() };
         let input = |s: &str| {
@@ -149,9 +150,13 @@ impl Derived {
                 }
                 None => (0.0, 1.0, t),
             };
+            // A bare input may carry a sign of its own (`-x`, `1 + -x`): scale ±1.
             let (scale, var) = match rest.split_once('*') {
                 Some((a, v)) => (a.trim().parse::<f64>().map_err(|_| bad("scale is not a number"))?, v),
-                None => (1.0, rest),
+                None => match rest.strip_prefix('-') {
+                    Some(v) => (-1.0, v),
+                    None => (1.0, rest.strip_prefix('+').unwrap_or(rest)),
+                },
             };
             DerivedExpr::Affine { input: input(var)?, offset, scale: sign * scale }
         };
@@ -699,13 +704,17 @@ mod tests {
             ("2.5E-1 - 3e+0*alpha", affine(0, 0.25, -3.0)),
             ("-1 - alpha", affine(0, -1.0, -1.0)),
             ("1 + -4*alpha", affine(0, 1.0, -4.0)),
+            ("-alpha", affine(0, 0.0, -1.0)),
+            ("+alpha", affine(0, 0.0, 1.0)),
+            ("1 + -alpha", affine(0, 1.0, -1.0)),
+            ("0.5 - -alpha", affine(0, 0.5, 1.0)),
         ] {
             let d = Derived::parse("d", text, &inputs).unwrap_or_else(|e| panic!("{text}: {e}"));
             assert_eq!(d.expr, want, "{text}");
             let described = d.describe(&inputs);
             assert_eq!(Derived::parse("d", &described, &inputs), Ok(d.clone()), "{text} described as {described:?}");
         }
-        for bad in ["-alpha", "1e + alpha", "alpha - 1"] {
+        for bad in ["--alpha", "-beta", "1e + alpha", "alpha - 1"] {
             assert!(Derived::parse("d", bad, &inputs).is_err(), "{bad} parsed");
         }
     }

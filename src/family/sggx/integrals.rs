@@ -553,6 +553,53 @@ mod tests {
         }
     }
 
+    /// An NDF given by a closure, for the distance tests.
+    struct Field<G: Fn(&V3) -> f64 + Sync>(G);
+    impl<G: Fn(&V3) -> f64 + Sync> Ndf for Field<G> {
+        fn d(&self, m: &V3) -> f64 {
+            (self.0)(m)
+        }
+    }
+
+    /// `distance` compares two NDFs as distributions p = D/∫D:
+    /// - a lobe and three times that lobe are the same distribution (to rounding: p ≤ 1, as
+    ///   ∫D ≥ ∫D|m·n| = 2 and D ≤ 2 here, so each |p − q| is a few ulps of 1, and TV ≤ ½·4π of
+    ///   that; bound 1e-14);
+    /// - D_a = 1 against D_b = 3 above the horizon and 1 below: p = 1/4π, q = 3/8π above and
+    ///   1/8π below, so |p − q| = 1/8π everywhere: TV ½·4π/8π = ¼, L2 √(4π)/8π = 1/(4√π), max
+    ///   1/8π, masses 4π and 8π. The θ panels end at π/2, where the indicator jumps, so the rule
+    ///   integrates both pieces at its order (8 points on panels of π/8 give sin θ to ~1e-16);
+    ///   the sums over 16 384 nodes round by up to 3e-13 (measured, on 8π); bound 1e-12;
+    /// - a narrow bump added to a constant: the worst node is the one nearest the bump, within
+    ///   the node spacing (8-point panels of π/32: nodes at most 0.018 apart, so the nearest
+    ///   is within 0.013 in θ and 0.013/sin θ in φ; bound 0.03 rad).
+    #[test]
+    fn distance_compares_normalised_distributions() {
+        let rule = SphereRule::new(8, 16, 8);
+        let (n, a) = texel(0.6, 1.1, 0.5, 0.3, 0.2);
+        let lobe = Lobe::new(sggx_from(n, a)).unwrap();
+        let thrice = Field(|m: &V3| 3.0 * lobe.d(m));
+        let d = distance(&lobe, &thrice, &rule);
+        assert!(d.tv < 1e-14 && d.l2 < 1e-14 && d.max < 1e-14, "{d:?}");
+        assert!((d.mass.1 / d.mass.0 - 3.0).abs() < 1e-13, "{d:?}");
+
+        let one = Field(|_: &V3| 1.0);
+        let step = Field(|m: &V3| if m.z > 0.0 { 3.0 } else { 1.0 });
+        let d = distance(&one, &step, &rule);
+        let close = |x: f64, want: f64| (x - want).abs() < 1e-12;
+        assert!(close(d.tv, 0.25) && close(d.l2, 0.25 / PI.sqrt()) && close(d.max, 0.125 / PI), "{d:?}");
+        assert!(close(d.mass.0, 4.0 * PI) && close(d.mass.1, 8.0 * PI), "{d:?}");
+
+        let rule = SphereRule::new(32, 64, 8);
+        for (theta, phi) in [(0.9, 2.2), (2.4, -1.0)] {
+            let peak = direction(theta, phi);
+            let bump = Field(move |m: &V3| 1.0 + 50.0 * (40.0 * (m.dot(&peak) - 1.0)).exp());
+            let d = distance(&one, &bump, &rule);
+            let dphi = (d.worst.1 - phi + PI).rem_euclid(2.0 * PI) - PI;
+            assert!((d.worst.0 - theta).abs() < 0.03 && dphi.abs() < 0.03, "({theta}, {phi}): {d:?}");
+        }
+    }
+
     #[test]
     fn ndf_is_normalised_and_projects_to_the_closed_form_area() {
         // ∫_{h·n>0} D(h)(h·n) dh = 1 and ∫ ⟨ω,m⟩₊ D dm = √(ωᵀSω), on the sphere rule. The lobes
