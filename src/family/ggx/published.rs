@@ -751,6 +751,38 @@ mod tests {
 
     /// The spread is the largest max − min of A + B over n·v within one roughness row, never
     /// across rows: rows (0.5, 0.7, 0.6) and (0.9, 0.9, 0.95) give 0.2, not 0.95 − 0.5.
+    /// The bevy item's compensation finding states its worst point's 1/A and 1/E, and where:
+    /// the printed (n·v, r) is a node of the grid to its digits (4 and 3 decimals); there,
+    /// Karis's A and the tabulated E = A + B of the integral give the printed values to their
+    /// digits (1/A to 0.05, 1/E to 5e-4); and together they give the item's own maximum relative
+    /// error, X/Y − 1, within what those digits allow (0.05/Y + 5e-4·X/Y²).
+    #[test]
+    fn the_compensation_finding_states_its_worst_point() {
+        let items = karis_items();
+        let item = items.iter().find(|i| i.name.starts_with("ggx-env: bevy")).expect("bevy item");
+        let text = item.findings.iter().find(|f| f.starts_with("Energy compensation")).expect("finding");
+        let number_after = |key: &str| -> f64 {
+            let rest = &text[text.find(key).unwrap_or_else(|| panic!("{key} in {text}")) + key.len()..];
+            let end = rest.find(|c: char| !(c.is_ascii_digit() || c == '.')).unwrap_or(rest.len());
+            rest[..end].parse().unwrap_or_else(|_| panic!("{key}: {rest}"))
+        };
+        let (x, y) = (number_after("that is 1/A = "), number_after("Turquin's 1/E = "));
+        let (m, r) = (number_after("(n·v = "), number_after(", r = "));
+        let hc = grid::standard(Target::Roughness);
+        let (node, t) = hc
+            .points()
+            .zip(&hc.values)
+            .min_by(|(a, _), (b, _)| ((a.0 - m).abs() + (a.1 - r).abs()).total_cmp(&((b.0 - m).abs() + (b.1 - r).abs())))
+            .unwrap();
+        assert!((node.0 - m).abs() <= 5e-5 && (node.1 - r).abs() <= 5e-4, "printed ({m}, {r}) is no node: {node:?}");
+        let a = KARIS.eval(node.1, node.0)[0];
+        assert!((1.0 / a - x).abs() <= 0.05 + 1e-9, "1/A: printed {x}, {} at {node:?}", 1.0 / a);
+        assert!((1.0 / (t[0] + t[1]) - y).abs() <= 5e-4 + 1e-9, "1/E: printed {y}, {}", 1.0 / (t[0] + t[1]));
+        let worst = item.extra.iter().find(|e| e.0 == "compensation_1_over_a_max_rel_error").unwrap().1;
+        let slack = 0.05 / y + 5e-4 * x / (y * y);
+        assert!((x / y - 1.0 - worst).abs() <= slack, "X/Y − 1 = {} vs the item's {worst}", x / y - 1.0);
+    }
+
     #[test]
     fn albedo_spread_is_the_widest_row_range() {
         let values = [[0.25, 0.25], [0.5, 0.2], [0.4, 0.2], [0.8, 0.1], [0.5, 0.4], [0.9, 0.05]].to_vec();
