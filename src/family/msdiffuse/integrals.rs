@@ -288,6 +288,36 @@ mod tests {
 
     const KEY: u64 = 0x5eed;
 
+    /// The paths of `eval` at a tolerance, by hand: (1/tol)² rounded up, at least one chunk and
+    /// at most 2^20 (a tolerance of 0, of 2^-10 or less, or NaN asks the most).
+    #[test]
+    fn eval_paths_are_the_inverse_square_of_the_tolerance_within_their_bounds() {
+        assert_eq!(eval_paths(0.1), CHUNK); // 100 paths: one chunk of 1024
+        assert_eq!(eval_paths(0.03), 1112); // 1111.1…, rounded up
+        assert_eq!(eval_paths(1e-2), 10_000);
+        assert_eq!(eval_paths(2e-3), 250_000);
+        assert_eq!(eval_paths(1e-3), 1_000_000); // below 2^20 = 1 048 576
+        for tol in [9.7e-4, 1e-12, 0.0, f64::NAN] {
+            assert_eq!(eval_paths(tol), 1 << 20, "{tol}");
+        }
+    }
+
+    /// The `specular_walks` flag: at or above ½ the light reflected by a facet walks on, below
+    /// it is gone; the cell of a point hashes its parameters' bits, in order.
+    #[test]
+    fn the_flag_picks_the_convention_and_cells_follow_the_bits() {
+        for (flag, want) in [(1.0, Specular::Walks), (0.5, Specular::Walks), (0.49, Specular::Gone), (0.0, Specular::Gone)] {
+            assert_eq!(specular_of(flag), want, "{flag}");
+        }
+        let p = [0.3, 0.7, 1.0];
+        assert_eq!(cell_of(&p), cell_of(&[0.3, 0.7, 1.0]));
+        for other in [[0.7, 0.3, 1.0], [0.3, 0.7, f64::from_bits(1.0f64.to_bits() + 1)], [0.3, -0.0, 1.0], [0.3, 0.0, 1.0]] {
+            assert_ne!(cell_of(&p), cell_of(&other), "{other:?}");
+        }
+        assert_ne!(cell_of(&[0.0]), cell_of(&[-0.0]));
+        assert_ne!(cell_of(&[0.3]), cell_of(&[0.3, 0.0]));
+    }
+
     #[test]
     fn directions_are_mirror_images_about_the_half_vector() {
         let (l, v) = directions(0.3, 0.7, 1.1).unwrap();

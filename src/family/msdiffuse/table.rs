@@ -679,6 +679,32 @@ pub(super) mod tests {
         }
     }
 
+    /// The cluster sharding: the table's cells computed in two ranges (split off the middle),
+    /// merged and decoded, are each cell of the table computed alone, bit for bit (value and
+    /// standard error); the count is the slices', the albedo's and the MERL cells'; a merged
+    /// payload one cell short is refused, naming the spec and both sizes.
+    #[test]
+    fn shards_merge_to_the_cells_of_one_run() {
+        let s = spec(SPEC);
+        let t = Table::from_spec(&s).unwrap();
+        let n = shard_cells(&s).unwrap();
+        assert_eq!(n, 4 * 3 * 2 + t.albedo_cells() + t.merl_cells());
+        let k = n / 2 + 1;
+        let mut payload = shard_compute(&s, 0..k).unwrap();
+        assert_eq!(payload.len() as u64, 16 * k);
+        payload.extend(shard_compute(&s, k..n).unwrap());
+        let cells = cells_of_payload(&t, &payload).unwrap();
+        assert_eq!(cells.len() as u64, n);
+        for (c, got) in cells.iter().enumerate() {
+            let want = t.cell(c as u64);
+            assert_eq!((got.value.to_bits(), got.se.to_bits()), (want.value.to_bits(), want.se.to_bits()), "cell {c}");
+        }
+        let short = &payload[..payload.len() - 16];
+        let e = cells_of_payload(&t, short).unwrap_err().to_string();
+        let (have, need) = (short.len().to_string(), (16 * n).to_string());
+        assert!(e.contains("msd_t") && e.contains(&have) && e.contains(&need), "{e}");
+    }
+
     #[test]
     fn cells_are_the_quantity_and_check_mode_rerenders_them() {
         let s = spec(SPEC);
