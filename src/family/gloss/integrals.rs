@@ -254,6 +254,21 @@ mod tests {
         eprintln!("gloss-length closed form vs quadrature, 256 glosses: max diff {worst:e}");
     }
 
+    /// Beyond the gloss domain (α > √1.5, where L takes its atan form) the closed form still
+    /// agrees with the quadrature of the definition; the integrand 2α²t²/(1 + (α² − 1)t²)² is
+    /// smooth there. Asked for 1e-14, bound 1e-12 as on the gloss domain. At α = √1.5 the two
+    /// forms meet (the series just below, the atan form just above).
+    #[test]
+    fn closed_form_matches_quadrature_beyond_the_gloss_domain() {
+        for alpha in [1.2248, 1.5, 2.0, 5.0, 30.0] {
+            let q = normal_length_quadrature(alpha, 1e-14);
+            assert!((normal_length(alpha) - q.value).abs() <= 1e-12, "α = {alpha}: closed {} vs quadrature {}", normal_length(alpha), q.value);
+        }
+        let edge = 1.5f64.sqrt();
+        let (below, above) = (normal_length(edge * (1.0 - 1e-15)), normal_length(edge * (1.0 + 1e-15)));
+        assert!((below - above).abs() < 1e-14, "{below} vs {above}");
+    }
+
     #[test]
     fn monotone_in_gloss() {
         let mut prev = 0.0;

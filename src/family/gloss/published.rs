@@ -173,6 +173,49 @@ mod tests {
         assert!((rational_1d(&typo, 1.0) - PUBLISHED_ENDS.1).abs() > 1e-4);
     }
 
+    /// The validation items' figures, re-measured here from the published constants and the
+    /// integral (`length_from_gloss`, judged against quadrature in `integrals`):
+    /// - the table's rows at their exact glosses k/255 (k = 0, 1, 2, 3, 252…255, listed by
+    ///   hand): the item's max error, each deviation the finding prints, their one sign, and the
+    ///   sample count 0.375/dev₀ that the bias at g = 0 implies;
+    /// - the published fit on g = i/255: its max error, its max error in gloss units (through
+    ///   the inverse), the typo's max error the finding quotes;
+    /// - the committed refit, loaded here from generated/: its error in gloss units.
+    /// Max errors within 1e-15 (the same f64 operations, summed in another order: none, a max
+    /// is exact); printed figures by their printed digits.
+    #[test]
+    fn items_state_the_tables_deviations_and_the_fits_errors() {
+        let items = items(Path::new("generated"));
+        let ks = [0.0, 1.0, 2.0, 3.0, 252.0, 253.0, 254.0, 255.0];
+        let dev: Vec<f64> = ks.iter().zip(PUBLISHED_TABLE).map(|(k, row)| row.1 - length_from_gloss(k / 255.0)).collect();
+        let table = &items[0];
+        assert_eq!(table.points, 8);
+        assert_eq!(table.max_abs_error, dev.iter().fold(0.0f64, |m, d| m.max(d.abs())));
+        assert!(table.findings[0].contains(&format!("({:+.1e})", 0.666670 - 2.0 / 3.0)), "{}", table.findings[0]);
+        let devs = dev.iter().map(|d| format!("{d:+.1e}")).collect::<Vec<_>>().join(", ");
+        let bias = &table.findings[1];
+        assert!(bias.contains(&format!("Deviations ({devs})")), "{bias}");
+        assert!(dev.iter().all(|d| *d > 0.0) && bias.contains("all of one sign"), "{bias}");
+        assert!(bias.contains(&format!("N ≈ {:.1e}", 0.375 / dev[0])), "{bias}");
+
+        let g: Vec<f64> = (0..256).map(|i| i as f64 / 255.0).collect();
+        let c = published_fit_coefficients(0.999958);
+        let fit = &items[1];
+        let err = g.iter().map(|&x| (rational_1d(&c, x) - length_from_gloss(x)).abs()).fold(0.0f64, f64::max);
+        assert_eq!(fit.max_abs_error, err);
+        let in_gloss = g.iter().map(|&x| (gloss_from_length(rational_1d(&c, x)) - x).abs()).fold(0.0f64, f64::max);
+        let extra = |item: &Item, name: &str| item.extra.iter().find(|e| e.0 == name).unwrap_or_else(|| panic!("{name}")).1;
+        assert_eq!(extra(fit, "max_abs_error_in_gloss"), in_gloss);
+        let typo = published_fit_coefficients(0.99958);
+        let typo_err = g.iter().map(|&x| (rational_1d(&typo, x) - length_from_gloss(x)).abs()).fold(0.0f64, f64::max);
+        assert!(fit.findings[1].contains(&format!("max error is {typo_err:.2e} instead of {err:.2e}")), "{}", fit.findings[1]);
+
+        let refit = crate::pipeline::committed::Refit::load(Path::new("generated"), "gloss_length", crate::family::catalog()).unwrap();
+        let refit_in_gloss = g.iter().map(|&x| (gloss_from_length(refit.eval(&[x])) - x).abs()).fold(0.0f64, f64::max);
+        assert_eq!(extra(fit, "refit_max_abs_error_in_gloss"), refit_in_gloss);
+        assert!(fit.findings.iter().any(|f| f.contains(&format!("recovered gloss units: {refit_in_gloss:.2e}"))));
+    }
+
     #[test]
     fn uniform_samples_include_both_ends() {
         // i/(n − 1): quarters are exact in binary, so equality is exact.
