@@ -310,6 +310,33 @@ mod tests {
         }
     }
 
+    /// The shader factor W = 1/M: 1 at k = 0 for every u·t (N = M = 1 there), 1/M(k, 1) in
+    /// closed form at c = 1 (to the integrator's 1e-12 relative, bound 4e-12); within τ of the
+    /// reference 1/M at 1e-14 and within its own estimate; and that estimate is M's, carried
+    /// by the derivative of 1/M, here a central difference of 1/x at M (its 1e-6 relative
+    /// step: truncation 1e-12, rounding of two values 2e-6 apart ~1e-10, relative; bound 1e-9).
+    #[test]
+    fn scale_is_one_over_the_mean_with_its_error_carried() {
+        for c in [0.0, 0.3, 1.0] {
+            assert!((scale(0.0, c, 1e-12).value - 1.0).abs() <= 4e-12, "c = {c}");
+        }
+        for k in [-0.99, -0.5, -0.1] {
+            assert!((scale(k, 1.0, 1e-12).value * mean_parallel(k) - 1.0).abs() <= 4e-12, "k = {k}");
+        }
+        for (k, c) in [(-0.99, 0.01), (-0.7, 0.5), (-0.3, 0.999)] {
+            let reference = 1.0 / mean(k, c, 1e-14).value;
+            for tol in [1e-6, 1e-9] {
+                let w = scale(k, c, tol);
+                assert!(w.error <= tol && (w.value - reference).abs() <= w.error + 1e-14, "k = {k}, c = {c}, tol = {tol:e}: {w:?}");
+                let m = mean(k, c, 0.09 * tol);
+                let h = 1e-6 * m.value;
+                let slope = (1.0 / (m.value - h) - 1.0 / (m.value + h)) / (2.0 * h);
+                assert!((w.error / (m.error * slope) - 1.0).abs() <= 1e-9, "k = {k}, c = {c}: {} vs {}", w.error, m.error * slope);
+                assert_eq!(w.evals, m.evals);
+            }
+        }
+    }
+
     #[test]
     fn small_k_follows_the_first_order_term() {
         // M = 1 + 2k ⟨x⟩ + O(k²), ⟨x⟩ the mean of sin∠(t, h) over v; at c = 1 that mean is

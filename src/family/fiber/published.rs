@@ -91,6 +91,18 @@ pub fn items(generated: &Path) -> Vec<Item> {
 mod tests {
     use super::*;
 
+    /// The committed refit's energy error max |W̃/W − 1| and its absolute error max |W̃ − W|
+    /// over the same points, with W ∈ [1, 3.28] (the item's domain): |W̃ − W| = |W̃/W − 1|·W,
+    /// so the relative maximum lies between the absolute one over 3.28 and the absolute one.
+    #[test]
+    fn the_refits_energy_error_is_its_error_relative_to_w() {
+        let items = items(Path::new("generated"));
+        let extra = |name: &str| items[1].extra.iter().find(|e| e.0 == name).unwrap_or_else(|| panic!("{name}")).1;
+        let (rel, abs) = (extra("refit_max_energy_error"), extra("refit_max_abs_error"));
+        assert!(abs > 0.0 && rel >= abs / 3.28 && rel <= abs, "relative {rel:e}, absolute {abs:e}");
+        assert!(items[1].findings.iter().any(|f| f.contains(&format!("max {rel:.2e}"))));
+    }
+
     #[test]
     fn conservative_r_never_gains_and_is_exact_at_parallel_light_and_k_zero() {
         // r_c·N ≤ 1 everywhere (N(k, c) ≤ N(k, 1)); = 1 at c = 1 and at k = 0. Bound: the
