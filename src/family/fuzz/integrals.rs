@@ -1333,6 +1333,25 @@ mod tests {
     /// −1, −sin θf, sin θf, the cone w = −a and, with a grazing band [s, L/2], −a ± s and −a ± L/2
     /// (L = 2α sqrt((1−α²)s_a² + α²)/(1−α²), the peak width written out here), where they fall
     /// inside; the log-mapped pieces are the band's.
+    /// No piece is empty: each takes a share of the tolerance, so an empty one would tighten
+    /// the others for nothing. Two distinct cuts can still lie at the same offset from the cone
+    /// in f64: with the cone at w₀ = 0.9 and a band of 1.9, the cut w₀ − 1.9 is the float just
+    /// above −1, and both −1 − w₀ and that cut − w₀ round to −1.9. The whole-circle range
+    /// between them is empty in ε and gets no piece.
+    #[test]
+    fn no_piece_is_empty_even_where_two_cuts_round_to_one_offset() {
+        let (a, s) = (-0.9f64, 1.9);
+        let w0 = -a;
+        let cut = w0 - s;
+        assert!(cut > -1.0 && cut - w0 == -1.0 - w0, "the construction needs the collision: {cut}");
+        let layer = Layer::new(0.3, 0.6);
+        let pieces = layer.pieces(a, (1.0 - a * a).sqrt(), Some(s));
+        for p in &pieces {
+            assert!(p.dx != 0.0, "an empty piece: {p:?}");
+        }
+        assert!(pieces.iter().any(|p| p.region == Region::Full), "{pieces:?}");
+    }
+
     #[test]
     fn pieces_tile_the_w_range_at_the_cuts() {
         for (alpha, theta_f, a, band) in [(0.3, 0.6, 0.7, Some(1e-4)), (0.3, 0.6, 0.7, None), (0.5, 1.2, -0.2, Some(1e-3)), (0.2, 0.9, 0.5, Some(2e-3))] {
