@@ -348,6 +348,27 @@ mod tests {
         bad("[profile]\nsigma = 1\n", 2, "sigma", "unknown field");
     }
 
+    /// A CSV profile loaded from its file: the profile, its bytes as the hash input (so an
+    /// edited file makes generated files stale), and their SHA-256 in the provenance. The hash
+    /// against FIPS 180-2's example ("abc", Appendix B.1) and the empty message; a preset has no
+    /// hash input.
+    #[test]
+    fn a_csv_profile_file_hashes_its_bytes() {
+        assert_eq!(sha256_hex(b"abc"), "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+        assert_eq!(sha256_hex(b""), "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855");
+        let d = tempfile::tempdir().unwrap();
+        let path = d.path().join("p.CSV");
+        let body = "radius_mm,red,green,blue\n0,3,6,1.5\n2,0,0,0\n";
+        std::fs::write(&path, body).unwrap();
+        let p = load_profile_file(&path).unwrap();
+        assert_eq!(p.profile, Profile::Tabulated { radius_mm: vec![0.0, 2.0], value: vec![[3.0, 6.0, 1.5], [0.0; 3]] });
+        assert_eq!(p.hash_input(), body.as_bytes());
+        assert_eq!(p.provenance()["csv_sha256"], sha256_hex(body.as_bytes()));
+        assert!(LoadedProfile::deon_luebke().hash_input().is_empty());
+        let e = load_profile_file(&d.path().join("missing.csv")).unwrap_err();
+        assert!(e.file.ends_with("missing.csv") && e.msg.contains("cannot read"), "{e}");
+    }
+
     #[test]
     fn csv_profiles_and_their_errors() {
         let d = tempfile::tempdir().unwrap();
