@@ -428,7 +428,8 @@ mod tests {
 
     /// A small spec of each kind, built from scratch; its JSON's verification claims are then
     /// re-measured here from the JSON alone (texels, axes) against the integral evaluated point
-    /// by point (`skin::punctual`, `skin::sh_band`), with this test's own interpolation.
+    /// by point (`skin::punctual`, `skin::sh_band`), with this test's own interpolation; and the
+    /// JSON read back in check mode renders the same artifacts.
     fn remeasure(text: &str) {
         let spec = crate::spec::Spec::parse(Path::new("fits/skin_t.toml"), text.to_string(), crate::family::catalog())
             .expect("a valid skin spec");
@@ -436,6 +437,18 @@ mod tests {
         let built = build(&spec, Mode::Fit, Path::new("")).unwrap();
         let json = built.artifacts.iter().find(|a| a.path.to_str().unwrap().ends_with(".json")).unwrap();
         let v: Value = serde_json::from_slice(&json.contents).unwrap();
+        // The committed read-back: with this JSON alone written under a root, a check-mode build
+        // renders every artifact again, byte for byte.
+        let dir = tempfile::tempdir().unwrap();
+        assert!(json.path.is_relative(), "{}", json.path.display());
+        let at = dir.path().join(&json.path);
+        std::fs::create_dir_all(at.parent().unwrap()).unwrap();
+        std::fs::write(&at, &json.contents).unwrap();
+        let again = build(&spec, Mode::Committed, dir.path()).unwrap();
+        assert_eq!(again.artifacts.len(), built.artifacts.len());
+        for (a, b) in built.artifacts.iter().zip(&again.artifacts) {
+            assert!(a.path == b.path && a.contents == b.contents, "{} differs when read back", a.path.display());
+        }
         let texels: Vec<[f64; 3]> = v["values"]
             .as_array()
             .unwrap()
