@@ -791,4 +791,24 @@ mod tests {
         let flat = Grid { values: vec![[0.3, 0.3]; 6], ..g };
         assert_eq!(albedo_spread(&flat), 0.0);
     }
+
+    /// A form's max error over a grid, by hand: the largest |error| of either channel at any
+    /// node, points running n·v fastest; a NaN anywhere is the worst (infinite), so a search
+    /// that minimises it never settles on a form that fails somewhere. The refits' Nelder–Mead
+    /// objective.
+    #[test]
+    fn max_error_is_the_largest_channel_error_and_nan_is_worst() {
+        let values = [[0.25, 0.25], [0.5, 0.2], [0.4, 0.2], [0.8, 0.1], [0.5, 0.4], [0.9, 0.05]].to_vec();
+        let g = Grid { target: Target::Roughness, mu: vec![0.2, 0.5, 1.0], y: vec![0.0, 1.0], values };
+        // Form (m + y, m): errors at (m, y) = (0.2, 0) are (−0.05, −0.05); (0.5, 0): (0, 0.3);
+        // (1, 0): (0.6, 0.8); (0.2, 1): (0.4, 0.1); (0.5, 1): (1.0, 0.1); (1, 1): (1.1, 0.95).
+        assert!((g.max_error(|m, y| [m + y, m]) - 1.1).abs() < 1e-15);
+        assert!((g.max_error(|_, _| [0.5, 0.5]) - 0.45).abs() < 1e-15);
+        for nan in [[f64::NAN, 0.4], [0.5, f64::NAN]] {
+            assert_eq!(g.max_error(|m, y| if m == 0.5 && y == 1.0 { nan } else { [0.0, 0.0] }), f64::INFINITY, "{nan:?}");
+        }
+        let e = g.errors(|m, y| [m + y, m]);
+        assert_eq!(e.len(), 6);
+        assert!((e[2][1] - 0.8).abs() < 1e-15 && (e[5][0] - 1.1).abs() < 1e-15, "{e:?}");
+    }
 }

@@ -102,12 +102,13 @@ impl Grid {
         }).collect()
     }
 
-    /// The largest |error| over both channels of a form.
+    /// The largest |error| over both channels of a form; a NaN in either channel is infinite.
     pub fn max_error(&self, form: impl Fn(f64, f64) -> [f64; 2]) -> f64 {
         self.points().zip(&self.values).fold(0.0f64, |m, ((x, y), t)| {
             let a = form(x, y);
-            let e = (a[0] - t[0]).abs().max((a[1] - t[1]).abs());
-            if e.is_nan() { f64::INFINITY } else { m.max(e) }
+            let (ea, eb) = ((a[0] - t[0]).abs(), (a[1] - t[1]).abs());
+            // f64::max drops a NaN: test each channel.
+            if ea.is_nan() || eb.is_nan() { f64::INFINITY } else { m.max(ea).max(eb) }
         })
     }
 }
