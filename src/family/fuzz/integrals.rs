@@ -1329,10 +1329,6 @@ mod tests {
         assert!(arc_won, "no case exercises the arc term");
     }
 
-    /// The pieces of a light's w-range tile [−1, sin θf] without gap or overlap, each end a cut:
-    /// −1, −sin θf, sin θf, the cone w = −a and, with a grazing band [s, L/2], −a ± s and −a ± L/2
-    /// (L = 2α sqrt((1−α²)s_a² + α²)/(1−α²), the peak width written out here), where they fall
-    /// inside; the log-mapped pieces are the band's.
     /// No piece is empty: each takes a share of the tolerance, so an empty one would tighten
     /// the others for nothing. Two distinct cuts can still lie at the same offset from the cone
     /// in f64: with the cone at w₀ = 0.9 and a band of 1.9, the cut w₀ − 1.9 is the float just
@@ -1352,6 +1348,10 @@ mod tests {
         assert!(pieces.iter().any(|p| p.region == Region::Full), "{pieces:?}");
     }
 
+    /// The pieces of a light's w-range tile [−1, sin θf] without gap or overlap, each end a cut:
+    /// −1, −sin θf, sin θf, the cone w = −a and, with a grazing band [s, L/2], −a ± s and −a ± L/2
+    /// (L = 2α sqrt((1−α²)s_a² + α²)/(1−α²), the peak width written out here), where they fall
+    /// inside; the log-mapped pieces are the band's.
     #[test]
     fn pieces_tile_the_w_range_at_the_cuts() {
         for (alpha, theta_f, a, band) in [(0.3, 0.6, 0.7, Some(1e-4)), (0.3, 0.6, 0.7, None), (0.5, 1.2, -0.2, Some(1e-3)), (0.2, 0.9, 0.5, Some(2e-3))] {

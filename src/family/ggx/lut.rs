@@ -82,7 +82,7 @@ mod tests {
     /// against an independent quadrature in `texels_match_the_integral_with_adaptive_azimuth_panels`),
     /// interpolated by this test's own lookup (texel centres at (i + ½)/n, clamped at the edges).
     /// The build's reference asks 1e-6 (VERIFY_TOLERANCE): the maxima agree within 1e-6 + 1e-10,
-    /// and so does each point's error, the worst point's included.
+    /// and so does the error at the worst point the build states.
     #[test]
     fn verification_is_re_measured_against_the_integral() {
         let lut = DfgLut::parse(Path::new("fits/ggx_t.toml"), SPEC).unwrap();

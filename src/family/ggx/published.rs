@@ -749,8 +749,6 @@ mod tests {
         }
     }
 
-    /// The spread is the largest max − min of A + B over n·v within one roughness row, never
-    /// across rows: rows (0.5, 0.7, 0.6) and (0.9, 0.9, 0.95) give 0.2, not 0.95 − 0.5.
     /// The bevy item's compensation finding states its worst point's 1/A and 1/E, and where:
     /// the printed (n·v, r) is a node of the grid to its digits (4 and 3 decimals); there,
     /// Karis's A and the tabulated E = A + B of the integral give the printed values to their
@@ -783,6 +781,8 @@ mod tests {
         assert!((x / y - 1.0 - worst).abs() <= slack, "X/Y − 1 = {} vs the item's {worst}", x / y - 1.0);
     }
 
+    /// The spread is the largest max − min of A + B over n·v within one roughness row, never
+    /// across rows: rows (0.5, 0.7, 0.6) and (0.9, 0.9, 0.95) give 0.2, not 0.95 − 0.5.
     #[test]
     fn albedo_spread_is_the_widest_row_range() {
         let values = [[0.25, 0.25], [0.5, 0.2], [0.4, 0.2], [0.8, 0.1], [0.5, 0.4], [0.9, 0.05]].to_vec();

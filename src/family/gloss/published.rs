@@ -181,8 +181,8 @@ mod tests {
     /// - the published fit on g = i/255: its max error, its max error in gloss units (through
     ///   the inverse), the typo's max error the finding quotes;
     /// - the committed refit, loaded here from generated/: its error in gloss units.
-    /// Max errors within 1e-15 (the same f64 operations, summed in another order: none, a max
-    /// is exact); printed figures by their printed digits.
+    /// Max errors compared exactly (the same f64 operations at the same points; a max does not
+    /// depend on order); printed figures by their printed digits.
     #[test]
     fn items_state_the_tables_deviations_and_the_fits_errors() {
         let items = items(Path::new("generated"));
