@@ -781,6 +781,28 @@ mod tests {
         assert!((x / y - 1.0 - worst).abs() <= slack, "X/Y − 1 = {} vs the item's {worst}", x / y - 1.0);
     }
 
+    /// The bevy item's clamp finding states Karis's smallest A over the grid and where: the
+    /// printed (n·v, r) is a node (to 4 and 3 decimals), Karis's A there is the printed A (to
+    /// 5e-5), and no node of the grid has an A below it (by more than the printed digits).
+    #[test]
+    fn the_clamp_finding_states_the_smallest_a_and_where() {
+        let items = karis_items();
+        let item = items.iter().find(|i| i.name.starts_with("ggx-env: bevy")).expect("bevy item");
+        let text = item.findings.iter().find(|f| f.starts_with("The v0.19 clamp")).expect("finding");
+        let number_after = |key: &str| -> f64 {
+            let rest = &text[text.find(key).unwrap_or_else(|| panic!("{key} in {text}")) + key.len()..];
+            let end = rest.find(|c: char| !(c.is_ascii_digit() || c == '.')).unwrap_or(rest.len());
+            rest[..end].parse().unwrap_or_else(|_| panic!("{key}: {rest}"))
+        };
+        let (a, m, r) = (number_after("(A = "), number_after(" at n·v = "), number_after(", r = "));
+        let hc = grid::standard(Target::Roughness);
+        let node = hc.points().min_by(|p, q| ((p.0 - m).abs() + (p.1 - r).abs()).total_cmp(&((q.0 - m).abs() + (q.1 - r).abs()))).unwrap();
+        assert!((node.0 - m).abs() <= 5e-5 && (node.1 - r).abs() <= 5e-4, "printed ({m}, {r}) is no node: {node:?}");
+        assert!((KARIS.eval(node.1, node.0)[0] - a).abs() <= 5e-5 + 1e-12, "A at {node:?}: printed {a}");
+        let lowest = hc.points().map(|(m, r)| KARIS.eval(r, m)[0]).fold(f64::MAX, f64::min);
+        assert!(lowest >= a - 5e-5 - 1e-12, "A = {lowest} on the grid, below the printed {a}");
+    }
+
     /// The spread is the largest max − min of A + B over n·v within one roughness row, never
     /// across rows: rows (0.5, 0.7, 0.6) and (0.9, 0.9, 0.95) give 0.2, not 0.95 − 0.5.
     #[test]
