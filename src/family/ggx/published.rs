@@ -749,6 +749,13 @@ mod tests {
         }
     }
 
+    /// The number printed right after `key` in a finding's text.
+    fn number_after(text: &str, key: &str) -> f64 {
+        let rest = &text[text.find(key).unwrap_or_else(|| panic!("{key} in {text}")) + key.len()..];
+        let end = rest.find(|c: char| !(c.is_ascii_digit() || c == '.')).unwrap_or(rest.len());
+        rest[..end].parse().unwrap_or_else(|_| panic!("{key}: {rest}"))
+    }
+
     /// The bevy item's compensation finding states its worst point's 1/A and 1/E, and where:
     /// the printed (n·v, r) is a node of the grid to its digits (4 and 3 decimals); there,
     /// Karis's A and the tabulated E = A + B of the integral give the printed values to their
@@ -759,11 +766,7 @@ mod tests {
         let items = karis_items();
         let item = items.iter().find(|i| i.name.starts_with("ggx-env: bevy")).expect("bevy item");
         let text = item.findings.iter().find(|f| f.starts_with("Energy compensation")).expect("finding");
-        let number_after = |key: &str| -> f64 {
-            let rest = &text[text.find(key).unwrap_or_else(|| panic!("{key} in {text}")) + key.len()..];
-            let end = rest.find(|c: char| !(c.is_ascii_digit() || c == '.')).unwrap_or(rest.len());
-            rest[..end].parse().unwrap_or_else(|_| panic!("{key}: {rest}"))
-        };
+        let number_after = |key: &str| number_after(text, key);
         let (x, y) = (number_after("that is 1/A = "), number_after("Turquin's 1/E = "));
         let (m, r) = (number_after("(n·v = "), number_after(", r = "));
         let hc = grid::standard(Target::Roughness);
@@ -789,11 +792,7 @@ mod tests {
         let items = karis_items();
         let item = items.iter().find(|i| i.name.starts_with("ggx-env: bevy")).expect("bevy item");
         let text = item.findings.iter().find(|f| f.starts_with("The v0.19 clamp")).expect("finding");
-        let number_after = |key: &str| -> f64 {
-            let rest = &text[text.find(key).unwrap_or_else(|| panic!("{key} in {text}")) + key.len()..];
-            let end = rest.find(|c: char| !(c.is_ascii_digit() || c == '.')).unwrap_or(rest.len());
-            rest[..end].parse().unwrap_or_else(|_| panic!("{key}: {rest}"))
-        };
+        let number_after = |key: &str| number_after(text, key);
         let (a, m, r) = (number_after("(A = "), number_after(" at n·v = "), number_after(", r = "));
         let hc = grid::standard(Target::Roughness);
         let node = hc.points().min_by(|p, q| ((p.0 - m).abs() + (p.1 - r).abs()).total_cmp(&((q.0 - m).abs() + (q.1 - r).abs()))).unwrap();
