@@ -749,6 +749,13 @@ mod tests {
         }
     }
 
+    /// The bevy item of `karis_items` and its finding that starts with `prefix`.
+    fn bevy_finding(prefix: &str) -> (Item, String) {
+        let item = karis_items().into_iter().find(|i| i.name.starts_with("ggx-env: bevy")).expect("bevy item");
+        let text = item.findings.iter().find(|f| f.starts_with(prefix)).expect("finding").clone();
+        (item, text)
+    }
+
     /// The number printed right after `key` in a finding's text.
     fn number_after(text: &str, key: &str) -> f64 {
         let rest = &text[text.find(key).unwrap_or_else(|| panic!("{key} in {text}")) + key.len()..];
@@ -763,10 +770,8 @@ mod tests {
     /// error, X/Y − 1, within what those digits allow (0.05/Y + 5e-4·X/Y²).
     #[test]
     fn the_compensation_finding_states_its_worst_point() {
-        let items = karis_items();
-        let item = items.iter().find(|i| i.name.starts_with("ggx-env: bevy")).expect("bevy item");
-        let text = item.findings.iter().find(|f| f.starts_with("Energy compensation")).expect("finding");
-        let number_after = |key: &str| number_after(text, key);
+        let (item, text) = bevy_finding("Energy compensation");
+        let number_after = |key: &str| number_after(&text, key);
         let (x, y) = (number_after("that is 1/A = "), number_after("Turquin's 1/E = "));
         let (m, r) = (number_after("(n·v = "), number_after(", r = "));
         let hc = grid::standard(Target::Roughness);
@@ -789,10 +794,8 @@ mod tests {
     /// 5e-5), and no node of the grid has an A below it (by more than the printed digits).
     #[test]
     fn the_clamp_finding_states_the_smallest_a_and_where() {
-        let items = karis_items();
-        let item = items.iter().find(|i| i.name.starts_with("ggx-env: bevy")).expect("bevy item");
-        let text = item.findings.iter().find(|f| f.starts_with("The v0.19 clamp")).expect("finding");
-        let number_after = |key: &str| number_after(text, key);
+        let (_, text) = bevy_finding("The v0.19 clamp");
+        let number_after = |key: &str| number_after(&text, key);
         let (a, m, r) = (number_after("(A = "), number_after(" at n·v = "), number_after(", r = "));
         let hc = grid::standard(Target::Roughness);
         let node = hc.points().min_by(|p, q| ((p.0 - m).abs() + (p.1 - r).abs()).total_cmp(&((q.0 - m).abs() + (q.1 - r).abs()))).unwrap();
