@@ -338,7 +338,7 @@ mod tests {
 
     /// Unit vector (sin θ cos φ, sin θ sin φ, cos θ).
     fn dir(theta: f64, phi: f64) -> V3 {
-        [theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos()]
+        crate::family::sggx::integrals::direction(theta, phi).into()
     }
 
     /// With F = 1 (f0 = 1) the mirror phase function is a distribution over wo: by wo = 2(wi·h)h −
