@@ -65,6 +65,15 @@ pub fn all(generated: &Path, validators: &[fn(&Path) -> Vec<Item>]) -> Vec<Item>
     validators.iter().flat_map(|v| v(generated)).collect()
 }
 
+/// The number printed right after `key` in a finding's text: the longest run of digits,
+/// points, signs and exponent letters there that parses (so `1.5e-3.` reads 1.5e-3).
+#[cfg(test)]
+pub(crate) fn number_after(text: &str, key: &str) -> f64 {
+    let rest = &text[text.find(key).unwrap_or_else(|| panic!("{key} in {text}")) + key.len()..];
+    let end = rest.find(|c: char| !(c.is_ascii_digit() || ".eE+-".contains(c))).unwrap_or(rest.len());
+    (1..=end).rev().find_map(|n| rest[..n].parse().ok()).unwrap_or_else(|| panic!("{key}: {rest}"))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

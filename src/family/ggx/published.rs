@@ -620,6 +620,7 @@ pub fn figures(out: &Path, _generated: &Path) -> Result<Vec<PathBuf>, PlotError>
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::validate::number_after;
 
     /// A pair form's per-channel maxima, by hand: scale errors 0.1, −0.3, 0.2 and bias errors
     /// −0.05, 0.04, 0.5 (truth minus approximation either way round) give 0.3 and 0.5.
@@ -754,13 +755,6 @@ mod tests {
         let item = karis_items().into_iter().find(|i| i.name.starts_with("ggx-env: bevy")).expect("bevy item");
         let text = item.findings.iter().find(|f| f.starts_with(prefix)).expect("finding").clone();
         (item, text)
-    }
-
-    /// The number printed right after `key` in a finding's text.
-    fn number_after(text: &str, key: &str) -> f64 {
-        let rest = &text[text.find(key).unwrap_or_else(|| panic!("{key} in {text}")) + key.len()..];
-        let end = rest.find(|c: char| !(c.is_ascii_digit() || c == '.')).unwrap_or(rest.len());
-        rest[..end].parse().unwrap_or_else(|_| panic!("{key}: {rest}"))
     }
 
     /// The bevy item's compensation finding states its worst point's 1/A and 1/E, and where:
