@@ -338,4 +338,43 @@ mod tests {
         let v: Vec<u16> = top.chunks(2).map(|c| u16::from_le_bytes([c[0], c[1]])).collect();
         assert!(v[0] > v[2], "√Sxx {} > √Syy {}", v[0], v[2]);
     }
+
+    /// The command end to end on a uniform 4×2 texture (normal code (191, 128, 230), aniso
+    /// [0.6, ½, 0.3]): its help; both files written, each a full chain 4×2, 2×1, 1×1 of 16-bit
+    /// texels that keep the input's normal (every level the mean of equal matrices: within one
+    /// 16-bit code of ½n + ½ with n = normalize(2c/255 − 1)); the report counts 8 + 2 + 1
+    /// texels. An aniso map of another size is refused naming both maps, and nothing is written.
+    #[test]
+    fn run_writes_both_chains_or_nothing() {
+        let args = |v: &[&str]| v.iter().map(|a| a.to_string()).collect::<Vec<_>>();
+        assert_eq!(run(&args(&["--out", "x", "--help"])).unwrap(), USAGE);
+        let dir = tempfile::tempdir().unwrap();
+        let (normal, aniso, small) = (dir.path().join("n.png"), dir.path().join("a.png"), dir.path().join("small.png"));
+        write_png(&normal, (4, 2), png::ColorType::Rgb, png::BitDepth::Eight, &[191u8, 128, 230].repeat(8));
+        write_png(&aniso, (4, 2), png::ColorType::Rgb, png::BitDepth::Eight, &[153u8, 128, 77].repeat(8));
+        write_png(&small, (2, 2), png::ColorType::Rgb, png::BitDepth::Eight, &[153u8, 128, 77].repeat(4));
+        let out = dir.path().join("m");
+        let (n_path, a_path) = (dir.path().join("m.normal.ktx2"), dir.path().join("m.aniso.ktx2"));
+        let path = |p: &Path| p.display().to_string();
+        let e = run(&args(&["--normal", &path(&normal), "--aniso", &path(&small), "--out", &path(&out)])).unwrap_err().to_string();
+        assert!(e.contains("small.png: size: 2×2") && e.contains("4×2") && e.contains("n.png"), "{e}");
+        assert!(!n_path.exists() && !a_path.exists());
+        let msg = run(&args(&["--normal", &path(&normal), "--aniso", &path(&aniso), "--out", &path(&out), "--bits", "16"])).unwrap();
+        let lines: Vec<&str> = msg.lines().collect();
+        assert_eq!(lines[..2], [path(&n_path), path(&a_path)]);
+        assert!(lines[2].starts_with("3 levels, 11 texels;") && lines[2].ends_with("0 not converged; 0 blocks clamped by the encoding"), "{msg}");
+        let c = [191.0, 128.0, 230.0].map(|v: f64| 2.0 * v / 255.0 - 1.0);
+        let len = (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
+        let want = [c[0] / len, c[1] / len].map(|x| (0.5 * x + 0.5) * 65535.0);
+        let bytes = std::fs::read(&n_path).unwrap();
+        let r = ktx2::Reader::new(&bytes[..]).unwrap();
+        let sizes: Vec<usize> = r.levels().map(|l| l.data.len()).collect();
+        assert_eq!(sizes, [8 * 4, 2 * 4, 4]);
+        for l in r.levels() {
+            let codes: Vec<f64> = l.data.chunks(2).map(|b| u16::from_le_bytes([b[0], b[1]]) as f64).collect();
+            assert!(codes.chunks(2).all(|p| (p[0] - want[0]).abs() <= 1.0 && (p[1] - want[1]).abs() <= 1.0), "{codes:?} vs {want:?}");
+        }
+        let a = std::fs::read(&a_path).unwrap();
+        assert_eq!(ktx2::Reader::new(&a[..]).unwrap().levels().map(|l| l.data.len()).collect::<Vec<_>>(), [8 * 8, 2 * 8, 8]);
+    }
 }
