@@ -785,10 +785,13 @@ mod tests {
 
     /// The bevy item's clamp finding states Karis's smallest A over the grid and where: the
     /// printed (n·v, r) is a node (to 4 and 3 decimals), Karis's A there is the printed A (to
-    /// 5e-5), and no node of the grid has an A below it (by more than the printed digits).
+    /// 5e-5), and no node of the grid has an A below it (by more than the printed digits). The
+    /// share of nodes where Karis's B < 0 is the printed whole percent (to ½), and the clamped
+    /// form's max and rms error, over both channels of every node against the integral's table,
+    /// are the item's extra and the printed figures (to their 4 digits).
     #[test]
     fn the_clamp_finding_states_the_smallest_a_and_where() {
-        let (_, text) = bevy_finding("The v0.19 clamp");
+        let (item, text) = bevy_finding("The v0.19 clamp");
         let number_after = |key: &str| number_after(&text, key);
         let (a, m, r) = (number_after("(A = "), number_after(" at n·v = "), number_after(", r = "));
         let hc = grid::standard(Target::Roughness);
@@ -797,6 +800,20 @@ mod tests {
         assert!((KARIS.eval(node.1, node.0)[0] - a).abs() <= 5e-5 + 1e-12, "A at {node:?}: printed {a}");
         let lowest = hc.points().map(|(m, r)| KARIS.eval(r, m)[0]).fold(f64::MAX, f64::min);
         assert!(lowest >= a - 5e-5 - 1e-12, "A = {lowest} on the grid, below the printed {a}");
+        let negative = hc.points().filter(|&(m, r)| KARIS.eval(r, m)[1] < 0.0).count() as f64 / hc.values.len() as f64;
+        let share = number_after("where it is negative (");
+        assert!(negative > 0.0 && (share - 100.0 * negative).abs() <= 0.5 + 1e-9, "printed {share} %, {} % of the nodes", 100.0 * negative);
+        let errors: Vec<f64> = hc.points().zip(&hc.values).flat_map(|((m, r), t)| {
+            let c = forms::bevy_clamped(r, m);
+            [c[0] - t[0], c[1] - t[1]]
+        }).collect();
+        let max = errors.iter().fold(0.0f64, |m, e| m.max(e.abs()));
+        let rms = (errors.iter().map(|e| e * e).sum::<f64>() / errors.len() as f64).sqrt();
+        let extra = item.extra.iter().find(|e| e.0 == "clamped_max_abs_error").unwrap().1;
+        // The same differences, folded in another order: equal to rounding (1e-15).
+        assert!((extra - max).abs() <= 1e-15, "clamped max: item {extra}, re-measured {max}");
+        let close = |p: f64, x: f64| (p - x).abs() <= 5e-4 * x;
+        assert!(close(number_after("(max "), max) && close(number_after(", rms "), rms), "{text}: max {max:e}, rms {rms:e}");
     }
 
     /// The spread is the largest max − min of A + B over n·v within one roughness row, never
