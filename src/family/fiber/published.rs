@@ -90,6 +90,7 @@ pub fn items(generated: &Path) -> Vec<Item> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::validate::number_after;
 
     /// The energy finding's averages over lights, at k = −0.99 and −0.5: the loss 1 − M(k,
     /// c)/M(k, 1) averaged over c = u·t ∈ [0, 1] by 16-point Gauss–Legendre (32 points agree to
@@ -100,23 +101,15 @@ mod tests {
     fn the_energy_finding_states_the_average_loss_over_lights() {
         let items = items(Path::new("/nonexistent"));
         let text = items[0].findings.iter().find(|f| f.starts_with("Energy lost")).expect("finding");
-        let percent_after = |key: &str| -> f64 {
-            let rest = &text[text.find(key).unwrap_or_else(|| panic!("{key} in {text}")) + key.len()..];
-            rest[..rest.find('%').unwrap()].parse::<f64>().unwrap() / 100.0
-        };
+        // A percentage printed after `key`, read from where `from` starts.
+        let percent = |from: &str, key: &str| number_after(&text[text.find(from).expect(from)..], key) / 100.0;
         let (x, w) = crate::integrate::gauss_legendre(16);
-        for (k, avg_key, perp_key) in [(-0.99, "at k = −0.99 the average over lights is ", "(u ⟂ t: "), (-0.5, "at k = −0.5 ", "at k = −0.5 ")] {
+        for (k, from, avg_key, perp_key) in [(-0.99, "at k = −0.99", "average over lights is ", "(u ⟂ t: "), (-0.5, "at k = −0.5", "at k = −0.5 ", "% (")] {
             let loss = |c: f64| 1.0 - mean(k, c, 1e-13).value / mean_parallel(k);
             let avg: f64 = x.iter().zip(&w).map(|(xi, wi)| 0.5 * wi * loss(0.5 * (xi + 1.0))).sum();
-            let printed = percent_after(avg_key);
+            let printed = percent(from, avg_key);
             assert!((printed - avg).abs() <= 6e-5, "k = {k}: average printed {printed}, {avg}");
-            let perp = if k == -0.5 {
-                let rest = &text[text.find(perp_key).unwrap() + perp_key.len()..];
-                let rest = &rest[rest.find('(').unwrap() + 1..];
-                rest[..rest.find('%').unwrap()].parse::<f64>().unwrap() / 100.0
-            } else {
-                percent_after(perp_key)
-            };
+            let perp = percent(from, perp_key);
             assert!((perp - loss(0.0)).abs() <= 5e-5 + 1e-9, "k = {k}: u ⟂ t printed {perp}, {}", loss(0.0));
         }
     }
