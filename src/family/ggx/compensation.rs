@@ -249,6 +249,25 @@ pub fn eval_furnace(p: &[f64], tol: f64) -> Estimate {
 mod tests {
     use super::*;
 
+    /// Each scheme's name, id and source name the same work (its authors, renderer or the
+    /// baseline), the ids are distinct lower-case file-name words, and `ALL` lists every
+    /// scheme once, in the order of the `scheme` parameter: single, Kulla–Conty, Turquin,
+    /// Fdez-Agüera, Cycles, bevy's old one.
+    #[test]
+    fn each_scheme_names_its_own_work() {
+        let keys = ["single", "kulla", "turquin", "fdez", "cycles", "bevy"];
+        for (s, key) in Scheme::ALL.iter().zip(keys) {
+            for text in [s.name(), s.id(), s.source()] {
+                assert!(text.to_lowercase().contains(key), "{s:?}: '{text}' does not name {key}");
+            }
+            assert!(s.id().chars().all(|c| c.is_ascii_lowercase() || c == '_'), "{}", s.id());
+        }
+        let mut ids: Vec<&str> = Scheme::ALL.iter().map(|s| s.id()).collect();
+        ids.sort();
+        ids.dedup();
+        assert_eq!(ids.len(), 6);
+    }
+
     #[test]
     fn furnace_error_estimate_covers_a_loose_evaluation() {
         // At tol 1e-4 the reported error must cover the distance to the same albedo at 1e-11
