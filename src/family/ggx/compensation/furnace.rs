@@ -497,6 +497,35 @@ mod tests {
         }
     }
 
+    /// The items restate the furnace table: a summary line per scheme (its id first), then one
+    /// item per scheme, named by its id and sourced by its source, whose max error at F = 1 is
+    /// the row's largest deviation and whose gain and loss extras are the row's. Single
+    /// scattering's finding names where it loses most, re-found here from its albedo on the
+    /// grid (r and n·v to the printed 2 and 4 decimals); Kulla–Conty's independent quadrature
+    /// check is within 1e-5 of 1 (kc_quadrature_check's own bound).
+    #[test]
+    fn items_restate_the_furnace_table() {
+        let generated = Path::new(env!("CARGO_MANIFEST_DIR")).join("generated");
+        let items = items(&generated);
+        let (rows, grid, points) = rows(&generated);
+        assert_eq!(items.len(), 1 + rows.len());
+        for (r, line) in rows.iter().zip(&items[0].findings[1..]) {
+            assert!(line.starts_with(&format!("{} | ", r.scheme.id())), "{line}");
+        }
+        for (r, it) in rows.iter().zip(&items[1..]) {
+            assert_eq!((it.name.as_str(), it.source.as_str()), (format!("ggx_furnace_{}", r.scheme.id()).as_str(), r.scheme.source()));
+            let extra = |k: &str| it.extra.iter().find(|e| e.0 == k).unwrap_or_else(|| panic!("{k}")).1;
+            assert_eq!((it.max_abs_error, extra("f1_max_gain"), extra("f1_max_loss")), (r.f1_max_dev, r.f1_gain, r.f1_loss));
+        }
+        let single = grid.furnace(Scheme::Single, 1.0);
+        let (k, _) = single.iter().enumerate().fold((0, 0.0), |b, (k, &a)| if 1.0 - a > b.1 { (k, 1.0 - a) } else { b });
+        let text = items[1].findings.last().unwrap();
+        let (r, m) = (crate::validate::number_after(text, "(r = "), crate::validate::number_after(text, "n·v = "));
+        assert!((r - points[k][0]).abs() <= 5e-3 && (m - points[k][1]).abs() <= 5e-5, "{text}: worst loss at {:?}", points[k]);
+        let kc = items.iter().find(|i| i.name.ends_with("kulla_conty")).unwrap();
+        assert!(kc.extra.iter().any(|e| e.0 == "f1_max_abs_dev_independent_quadrature" && e.1 < 1e-5));
+    }
+
     /// The energy finding names the loss, the gain, conservation below 1e-6 and a deviation
     /// above it (with the numbers it is given, printed as the report prints them).
     #[test]
