@@ -328,7 +328,7 @@ impl Lean {
         Some(Lean { mean, a, inv: a.try_inverse()?, sqrt_det: det.sqrt() })
     }
 
-    /// The filtered normal −(μ, −1) normalised, and its slope matrix.
+    /// The filtered normal: (μ, 1) normalised (a normal n has the slope (n_x, n_y)/n_z here).
     pub fn normal(&self) -> V3 {
         V3::new(self.mean.x, self.mean.y, 1.0).normalize()
     }
@@ -801,5 +801,19 @@ mod tests {
         let lobe = Lobe::new(sggx_from(tilted[0].1, tilted[0].2)).unwrap();
         let m = direction(0.8, 0.0);
         assert!((Ndf::d(&lean, &m) / lobe.d(&m) - 1.0).abs() > 0.1);
+    }
+
+    /// LEAN's filtered normal is the one of the mean slope: one texel gives its own normal back,
+    /// and normals at ±0.5 rad about x with weights 3 and 1 give slopes ±tan 0.5 whose weighted
+    /// mean, tan(0.5)/2, is the tangent of the filtered normal's angle (f64 rounding, 1e-15).
+    #[test]
+    fn lean_normal_is_the_mean_slopes_normal() {
+        let n = direction(0.7, 2.0);
+        let one = Lean::filter(&[(1.0, n, Aniso::isotropic(0.3))]).unwrap();
+        assert!((one.normal() - n).norm() < 1e-15, "{} vs {n}", one.normal());
+        let a = Aniso::isotropic(0.2);
+        let two = Lean::filter(&[(3.0, direction(0.5, 0.0), a), (1.0, direction(0.5, PI), a)]).unwrap();
+        let want = V3::new((0.5f64).tan() / 2.0, 0.0, 1.0).normalize();
+        assert!((two.normal() - want).norm() < 1e-15, "{} vs {want}", two.normal());
     }
 }
