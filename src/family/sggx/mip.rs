@@ -339,8 +339,8 @@ mod tests {
         assert!(v[0] > v[2], "√Sxx {} > √Syy {}", v[0], v[2]);
     }
 
-    /// The command end to end on a uniform 4×2 texture (normal code (191, 128, 230), aniso
-    /// [0.6, ½, 0.3]): its help; both files written, each a full chain 4×2, 2×1, 1×1 of 16-bit
+    /// The command end to end on a uniform 4×2 texture (normal codes (191, 128, 230), aniso
+    /// codes (153, 128, 77), about [0.6, ½, 0.3]): its help; both files written, each a full chain 4×2, 2×1, 1×1 of 16-bit
     /// texels that keep the input's normal (every level the mean of equal matrices: within one
     /// 16-bit code of ½n + ½ with n = normalize(2c/255 − 1)); the report counts 8 + 2 + 1
     /// texels. An aniso map of another size is refused naming both maps, and nothing is written.
