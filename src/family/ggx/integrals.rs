@@ -704,7 +704,7 @@ mod tests {
 
     /// Smith's Λ of GGX against two references of its own. The textbook form
     /// Λ = (−1 + sqrt(1 + α² tan²θ))/2 (Heitz 2014, "Understanding the masking-shadowing
-    /// function", Eq. 72), to 1e-13 relative away from μ = 1 (where the textbook form cancels).
+    /// function", GGX's Λ), to 1e-13 relative away from μ = 1 (where the textbook form cancels).
     /// And the projected area of the microsurface, ∫ ⟨ω·m⟩ D(m) dm = μ (1 + Λ(μ)) (Heitz 2014,
     /// the normalisation of G1 = 1/(1 + Λ)): the azimuth integral of ⟨ω·m⟩ in closed form,
     /// 2π a when b ≤ a, else 2(a φ* + b sin φ*) with cos φ* = −a/b (a = μ cos θm,
