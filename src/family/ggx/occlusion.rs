@@ -544,6 +544,12 @@ mod tests {
     use super::*;
     use crate::validate::number_after;
 
+    /// The row mapping a committed cone LUT names by its row argument.
+    fn row_mapping(l: &lut::plot::Committed) -> super::super::lut::spec::RoughnessMapping {
+        use super::super::lut::spec::RoughnessMapping as M;
+        [M::Perceptual, M::Alpha, M::Gloss].into_iter().find(|m| m.argument() == l.row).unwrap()
+    }
+
     /// The readers are the committed cone LUTs, one for each spec of that kind in fits/
     /// (read here from the TOML files), and each reads back the hemisphere integral at its
     /// texel centres on slice 0 (cos θc = 0): `env` recomputed at 1e-9 against the stored f16
@@ -566,8 +572,7 @@ mod tests {
         assert_eq!(readers.iter().map(|r| r.name().to_string()).collect::<Vec<_>>(), specs);
         for reader in &readers {
             let l = &reader.lut;
-            use super::super::lut::spec::RoughnessMapping as M;
-            let mapping = [M::Perceptual, M::Alpha, M::Gloss].into_iter().find(|m| m.argument() == l.row).unwrap();
+            let mapping = row_mapping(l);
             for (i, j) in [(0, 0), (5, 17), (16, 3), (31, 31), (20, 28)] {
                 let (u, t) = ((i as f64 + 0.5) / l.width as f64, (j as f64 + 0.5) / l.height as f64);
                 let alpha = mapping.alpha(t);
@@ -837,13 +842,12 @@ mod tests {
     /// (δN + SO·δD)/D. Slice 0 is the hemisphere itself: SO = 1 exactly.
     #[test]
     fn lut_readers_give_the_cone_models_occlusion_at_texel_centres() {
-        use super::super::lut::spec::RoughnessMapping as M;
         let root = Path::new(env!("CARGO_MANIFEST_DIR"));
         let readers = lut_readers(&root.join("generated"));
         assert!(!readers.is_empty());
         for reader in &readers {
             let l = &reader.lut;
-            let mapping = [M::Perceptual, M::Alpha, M::Gloss].into_iter().find(|m| m.argument() == l.row).unwrap();
+            let mapping = row_mapping(l);
             for (i, j, k) in [(5, 17, 0), (16, 3, 1), (20, 28, l.depth / 2), (9, 12, l.depth - 2), (30, 20, 2)] {
                 let (u, alpha) = ((i as f64 + 0.5) / l.width as f64, mapping.alpha((j as f64 + 0.5) / l.height as f64));
                 let c = k as f64 / (l.depth - 1) as f64;
@@ -898,24 +902,26 @@ mod tests {
         for r in &readers {
             forms.push((format!("3-D environment BRDF ({})", r.name()), Box::new(move |p| r.so(p[1], p[0] * p[0], p[2], F0))));
         }
-        let max_of = |e: &mut dyn Iterator<Item = f64>| e.fold(0.0f64, f64::max);
+        fn max_of(e: impl Iterator<Item = f64>) -> f64 {
+            e.fold(0.0, f64::max)
+        }
         let mut by_name = std::collections::HashMap::new();
         for (key, so) in &forms {
             let item = items.iter().find(|i| i.name.contains(key.as_str())).unwrap_or_else(|| panic!("{key}"));
             let a: Vec<f64> = pts.iter().map(|p| so(p)).collect();
             let err: Vec<f64> = a.iter().zip(&refs).map(|(a, t)| a - t[0]).collect();
             let close = |x: f64, y: f64| (x - y).abs() <= 1e-15;
-            assert!(close(item.max_abs_error, max_of(&mut err.iter().map(|e| e.abs()))), "{key}: max {}", item.max_abs_error);
+            assert!(close(item.max_abs_error, max_of(err.iter().map(|e| e.abs()))), "{key}: max {}", item.max_abs_error);
             let rms = (err.iter().map(|e| e * e).sum::<f64>() / 6.0).sqrt();
             assert!(close(item.rms_error, rms), "{key}: rms {} vs {rms}", item.rms_error);
             let extra = |k: &str| item.extra.iter().find(|(n, _)| n == k).unwrap_or_else(|| panic!("{key}: {k}")).1;
-            let white = max_of(&mut a.iter().zip(&refs).map(|(a, t)| (a - t[1]).abs()));
+            let white = max_of(a.iter().zip(&refs).map(|(a, t)| (a - t[1]).abs()));
             assert!(close(extra("f0_1_max_abs_error"), white), "{key}: F = 1 max {}", extra("f0_1_max_abs_error"));
             let mean = err.iter().sum::<f64>() / 6.0;
             assert!(close(extra("mean_signed_error"), mean), "{key}: mean {}", extra("mean_signed_error"));
             let word = if mean < 0.0 { "over-occludes" } else { "under-occludes" };
             assert!(item.findings[0].contains(word) && printed_as(number_after(&item.findings[0], "Mean signed error "), mean), "{key}: {}", item.findings[0]);
-            let side = |out: bool| max_of(&mut err.iter().zip(&outside).filter(|(_, o)| **o == out).map(|(e, _)| e.abs()));
+            let side = |out: bool| max_of(err.iter().zip(&outside).filter(|(_, o)| **o == out).map(|(e, _)| e.abs()));
             by_name.insert(key.clone(), (item, a.clone(), side(true), side(false)));
         }
         // The stated split outside and inside the cone.
@@ -941,11 +947,11 @@ mod tests {
         for r in &readers {
             let (item, _, out_c, in_c) = &by_name[&format!("3-D environment BRDF ({})", r.name())];
             let read: Vec<[f64; 2]> = pts.iter().map(|p| r.scale_bias(p[1], p[0] * p[0], (1.0 - p[2]).sqrt())).collect();
-            let e = max_of(&mut read.iter().zip(&refs).map(|(s, t)| (F0 * s[0] + s[1] - (F0 * t[2] + t[3])).abs()));
+            let e = max_of(read.iter().zip(&refs).map(|(s, t)| (F0 * s[0] + s[1] - (F0 * t[2] + t[3])).abs()));
             let extra = |k: &str| item.extra.iter().find(|(n, _)| n == k).unwrap().1;
             assert!((extra("occluded_specular_max_abs_error") - e).abs() <= 1e-15, "{}: {e}", r.name());
-            assert_eq!(extra("scale_max_abs_error"), max_of(&mut read.iter().zip(&refs).map(|(s, t)| (s[0] - t[2]).abs())));
-            assert_eq!(extra("bias_max_abs_error"), max_of(&mut read.iter().zip(&refs).map(|(s, t)| (s[1] - t[3]).abs())));
+            assert_eq!(extra("scale_max_abs_error"), max_of(read.iter().zip(&refs).map(|(s, t)| (s[0] - t[2]).abs())));
+            assert_eq!(extra("bias_max_abs_error"), max_of(read.iter().zip(&refs).map(|(s, t)| (s[1] - t[3]).abs())));
             let text = &item.findings[2];
             assert!(printed_as(number_after(text, "SO max error "), *out_c) && printed_as(number_after(text, "outside the cone, "), *in_c), "{text}");
         }

@@ -757,6 +757,18 @@ mod tests {
         (item, text)
     }
 
+    /// The node of `g` nearest the printed (n·v, r) = (m, r), and its tabulated values; it must
+    /// be that point to the printed digits (4 and 3 decimals).
+    fn printed_node(g: &Grid, m: f64, r: f64) -> ((f64, f64), [f64; 2]) {
+        let (node, t) = g
+            .points()
+            .zip(&g.values)
+            .min_by(|(a, _), (b, _)| ((a.0 - m).abs() + (a.1 - r).abs()).total_cmp(&((b.0 - m).abs() + (b.1 - r).abs())))
+            .unwrap();
+        assert!((node.0 - m).abs() <= 5e-5 && (node.1 - r).abs() <= 5e-4, "printed ({m}, {r}) is no node: {node:?}");
+        (node, *t)
+    }
+
     /// The bevy item's compensation finding states its worst point's 1/A and 1/E, and where:
     /// the printed (n·v, r) is a node of the grid to its digits (4 and 3 decimals); there,
     /// Karis's A and the tabulated E = A + B of the integral give the printed values to their
@@ -769,12 +781,7 @@ mod tests {
         let (x, y) = (number_after("that is 1/A = "), number_after("Turquin's 1/E = "));
         let (m, r) = (number_after("(n·v = "), number_after(", r = "));
         let hc = grid::standard(Target::Roughness);
-        let (node, t) = hc
-            .points()
-            .zip(&hc.values)
-            .min_by(|(a, _), (b, _)| ((a.0 - m).abs() + (a.1 - r).abs()).total_cmp(&((b.0 - m).abs() + (b.1 - r).abs())))
-            .unwrap();
-        assert!((node.0 - m).abs() <= 5e-5 && (node.1 - r).abs() <= 5e-4, "printed ({m}, {r}) is no node: {node:?}");
+        let (node, t) = printed_node(&hc, m, r);
         let a = KARIS.eval(node.1, node.0)[0];
         assert!((1.0 / a - x).abs() <= 0.05 + 1e-9, "1/A: printed {x}, {} at {node:?}", 1.0 / a);
         assert!((1.0 / (t[0] + t[1]) - y).abs() <= 5e-4 + 1e-9, "1/E: printed {y}, {}", 1.0 / (t[0] + t[1]));
@@ -795,8 +802,7 @@ mod tests {
         let number_after = |key: &str| number_after(&text, key);
         let (a, m, r) = (number_after("(A = "), number_after(" at n·v = "), number_after(", r = "));
         let hc = grid::standard(Target::Roughness);
-        let node = hc.points().min_by(|p, q| ((p.0 - m).abs() + (p.1 - r).abs()).total_cmp(&((q.0 - m).abs() + (q.1 - r).abs()))).unwrap();
-        assert!((node.0 - m).abs() <= 5e-5 && (node.1 - r).abs() <= 5e-4, "printed ({m}, {r}) is no node: {node:?}");
+        let (node, _) = printed_node(&hc, m, r);
         assert!((KARIS.eval(node.1, node.0)[0] - a).abs() <= 5e-5 + 1e-12, "A at {node:?}: printed {a}");
         let lowest = hc.points().map(|(m, r)| KARIS.eval(r, m)[0]).fold(f64::MAX, f64::min);
         assert!(lowest >= a - 5e-5 - 1e-12, "A = {lowest} on the grid, below the printed {a}");
