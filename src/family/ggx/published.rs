@@ -852,4 +852,55 @@ mod tests {
         assert_eq!(e.len(), 6);
         assert!((e[2][1] - 0.8).abs() < 1e-15 && (e[5][0] - 1.1).abs() < 1e-15, "{e:?}");
     }
+
+    /// The constants a WGSL form prints, in order: its literals in exponent notation (`{:e}`
+    /// prints every constant so, shortest round-trip for the f32; the clamp bounds `0.0`, `1.0`
+    /// and names such as `vec4`, `exp2`, `x2` are not read).
+    fn printed_constants(wgsl: &str) -> Vec<f32> {
+        wgsl.split(|c: char| !(c.is_ascii_alphanumeric() || ".+-_".contains(c)))
+            .filter(|t| t.contains('e'))
+            .filter_map(|t| t.parse().ok())
+            .collect()
+    }
+
+    /// naga parses and validates a WGSL source.
+    fn naga_accepts(src: &str) {
+        let module = naga::front::wgsl::parse_str(src).unwrap_or_else(|e| panic!("{}\n{src}", e.emit_to_string(src)));
+        naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::empty())
+            .validate(&module)
+            .unwrap_or_else(|e| panic!("{e:?}\n{src}"));
+    }
+
+    /// Karis's WGSL, whose operations the bench counts, prints the form's constants in the
+    /// order of the published listing (`EnvBRDFApprox`: c0, c1, the exp2 factor, then the pair
+    /// (−1.04, 1.04), here (−s, s)) as f32, and returns A + B, A or B as asked. The committed
+    /// refit's constants are all distinct, so a swap or a lost sign shows.
+    #[test]
+    fn karis_wgsl_prints_the_forms_constants_in_the_listings_order() {
+        let k = refit::COMMITTED.karis_hc;
+        let listing: Vec<f32> = k.c0.iter().chain(&k.c1).chain(&[k.k, -k.s, k.s]).map(|&v| v as f32).collect();
+        for (channel, ret) in [(None, "ab.x + ab.y"), (Some(0), "ab.x"), (Some(1), "ab.y")] {
+            let src = karis_wgsl(&k, channel);
+            assert_eq!(printed_constants(&src), listing, "{src}");
+            assert!(src.contains(&format!("return {ret};")), "{channel:?}: {src}");
+            naga_accepts(&src);
+        }
+        // The published constants print as the listing writes them.
+        assert_eq!(printed_constants(&karis_wgsl(&KARIS, None)), [-1.0, -0.0275, -0.572, 0.022, 1.0, 0.0425, 1.04, -0.04, -9.28, -1.04, 1.04]);
+    }
+
+    /// MaterialX's WGSL prints its nine vec4 rows in the source's order (the monomials 1, x,
+    /// y, xy, x², y², x²y, xy², x²y²) as f32, and returns A + B, A or B as asked.
+    #[test]
+    fn materialx_wgsl_prints_the_rows_in_the_sources_order() {
+        let m = refit::COMMITTED.materialx;
+        let rows: Vec<f32> = m.r.as_flattened().iter().map(|&v| v as f32).collect();
+        for (channel, ret) in [(None, "ab.x + ab.y"), (Some(0), "ab.x"), (Some(1), "ab.y")] {
+            let src = materialx_wgsl(&m, channel);
+            assert_eq!(printed_constants(&src), rows, "{src}");
+            assert!(src.contains(&format!("return {ret};")), "{channel:?}: {src}");
+            naga_accepts(&src);
+        }
+        assert_eq!(printed_constants(&materialx_wgsl(&MATERIALX, None))[..4], [0.1003, 0.9345, 1.0, 1.0]);
+    }
 }

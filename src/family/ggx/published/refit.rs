@@ -76,12 +76,17 @@ pub fn lazarov(start: &Lazarov) -> Lazarov {
 }
 
 /// MaterialX's rational pair refitted minimax (each channel, with a denominator proven
-/// positive on the grid's box: see the body for the fallbacks), clamp to [0, 1] as the source, on
-/// every other point of the standard α grid in each direction (32 × 33: the LP polish of the
-/// full 64 × 65 takes minutes; the refit is measured on the full grid).
+/// positive on the grid's box: see [`materialx_on`]), clamp to [0, 1] as the source, on every
+/// other point of the standard α grid in each direction (32 × 33: the LP polish of the full
+/// 64 × 65 takes minutes; the refit is measured on the full grid).
 pub fn materialx() -> MaterialX {
-    let full = grid::standard(Target::Alpha);
-    let g = &Grid {
+    materialx_on(&every_other(grid::standard(Target::Alpha)))
+}
+
+/// The grid of every other node of `full` in each direction (the first, third, … of each axis),
+/// with the values there.
+pub fn every_other(full: &Grid) -> Grid {
+    Grid {
         target: full.target,
         mu: full.mu.iter().step_by(2).copied().collect(),
         y: full.y.iter().step_by(2).copied().collect(),
@@ -92,7 +97,12 @@ pub fn materialx() -> MaterialX {
             .filter(|(k, _)| (k % full.mu.len()).is_multiple_of(2) && (k / full.mu.len()).is_multiple_of(2))
             .map(|(_, v)| *v)
             .collect(),
-    };
+    }
+}
+
+/// MaterialX's pair refitted minimax on the grid `g` (n·v, α), each channel on its own (see the
+/// body for the fallbacks).
+pub fn materialx_on(g: &Grid) -> MaterialX {
     let model = materialx_model();
     let x: Vec<Vec<f64>> = g.points().map(|(m, a)| vec![m, a]).collect();
     let mut r = [[0.0; 4]; 9];
@@ -221,6 +231,83 @@ mod tests {
         let (start_b, refit_b) = (max(false, &KULLA_CONTY), max(false, &r));
         eprintln!("η ≥ 1: {start_a:e} → {refit_a:e}; η < 1: {start_b:e} → {refit_b:e}");
         assert!(refit_a < start_a && refit_b < start_b);
+    }
+
+    /// A grid n·v × y with the values `f(n·v, y)` at its points (n·v fastest), of target α.
+    fn grid_of(mu: &[f64], y: &[f64], f: impl Fn(f64, f64) -> [f64; 2]) -> Grid {
+        let values = y.iter().flat_map(|&y| mu.iter().map(move |&m| (m, y))).map(|(m, y)| f(m, y)).collect();
+        Grid { target: Target::Alpha, mu: mu.to_vec(), y: y.to_vec(), values }
+    }
+
+    /// Every other node of a 5 × 4 grid whose values are functions of the coordinates: the
+    /// axes keep their first, third, … entries, and each kept value is the function at its
+    /// own point (a row/column mix-up or an odd-numbered node shows as a wrong value).
+    #[test]
+    fn every_other_keeps_the_odd_numbered_nodes_with_their_values() {
+        let f = |m: f64, y: f64| [m + 10.0 * y, m * y];
+        let full = grid_of(&[0.1, 0.2, 0.3, 0.4, 0.5], &[0.0, 0.25, 0.5, 0.75], f);
+        let half = every_other(&full);
+        assert_eq!(half.mu, [0.1, 0.3, 0.5]);
+        assert_eq!(half.y, [0.0, 0.5]);
+        assert_eq!(half.target, Target::Alpha);
+        assert_eq!(half.values.len(), 6);
+        for ((m, y), v) in half.points().zip(&half.values) {
+            assert_eq!(*v, f(m, y), "at ({m}, {y})");
+        }
+    }
+
+    /// Two rationals of MaterialX's form (numerator over the nine monomials, denominator 1 +
+    /// the other eight, positive on the box), with values in (0.05, 0.9) there: this channel's
+    /// scale and bias.
+    const SCALE_NUM: [f64; 9] = [0.1, 0.6, 0.2, -0.1, 0.05, 0.02, 0.03, -0.02, 0.01];
+    const SCALE_DEN: [f64; 8] = [0.5, 0.3, 0.1, 0.05, 0.02, -0.03, 0.04, 0.01];
+    const BIAS_NUM: [f64; 9] = [0.3, -0.2, 0.1, 0.05, 0.04, -0.02, 0.01, 0.02, -0.01];
+    const BIAS_DEN: [f64; 8] = [0.2, 0.4, -0.1, 0.03, 0.05, 0.02, -0.02, 0.01];
+
+    fn rational(num: &[f64; 9], den: &[f64; 8], x: f64, y: f64) -> f64 {
+        let m = super::super::forms::materialx_monomials(x, y);
+        let p: f64 = (0..9).map(|k| num[k] * m[k]).sum();
+        let q: f64 = 1.0 + (0..8).map(|k| den[k] * m[k + 1]).sum::<f64>();
+        p / q
+    }
+
+    /// The refit of data that are exactly of the form recovers the pair: on the grid and
+    /// between its nodes, `MaterialX::eval` of the refit gives both rationals, and the rows
+    /// hold numerator then denominator with the denominators' constant 1. The bound 1e-7: the
+    /// data are exact, so the minimax optimum is the pair itself up to the rounding of a
+    /// 17-coefficient solve on 72 points (condition ~1e6 at most here, times 1e-16).
+    #[test]
+    fn materialx_refit_recovers_a_pair_of_its_own_form() {
+        let truth = |m: f64, a: f64| [rational(&SCALE_NUM, &SCALE_DEN, m, a), rational(&BIAS_NUM, &BIAS_DEN, m, a)];
+        let mu: Vec<f64> = (0..9).map(|i| 0.1 + 0.1 * i as f64).collect();
+        let al: Vec<f64> = (0..8).map(|j| 0.05 + (0.95 / 7.0) * j as f64).collect();
+        let g = grid_of(&mu, &al, truth);
+        assert!(g.values.iter().flatten().all(|v| (0.05..0.9).contains(v)), "{:?}", g.values);
+        let r = materialx_on(&g);
+        assert_eq!([r.r[0][2], r.r[0][3]], [1.0, 1.0]);
+        let worst = |pts: &[(f64, f64)]| pts.iter().map(|&(m, a)| {
+            let (got, want) = (r.eval(m, a), truth(m, a));
+            (got[0] - want[0]).abs().max((got[1] - want[1]).abs())
+        }).fold(0.0f64, f64::max);
+        let on: Vec<(f64, f64)> = g.points().collect();
+        let between: Vec<(f64, f64)> = (0..8).flat_map(|i| (0..7).map(move |j| (0.15 + 0.1 * i as f64, 0.1 + 0.13 * j as f64))).collect();
+        let (e_on, e_between) = (worst(&on), worst(&between));
+        assert!(e_on < 1e-7 && e_between < 1e-7, "{e_on:e} {e_between:e}");
+    }
+
+    /// A channel that cannot be fitted (NaN data: both solves fail) keeps MaterialX's
+    /// published constants, in their rows; the other channel is still refitted.
+    #[test]
+    fn an_unfittable_channel_keeps_the_published_constants() {
+        let mu: Vec<f64> = (0..9).map(|i| 0.1 + 0.1 * i as f64).collect();
+        let al: Vec<f64> = (0..8).map(|j| 0.05 + (0.95 / 7.0) * j as f64).collect();
+        let g = grid_of(&mu, &al, |m, a| [rational(&SCALE_NUM, &SCALE_DEN, m, a), f64::NAN]);
+        let r = materialx_on(&g);
+        for k in 0..9 {
+            assert_eq!([r.r[k][1], r.r[k][3]], [MATERIALX.r[k][1], MATERIALX.r[k][3]], "row {k}");
+        }
+        let e = (r.eval(0.55, 0.5)[0] - rational(&SCALE_NUM, &SCALE_DEN, 0.55, 0.5)).abs();
+        assert!(e < 1e-7, "{e:e}");
     }
 
     fn rust_karis(name: &str, k: &Karis) -> String {
