@@ -385,4 +385,45 @@ mod tests {
             assert!(worst_t > 0.0 && worst_t <= 6.4 * delta / at, "{bits} bits: α_t off by {worst_t}");
         }
     }
+
+    /// The hardware-filter items against the closed form of filtering the stored channels: the
+    /// texture unit averages x = √Sxx, y = ½ρ + ½ (ρ = Sxy/√(Sxx·Syy)) and z = √Syy of the two
+    /// blocks, and decoding gives (x̄², x̄(2ȳ − 1)z̄, z̄²); Sxx comes back as ((√a + √b)/2)²,
+    /// short of the average (a + b)/2 by (√a − √b)²/4. Each item's largest error is the closed
+    /// form's over the same 2000 pairs, within what quantisation moves an entry: a channel moves
+    /// by δ ≤ 2^-(b+1), an entry by ≤ 4δ(1 + δ)² (the bound of the test above). The decoder
+    /// clamps the eigenvalues to [α_min², 1] (the larger one passes 1 for some pairs): the
+    /// closed form does too, through the spectral projectors (M − λ₋I)/(λ₊ − λ₋) and
+    /// (λ₊I − M)/(λ₊ − λ₋), not through the decoder's angle.
+    #[test]
+    fn hardware_filtering_errs_by_the_encodings_closed_form() {
+        let pairs = filter_pairs(2000);
+        let (mut closed, mut clamped) = (0.0f64, 0);
+        for (a, b) in &pairs {
+            let (xa, xb, za, zb) = (a.sxx.sqrt(), b.sxx.sqrt(), a.syy.sqrt(), b.syy.sqrt());
+            let (x, z) = (0.5 * (xa + xb), 0.5 * (za + zb));
+            let r = 0.5 * (a.sxy / (xa * za) + b.sxy / (xb * zb));
+            let m = [x * x, x * r * z, z * z];
+            let (tr, det) = (m[0] + m[2], m[0] * m[2] - m[1] * m[1]);
+            let disc = (tr * tr - 4.0 * det).sqrt();
+            let (hi, lo) = (0.5 * (tr + disc), 0.5 * (tr - disc));
+            let (dhi, dlo) = (hi.clamp(ALPHA_MIN * ALPHA_MIN, 1.0) - hi, lo.clamp(ALPHA_MIN * ALPHA_MIN, 1.0) - lo);
+            clamped += usize::from(dhi != 0.0 || dlo != 0.0);
+            // M + Δ₊ P₊ + Δ₋ P₋, entry by entry (the identity's off-diagonal is 0).
+            let entry = |k: usize, id: f64| m[k] + (dhi * (m[k] - lo * id) + dlo * (hi * id - m[k])) / disc;
+            let d = [entry(0, 1.0), entry(1, 0.0), entry(2, 1.0)];
+            let errs = [d[0] - 0.5 * (a.sxx + b.sxx), d[1] - 0.5 * (a.sxy + b.sxy), d[2] - 0.5 * (a.syy + b.syy)];
+            closed = errs.iter().fold(closed, |m, e| m.max(e.abs()));
+        }
+        assert!(clamped > 0, "the clamp is exercised");
+        for bits in [8u32, 16] {
+            let item = hardware_filter_item(bits);
+            let delta = 0.5f64.powi(bits as i32 + 1);
+            let bound = 4.0 * delta * (1.0 + delta).powi(2);
+            eprintln!("{bits} bits: item {:e}, closed form {closed:e} ({clamped} pairs clamped), bound {bound:e}", item.max_abs_error);
+            assert_eq!(item.points, 3 * pairs.len());
+            assert!((item.max_abs_error - closed).abs() <= bound, "{bits} bits: {} against {closed}", item.max_abs_error);
+            assert!(item.rms_error > 0.0 && item.rms_error <= item.max_abs_error);
+        }
+    }
 }
