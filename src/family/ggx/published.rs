@@ -903,4 +903,100 @@ mod tests {
         }
         assert_eq!(printed_constants(&materialx_wgsl(&MATERIALX, None))[..4], [0.1003, 0.9345, 1.0, 1.0]);
     }
+
+    /// The value of `key` in an item's extras.
+    fn extra(it: &Item, key: &str) -> f64 {
+        it.extra.iter().find(|(k, _)| k == key).unwrap_or_else(|| panic!("{}: no {key}", it.name)).1
+    }
+
+    /// Max |error| and rms over both channels, and each channel's max, of a pair form on a grid,
+    /// counted here point by point.
+    fn pair_errors(g: &Grid, form: impl Fn(f64, f64) -> [f64; 2]) -> (f64, f64, [f64; 2]) {
+        let (mut ch, mut sq) = ([0.0f64; 2], 0.0);
+        for ((m, y), t) in g.points().zip(&g.values) {
+            let a = form(m, y);
+            for c in 0..2 {
+                let e = a[c] - t[c];
+                ch[c] = ch[c].max(e.abs());
+                sq += e * e;
+            }
+        }
+        (ch[0].max(ch[1]), (sq / (2 * g.values.len()) as f64).sqrt(), ch)
+    }
+
+    /// A refit's finding, "…: max M (X× the published), rms R (Y×)…": its four numbers.
+    fn refit_finding(it: &Item) -> [f64; 4] {
+        let f = it.findings.iter().find(|f| f.starts_with("shadefit's refit")).unwrap_or_else(|| panic!("{}: no refit finding", it.name));
+        let tail = &f[f.find("): max ").expect("a max")..];
+        let rms = &tail[tail.find(", rms ").expect("an rms")..];
+        [number_after(tail, "): max "), number_after(tail, " ("), number_after(rms, ", rms "), number_after(rms, " (")]
+    }
+
+    /// The refit's figures: extras equal to `(max, rms)` counted here (1e-12 relative: the sum of
+    /// squares in another order), and the finding's printed max and rms to their three decimals
+    /// and the ratios to the published max and rms to their two.
+    fn assert_refit_figures(it: &Item, max: f64, rms: f64) {
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * b.abs();
+        assert!(close(extra(it, "refit_max_abs_error"), max) && close(extra(it, "refit_rms_error"), rms), "{}", it.name);
+        let [m, x, r, y] = refit_finding(it);
+        assert!((m - max).abs() <= 5e-4 * max && (r - rms).abs() <= 5e-4 * rms, "{}: {m} {r}", it.name);
+        assert!((x - max / it.max_abs_error).abs() <= 5e-3 && (y - rms / it.rms_error).abs() <= 5e-3, "{}: {x} {y}", it.name);
+    }
+
+    /// The pair items (Karis against UE4's G and as bevy, Lazarov, MaterialX) and Kulla–Conty's,
+    /// restated from the public forms on the public grids: each published form's max and rms over
+    /// both channels and its channels' maxima, counted here; its refit's beside it; MaterialX's
+    /// unrounded constants and the word the finding picks for them; Kulla–Conty's jump at η = 1,
+    /// which is the sum of the cubic's coefficients (the other branch is 0 there).
+    #[test]
+    fn items_restate_the_forms_errors_on_the_grids() {
+        let items = items(Path::new("generated"));
+        let item = |prefix: &str| items.iter().find(|i| i.name.starts_with(prefix)).unwrap_or_else(|| panic!("no item {prefix}"));
+        let r = &refit::COMMITTED;
+        type Form<'a> = Box<dyn Fn(f64, f64) -> [f64; 2] + 'a>;
+        let cases: [(&str, Target, Form, Form); 4] = [
+            ("ggx-env-ue4: Karis", Target::RoughnessUe4, Box::new(|m, y| KARIS.eval(y, m)), Box::new(|m, y| r.karis_ue4.eval(y, m))),
+            ("ggx-env: bevy", Target::Roughness, Box::new(|m, y| KARIS.eval(y, m)), Box::new(|m, y| r.karis_hc.eval(y, m))),
+            ("ggx-env: Lazarov", Target::Gloss, Box::new(|m, y| LAZAROV.eval(y, m)), Box::new(|m, y| r.lazarov.eval(y, m))),
+            ("ggx-env: MaterialX", Target::Alpha, Box::new(|m, y| MATERIALX.eval(m, y)), Box::new(|m, y| emit::materialx_refit(&r.materialx, m, y))),
+        ];
+        for (prefix, target, published, refit) in &cases {
+            let it = item(prefix);
+            let g = grid::standard(*target);
+            let (max, rms, ch) = pair_errors(g, published);
+            assert_eq!(it.points, 2 * 64 * 65, "{prefix}");
+            assert!(it.domain.ends_with(&format!("{} points", 2 * 64 * 65)), "{}", it.domain);
+            assert_eq!(it.max_abs_error, max, "{prefix}");
+            assert!((it.rms_error - rms).abs() <= 1e-12 * rms, "{prefix}");
+            assert_eq!([extra(it, "scale_max_abs_error"), extra(it, "bias_max_abs_error")], ch, "{prefix}");
+            let (rmax, rrms, _) = pair_errors(g, refit);
+            assert_refit_figures(it, rmax, rrms);
+        }
+        let mx = item("ggx-env: MaterialX");
+        let (um, _, _) = pair_errors(grid::standard(Target::Alpha), |m, a| MATERIALX_UNROUNDED.eval(m, a));
+        assert_eq!(extra(mx, "unrounded_max_abs_error"), um);
+        let word = if (um - mx.max_abs_error).abs() < 0.1 * mx.max_abs_error { "so the rounding is not the error" } else { "so the rounding is part of the error" };
+        assert!(mx.findings.iter().any(|f| f.contains(word)), "{word}");
+
+        for (above, prefix) in [(true, "fresnel-avg-dielectric: Kulla–Conty fit, η ≥ 1"), (false, "fresnel-avg-dielectric: Kulla–Conty fit, η < 1")] {
+            let it = item(prefix);
+            let (eta, f) = grid::fresnel(above);
+            let errs = |k: &forms::KullaConty| eta.iter().zip(f).map(|(&e, &t)| k.eval(e) - t).collect::<Vec<f64>>();
+            let stats = |e: &[f64]| (e.iter().fold(0.0f64, |m, v| m.max(v.abs())), (e.iter().map(|v| v * v).sum::<f64>() / e.len() as f64).sqrt());
+            let (max, rms) = stats(&errs(&KULLA_CONTY));
+            assert_eq!((it.points, it.max_abs_error), (513, max), "{prefix}");
+            assert!((it.rms_error - rms).abs() <= 1e-12 * rms, "{prefix}");
+            let (rmax, rrms) = stats(&errs(&r.kulla_conty));
+            assert_refit_figures(it, rmax, rrms);
+            let jump = it.findings.iter().find(|f| f.starts_with("The branches disagree"));
+            if above {
+                assert!(jump.is_none());
+            } else {
+                let sum: f64 = KULLA_CONTY.below.iter().sum();
+                let text = jump.expect("the jump finding");
+                assert!((number_after(text, "at η = 1 by ") - sum).abs() <= 5e-3 * sum, "{text}");
+                assert!((number_after(text, "the cubic gives ") - sum).abs() <= 5e-6, "{text}");
+            }
+        }
+    }
 }
