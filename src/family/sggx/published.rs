@@ -426,4 +426,43 @@ mod tests {
             assert!(item.rms_error > 0.0 && item.rms_error <= item.max_abs_error);
         }
     }
+
+    /// The course cases' items carry each method's distance as `compare` measured it (total
+    /// variation, L2, the worst node, the largest density difference, the rule's node count);
+    /// only the linear filter's carry the power iterations and the stored block's largest
+    /// eigenvalue, which is the closed form (Sxx + Syy + √((Sxx − Syy)² + 4Sxy²))/2 (1e-12:
+    /// rounding); the finding that the block does not fit the encoding appears exactly where
+    /// that eigenvalue passes 1, and prints it.
+    #[test]
+    fn course_case_items_carry_each_methods_distance() {
+        let comparisons = comparisons();
+        let items = items_of(&comparisons);
+        let nodes = SphereRule::standard().points.len();
+        let mut passes_one = 0;
+        for c in &comparisons[..course_cases().len()] {
+            for (method, d) in [("(a) linear S filter", c.linear), ("(b) SGGX parameter estimation", c.estimation), ("(c) LEAN adapted to GGX", c.lean)] {
+                let name = format!("SGGX filtering, {}: {method}", c.case);
+                let it = items.iter().find(|i| i.name == name).unwrap_or_else(|| panic!("no item {name}"));
+                assert_eq!((it.max_abs_error, it.rms_error, it.points), (d.tv, d.l2, nodes), "{name}");
+                assert_eq!(it.worst_point, [d.worst.0, d.worst.1], "{name}");
+                assert_eq!(it.extra[0], ("max_density_difference".to_string(), d.max), "{name}");
+                if !method.starts_with("(a)") {
+                    assert_eq!((it.extra.len(), it.findings.len()), (1, 0), "{name}");
+                    continue;
+                }
+                let b = c.block;
+                let eigen = 0.5 * (b.sxx + b.syy + ((b.sxx - b.syy).powi(2) + 4.0 * b.sxy * b.sxy).sqrt());
+                assert!((c.block_max_eigen - eigen).abs() <= 1e-12, "{name}: {} vs {eigen}", c.block_max_eigen);
+                assert_eq!(it.extra[1], ("power_iterations".to_string(), c.iterations as f64), "{name}");
+                assert_eq!(it.extra[2], ("block_max_eigenvalue".to_string(), c.block_max_eigen), "{name}");
+                let finding = it.findings.iter().find(|f| f.contains("cannot store"));
+                assert_eq!(finding.is_some(), eigen > 1.0 + 1e-9, "{name}: eigenvalue {eigen}");
+                if let Some(f) = finding {
+                    passes_one += 1;
+                    assert!((crate::validate::number_after(f, "has an eigenvalue ") - eigen).abs() <= 5e-4, "{f}");
+                }
+            }
+        }
+        eprintln!("{passes_one} course cases with a block eigenvalue above 1");
+    }
 }
