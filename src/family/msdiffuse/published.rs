@@ -431,6 +431,7 @@ fn per_gloss(it: &mut Item, s: &Slices, approx: &[f64]) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::validate::number_after;
 
     /// The shipped hand fit at g = 0.5, l·h = 1, n·l = 0.5, n·v = 0.8, n·h = 0.64, by hand from
     /// the talk's formula: f0 = 1; f1 = (1 − 0.75/32)(1 − 0.75·0.2⁵) = 0.9765625·0.99976 =
@@ -611,5 +612,124 @@ mod tests {
             let albedo = sum * (1.0 / n as f64) * (2.0 * PI / n as f64);
             assert!((albedo - 1.0).abs() < 2e-3, "r {r} mu {mu}: {albedo}");
         }
+    }
+
+    /// A committed slices file read here: its glosses, its F0 and every cell as (gloss, the
+    /// cosines at the cell's centre θh = (i + ½)/w·π/2, θd = (j + ½)/h·π/2, value, standard
+    /// error), layer by layer (`slices[(k·h + j)·w + i]`, the layout the file states).
+    fn cells_of(name: &str) -> (Vec<f64>, f64, Vec<(f64, Cosines, f64, f64)>) {
+        let generated = Path::new(env!("CARGO_MANIFEST_DIR")).join("generated");
+        let v: Value = serde_json::from_str(&std::fs::read_to_string(generated.join(format!("json/{name}.json"))).unwrap()).unwrap();
+        let gloss: Vec<f64> = serde_json::from_value(v["gloss"].clone()).unwrap();
+        let (w, h) = (v["axes"][0]["count"].as_u64().unwrap() as usize, v["axes"][1]["count"].as_u64().unwrap() as usize);
+        let phi = v["phi_d"].as_f64().unwrap();
+        let mut cells = Vec::new();
+        for (k, &g) in gloss.iter().enumerate() {
+            for j in 0..h {
+                for i in 0..w {
+                    let (th, td) = ((i as f64 + 0.5) / w as f64 * FRAC_PI_2, (j as f64 + 0.5) / h as f64 * FRAC_PI_2);
+                    let cell = &v["slices"][(k * h + j) * w + i];
+                    cells.push((g, Cosines::at(th, td, phi).unwrap(), cell[0].as_f64().unwrap(), cell[1].as_f64().unwrap()));
+                }
+            }
+        }
+        (gloss, v["f0"].as_f64().unwrap(), cells)
+    }
+
+    fn extra(it: &Item, key: &str) -> f64 {
+        it.extra.iter().find(|(k, _)| k == key).unwrap_or_else(|| panic!("{}: no {key}", it.name)).1
+    }
+
+    fn max_rms(e: &[f64]) -> (f64, f64) {
+        (e.iter().fold(0.0f64, |m, v| m.max(v.abs())), (e.iter().map(|v| v * v).sum::<f64>() / e.len() as f64).sqrt())
+    }
+
+    /// 1e-12 relative: the same sums of squares in another order.
+    fn close(a: f64, b: f64) -> bool {
+        (a - b).abs() <= 1e-12 * b.abs()
+    }
+
+    /// An item measured on `cells` (every layer): its max, rms and point count, each gloss
+    /// layer's max and rms, and the reference's rms standard error, against `model(gloss,
+    /// cosines)` counted here.
+    fn assert_measured(it: &Item, gloss: &[f64], cells: &[(f64, Cosines, f64, f64)], model: impl Fn(f64, &Cosines) -> f64) {
+        let e: Vec<f64> = cells.iter().map(|(g, c, v, _)| model(*g, c) - v).collect();
+        let (max, rms) = max_rms(&e);
+        assert_eq!((it.points, it.max_abs_error), (cells.len(), max), "{}", it.name);
+        assert!(close(it.rms_error, rms), "{}", it.name);
+        for &g in gloss {
+            let layer: Vec<f64> = cells.iter().zip(&e).filter(|(c, _)| c.0 == g).map(|(_, e)| *e).collect();
+            assert_eq!(layer.len(), cells.len() / gloss.len());
+            let (m, r) = max_rms(&layer);
+            assert_eq!(extra(it, &format!("gloss_{g}_max_abs_error")), m, "{} at gloss {g}", it.name);
+            assert!(close(extra(it, &format!("gloss_{g}_rms_error")), r), "{} at gloss {g}", it.name);
+        }
+        let se: Vec<f64> = cells.iter().map(|c| c.3).collect();
+        assert!(close(extra(it, "reference_rms_standard_error"), max_rms(&se).1), "{}", it.name);
+    }
+
+    /// The validator's items restated from the committed files alone: the hand fit, Burley's and
+    /// Hammon's diffuse on every F0 = 0.04 layer and EON on every F0 = 0 one (max, rms, each
+    /// layer's, the reference's standard error); the gloss-dependent rational on the cells its
+    /// domain covers (n·h and l·h at or above its axes' lower end, as many as its finding says),
+    /// the hand fit on the same cells and the rms error in standard errors; the gloss-0 rational's
+    /// π R(1, 1) = π ΣN/ΣD (every monomial is 1 there), its ratio's median and quartiles to the
+    /// F0 = 0 walk and its refit's ratios, each to its printed digits.
+    #[test]
+    fn items_restate_the_slices_measures() {
+        let items = committed_items();
+        let item = |prefix: &str| items.iter().find(|i| i.name.starts_with(prefix)).unwrap_or_else(|| panic!("no item {prefix}"));
+        let (gloss, f0, cells) = cells_of("ms_diffuse_slices");
+        let (lgloss, lf0, lcells) = cells_of("ms_diffuse_slices_lambert");
+        assert_eq!((f0, lf0), (TALK_F0, 0.0));
+        assert_measured(item("ms-diffuse slices: shipped hand fit"), &gloss, &cells, hand_fit);
+        assert_measured(item("ms-diffuse slices: Burley 2012"), &gloss, &cells, |g, c| burley(alpha_from_gloss(g).sqrt(), c));
+        assert_measured(item("ms-diffuse slices: Hammon 2017"), &gloss, &cells, |g, c| hammon(alpha_from_gloss(g), c));
+        let eon_item = item("ms-diffuse slices (F0 = 0): EON");
+        assert_measured(eon_item, &lgloss, &lcells, |g, c| eon(alpha_from_gloss(g), c));
+        assert!(eon_item.findings.iter().any(|f| f.ends_with(&format!("; F0 = {lf0} in the reference."))));
+
+        // The gloss-dependent rational on the cells of its domain.
+        let generated = Path::new(env!("CARGO_MANIFEST_DIR")).join("generated");
+        let spec: Value = serde_json::from_str(&std::fs::read_to_string(generated.join("json/ms_diffuse_rational.json")).unwrap()).unwrap();
+        let floor = spec["axes"][1]["range"][0].as_f64().unwrap().max(spec["axes"][2]["range"][0].as_f64().unwrap());
+        let covered: Vec<_> = cells.iter().copied().filter(|c| c.1.n_dot_h >= floor && c.1.l_dot_h >= floor).collect();
+        assert!(!covered.is_empty() && covered.len() < cells.len(), "the floor {floor} leaves some cells out");
+        let fit = CommittedRational::load(&generated).unwrap();
+        let rational_item = item("ms-diffuse slices: shadefit gloss-dependent rational");
+        assert_measured(rational_item, &gloss, &covered, |g, c| fit.eval(alpha_from_gloss(g), c.n_dot_h, c.l_dot_h));
+        let hand: Vec<f64> = covered.iter().map(|(g, c, v, _)| hand_fit(*g, c) - v).collect();
+        let (hm, hr) = max_rms(&hand);
+        assert_eq!(extra(rational_item, "hand_fit_max_abs_error_same_cells"), hm);
+        assert!(close(extra(rational_item, "hand_fit_rms_error_same_cells"), hr));
+        let z: Vec<f64> = covered.iter().map(|(g, c, v, se)| (fit.eval(alpha_from_gloss(*g), c.n_dot_h, c.l_dot_h) - v) / se).collect();
+        assert!(close(extra(rational_item, "rms_error_over_standard_error"), max_rms(&z).1));
+        let text = rational_item.findings.iter().find(|f| f.starts_with("On the same")).unwrap();
+        assert_eq!(number_after(text, "On the same "), covered.len() as f64, "{text}");
+
+        // The published rational on the gloss-0 layer.
+        let it = item("ms-diffuse gloss-0 slice: published");
+        let g0: Vec<_> = cells.iter().filter(|c| c.0 == 0.0).collect();
+        let r = |c: &Cosines| PI * rational(&RATIONAL_NUM, &RATIONAL_DEN, c.n_dot_h, c.l_dot_h);
+        let (max, rms) = max_rms(&g0.iter().map(|(_, c, v, _)| r(c) - v).collect::<Vec<f64>>());
+        assert_eq!((it.points, it.max_abs_error), (g0.len(), max));
+        assert!(close(it.rms_error, rms));
+        let at_one = PI * RATIONAL_NUM.iter().sum::<f64>() / RATIONAL_DEN.iter().sum::<f64>();
+        let f = &it.findings[0];
+        assert!((number_after(f, "π R(1, 1) = ") - at_one).abs() <= 5e-4, "{f} against {at_one}");
+        let mut ratio: Vec<f64> = lcells.iter().filter(|c| c.0 == 0.0).map(|(_, c, v, _)| r(c) / v).collect();
+        ratio.sort_by(f64::total_cmp);
+        let n = ratio.len();
+        let f = it.findings.iter().find(|f| f.contains("has median")).unwrap();
+        assert!((number_after(f, "has median ") - ratio[n / 2]).abs() <= 5e-4, "{f}");
+        assert!((number_after(f, "(quartiles ") - ratio[n / 4]).abs() <= 5e-4, "{f}");
+        assert!((number_after(f, &format!("{:.3}, ", ratio[n / 4])) - ratio[3 * n / 4]).abs() <= 5e-4, "{f}");
+        let f = it.findings.iter().find(|f| f.starts_with("Refitted")).unwrap();
+        let (rm, rr) = (extra(it, "refit_max_abs_error"), extra(it, "refit_rms_error"));
+        assert!(rm < max && rr < rms, "a least-squares refit of the same form does better: {rm} {rr}");
+        let tail = &f[f.find("max ").unwrap()..];
+        assert!((number_after(tail, "max ") - rm).abs() <= 5e-4 * rm && (number_after(tail, " (") - rm / max).abs() <= 5e-3, "{f}");
+        let tail = &f[f.find(", rms ").unwrap()..];
+        assert!((number_after(tail, ", rms ") - rr).abs() <= 5e-4 * rr && (number_after(tail, " (") - rr / rms).abs() <= 5e-3, "{f}");
     }
 }
