@@ -275,8 +275,7 @@ mod tests {
     /// between its nodes, `MaterialX::eval` of the refit gives both rationals, and the rows
     /// hold numerator then denominator with the denominators' constant 1. The bound 1e-7: the
     /// data are exact, so the minimax optimum is the pair itself; the bound leaves the rounding
-    /// of a 17-coefficient solve on 72 points nine decades above f64's 1e-16 (a wrong row or
-    /// a lost coefficient moves the values by more than 1e-3).
+    /// of a 17-coefficient solve on 72 points nine decades above f64's 1e-16.
     #[test]
     fn materialx_refit_recovers_a_pair_of_its_own_form() {
         let truth = |m: f64, a: f64| [rational(&SCALE_NUM, &SCALE_DEN, m, a), rational(&BIAS_NUM, &BIAS_DEN, m, a)];
