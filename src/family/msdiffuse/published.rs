@@ -614,10 +614,13 @@ mod tests {
         }
     }
 
+    /// A cell of a slices file: gloss, cosines, value, standard error.
+    type Cell = (f64, Cosines, f64, f64);
+
     /// A committed slices file read here: its glosses, its F0 and every cell as (gloss, the
     /// cosines at the cell's centre θh = (i + ½)/w·π/2, θd = (j + ½)/h·π/2, value, standard
     /// error), layer by layer (`slices[(k·h + j)·w + i]`, the layout the file states).
-    fn cells_of(name: &str) -> (Vec<f64>, f64, Vec<(f64, Cosines, f64, f64)>) {
+    fn cells_of(name: &str) -> (Vec<f64>, f64, Vec<Cell>) {
         let generated = Path::new(env!("CARGO_MANIFEST_DIR")).join("generated");
         let v: Value = serde_json::from_str(&std::fs::read_to_string(generated.join(format!("json/{name}.json"))).unwrap()).unwrap();
         let gloss: Vec<f64> = serde_json::from_value(v["gloss"].clone()).unwrap();
@@ -652,7 +655,7 @@ mod tests {
     /// An item measured on `cells` (every layer): its max, rms and point count, each gloss
     /// layer's max and rms, and the reference's rms standard error, against `model(gloss,
     /// cosines)` counted here.
-    fn assert_measured(it: &Item, gloss: &[f64], cells: &[(f64, Cosines, f64, f64)], model: impl Fn(f64, &Cosines) -> f64) {
+    fn assert_measured(it: &Item, gloss: &[f64], cells: &[Cell], model: impl Fn(f64, &Cosines) -> f64) {
         let e: Vec<f64> = cells.iter().map(|(g, c, v, _)| model(*g, c) - v).collect();
         let (max, rms) = max_rms(&e);
         assert_eq!((it.points, it.max_abs_error), (cells.len(), max), "{}", it.name);
