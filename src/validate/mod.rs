@@ -74,6 +74,12 @@ pub(crate) fn number_after(text: &str, key: &str) -> f64 {
     (1..=end).rev().find_map(|n| rest[..n].parse().ok()).unwrap_or_else(|| panic!("{key}: {rest}"))
 }
 
+/// The value of `key` among an item's extras; panics, naming the item, when it has none.
+#[cfg(test)]
+pub(crate) fn extra(it: &Item, key: &str) -> f64 {
+    it.extra.iter().find(|(k, _)| k == key).unwrap_or_else(|| panic!("{}: no {key}", it.name)).1
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -620,7 +620,7 @@ pub fn figures(out: &Path, _generated: &Path) -> Result<Vec<PathBuf>, PlotError>
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::validate::number_after;
+    use crate::validate::{extra, number_after};
 
     /// A pair form's per-channel maxima, by hand: scale errors 0.1, −0.3, 0.2 and bias errors
     /// −0.05, 0.04, 0.5 (truth minus approximation either way round) give 0.3 and 0.5.
@@ -902,11 +902,6 @@ mod tests {
             naga_accepts(&src);
         }
         assert_eq!(printed_constants(&materialx_wgsl(&MATERIALX, None))[..4], [0.1003, 0.9345, 1.0, 1.0]);
-    }
-
-    /// The value of `key` in an item's extras.
-    fn extra(it: &Item, key: &str) -> f64 {
-        it.extra.iter().find(|(k, _)| k == key).unwrap_or_else(|| panic!("{}: no {key}", it.name)).1
     }
 
     /// Max |error| and rms over both channels, and each channel's max, of a pair form on a grid,

@@ -431,7 +431,7 @@ fn per_gloss(it: &mut Item, s: &Slices, approx: &[f64]) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::validate::number_after;
+    use crate::validate::{extra, number_after};
 
     /// The shipped hand fit at g = 0.5, l·h = 1, n·l = 0.5, n·v = 0.8, n·h = 0.64, by hand from
     /// the talk's formula: f0 = 1; f1 = (1 − 0.75/32)(1 − 0.75·0.2⁵) = 0.9765625·0.99976 =
@@ -637,10 +637,6 @@ mod tests {
             }
         }
         (gloss, v["f0"].as_f64().unwrap(), cells)
-    }
-
-    fn extra(it: &Item, key: &str) -> f64 {
-        it.extra.iter().find(|(k, _)| k == key).unwrap_or_else(|| panic!("{}: no {key}", it.name)).1
     }
 
     fn max_rms(e: &[f64]) -> (f64, f64) {
