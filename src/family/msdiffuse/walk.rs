@@ -336,6 +336,46 @@ mod tests {
         }
     }
 
+    /// The heights of the next intersection follow Smith's masking in the height CDF (Heitz et
+    /// al. 2016, §5: a ray from height u is unoccluded up to height v with probability (u/v)^Λ
+    /// going up, (v/u)^|Λ| going down, Λ(−ω) = −1 − Λ(ω)), with Λ = (√(1 + α² tan²θ) − 1)/2
+    /// written out here. Over N stratified draws ξ = (i + ½)/N the share of escapes and of hits
+    /// at or below v is a share of the ξ below a threshold, so each is within 1/(2N) of its
+    /// probability; the bound 1/N leaves the rounding of the thresholds room. A ray along the
+    /// normal escapes; a horizontal one stays at its height.
+    #[test]
+    fn next_heights_follow_smiths_masking_in_the_height_cdf() {
+        const N: usize = 4096;
+        let smith = |alpha: f64, mu: f64| ((1.0 + alpha * alpha * (1.0 - mu * mu) / (mu * mu)).sqrt() - 1.0) / 2.0;
+        for alpha in [0.3, 1.0] {
+            for mu in [0.2, 0.7] {
+                let lam = smith(alpha, mu);
+                for u in [0.35, 0.8] {
+                    let share = |wz: f64, pred: &dyn Fn(Option<f64>) -> bool| {
+                        (0..N).filter(|&i| pred(next_height(alpha, wz, u, (i as f64 + 0.5) / N as f64))).count() as f64 / N as f64
+                    };
+                    let at = format!("α {alpha}, μ {mu}, u {u}");
+                    // Up: escapes with u^Λ; a hit is in (u, 1], at or below v with 1 − (u/v)^Λ.
+                    let escaped = share(mu, &|h| h.is_none());
+                    assert!((escaped - u.powf(lam)).abs() < 1.0 / N as f64, "{at}: escaped {escaped} vs {}", u.powf(lam));
+                    assert_eq!(share(mu, &|h| h.is_some_and(|h| h < u || h > 1.0)), 0.0, "{at}");
+                    for v in [u + 0.25 * (1.0 - u), u + 0.75 * (1.0 - u)] {
+                        let (got, want) = (share(mu, &|h| h.is_some_and(|h| h <= v)), 1.0 - (u / v).powf(lam));
+                        assert!((got - want).abs() < 1.0 / N as f64, "{at}, up to {v}: {got} vs {want}");
+                    }
+                    // Down (Λ(−ω) = −1 − Λ(ω)): always hits, in [0, u], at or below v with (v/u)^(1 + Λ).
+                    assert_eq!(share(-mu, &|h| h.is_none_or(|h| !(0.0..=u).contains(&h))), 0.0, "{at}");
+                    for v in [0.25 * u, 0.75 * u] {
+                        let (got, want) = (share(-mu, &|h| h.is_some_and(|h| h <= v)), (v / u).powf(1.0 + lam));
+                        assert!((got - want).abs() < 1.0 / N as f64, "{at}, down to {v}: {got} vs {want}");
+                    }
+                }
+            }
+        }
+        assert_eq!(next_height(0.5, 1.0, 0.4, 0.3), None);
+        assert_eq!(next_height(0.5, 0.0, 0.4, 0.3), Some(0.4));
+    }
+
     /// Unit vector (sin θ cos φ, sin θ sin φ, cos θ).
     fn dir(theta: f64, phi: f64) -> V3 {
         crate::family::sggx::integrals::direction(theta, phi).into()
