@@ -1850,6 +1850,25 @@ mod tests {
         }
     }
 
+    /// The tolerance a caller gives is the one used (module doc): a looser one takes fewer
+    /// evaluations and still holds against 2E₃; zero, a negative one and NaN mean
+    /// DEFAULT_TOL, value and evaluations alike; one below 1e-15 means 1e-15.
+    #[test]
+    fn tolerances_are_used_as_given_and_cleaned_as_documented() {
+        let d = 0.3;
+        let (loose, tight) = (q(d, 1e-4), q(d, 1e-12));
+        assert!(loose.evals < tight.evals, "{loose:?} {tight:?}");
+        // 4 ulps of Q ≈ 0.5 bound q_exact's rounding beside the tolerance itself.
+        assert!((loose.value - q_exact(d)).abs() <= 1e-4 && (tight.value - q_exact(d)).abs() <= 1e-12 + 4.0 * f64::EPSILON);
+        let dflt = q(d, DEFAULT_TOL);
+        for tol in [0.0, -1.0, f64::NAN] {
+            let e = q(d, tol);
+            assert_eq!((e.value.to_bits(), e.evals), (dflt.value.to_bits(), dflt.evals), "tol {tol}");
+        }
+        let (tiny, floor) = (q(d, 1e-30), q(d, 1e-15));
+        assert_eq!((tiny.value.to_bits(), tiny.evals), (floor.value.to_bits(), floor.evals));
+    }
+
     #[test]
     fn g_matches_closed_form_and_limits() {
         // Quadrature at 1e-13 against the E₁/E₂ closed form: 1e-12 bounds both. The closed form
