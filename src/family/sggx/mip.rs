@@ -296,6 +296,26 @@ mod tests {
         assert!(e.contains("grey.png") && e.contains("color type") && e.contains("(aniso map)"), "{e}");
     }
 
+    /// The report counts what it names, on 1×1 textures (one level, one texel):
+    /// - a lobe whose normal's eigenvalue 1 is the start's (z) but not the largest (α_t = 1.2 in
+    ///   the plane): the iteration stops at once on z, and the block's α_t² = 1.44 passes 1, so
+    ///   the encoding clamps it;
+    /// - a tilted lobe of α = 0.9999: the residual shrinks by λ₂/λ₁ = α² a step, so reaching
+    ///   POWER_TOL would take ln(1e-14)/ln(α²) ≈ 161 000 steps, past POWER_MAX_ITER (100 000):
+    ///   not converged, and the block (within e^-20 of the converged one) stays under 1.
+    #[test]
+    fn the_report_counts_unconverged_and_clamped_texels() {
+        use super::super::integrals::{Aniso, POWER_MAX_ITER, direction};
+        let count = |s: M3| {
+            let r = mip_chain(1, 1, vec![s], 8, 2, &|_| {}).2;
+            (r.levels, r.texels, r.max_iterations, r.not_converged, r.clamped)
+        };
+        assert_eq!(count(sggx_from(V3::z(), Aniso::from_alphas(1.2, 0.5, 0.0))), (1, 1, 0, 0, 1));
+        let predicted = (1e-14f64).ln() / (0.9999f64 * 0.9999).ln();
+        assert!(predicted > 1.5 * POWER_MAX_ITER as f64, "{predicted}");
+        assert_eq!(count(sggx_from(direction(0.6, 0.3), Aniso::isotropic(0.9999))), (1, 1, POWER_MAX_ITER, 1, 0));
+    }
+
     #[test]
     fn a_uniform_texture_keeps_its_texel_at_every_level() {
         // Every level's S is the mean of equal matrices, so every texel is the input's to the
