@@ -53,11 +53,6 @@ impl TextureFormat {
         }
     }
 
-    /// Bytes per texel (4 channels).
-    pub fn texel_size(self) -> u32 {
-        4 * self.type_size()
-    }
-
     /// The WebGPU name (`rgba16float`, `rgba32float`).
     pub fn name(self) -> &'static str {
         match self {
