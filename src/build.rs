@@ -463,3 +463,32 @@ pub fn merge(paths: &Paths, files: &[PathBuf], tick: &(dyn Fn(usize) + Sync)) ->
     }
     run(paths, &names, false, &[], tick)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every module of the runtime index is gated on its family's feature (its quantity up to the
+    /// first '-'), and the runtime crate's manifest declares every feature the index names: a
+    /// `cfg(feature)` on an undeclared name compiles its module out with only a warning. Over the
+    /// committed specs (fits/) and generated/Cargo.toml's `[features]`. Here, not in `pipeline`:
+    /// the catalog of the committed specs is `family`'s, and `pipeline` does not import `family`.
+    #[test]
+    fn the_runtime_index_gates_modules_on_features_the_runtime_crate_declares() {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+        let specs = spec::load_dir(&root.join("fits"), family::catalog()).unwrap();
+        assert!(specs.len() > 20, "{} specs", specs.len());
+        let text = String::from_utf8(pipeline::runtime_index(&specs).contents).unwrap();
+        let manifest: toml::Table = std::fs::read_to_string(root.join("generated/Cargo.toml")).unwrap().parse().unwrap();
+        let declared = manifest["features"].as_table().unwrap();
+        let named: std::collections::BTreeSet<&str> = text.split("feature = \"").skip(1).map(|r| r.split('"').next().unwrap()).collect();
+        for f in &named {
+            assert!(declared.contains_key(*f), "the index names feature '{f}', which generated/Cargo.toml does not declare");
+        }
+        for s in &specs {
+            let fam = s.file.quantity.split_once('-').map_or(s.file.quantity.as_str(), |(f, _)| f);
+            let gate = format!("#[cfg(feature = \"{fam}\")]\n#[path = \"{}.rs\"]", s.file.name);
+            assert!(text.contains(&gate), "{}: no '{gate}'", s.file.name);
+        }
+    }
+}
