@@ -425,6 +425,33 @@ mod tests {
         assert!(cone.contains("Schlick Fc, lights in the cone n·l ≥ 0.5)."), "{cone}");
     }
 
+    /// The quadrature figures `tabulate` reports are those of the texels' own integrals: each
+    /// texel is `env` at its n·v and its row's α (row-major, n·v fastest), the evaluations a
+    /// texel are their total over the texel count (rounded: the JSON's figure), between the
+    /// fewest and the most one texel took, and the error estimate is the largest one.
+    #[test]
+    fn tabulate_reports_the_texels_own_quadrature() {
+        let text = "name = \"ggx_t\"\nkind = \"ggx-dfg-lut\"\nquantity = \"ggx-env\"\nresolution = [4, 3]\n\n[emit]\nfunction = \"ggx_t\"\n";
+        let lut = DfgLut::parse(std::path::Path::new("fits/ggx_t.toml"), text).unwrap();
+        let (texels, q) = tabulate(&lut);
+        let each: Vec<EnvEstimate> = (0..3)
+            .flat_map(|j| {
+                let alpha = lut.mapping.alpha(lut.row_coordinate(j));
+                let lut = &lut;
+                (0..4).map(move |i| env(alpha, lut.n_dot_v(i), lut.cos_cone, lut.shadowing_at(alpha), lut.tolerance))
+            })
+            .collect();
+        assert_eq!(texels, each.iter().map(|e| [e.scale, e.bias]).collect::<Vec<_>>());
+        let evals: Vec<f64> = each.iter().map(|e| e.evals as f64).collect();
+        assert_eq!(q.evals_per_texel, (evals.iter().sum::<f64>() / 12.0).round());
+        // Every texel takes more evaluations than there are texels, so a remainder (< 12) or a
+        // total (> the most) is told from the mean.
+        let (fewest, most) = (evals.iter().copied().fold(f64::INFINITY, f64::min), evals.iter().copied().fold(0.0, f64::max));
+        assert!(fewest <= q.evals_per_texel && q.evals_per_texel <= most && fewest > 12.0, "{q:?}: {evals:?}");
+        assert_eq!(q.max_error_estimate, each.iter().map(|e| e.error).fold(0.0, f64::max));
+        assert_eq!(q.tolerance, lut.tolerance);
+    }
+
     /// Bilinear filtering of texels that are linear in the texel index, f(i, j) = i + 10j (and
     /// 2i − j), returns the same linear function at the texel-space point (u·w − ½, t·h − ½),
     /// clamped to the edge texels outside their centres.
