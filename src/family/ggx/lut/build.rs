@@ -434,20 +434,21 @@ mod tests {
         let text = "name = \"ggx_t\"\nkind = \"ggx-dfg-lut\"\nquantity = \"ggx-env\"\nresolution = [4, 3]\n\n[emit]\nfunction = \"ggx_t\"\n";
         let lut = DfgLut::parse(std::path::Path::new("fits/ggx_t.toml"), text).unwrap();
         let (texels, q) = tabulate(&lut);
-        let each: Vec<EnvEstimate> = (0..3)
+        let each: Vec<EnvEstimate> = (0..lut.height)
             .flat_map(|j| {
                 let alpha = lut.mapping.alpha(lut.row_coordinate(j));
                 let lut = &lut;
-                (0..4).map(move |i| env(alpha, lut.n_dot_v(i), lut.cos_cone, lut.shadowing_at(alpha), lut.tolerance))
+                (0..lut.width).map(move |i| env(alpha, lut.n_dot_v(i), lut.cos_cone, lut.shadowing_at(alpha), lut.tolerance))
             })
             .collect();
         assert_eq!(texels, each.iter().map(|e| [e.scale, e.bias]).collect::<Vec<_>>());
         let evals: Vec<f64> = each.iter().map(|e| e.evals as f64).collect();
-        assert_eq!(q.evals_per_texel, (evals.iter().sum::<f64>() / 12.0).round());
-        // Every texel takes more evaluations than there are texels, so a remainder (< 12) or a
+        let n = evals.len() as f64;
+        assert_eq!(q.evals_per_texel, (evals.iter().sum::<f64>() / n).round());
+        // Every texel takes more evaluations than there are texels, so a remainder (< their count) or a
         // total (> the most) is told from the mean.
         let (fewest, most) = (evals.iter().copied().fold(f64::INFINITY, f64::min), evals.iter().copied().fold(0.0, f64::max));
-        assert!(fewest <= q.evals_per_texel && q.evals_per_texel <= most && fewest > 12.0, "{q:?}: {evals:?}");
+        assert!(fewest <= q.evals_per_texel && q.evals_per_texel <= most && fewest > n, "{q:?}: {evals:?}");
         assert_eq!(q.max_error_estimate, each.iter().map(|e| e.error).fold(0.0, f64::max));
         assert_eq!(q.tolerance, lut.tolerance);
     }
