@@ -282,6 +282,54 @@ mod tests {
         assert!((m.texture.max_abs_error - 75.0).abs() < 1.0, "{:?}", m.texture);
     }
 
+    /// Each cell of the error map is the largest texture error over its own block of
+    /// VERIFY_DENSITY³ points: texel footprint (i, j) and slice interval k. On a 2 × 2 × 3 LUT
+    /// the last slice's texel (i, j) is raised by P = 100·(1 + i + 2j). The texture's error at
+    /// (u, t, c) is then that raise read trilinearly, 100·(1 + x + 2y)·max(0, 2c − 1) with
+    /// x = clamp(2u − 0.5, 0, 1) and y = clamp(2t − 0.5, 0, 1) (a linear field between texel
+    /// centres, clamped past them; the last slice's weight), plus the table's own error (its
+    /// values are in [0, 1], so below 1). Slice interval 0 never reads the last slice: its cells
+    /// stay below 1; interval 1's cells grow with i and j. Tolerance 2: the table's error (< 1),
+    /// f16 rounding of values ≤ 401 (≤ 0.125) and the map's 3 significant digits (≤ 0.5 below
+    /// 1000).
+    #[test]
+    fn each_error_map_cell_is_the_largest_error_of_its_own_block() {
+        let text = super::super::spec::tests::SPEC.replace("[8, 4, 3]", "[2, 2, 3]");
+        let lut = ConeLut::parse(Path::new("fits/ggx_c.toml"), &text).unwrap();
+        let (w, h, d, n) = (2, 2, 3, VERIFY_DENSITY);
+        let (mut values, _) = tabulate(&lut);
+        for j in 0..h {
+            for i in 0..w {
+                let raise = 100.0 * (1 + i + 2 * j) as f64;
+                values[(2 * h + j) * w + i] = values[(2 * h + j) * w + i].map(|x| x + raise);
+            }
+        }
+        let m = verify(&lut, &values).unwrap();
+        assert_eq!(m.error_map.len(), w * h * (d - 1));
+        let centre = |k: usize, count: usize| (k as f64 + 0.5) / count as f64;
+        for k in 0..d - 1 {
+            for j in 0..h {
+                for i in 0..w {
+                    let mut want = 0.0f64;
+                    for (a, b, e) in block_offsets(n) {
+                        let u = centre(i * n + a, n * w);
+                        let t = centre(j * n + b, n * h);
+                        let c = centre(k * n + e, n * (d - 1));
+                        let (x, y) = ((2.0 * u - 0.5).clamp(0.0, 1.0), (2.0 * t - 0.5).clamp(0.0, 1.0));
+                        want = want.max(100.0 * (1.0 + x + 2.0 * y) * (2.0 * c - 1.0).max(0.0));
+                    }
+                    let got = m.error_map[(k * h + j) * w + i];
+                    assert!((got - want).abs() < 2.0, "cell (i {i}, j {j}, k {k}): {got} against {want}; map {:?}", m.error_map);
+                }
+            }
+        }
+    }
+
+    /// The (a, b, e) offsets of the points of one block, each in 0..n.
+    fn block_offsets(n: usize) -> impl Iterator<Item = (usize, usize, usize)> {
+        (0..n).flat_map(move |a| (0..n).flat_map(move |b| (0..n).map(move |e| (a, b, e))))
+    }
+
     #[test]
     fn trilinear_reproduces_a_linear_field_with_slices_at_k_over_d_minus_1() {
         // Texels holding channel 0 = k (the slice index) and channel 1 = i + 10 j on a
