@@ -325,6 +325,115 @@ mod tests {
         }
     }
 
+    /// Every figure of the verification re-measured by this test's own means: the integral by
+    /// `env_with` with adaptive azimuth panels at 1e-10 (independent of the nested rules the
+    /// build integrates with), the f16 texels by the `half` crate, trilinear weights written out
+    /// (clamped texel coordinates, slices at k/(d − 1)). A 6 × 5 × 4 LUT in Filament's layout
+    /// (R = bias, G = scale + bias: the encoding is judged too), VERIFY_DENSITY (2) points a
+    /// texel and a slice interval: 12 × 10 × 6 points, 10 × 8 × 6 of them between the outer texel
+    /// centres. The build's reference asks 1e-6: every maximum and rms agrees within
+    /// 1e-6 + 1e-10 (each point's error moves by at most the two references' difference), and
+    /// the emitted f32 lookup within 1e-6 more (f32 coordinates and arithmetic on values ≤ 2:
+    /// a few ulps of 2^-23 times the table's slope, far below 1e-6). The f16 rounding is
+    /// recomputed exactly.
+    #[test]
+    fn every_verification_figure_is_re_measured() {
+        use crate::family::ggx::integrals::{Inner, Shadowing, env_with};
+        let text = super::super::spec::tests::SPEC.replace("[8, 4, 3]", "[6, 5, 4]\nlayout = \"filament\"");
+        let lut = ConeLut::parse(Path::new("fits/ggx_c.toml"), &text).unwrap();
+        let (w, h, d) = (6usize, 5usize, 4usize);
+        let (values, _) = tabulate(&lut);
+        let m = verify(&lut, &values).unwrap();
+        let encode = |[s, b]: [f64; 2]| [b, s + b];
+        let f16 = |x: f64| f64::from(half::f16::from_f32(x as f32).to_f32());
+        let stored: Vec<[f64; 2]> = values.iter().map(|v| encode(*v).map(f16)).collect();
+        let exact: Vec<[f64; 2]> = values.iter().map(|v| encode(*v)).collect();
+        let storage = values.iter().flat_map(|v| encode(*v).map(|x| (x - f16(x)).abs())).fold(0.0, f64::max);
+        assert_eq!(m.max_abs_storage_error, storage);
+        assert!(storage > 0.0);
+        let coord = |p: f64, n: usize| {
+            let x = (p * n as f64 - 0.5).clamp(0.0, (n - 1) as f64);
+            let i = (x.floor() as usize).min(n - 2);
+            (i, x - i as f64)
+        };
+        let read = |tex: &[[f64; 2]], u: f64, t: f64, c: f64| -> [f64; 2] {
+            let ((i, fx), (j, fy)) = (coord(u, w), coord(t, h));
+            let z = c * (d - 1) as f64;
+            let k = (z.floor() as usize).min(d - 2);
+            let fz = z - k as f64;
+            std::array::from_fn(|ch| {
+                let at = |i: usize, j: usize, k: usize| tex[(k * h + j) * w + i][ch];
+                let plane = |k: usize| {
+                    let row = |j: usize| at(i, j, k) * (1.0 - fx) + at(i + 1, j, k) * fx;
+                    row(j) * (1.0 - fy) + row(j + 1) * fy
+                };
+                plane(k) * (1.0 - fz) + plane(k + 1) * fz
+            })
+        };
+        let centres = |count: usize| -> Vec<f64> { (0..count).map(|k| (k as f64 + 0.5) / count as f64).collect() };
+        let (us, ts, cs) = (centres(2 * w), centres(2 * h), centres(2 * (d - 1)));
+        let err = |got: [f64; 2], want: [f64; 2]| (got[0] - want[0]).abs().max((got[1] - want[1]).abs());
+        let (mut tex, mut inner, mut interp, mut ss, mut inner_points) = (0.0f64, 0.0f64, 0.0f64, 0.0, 0);
+        for &c in &cs {
+            for &t in &ts {
+                for &u in &us {
+                    let r = env_with(lut.base.mapping.alpha(t), u, c, Shadowing::HeightCorrelated, 1e-10, Inner::Adaptive);
+                    let want = encode([r.scale, r.bias]);
+                    let got = read(&stored, u, t, c);
+                    let e = err(got, want);
+                    tex = tex.max(e);
+                    ss += (got[0] - want[0]).powi(2) + (got[1] - want[1]).powi(2);
+                    let between = |p: f64, n: usize| p > 0.5 / n as f64 && p < 1.0 - 0.5 / n as f64;
+                    if between(u, w) && between(t, h) {
+                        inner = inner.max(e);
+                        inner_points += 1;
+                    }
+                    interp = interp.max(err(read(&exact, u, t, c), want));
+                }
+            }
+        }
+        let points = us.len() * ts.len() * cs.len();
+        assert_eq!((m.points, inner_points), (12 * 10 * 6, 10 * 8 * 6));
+        let bound = 1e-6 + 1e-10;
+        let rms = (ss / (2 * points) as f64).sqrt();
+        for (what, claimed, measured) in [
+            ("texture max", m.texture.max_abs_error, tex),
+            ("texture rms", m.texture.rms_error, rms),
+            ("interior max", m.texture_interior.max_abs_error, inner),
+            ("interpolation max", m.interpolation.max_abs_error, interp),
+            ("f32 lookup max", m.lookup_f32.max_abs_error, tex),
+        ] {
+            let slack = if what.starts_with("f32") { 2.0 * bound } else { bound };
+            assert!((claimed - measured).abs() <= slack, "{what}: claimed {claimed:e}, re-measured {measured:e}");
+            assert!(measured > 100.0 * slack, "{what}: not a vacuous comparison ({measured:e})");
+        }
+        // The interior leaves out the clamped border, where filtering is worst: a smaller max.
+        assert!(inner < tex, "{inner:e} vs {tex:e}");
+        assert!(m.reference_max_error_estimate > 0.0 && m.reference_max_error_estimate <= VERIFY_TOLERANCE, "{}", m.reference_max_error_estimate);
+        assert_eq!((m.density, m.reference_tolerance), (VERIFY_DENSITY, VERIFY_TOLERANCE));
+    }
+
+    /// The quadrature a cone LUT reports is that of its slices, each the 2-D table's own: the
+    /// largest error estimate of any slice and the slices' evaluations a texel, averaged and
+    /// rounded. The closed cone (the last slice) takes no evaluation at all, so a sum or the
+    /// first slice's figure would differ from the mean.
+    #[test]
+    fn tabulate_reports_its_slices_quadrature() {
+        let text = super::super::spec::tests::SPEC.replace("[8, 4, 3]", "[6, 5, 4]");
+        let lut = ConeLut::parse(Path::new("fits/ggx_c.toml"), &text).unwrap();
+        let (values, q) = tabulate(&lut);
+        assert_eq!(values.len(), 6 * 5 * 4);
+        let slices: Vec<Quadrature> = (0..4).map(|k| tabulate_2d(&lut.slice(k)).1).collect();
+        assert_eq!(slices[3].evals_per_texel, 0.0, "{slices:?}");
+        let worst = slices.iter().map(|s| s.max_error_estimate).fold(0.0, f64::max);
+        assert!(worst > 0.0 && slices.iter().any(|s| s.max_error_estimate < worst), "{slices:?}");
+        assert_eq!(q.max_error_estimate, worst);
+        let mean = slices.iter().map(|s| s.evals_per_texel).sum::<f64>() / 4.0;
+        assert_eq!(q.evals_per_texel, mean.round());
+        assert!(slices.iter().all(|s| s.evals_per_texel != q.evals_per_texel), "{slices:?}");
+        assert_eq!(q.tolerance, lut.base.tolerance);
+    }
+
     /// The (a, b, e) offsets of the points of one block, each in 0..n.
     fn block_offsets(n: usize) -> impl Iterator<Item = (usize, usize, usize)> {
         (0..n).flat_map(move |a| (0..n).flat_map(move |b| (0..n).map(move |e| (a, b, e))))
