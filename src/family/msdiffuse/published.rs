@@ -565,6 +565,15 @@ mod tests {
         assert!((burley(0.7, &c) - 1.0).abs() < 1e-15);
         // Hammon at α = 1: facing = 1, rough = 0.5·1.5 = 0.75, + π·0.1159.
         assert!((hammon(1.0, &c) - (0.75 + PI * 0.1159)).abs() < 1e-14);
+        // Hammon off the normal, n·l = 0.5, n·v = 0.8, n·h = 0.9, l·v = 0.2 (a formula check: the
+        // cosines need not come from one pair of directions). α = 0 leaves the smooth term,
+        // 1.05·(1 − 0.5⁵)·(1 − 0.2⁵) = 1.05·0.96875·0.99968; at α = 0.5, facing = 0.6, rough =
+        // 0.6·(0.9 − 0.24)·(1.4/0.9) = 0.396·1.4/0.9, halfway between, plus π·0.1159·0.5.
+        let off = Cosines { n_dot_l: 0.5, n_dot_v: 0.8, n_dot_h: 0.9, l_dot_h: 0.95, l_dot_v: 0.2 };
+        let smooth = 1.05 * 0.96875 * 0.99968;
+        assert!((hammon(0.0, &off) - smooth).abs() < 1e-14);
+        let rough = 0.396 * 1.4 / 0.9;
+        assert!((hammon(0.5, &off) - (0.5 * (smooth + rough) + PI * 0.1159 * 0.5)).abs() < 1e-14);
         // EON at r = 0 is Lambert, up to its ε = 1e-7 floor of the multiple-scattering term.
         let c2 = Cosines::at(0.4, 0.6, 1.0).unwrap();
         assert!((eon(0.0, &c2) - 1.0).abs() < 2e-7);

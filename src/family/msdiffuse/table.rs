@@ -679,6 +679,35 @@ pub(super) mod tests {
         }
     }
 
+    /// A MERL cell states its standard error in its value's units: both the walk's estimate of
+    /// π f/ρ divided by π and by the file's red scale (merl::SCALES[0]), so the cell's relative
+    /// error is the walk's. Checked on cells of directions above the horizon (with 2 paths a
+    /// cell, their errors are not zero) and on one below it (the file's −1, no error).
+    #[test]
+    fn merl_cells_state_their_error_in_the_values_units() {
+        let text = SPEC.replace("[4, 3, 2]", "[2, 2, 1]").replace("albedo_resolution = 3", "albedo_resolution = 2\nmerl_paths = 2");
+        let t = Table::from_spec(&spec(&text)).unwrap();
+        let base = t.slice_cells() + t.albedo_cells();
+        let mut seen = 0;
+        for cell in [0usize, 1234, 90 * 180 * 45 + 180 * 30 + 90, merl::CELLS - 1] {
+            let got = t.cell(base + cell as u64);
+            let (th, td, pd) = merl::cell_angles(cell);
+            match directions(th, td, pd) {
+                Some((l, v)) => {
+                    let e = brdf(&surface(0.0, TALK_F0, Specular::Gone), l, v, Order::All, t.key(), base + cell as u64, 2, false);
+                    assert!(e.error > 0.0 && e.value > 0.0, "cell {cell}: {e:?}");
+                    // Relative error: the same quotient up to a few roundings of the two divisions.
+                    let (rel_got, rel_want) = (got.se / got.value, e.error / e.value);
+                    assert!((rel_got - rel_want).abs() <= 1e-12 * rel_want, "cell {cell}: {rel_got} vs {rel_want}");
+                    assert!((got.value * merl::SCALES[0] * PI - e.value).abs() <= 1e-12 * e.value, "cell {cell}");
+                    seen += 1;
+                }
+                None => assert_eq!((got.value, got.se), (-1.0, 0.0), "cell {cell}"),
+            }
+        }
+        assert!(seen >= 2, "{seen} cells above the horizon");
+    }
+
     /// The cluster sharding: the table's cells computed in two ranges (split off the middle),
     /// merged and decoded, are each cell of the table computed alone, bit for bit (value and
     /// standard error); the count is the slices', the albedo's and the MERL cells'; a merged
