@@ -702,6 +702,63 @@ mod tests {
         }
     }
 
+    /// Where `phi_panels` cuts, as its documentation states: in q = cos φ − κ (μl − c = slope·q,
+    /// slope = 2 cos θh sin θv sin θh), breakpoints at q_max·16^−j from q_max = 1 − κ, each a
+    /// sixteenth of the one before, the last the first at or below 16 q_pole, q_pole the pole's
+    /// distance from the boundary, (c + p)/slope with p = μv(α/2)/(μv + μvΛ(μv))
+    /// (height-correlated; Λ by the textbook form) or k/(1 − k) (separable); none when
+    /// q_max ≤ 16 q_pole. The panels tile [0, φmax]. The breakpoints' q are recovered as
+    /// cos φ − κ: a few ulps of 1 absolute, ≤ 1e-9 relative for q ≥ 1e-6 (q_pole here ≥ 1e-5).
+    #[test]
+    fn phi_panels_cut_sixteen_fold_down_to_the_poles_distance() {
+        let (mut cut, mut uncut) = (0, 0);
+        for shadowing in [HC, Shadowing::Separable { k: 0.001 }] {
+            for alpha in [1e-3, 1e-2] {
+                for mu in [0.2f64, 0.7] {
+                    for c in [0.0, 0.3] {
+                        let view = View::new(alpha, mu, c, shadowing);
+                        let sin_v = (1.0 - mu * mu).sqrt();
+                        let p = match shadowing {
+                            Shadowing::HeightCorrelated => {
+                                let lambda = 0.5 * ((1.0 + alpha * alpha * sin_v * sin_v / (mu * mu)).sqrt() - 1.0);
+                                mu * (0.5 * alpha) / (mu + mu * lambda)
+                            }
+                            Shadowing::Separable { k } => k / (1.0 - k),
+                        };
+                        for j in 1..40 {
+                            let (sh, ch) = (0.5 * PI * j as f64 / 40.0).sin_cos();
+                            let kappa = view.kappa(sh, ch);
+                            if !(kappa > -1.0 && kappa < 1.0) {
+                                continue;
+                            }
+                            let phi_max = kappa.acos();
+                            let panels = view.phi_panels(sh, ch, kappa, phi_max);
+                            let what = format!("{shadowing:?} α={alpha} μv={mu} c={c} θh at {j}/40 of π/2: {panels:?}");
+                            assert_eq!((panels[0].0, panels[panels.len() - 1].1), (0.0, phi_max), "{what}");
+                            assert!(panels.windows(2).all(|w| w[0].1 == w[1].0 && w[0].0 < w[0].1), "{what}");
+                            let q_max = 1.0 - kappa;
+                            let q_pole = (c + p) / (2.0 * ch * sin_v * sh);
+                            let qs: Vec<f64> = panels[1..].iter().map(|&(a, _)| a.cos() - kappa).collect();
+                            if qs.is_empty() {
+                                assert!(q_max <= 16.0 * q_pole, "{what}: q_max {q_max}, q_pole {q_pole}");
+                                uncut += 1;
+                                continue;
+                            }
+                            cut += 1;
+                            let close = |a: f64, b: f64| (a - b).abs() <= 1e-9 * b;
+                            assert!(close(qs[0], q_max / 16.0), "{what}: first q {} of q_max {q_max}", qs[0]);
+                            assert!(qs.windows(2).all(|w| close(w[1], w[0] / 16.0)), "{what}: {qs:?}");
+                            let last = qs[qs.len() - 1];
+                            assert!(last > q_pole && last <= 16.0 * q_pole, "{what}: last q {last}, q_pole {q_pole}");
+                        }
+                    }
+                }
+            }
+        }
+        // Both cases occur (a test passing on panels never cut would be vacuous).
+        assert!(cut > 20 && uncut > 20, "{cut} cut, {uncut} uncut");
+    }
+
     /// Smith's Λ of GGX against two references of its own. The textbook form
     /// Λ = (−1 + sqrt(1 + α² tan²θ))/2 (Heitz 2014, "Understanding the masking-shadowing
     /// function", GGX's Λ), to 1e-13 relative away from μ = 1 (where the textbook form cancels).
