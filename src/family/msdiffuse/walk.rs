@@ -336,6 +336,16 @@ mod tests {
         }
     }
 
+    /// A text's key is its 64-bit FNV-1a hash (Fowler, Noll & Vo; the test vectors of the FNV
+    /// reference test_fnv.c: "" → cbf29ce484222325, the offset basis; "a" → af63dc4c8601ec8c;
+    /// "foobar" → 85944171f73967e8) through the finaliser, itself pinned to SplitMix64 above.
+    #[test]
+    fn keys_are_fnv1a_through_the_finaliser() {
+        for (text, fnv) in [("", 0xcbf2_9ce4_8422_2325u64), ("a", 0xaf63_dc4c_8601_ec8c), ("foobar", 0x8594_4171_f739_67e8)] {
+            assert_eq!(key_of(text), mix64(fnv), "{text:?}");
+        }
+    }
+
     /// The heights of the next intersection follow Smith's masking in the height CDF (Heitz et
     /// al. 2016, §5: a ray from height u is unoccluded up to height v with probability (u/v)^Λ
     /// going up, (v/u)^|Λ| going down, Λ(−ω) = −1 − Λ(ω)), with Λ = (√(1 + α² tan²θ) − 1)/2
