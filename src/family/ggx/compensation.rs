@@ -403,6 +403,21 @@ mod tests {
         assert!(want > 0.1);
     }
 
+    /// The view-only factors by hand at A = 0.6, B = 0.2 (E = 0.8, E_ms = 0.2), F0 = 0.5
+    /// (F_avg = 0.5 + 0.5/21 = 11/21, F_ss E_ss = 0.5·0.6 + 0.2 = 0.5). Fdez-Agüera 2019's extra
+    /// lobe F_ms E_ms = F_ss E_ss·F_avg·E_ms/(1 − E_ms F_avg) = (1.1/21)/(18.8/21) = 1.1/18.8;
+    /// the furnace adds it to F_ss E_ss. Turquin's c = 1 + F0 (1 − E)/E = 1.125; the reciprocal
+    /// schemes have none. 1e-15: a few roundings of values below 2.
+    #[test]
+    fn view_factors_by_hand() {
+        let x = Inputs { a: 0.6, b: 0.2, e_avg: 0.7 };
+        let fdez = view_factor(Scheme::FdezAguera, 0.5, &x).unwrap();
+        assert!((fdez - 1.1 / 18.8).abs() < 1e-15, "{fdez}");
+        assert!((furnace(Scheme::FdezAguera, 0.5, &x, 0.3) - (0.5 + 1.1 / 18.8)).abs() < 1e-15);
+        assert!((view_factor(Scheme::Turquin, 0.5, &x).unwrap() - 1.125).abs() < 1e-15);
+        assert_eq!((view_factor(Scheme::Single, 0.5, &x), view_factor(Scheme::KullaConty, 0.5, &x)), (None, None));
+    }
+
     #[test]
     fn furnace_quantity_matches_the_formula() {
         let x = inputs(0.5, 0.3);
