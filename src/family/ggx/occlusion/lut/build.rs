@@ -296,7 +296,7 @@ mod tests {
     fn each_error_map_cell_is_the_largest_error_of_its_own_block() {
         let text = super::super::spec::tests::SPEC.replace("[8, 4, 3]", "[2, 2, 3]");
         let lut = ConeLut::parse(Path::new("fits/ggx_c.toml"), &text).unwrap();
-        let (w, h, d, n) = (2, 2, 3, VERIFY_DENSITY);
+        let (w, h, d, n) = (lut.base.width, lut.base.height, lut.depth, VERIFY_DENSITY);
         let (mut values, _) = tabulate(&lut);
         for j in 0..h {
             for i in 0..w {
@@ -306,7 +306,6 @@ mod tests {
         }
         let m = verify(&lut, &values).unwrap();
         assert_eq!(m.error_map.len(), w * h * (d - 1));
-        let centre = |k: usize, count: usize| (k as f64 + 0.5) / count as f64;
         for k in 0..d - 1 {
             for j in 0..h {
                 for i in 0..w {
@@ -341,7 +340,7 @@ mod tests {
         use crate::family::ggx::integrals::{Inner, Shadowing, env_with};
         let text = super::super::spec::tests::SPEC.replace("[8, 4, 3]", "[6, 5, 4]\nlayout = \"filament\"");
         let lut = ConeLut::parse(Path::new("fits/ggx_c.toml"), &text).unwrap();
-        let (w, h, d) = (6usize, 5usize, 4usize);
+        let (w, h, d) = (lut.base.width, lut.base.height, lut.depth);
         let (values, _) = tabulate(&lut);
         let m = verify(&lut, &values).unwrap();
         let encode = |[s, b]: [f64; 2]| [b, s + b];
@@ -370,7 +369,7 @@ mod tests {
                 plane(k) * (1.0 - fz) + plane(k + 1) * fz
             })
         };
-        let centres = |count: usize| -> Vec<f64> { (0..count).map(|k| (k as f64 + 0.5) / count as f64).collect() };
+        let centres = |count: usize| -> Vec<f64> { (0..count).map(|k| centre(k, count)).collect() };
         let (us, ts, cs) = (centres(2 * w), centres(2 * h), centres(2 * (d - 1)));
         let err = |got: [f64; 2], want: [f64; 2]| (got[0] - want[0]).abs().max((got[1] - want[1]).abs());
         let (mut tex, mut inner, mut interp, mut ss, mut inner_points) = (0.0f64, 0.0f64, 0.0f64, 0.0, 0);
@@ -432,6 +431,11 @@ mod tests {
         assert_eq!(q.evals_per_texel, mean.round());
         assert!(slices.iter().all(|s| s.evals_per_texel != q.evals_per_texel), "{slices:?}");
         assert_eq!(q.tolerance, lut.base.tolerance);
+    }
+
+    /// The centre of cell k of `count` equal cells of [0, 1]: where the verification samples.
+    fn centre(k: usize, count: usize) -> f64 {
+        (k as f64 + 0.5) / count as f64
     }
 
     /// The (a, b, e) offsets of the points of one block, each in 0..n.
