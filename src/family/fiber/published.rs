@@ -126,6 +126,36 @@ mod tests {
         assert!(items[1].findings.iter().any(|f| f.contains(&format!("max {rel:.2e}"))));
     }
 
+    /// The shader-factor item measures the conservative W_c(k) = 1/M(k, 1) against W = 1/M(k,
+    /// u·t): its largest error, re-measured over the same grid with W_c in the module doc's
+    /// closed form m²/(2 (ln(1 + m) − m/(1 + m))), m = −k (1 at k = 0). Bound 5e-11: M's
+    /// integrator tolerance 1e-12 on M ≥ 0.3 moves 1/M by ≤ 1.2e-11; the closed form's
+    /// cancellation at m ≥ 0.01 (ln(1 + m) − m/(1 + m) ≈ m²/2 ≥ 5e-5) costs ≤ 1e-13 of W_c ≤ 3.3.
+    #[test]
+    fn the_shader_factor_item_measures_the_closed_form_conservative_w() {
+        let items = items(Path::new("/nonexistent"));
+        // Below |m| = 0.05 (the grid's last k is 1.1e-16, not 0) the series of ln(1 + m) −
+        // m/(1 + m) = Σ_{n ≥ 2} (−1)ⁿ (n − 1)/n mⁿ, to n = 21 (m¹⁹ < 1e-24).
+        let wc = |k: f64| {
+            let m = -k;
+            if m.abs() < 0.05 {
+                1.0 / (2.0 * (2..22).map(|n| (-m).powi(n - 2) * (n - 1) as f64 / n as f64).sum::<f64>())
+            } else {
+                m * m / (2.0 * ((1.0 + m).ln() - m / (1.0 + m)))
+            }
+        };
+        let (mut max, mut worst) = (0.0f64, vec![]);
+        for p in grid() {
+            let e = (wc(p[0]) - 1.0 / mean(p[0], p[1], TOL).value).abs();
+            if e > max {
+                (max, worst) = (e, p.clone());
+            }
+        }
+        assert!(max > 0.1, "the conservative factor loses most at spread 0, u ⟂ t: {max:e} at {worst:?}");
+        assert!((items[1].max_abs_error - max).abs() <= 5e-11, "item {} vs {max}", items[1].max_abs_error);
+        assert_eq!(items[1].worst_point, worst);
+    }
+
     #[test]
     fn conservative_r_never_gains_and_is_exact_at_parallel_light_and_k_zero() {
         // r_c·N ≤ 1 everywhere (N(k, c) ≤ N(k, 1)); = 1 at c = 1 and at k = 0. Bound: the

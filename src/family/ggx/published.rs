@@ -356,7 +356,7 @@ fn filament_item() -> Item {
     for j in 0..n {
         for (c, &i) in fm.cols.iter().enumerate() {
             for ch in 0..2 {
-                points.push(vec![fm.mu[c], (j as f64 + 0.5) / n as f64, ch as f64]);
+                points.push(vec![fm.mu[c], fm.grid.y[j], ch as f64]);
                 truth.push(fm.exact(c, j)[ch]);
                 approx.push(fm.table.f16s[j * n + i][ch]);
             }
@@ -592,8 +592,8 @@ pub fn figures(out: &Path, _generated: &Path) -> Result<Vec<PathBuf>, PlotError>
     }
     // Filament: the regenerated LUT's error at its own coordinates and as sampled.
     let fm = filament_measures();
-    let n = filament::SIZE;
-    let ys: Vec<f64> = (0..n).map(|j| (j as f64 + 0.5) / n as f64).collect();
+    // The heat maps' rows are the shader's roughness of each table row: the grid's first n rows.
+    let ys = &fm.grid.y[..filament::SIZE];
     let (b_own, e_own, b_s, e_s) = (fm.errors(0, true, true), fm.errors(1, true, true), fm.errors(0, true, false), fm.errors(1, true, false));
     let label = |what: &str, v: &[f64]| format!("{what}: max {:.2e}", v.iter().fold(0.0f64, |m, x| m.max(x.abs())));
     files.extend(crate::plot::grid_of_heatmaps(
@@ -602,7 +602,7 @@ pub fn figures(out: &Path, _generated: &Path) -> Result<Vec<PathBuf>, PlotError>
         "n·v",
         "roughness r (shader's v)",
         &fm.mu,
-        &ys,
+        ys,
         &[
             Panel { title: &label("bias, own roughness", &b_own), values: &b_own },
             Panel { title: &label("E, own roughness", &e_own), values: &e_own },
@@ -653,6 +653,7 @@ mod tests {
         for (c, k) in [(0, 0), (5, 40), (17, 127), (31, 128)] {
             let r = if k < n { (k as f64 + 0.5) / n as f64 } else { 1.0 };
             let want = filament::exact((fm.cols[c] as f64 + 0.5) / n as f64, r * r, 1e-10);
+            assert_eq!(fm.grid.y[k], r, "grid row {k}");
             let got = fm.exact(c, k);
             // The grid's tolerance 1e-7 against a direct integral at 1e-10.
             assert!((got[0] - want[0]).abs() < 2e-7 && (got[1] - want[1]).abs() < 2e-7, "({c}, {k}): {got:?} vs {want:?}");
