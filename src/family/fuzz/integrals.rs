@@ -1620,15 +1620,24 @@ mod tests {
     #[test]
     fn ps_directions_matches_ps() {
         // With the directions that coincide (θu = 0 at any φu; any φu at θf = 0), integrated
-        // once: every value has the bits of its own `ps`.
+        // once: every value has the bits of its own `ps`. The mirror images φu → −φu about the
+        // plane of n and the fiber (θf = 0.9 tilts the fiber towards φ = 0) share u·t but not
+        // η_u: each is integrated on its own, and they agree by the mirror symmetry of the
+        // layer, to the two estimates' tolerance.
         let mut dirs = fitting_directions(4, 5);
         dirs.extend((0..5).map(|j| (0.0, 0.7 * j as f64)));
         dirs.extend((0..5).map(|j| (0.4, 0.7 * j as f64)));
+        dirs.extend((1..5).map(|j| (0.4, -0.7 * j as f64)));
         for tf in [0.9, 0.0] {
             let batch = ps_directions(0.3, tf, &dirs, DEFAULT_TOL);
             for (&(tu, pu), b) in dirs.iter().zip(&batch) {
                 let one = ps(0.3, tf, tu, pu, DEFAULT_TOL);
-                assert_eq!((b.value.to_bits(), b.error.to_bits()), (one.value.to_bits(), one.error.to_bits()));
+                assert_eq!((b.value.to_bits(), b.error.to_bits()), (one.value.to_bits(), one.error.to_bits()), "θf {tf}, ({tu}, {pu})");
+            }
+            let n = dirs.len();
+            for j in 1..5 {
+                let (plus, minus) = (batch[n - 9 + j].value, batch[n - 5 + j].value);
+                assert!((plus - minus).abs() <= 2.0 * DEFAULT_TOL, "θf {tf}, φu ±{}: {plus} {minus}", 0.7 * j as f64);
             }
         }
         assert!(ps(0.0, 0.9, 0.1, 0.1, DEFAULT_TOL).value.is_nan());

@@ -453,6 +453,12 @@ mod tests {
         // f32 arithmetic of the interpolation at the GL nodes: a few ulps of f32.
         assert!((t.ms_integral - 1.0 / 3.0).abs() < 1e-6, "{}", t.ms_integral);
         assert_eq!(t.e, vec![1.0, 0.5]);
+        // The same E on two cells of n·v ∈ [1/4, 1] (nodes 1/4, 5/8, 1: E = 7/8, 11/16, 1/2, exact
+        // in f32), so each cell is weighed by its own width: 2∫_{1/4}^1 (μ/2)μ dμ = (1 − 1/64)/3.
+        let e = Table { values: vec![0.875, 0.875, 0.6875, 0.6875, 0.5, 0.5], counts: vec![2, 3], domain: vec![(0.0, 1.0), (0.25, 1.0)] };
+        let t = tabulated(&e, &avg, 0.5, &[0.25, 1.0]);
+        assert!((t.ms_integral - 63.0 / 192.0).abs() < 1e-6, "{}", t.ms_integral);
+        assert_eq!(t.e, vec![0.875, 0.5]);
     }
 
     #[test]

@@ -453,6 +453,39 @@ mod tests {
         assert_eq!(q.tolerance, lut.tolerance);
     }
 
+    /// Each cell of the error map is the largest texture error over its own texel footprint of
+    /// VERIFY_DENSITY² points. On a 2 × 2 LUT texel (i, j) is raised by P = 100·(1 + i + 2j);
+    /// the texture's error at (u, t) is then that raise read bilinearly, 100·(1 + x + 2y) with
+    /// x = clamp(2u − 0.5, 0, 1) and y = clamp(2t − 0.5, 0, 1) (linear between the texel
+    /// centres, clamped past them), plus the table's interpolation error (its values are in
+    /// [0, 1], so below 1). The raise grows with x and y: each cell's largest error is at its
+    /// footprint's last point on each axis. Tolerance 2: the table's error (< 1), f16 rounding
+    /// of values ≤ 401 (≤ 0.125) and the map's 3 significant digits (≤ 0.5 below 1000).
+    #[test]
+    fn each_error_map_cell_is_the_largest_error_of_its_own_footprint() {
+        let text = "name = \"ggx_t\"\nkind = \"ggx-dfg-lut\"\nquantity = \"ggx-env\"\nresolution = [2, 2]\n\n[emit]\nfunction = \"ggx_t\"\n";
+        let lut = DfgLut::parse(std::path::Path::new("fits/ggx_t.toml"), text).unwrap();
+        let (w, h, n) = (lut.width, lut.height, VERIFY_DENSITY);
+        let (mut values, _) = tabulate(&lut);
+        for j in 0..h {
+            for i in 0..w {
+                values[j * w + i] = values[j * w + i].map(|x| x + 100.0 * (1 + i + 2 * j) as f64);
+            }
+        }
+        let m = verify(&lut, &values).unwrap();
+        assert_eq!(m.error_map.len(), w * h);
+        // The last verification point of footprint i along an axis of `count` texels.
+        let last = |i: usize, count: usize| ((i * n + n - 1) as f64 + 0.5) / (n * count) as f64;
+        for j in 0..h {
+            for i in 0..w {
+                let (x, y) = ((2.0 * last(i, w) - 0.5).clamp(0.0, 1.0), (2.0 * last(j, h) - 0.5).clamp(0.0, 1.0));
+                let want = 100.0 * (1.0 + x + 2.0 * y);
+                let got = m.error_map[j * w + i];
+                assert!((got - want).abs() < 2.0, "cell (i {i}, j {j}): {got} against {want}; map {:?}", m.error_map);
+            }
+        }
+    }
+
     /// Bilinear filtering of texels that are linear in the texel index, f(i, j) = i + 10j (and
     /// 2i − j), returns the same linear function at the texel-space point (u·w − ½, t·h − ½),
     /// clamped to the edge texels outside their centres.
