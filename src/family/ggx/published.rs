@@ -263,8 +263,8 @@ fn materialx_item() -> Item {
     item.extra.push(("pr826_mean_abs_error".into(), umean));
     item.findings.push(format!(
         "Input α (GGX alpha, MaterialX clamps it to ≥ M_FLOAT_EPS; α = 0 here is the mirror limit). The published constants \
-         are PR #831's (commit 77ff72f35: rebuilt with MATLAB from a Monte Carlo estimate with height-correlated G2, printed \
-         to 4 significant figures); they replaced PR #826's of a week before (commit 53ee6847c: fitted to a Monte Carlo \
+         are PR #831's (commit 77ff72f35: rebuilt with MATLAB, beside a more precise mx_ggx_dir_albedo_monte_carlo with \
+         height-correlated G2, printed to 4 significant figures); they replaced PR #826's of a week before (commit 53ee6847c: fitted to a Monte Carlo \
          simulation with 16K samples per pixel, average error stated as 0.0012), which are a different fit, not these \
          unrounded. Mean |error| over both channels here: published {published_mean:.3e}; PR #826's {umean:.3e} \
          (max {um:.3e}, rms {urms:.3e})."
