@@ -1226,6 +1226,24 @@ mod tests {
         assert!(free_max <= max, "uncapped max {free_max} vs capped {max}");
     }
 
+    /// An rms cap no fit can meet, half least squares' rms (least squares is the smallest rms
+    /// of this shape, to its solver's convergence): the start does not qualify, nor does any
+    /// iterate, so minimax refuses with an error naming the cap instead of returning a fit
+    /// above it.
+    #[test]
+    fn fields_minimax_under_an_unreachable_rms_cap_is_an_error() {
+        let (x, data) = noisy();
+        let models: Vec<RationalModel> = OFFSETS.iter().map(|&o| field(o)).collect();
+        let lsq = fit_fields(&models, &x, &data, &FieldOptions::default(), "noisy").unwrap();
+        let cap = 0.5 * errors(&models, &lsq.coefficients, &x, &data).1;
+        let opts = FieldOptions { objective: Objective::Minimax, max_rms: Some(cap), ..FieldOptions::default() };
+        match fit_fields(&models, &x, &data, &opts, "noisy") {
+            Err(FitError::Solver { msg, .. }) => assert!(msg.contains(&format!("rms ≤ {cap:e}")), "{msg}"),
+            Ok(fit) => panic!("a fit returned with rms {:e} above the cap {cap:e}", fit.rms_error),
+            Err(e) => panic!("another error: {e:?}"),
+        }
+    }
+
     /// The minimax fit cannot be improved by a compass search on its max error (each
     /// coefficient moved ± a step, the step halved from 1e-2 to 1e-9 when no move helps): the
     /// search, started from the returned coefficients, lowers the max error by less than 3 %,
