@@ -249,6 +249,32 @@ pub fn eval_furnace(p: &[f64], tol: f64) -> Estimate {
 mod tests {
     use super::*;
 
+    /// bevy's old scheme at F0 = 1 is v = (A + B)/A, so the reported error must cover
+    /// |∂v/∂A| + |∂v/∂B| = B/A² + 1/A times the error of A and B (here both the env
+    /// integral's estimate). At grazing views of smooth surfaces B exceeds A three times over
+    /// (α = 0.02, n·v = 0.01) and the 1/A² sensitivity dominates: a bound through 1/min(E, …)
+    /// instead falls short there.
+    #[test]
+    fn bevy_olds_error_covers_its_one_over_a_sensitivity() {
+        let bevy = Scheme::ALL.iter().position(|&s| s == Scheme::BevyOld).unwrap() as f64;
+        let mut widest = 0.0f64;
+        for alpha in [0.02, 0.1, 0.5, 1.0] {
+            for mu in [0.01, 0.05, 0.5] {
+                let r = integrals::env(alpha, mu, 0.0, Shadowing::HeightCorrelated, 1e-8);
+                let (a, b) = (r.scale, r.bias);
+                assert!(r.error > 0.0, "({alpha}, {mu}): an error estimate to scale");
+                let est = eval_furnace(&[alpha, mu, 1.0, bevy], 1e-8);
+                // The value by hand, to rounding.
+                assert!((est.value - (a + b) / a).abs() <= 1e-12 * est.value, "({alpha}, {mu}): {} vs {}", est.value, (a + b) / a);
+                let need = (b / (a * a) + 1.0 / a) * r.error;
+                assert!(est.error >= need, "({alpha}, {mu}): error {:e} below the sensitivity's {need:e} (A {a}, B {b})", est.error);
+                widest = widest.max(b / a);
+            }
+        }
+        // Some point is in the regime that tells the bounds apart.
+        assert!(widest > 2.0, "largest B/A {widest}");
+    }
+
     /// Each scheme's name, id and source name the same work (its authors, renderer or the
     /// baseline), the ids are distinct lower-case file-name words, and `ALL` lists every
     /// scheme once, in the order of the `scheme` parameter: single, Kulla–Conty, Turquin,
