@@ -412,12 +412,17 @@ pub fn lut_built(
 mod tests {
     use super::*;
 
+    /// A DFG LUT spec `ggx_t` of the default quantity at `resolution` (n·v × rows).
+    fn spec_text([w, h]: [usize; 2]) -> String {
+        format!("name = \"ggx_t\"\nkind = \"ggx-dfg-lut\"\nquantity = \"ggx-env\"\nresolution = [{w}, {h}]\n\n[emit]\nfunction = \"ggx_t\"\n")
+    }
+
     /// The module doc names the function, the quantity, the G it integrates and the light cone.
     #[test]
     fn the_description_names_the_g_and_the_cone() {
-        let text = "name = \"ggx_t\"\nkind = \"ggx-dfg-lut\"\nquantity = \"ggx-env\"\nresolution = [10, 7]\n\n[emit]\nfunction = \"ggx_t\"\n";
+        let text = spec_text([10, 7]);
         let path = std::path::Path::new("fits/ggx_t.toml");
-        let hc = describe(&DfgLut::parse(path, text).unwrap());
+        let hc = describe(&DfgLut::parse(path, &text).unwrap());
         assert_eq!(hc, "`ggx_t` looks up the GGX split-sum environment BRDF (scale, bias) of quantity `ggx-env` (height-correlated Smith G2, Schlick Fc).");
         let ue4 = describe(&DfgLut::parse(path, &text.replace("ggx-env", "ggx-env-ue4")).unwrap());
         assert!(ue4.contains("`ggx-env-ue4` (UE4's separable Schlick–Smith G (k = α/2), Schlick Fc)"), "{ue4}");
@@ -431,8 +436,8 @@ mod tests {
     /// fewest and the most one texel took, and the error estimate is the largest one.
     #[test]
     fn tabulate_reports_the_texels_own_quadrature() {
-        let text = "name = \"ggx_t\"\nkind = \"ggx-dfg-lut\"\nquantity = \"ggx-env\"\nresolution = [4, 3]\n\n[emit]\nfunction = \"ggx_t\"\n";
-        let lut = DfgLut::parse(std::path::Path::new("fits/ggx_t.toml"), text).unwrap();
+        let text = spec_text([4, 3]);
+        let lut = DfgLut::parse(std::path::Path::new("fits/ggx_t.toml"), &text).unwrap();
         let (texels, q) = tabulate(&lut);
         let each: Vec<EnvEstimate> = (0..lut.height)
             .flat_map(|j| {
@@ -463,8 +468,8 @@ mod tests {
     /// of values ≤ 401 (≤ 0.125) and the map's 3 significant digits (≤ 0.5 below 1000).
     #[test]
     fn each_error_map_cell_is_the_largest_error_of_its_own_footprint() {
-        let text = "name = \"ggx_t\"\nkind = \"ggx-dfg-lut\"\nquantity = \"ggx-env\"\nresolution = [2, 2]\n\n[emit]\nfunction = \"ggx_t\"\n";
-        let lut = DfgLut::parse(std::path::Path::new("fits/ggx_t.toml"), text).unwrap();
+        let text = spec_text([2, 2]);
+        let lut = DfgLut::parse(std::path::Path::new("fits/ggx_t.toml"), &text).unwrap();
         let (w, h, n) = (lut.width, lut.height, VERIFY_DENSITY);
         let (mut values, _) = tabulate(&lut);
         for j in 0..h {
