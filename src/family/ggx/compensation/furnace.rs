@@ -484,8 +484,31 @@ mod tests {
     #[test]
     fn furnace_table_says_what_the_module_doc_does() {
         let generated = Path::new(env!("CARGO_MANIFEST_DIR")).join("generated");
-        let (rows, _, _) = rows(&generated);
+        let (rows, grid, _) = rows(&generated);
+        // Read through the committed tables, Turquin's and Cycles' albedos at F = 1 are both
+        // E·(1 + (1 − E_t)/E_t) = E/E_t (Cycles' f_ms is 1 at F_avg = 1), so their tables'
+        // deviation is max |E/E_t − 1| over the grid, E_t the emitted f32 lookup at (r², n·v).
+        // Relative rounding of a few operations on values ~1: 1e-12.
+        let e_t = Table::load(&generated, E_TABLE).expect("committed E table");
+        let mut want = 0.0f64;
+        for (j, &r) in grid.roughness.iter().enumerate() {
+            for (i, &m) in grid.mu.iter().enumerate() {
+                want = want.max((grid.at(j, i).e() / e_t.eval(&[r * r, m]) - 1.0).abs());
+            }
+        }
+        // The tables are a 32×32 bilinear interpolant of E: off it by more than the exact
+        // integrals' 1e-7 near the mirror limit, by far less than E itself.
+        assert!(want > 1e-6 && want < 0.5, "{want}");
         for r in &rows {
+            match r.scheme {
+                Scheme::Turquin | Scheme::Cycles => {
+                    let t = r.tables_f1_max_dev.expect("tables read");
+                    assert!((t - want).abs() <= 1e-12, "{:?}: {t} vs max |E/E_t − 1| = {want}", r.scheme);
+                }
+                // Kulla–Conty reads E, E_avg and the table's own integral: some deviation.
+                Scheme::KullaConty => assert!(r.tables_f1_max_dev.is_some_and(|t| t > 0.0 && t < 0.5), "{r:?}"),
+                Scheme::Single | Scheme::BevyOld | Scheme::FdezAguera => assert_eq!(r.tables_f1_max_dev, None),
+            }
             match r.scheme {
                 // Exact at F = 1 up to the inputs' tolerances (1e-9, 1e-8) through factors ≤ 1/E.
                 Scheme::KullaConty | Scheme::Turquin | Scheme::FdezAguera | Scheme::Cycles => {
