@@ -114,6 +114,32 @@ mod tests {
         }
     }
 
+    /// The energy item's loss figures, re-measured with M(k, 1) in closed form (the item goes
+    /// through r_c(k)·(1 − k²)): the largest loss is where the finding says, at k = −0.99 with
+    /// u ⟂ t, 1 − M(−0.99, 0)/M(−0.99, 1); the mean is the loss 1 − M(k, c)/M(k, 1) averaged
+    /// over the 100 × 65 points of the stated domain (k uniform on [−0.99, 0], c on [0, 1]), and
+    /// the finding prints both to hundredths of a percent. Bound 1e-11: M's tolerance 1e-12 on
+    /// M ≥ 0.3 moves each ratio by ≤ 3.4e-12, and the closed form's rounding is ~1e-15.
+    #[test]
+    fn the_energy_items_loss_figures_are_re_measured() {
+        let items = items(Path::new("/nonexistent"));
+        let extra = |name: &str| items[0].extra.iter().find(|e| e.0 == name).unwrap_or_else(|| panic!("{name}")).1;
+        let loss = |k: f64, c: f64| 1.0 - mean(k, c, TOL).value / mean_parallel(k);
+        let (max, mean_loss) = (extra("max_energy_loss"), extra("mean_energy_loss"));
+        assert!((max - loss(-0.99, 0.0)).abs() <= 1e-11, "max {max} vs {}", loss(-0.99, 0.0));
+        let mut sum = 0.0;
+        for i in 0..100 {
+            for j in 0..=64 {
+                sum += loss(-0.99 + 0.99 * i as f64 / 99.0, j as f64 / 64.0);
+            }
+        }
+        let want = sum / 6500.0;
+        assert!(want > 0.0 && (mean_loss - want).abs() <= 1e-11, "mean {mean_loss} vs {want}");
+        let text = items[0].findings.iter().find(|f| f.starts_with("Energy lost")).expect("finding");
+        assert!((number_after(text, "Energy lost: max ") / 100.0 - max).abs() <= 5e-5 + 1e-9, "{text}");
+        assert!((number_after(text, "u ⟂ t), mean ") / 100.0 - want).abs() <= 5e-5 + 1e-9, "{text}");
+    }
+
     /// The committed refit's energy error max |W̃/W − 1| and its absolute error max |W̃ − W|
     /// over the same points, with W ∈ [1, 3.28] (the item's domain): |W̃ − W| = |W̃/W − 1|·W,
     /// so the relative maximum lies between the absolute one over 3.28 and the absolute one.

@@ -918,6 +918,8 @@ mod tests {
             let extra = |k: &str| item.extra.iter().find(|(n, _)| n == k).unwrap_or_else(|| panic!("{key}: {k}")).1;
             let white = max_of(a.iter().zip(&refs).map(|(a, t)| (a - t[1]).abs()));
             assert!(close(extra("f0_1_max_abs_error"), white), "{key}: F = 1 max {}", extra("f0_1_max_abs_error"));
+            let white_rms = (a.iter().zip(&refs).map(|(a, t)| (a - t[1]) * (a - t[1])).sum::<f64>() / 6.0).sqrt();
+            assert!(close(extra("f0_1_rms_error"), white_rms), "{key}: F = 1 rms {} vs {white_rms}", extra("f0_1_rms_error"));
             let mean = err.iter().sum::<f64>() / 6.0;
             assert!(close(extra("mean_signed_error"), mean), "{key}: mean {}", extra("mean_signed_error"));
             let word = if mean < 0.0 { "over-occludes" } else { "under-occludes" };
@@ -951,6 +953,9 @@ mod tests {
             let e = max_of(read.iter().zip(&refs).map(|(s, t)| (F0 * s[0] + s[1] - (F0 * t[2] + t[3])).abs()));
             let extra = |k: &str| item.extra.iter().find(|(n, _)| n == k).unwrap().1;
             assert!((extra("occluded_specular_max_abs_error") - e).abs() <= 1e-15, "{}: {e}", r.name());
+            let sq: f64 = read.iter().zip(&refs).map(|(s, t)| (F0 * s[0] + s[1] - (F0 * t[2] + t[3])).powi(2)).sum();
+            let e_rms = (sq / pts.len() as f64).sqrt();
+            assert!((extra("occluded_specular_rms_error") - e_rms).abs() <= 1e-15, "{}: rms {e_rms}", r.name());
             assert_eq!(extra("scale_max_abs_error"), max_of(read.iter().zip(&refs).map(|(s, t)| (s[0] - t[2]).abs())));
             assert_eq!(extra("bias_max_abs_error"), max_of(read.iter().zip(&refs).map(|(s, t)| (s[1] - t[3]).abs())));
             let text = &item.findings[2];

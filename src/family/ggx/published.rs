@@ -995,6 +995,20 @@ mod tests {
         assert!((number_after(finding, "here: published ") - extra(mx, "mean_abs_error")).abs() <= 5e-4 * extra(mx, "mean_abs_error"), "{finding}");
         assert!((number_after(finding, "; PR #826's ") - extra(mx, "pr826_mean_abs_error")).abs() <= 5e-4 * extra(mx, "pr826_mean_abs_error"), "{finding}");
 
+        // Karis's constants measured against the height-correlated integral as well: that
+        // grid's max and rms over both channels.
+        let hc = grid::standard(Target::Roughness);
+        let karis = item("ggx-env-ue4: Karis");
+        let (hmax, hrms, _) = pair_errors(hc, |m, y| KARIS.eval(y, m));
+        assert_eq!(extra(karis, "height_correlated_max_abs_error"), hmax);
+        assert!((extra(karis, "height_correlated_rms_error") - hrms).abs() <= 1e-12 * hrms);
+        // bevy's compensation with A + B: Karis's A + B is 1 − 0.55 r, so against Turquin's 1/E
+        // its relative error is max |E/(1 − 0.55 r) − 1| over the grid's E = A + B. The a004
+        // terms cancel to a few ulps of values ~1, each ratio then moves by ~1e-15: 1e-12.
+        let sum = hc.points().zip(&hc.values).map(|((_, r), t)| ((t[0] + t[1]) / (1.0 - 0.55 * r) - 1.0).abs()).fold(0.0f64, f64::max);
+        let got = extra(item("ggx-env: bevy"), "compensation_1_over_a_plus_b_max_rel_error");
+        assert!(sum > 0.01 && (got - sum).abs() <= 1e-12, "1/(A + B): item {got}, re-measured {sum}");
+
         for (above, prefix) in [(true, "fresnel-avg-dielectric: Kulla–Conty fit, η ≥ 1"), (false, "fresnel-avg-dielectric: Kulla–Conty fit, η < 1")] {
             let it = item(prefix);
             let (eta, f) = grid::fresnel(above);

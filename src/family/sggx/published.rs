@@ -335,6 +335,20 @@ mod tests {
             // Not a degenerate sample: the three differ (power means of unequal values).
             assert!(mean < rms && rms < max, "{method}: {mean} {rms} {max}");
         }
+        // The linear filter's item: the most power iterations any footprint took, and on how
+        // many footprints it is at least as close as LEAN, counted here.
+        let a = items.iter().find(|i| i.name.contains("random footprints") && i.name.contains("(a)")).unwrap();
+        let iters = random.iter().map(|c| c.iterations).max().unwrap();
+        assert!(iters > 0);
+        assert_eq!(a.extra[1], ("max_power_iterations".to_string(), iters as f64));
+        let better = random.iter().filter(|c| c.linear.tv <= c.lean.tv).count();
+        assert_eq!(a.findings, [format!("the linear S filter is at least as close as LEAN on {better} of {} footprints", random.len())]);
+        // The course's artefact pair: its finding prints the 8-bit item's relative α_b error,
+        // re-measured here as the error over α_b, as a whole percent.
+        let listed = items.iter().find(|i| i.name.contains("8-bit encoding at α_t = 0.87, α_b = 0.04")).unwrap();
+        let rel = listed.max_abs_error / 0.04;
+        let f = listed.findings.iter().find(|f| f.starts_with("the course's artefact case")).unwrap();
+        assert!(rel > 0.2 && (crate::validate::number_after(f, "as much as ") - 100.0 * rel).abs() <= 0.5 + 1e-9, "{f}: {rel}");
     }
 
     #[test]
@@ -372,6 +386,9 @@ mod tests {
         // The worst ψ is at least as bad as ψ = 45° (up to the ψ grid's rounding of √Sxx).
         assert!(i8.max_abs_error >= (predicted - ab).abs() * 0.9, "{} vs {}", i8.max_abs_error, predicted - ab);
         assert!(i8.max_abs_error / ab > 0.2);
+        // The relative figure is the error over α_b (one division: 1e-15).
+        let rel = i8.extra.iter().find(|(k, _)| k == "max_relative_alpha_b_error").map(|e| e.1).unwrap();
+        assert!((rel * ab - i8.max_abs_error).abs() <= 1e-15, "{rel} × {ab} vs {}", i8.max_abs_error);
         // 16 bits: each step is 2^-16, α_b stays within 1%; 0.29/0.04 within 10% at 8 bits.
         let i16 = encoding_item(at, ab, 16);
         assert!(i16.max_abs_error / ab < 0.01);

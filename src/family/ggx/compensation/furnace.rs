@@ -429,6 +429,34 @@ mod tests {
         }
     }
 
+    /// At F0 = 1 Turquin's and Cycles' view factors are both 1/E (Cycles' f_ms is 1 there), so
+    /// a pair's asymmetry |1/E_o − 1/E_i|/max(1/E_o, 1/E_i) is |E_o − E_i|/max(E_o, E_i), and
+    /// the grid's largest is the widest row's (max E − min E)/max E, between that row's n·v of
+    /// least and greatest E. Rounding of a few operations on values ~1: 1e-12.
+    #[test]
+    fn scaling_schemes_asymmetry_is_the_relative_spread_of_e() {
+        let grid = Grid::exact(&[0.3, 0.8], &[0.05, 0.4, 1.0]);
+        let (mut want, mut at) = (0.0f64, [0.0; 3]);
+        for (j, &r) in grid.roughness.iter().enumerate() {
+            let e: Vec<f64> = (0..grid.mu.len()).map(|i| grid.at(j, i).e()).collect();
+            let (lo, hi) = (e.iter().copied().fold(f64::MAX, f64::min), e.iter().copied().fold(0.0, f64::max));
+            let spread = (hi - lo) / hi;
+            if spread > want {
+                let mu_of = |v: f64| grid.mu[e.iter().position(|&x| x == v).unwrap()];
+                (want, at) = (spread, [r, mu_of(lo), mu_of(hi)]);
+            }
+        }
+        // A rough surface's E varies with n·v by far more than rounding: the test has a point.
+        assert!(want > 0.01, "{want}");
+        for s in [Scheme::Turquin, Scheme::Cycles] {
+            let (a, p) = grid.asymmetry(s, 1.0).expect("not reciprocal");
+            assert!((a - want).abs() <= 1e-12, "{s:?}: {a} vs {want}");
+            // The worst pair is the row's least and greatest E, in either order.
+            assert!(p[0] == at[0] && ((p[1], p[2]) == (at[1], at[2]) || (p[1], p[2]) == (at[2], at[1])), "{s:?}: {p:?} vs {at:?}");
+        }
+        assert_eq!(grid.asymmetry(Scheme::KullaConty, 1.0), None);
+    }
+
     #[test]
     fn kc_quadrature_check_agrees_with_the_identity() {
         // Kulla–Conty at F = 1 is exactly 1 with the identity 2∫(1 − E)μ dμ = 1 − E_avg; with

@@ -192,12 +192,17 @@ fn committed_rows(v: &Value, spec: &str) -> Result<Vec<Row>, BuildError> {
         .collect()
 }
 
-/// The MaterialX refit's denominators (r.z, r.w) proven positive on the clamped domain.
+/// The MaterialX refit's denominators (r.z, r.w) proven positive on the clamped domain: the
+/// least of the two proven lower bounds. The model's denominators have the constant term 1, as
+/// the refit's (and the published form's) do; a form with another constant is refused.
 fn materialx_denominators_positive(m: &MaterialX) -> Result<f64, String> {
     let model = refit::materialx_model();
     let domain = [MATERIALX_N_DOT_V, (0.0, 1.0)];
     let mut lowest = f64::INFINITY;
     for ch in 2..4 {
+        if m.r[0][ch] != 1.0 {
+            return Err(format!("channel {ch}: constant term {} (the proof's model has 1)", m.r[0][ch]));
+        }
         // The model's coefficients: 9 numerator terms (unused here: r.x), then the 8
         // denominator terms after the constant r[0] = 1.
         let c: Vec<f64> = (0..9).map(|k| m.r[k][ch - 2]).chain((1..9).map(|k| m.r[k][ch])).collect();
@@ -490,6 +495,46 @@ mod tests {
     }
 
     const SPECIAL: [f32; 9] = [f32::NAN, -f32::NAN, f32::INFINITY, f32::NEG_INFINITY, f32::MAX, -1.0, -0.0, 1e-45, 2.0];
+
+    /// The proven lower bound of the emitted MaterialX refit's denominators (r.z and r.w of the
+    /// form, constant term 1) on its clamp box n·v ∈ [1/128, 125/128] × α ∈ [0, 1] is a lower
+    /// bound: positive and never above their least value on a 257 × 257 grid of the box, each
+    /// written out as Σ_k r[k][ch]·monomial_k. The same with r.w's x and x² terms set to −1.9
+    /// and 1 (1 − 1.9x + x² ≈ 0.0975 at x = 0.95, α = 0, where the α terms add 12.45α + 69.15α²):
+    /// the bound follows the coefficients down. With x's −3 (1 − 3x + x² = −0.25 at x = ½) and
+    /// with a constant term other than the model's 1, the form is refused, naming the channel.
+    #[test]
+    fn the_materialx_denominator_bound_is_below_the_sampled_minimum() {
+        let least = |m: &MaterialX| {
+            let (lo, hi) = MATERIALX_N_DOT_V;
+            let mut least = f64::INFINITY;
+            for i in 0..=256 {
+                for j in 0..=256 {
+                    let (x, y) = (lo + (hi - lo) * i as f64 / 256.0, j as f64 / 256.0);
+                    let t = [1.0, x, y, x * y, x * x, y * y, x * x * y, x * y * y, x * x * y * y];
+                    for ch in 2..4 {
+                        least = least.min((0..9).map(|k| m.r[k][ch] * t[k]).sum::<f64>());
+                    }
+                }
+            }
+            least
+        };
+        let m = emitted().materialx;
+        let lower = materialx_denominators_positive(&m).expect("proven positive");
+        assert!(lower > 0.0 && lower <= least(&m), "bound {lower}, sampled least {}", least(&m));
+        let mut low = m;
+        (low.r[1][3], low.r[4][3]) = (-1.9, 1.0);
+        let lower = materialx_denominators_positive(&low).expect("proven positive");
+        assert!(least(&low) < 0.1 && lower > 0.0 && lower <= least(&low), "bound {lower}, sampled least {}", least(&low));
+        let mut negative = low;
+        negative.r[1][3] = -3.0;
+        let err = materialx_denominators_positive(&negative).expect_err("r.w < 0 at x = ½");
+        assert!(err.starts_with("channel 3: interval bound "), "{err}");
+        let mut constant = m;
+        constant.r[0][2] = 2.0;
+        let err = materialx_denominators_positive(&constant).expect_err("constant term 2");
+        assert!(err.starts_with("channel 2: constant term 2 "), "{err}");
+    }
 
     #[test]
     fn emitted_rust_equals_the_committed_forms_in_f64() {
