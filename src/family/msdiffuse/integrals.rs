@@ -288,6 +288,33 @@ mod tests {
 
     const KEY: u64 = 0x5eed;
 
+    /// The sums' mean and standard error against the textbook ones of a small sample: 1, 2, 3,
+    /// 4 has mean 5/2, sample variance Σ(x − 5/2)²/3 = 5/3 and standard error sqrt(5/3/4) =
+    /// sqrt(5/12); merged from two halves, the same; scaled by −2, value −5 and error
+    /// 2·sqrt(5/12). One or no sample has no standard error (infinite). Exact sums of small
+    /// integers, then a few roundings: 1e-15.
+    #[test]
+    fn sums_give_the_sample_mean_and_its_standard_error() {
+        let mut all = Sums::default();
+        let (mut a, mut b) = (Sums::default(), Sums::default());
+        for (i, x) in [1.0, 2.0, 3.0, 4.0].into_iter().enumerate() {
+            all.add(x);
+            if i < 2 { a.add(x) } else { b.add(x) }
+        }
+        a.merge(&b);
+        for s in [all, a] {
+            assert_eq!((s.n, s.mean()), (4, 2.5));
+            assert!((s.se() - (5.0f64 / 12.0).sqrt()).abs() <= 1e-15, "{}", s.se());
+        }
+        let e = all.estimate(-2.0);
+        assert_eq!((e.value, e.evals), (-5.0, 4));
+        assert!((e.error - 2.0 * (5.0f64 / 12.0).sqrt()).abs() <= 1e-15, "{}", e.error);
+        let mut one = Sums::default();
+        one.add(3.0);
+        assert_eq!((one.mean(), one.se()), (3.0, f64::INFINITY));
+        assert_eq!((Sums::default().mean(), Sums::default().se()), (0.0, f64::INFINITY));
+    }
+
     /// The paths of `eval` at a tolerance, by hand: (1/tol)² rounded up, at least one chunk and
     /// at most 2^20 (a tolerance of 0, of 2^-10 or less, or NaN asks the most).
     #[test]
