@@ -90,7 +90,7 @@ pub fn items(generated: &Path) -> Vec<Item> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::validate::number_after;
+    use crate::validate::{extra, number_after};
 
     /// The energy finding's averages over lights, at k = −0.99 and −0.5: the loss 1 − M(k,
     /// c)/M(k, 1) averaged over c = u·t ∈ [0, 1] by 16-point Gauss–Legendre (32 points agree to
@@ -123,9 +123,8 @@ mod tests {
     #[test]
     fn the_energy_items_loss_figures_are_re_measured() {
         let items = items(Path::new("/nonexistent"));
-        let extra = |name: &str| items[0].extra.iter().find(|e| e.0 == name).unwrap_or_else(|| panic!("{name}")).1;
         let loss = |k: f64, c: f64| 1.0 - mean(k, c, TOL).value / mean_parallel(k);
-        let (max, mean_loss) = (extra("max_energy_loss"), extra("mean_energy_loss"));
+        let (max, mean_loss) = (extra(&items[0], "max_energy_loss"), extra(&items[0], "mean_energy_loss"));
         assert!((max - loss(-0.99, 0.0)).abs() <= 1e-11, "max {max} vs {}", loss(-0.99, 0.0));
         let mut sum = 0.0;
         for i in 0..100 {
@@ -146,8 +145,7 @@ mod tests {
     #[test]
     fn the_refits_energy_error_is_its_error_relative_to_w() {
         let items = items(Path::new("generated"));
-        let extra = |name: &str| items[1].extra.iter().find(|e| e.0 == name).unwrap_or_else(|| panic!("{name}")).1;
-        let (rel, abs) = (extra("refit_max_energy_error"), extra("refit_max_abs_error"));
+        let (rel, abs) = (extra(&items[1], "refit_max_energy_error"), extra(&items[1], "refit_max_abs_error"));
         assert!(abs > 0.0 && rel >= abs / 3.28 && rel <= abs, "relative {rel:e}, absolute {abs:e}");
         assert!(items[1].findings.iter().any(|f| f.contains(&format!("max {rel:.2e}"))));
     }

@@ -387,7 +387,7 @@ mod tests {
         assert!(i8.max_abs_error >= (predicted - ab).abs() * 0.9, "{} vs {}", i8.max_abs_error, predicted - ab);
         assert!(i8.max_abs_error / ab > 0.2);
         // The relative figure is the error over α_b (one division: 1e-15).
-        let rel = i8.extra.iter().find(|(k, _)| k == "max_relative_alpha_b_error").map(|e| e.1).unwrap();
+        let rel = crate::validate::extra(&i8, "max_relative_alpha_b_error");
         assert!((rel * ab - i8.max_abs_error).abs() <= 1e-15, "{rel} × {ab} vs {}", i8.max_abs_error);
         // 16 bits: each step is 2^-16, α_b stays within 1%; 0.29/0.04 within 10% at 8 bits.
         let i16 = encoding_item(at, ab, 16);

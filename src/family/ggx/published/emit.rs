@@ -499,7 +499,7 @@ mod tests {
     /// The proven lower bound of the emitted MaterialX refit's denominators (r.z and r.w of the
     /// form, constant term 1) on its clamp box n·v ∈ [1/128, 125/128] × α ∈ [0, 1] is a lower
     /// bound: positive and never above their least value on a 257 × 257 grid of the box, each
-    /// written out as Σ_k r[k][ch]·monomial_k. The same with r.w's x and x² terms set to −1.9
+    /// evaluated as Σ_k r[k][ch]·monomial_k (the form's monomials, not the proof's model). The same with r.w's x and x² terms set to −1.9
     /// and 1 (1 − 1.9x + x² ≈ 0.0975 at x = 0.95, α = 0, where the α terms add 12.45α + 69.15α²):
     /// the bound follows the coefficients down. With x's −3 (1 − 3x + x² = −0.25 at x = ½) and
     /// with a constant term other than the model's 1, the form is refused, naming the channel.
@@ -510,8 +510,7 @@ mod tests {
             let mut least = f64::INFINITY;
             for i in 0..=256 {
                 for j in 0..=256 {
-                    let (x, y) = (lo + (hi - lo) * i as f64 / 256.0, j as f64 / 256.0);
-                    let t = [1.0, x, y, x * y, x * x, y * y, x * x * y, x * y * y, x * x * y * y];
+                    let t = super::super::forms::materialx_monomials(lo + (hi - lo) * i as f64 / 256.0, j as f64 / 256.0);
                     for ch in 2..4 {
                         least = least.min((0..9).map(|k| m.r[k][ch] * t[k]).sum::<f64>());
                     }
