@@ -249,6 +249,26 @@ pub fn eval_furnace(p: &[f64], tol: f64) -> Estimate {
 mod tests {
     use super::*;
 
+    /// Kulla–Conty's F_ms as the series it sums: light that misses the single-scattering lobe
+    /// (share 1 − E_avg) meets the surface again, each bounce keeping F_avg of it, and leaves with
+    /// share E_avg: F_ms = (F_avg E_avg/(1 − E_avg)) Σ_{k≥1} (F_avg (1 − E_avg))^k, summed here to
+    /// 200 terms (the ratio is ≤ 0.81: the tail is below 1e-18, and 1e-12 bounds
+    /// it with the rounding). At F_avg = 1 it is 1, at E_avg = 1 it is F_avg², without Fresnel 0.
+    #[test]
+    fn kulla_contys_fresnel_factor_sums_the_bounces() {
+        for f in [0.04f64, 0.3, 0.9] {
+            for e in [0.1, 0.5, 0.95] {
+                let x = f * (1.0 - e);
+                let series: f64 = (1..=200).map(|k| x.powi(k)).sum::<f64>() * f * e / (1.0 - e);
+                assert!((kc_f_ms(f, e) - series).abs() < 1e-12, "F_avg {f}, E_avg {e}: {} vs {series}", kc_f_ms(f, e));
+            }
+            assert_eq!(kc_f_ms(f, 1.0), f * f);
+            // 1 − (1 − E_avg) gives E_avg back to half an ulp of 1: relative ε/(2 E_avg).
+            assert!((kc_f_ms(1.0, f) - 1.0).abs() < f64::EPSILON / f + 4.0 * f64::EPSILON, "E_avg {f}: {}", kc_f_ms(1.0, f));
+            assert_eq!(kc_f_ms(0.0, f), 0.0);
+        }
+    }
+
     /// bevy's old scheme at F0 = 1 is v = (A + B)/A, so the reported error must cover
     /// |∂v/∂A| + |∂v/∂B| = B/A² + 1/A times the error of A and B (here both the env
     /// integral's estimate). At grazing views of smooth surfaces B exceeds A three times over
