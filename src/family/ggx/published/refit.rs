@@ -214,6 +214,25 @@ pub const COMMITTED: Refits = Refits {
 mod tests {
     use super::*;
 
+    /// The restarted Nelder–Mead finds the minimum of a scaled quadratic bowl from a start
+    /// with a zero coordinate (whose simplex step is absolute) to 1e-6 (the simplex's spread
+    /// tolerance is 1e-15 in cost; 1e-12 in cost is 1e-6 in a coordinate of weight 1), and the
+    /// cost it returns is the function's at the point it returns. Started at the minimum it
+    /// stays there: a round keeps its result only when it improves on the best so far.
+    #[test]
+    fn nelder_mead_finds_a_bowls_minimum_and_never_returns_worse() {
+        let centre = [0.7, -1.3, 2.0];
+        let bowl = |p: &[f64]| (p[0] - centre[0]).powi(2) + 3.0 * (p[1] - centre[1]).powi(2) + 0.5 * (p[2] - centre[2]).powi(2);
+        let (x, cost) = nelder_mead(bowl, &[1.0, 0.0, 1.5]);
+        assert_eq!(cost, bowl(&x));
+        assert!(cost < 1e-12, "{cost:e} at {x:?}");
+        for (got, want) in x.iter().zip(centre) {
+            assert!((got - want).abs() < 2e-6, "{x:?}");
+        }
+        let (x, cost) = nelder_mead(bowl, &centre);
+        assert_eq!((x, cost), (centre.to_vec(), 0.0));
+    }
+
     /// Kulla–Conty's refit from the published constants: each branch's max error on its η
     /// grid, measured through the form (`KullaConty::eval`: (η − 1)/(a₀ + a₁η) for η ≥ 1,
     /// b₀ + b₁η + b₂η² + b₃η³ below), not through the solver's objective, is below the
