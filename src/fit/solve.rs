@@ -462,6 +462,20 @@ struct Watched<'a> {
     stalled: std::cell::Cell<Option<f64>>,
 }
 
+impl<'a> Watched<'a> {
+    /// A fresh watch over `inner`, its cap that of the LM run it watches.
+    fn new(inner: Residuals<'a>) -> Self {
+        Watched {
+            max_evals: LM_PATIENCE * (inner.theta.len() + 1),
+            inner,
+            evals: std::cell::Cell::new(0),
+            last: std::cell::Cell::new(f64::NAN),
+            history: std::cell::RefCell::new(Vec::new()),
+            stalled: std::cell::Cell::new(None),
+        }
+    }
+}
+
 impl LeastSquaresProblem<f64, Dyn, Dyn> for Watched<'_> {
     type ResidualStorage = Owned<f64, Dyn>;
     type JacobianStorage = Owned<f64, Dyn, Dyn>;
@@ -501,15 +515,7 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Watched<'_> {
 /// LM from `problem.theta` as [`least_squares`] does, watched for a [`Stall`]: (θ,
 /// evaluations, `Some(lower)` when stopped). Unstalled, the same bits as [`least_squares`].
 fn least_squares_watched(problem: &mut Residuals<'_>, what: &str) -> Result<(DVector<f64>, usize, Option<f64>), FitError> {
-    let watched = Watched {
-        inner: problem.clone(),
-        max_evals: LM_PATIENCE * (problem.theta.len() + 1),
-        evals: std::cell::Cell::new(0),
-        last: std::cell::Cell::new(f64::NAN),
-        history: std::cell::RefCell::new(Vec::new()),
-        stalled: std::cell::Cell::new(None),
-    };
-    let (w, report) = lm_solver().minimize(watched);
+    let (w, report) = lm_solver().minimize(Watched::new(problem.clone()));
     let theta = finite_lm_result(w.inner.theta.clone(), &report, what)?;
     problem.theta.copy_from(&theta);
     Ok((theta, report.number_of_evaluations, w.stalled.get()))
@@ -740,6 +746,33 @@ mod tests {
         // threshold is δ < 2e-7 (SHARE·rss·200/1000).
         assert_eq!(step(vec![(100, 1.0 + 1.9e-7)]), (true, Some(0.1), 1));
         assert_eq!(step(vec![(100, 1.0 + 2.1e-7)]), (false, None, 2));
+    }
+
+    /// The watch's cap is the LM run's own: an unwatched run that ends for lack of patience
+    /// (levenberg-marquardt's `LostPatience`, after exactly patience · (n + 1) evaluations)
+    /// has taken as many evaluations as `Watched::new` allows it, so the evaluations "left"
+    /// in the stall rule are those the run really has. The unit step of the test above, whose
+    /// crawling starts include ones that run out of patience.
+    #[test]
+    fn the_watchs_cap_is_the_lm_runs_own() {
+        let x: Vec<Vec<f64>> = (0..200).map(|i| vec![i as f64 / 199.0]).collect();
+        let data = Data { y: x.iter().map(|p| if p[0] < 0.3 { 0.0 } else { 1.0 }).collect(), x };
+        let mut out_of_patience = 0;
+        for (m, n) in [(2, 3), (3, 3)] {
+            let model = RationalModel::rational_1d("x", m, n);
+            for start in linearised_starts(&model, &data, "step").unwrap() {
+                let problem = Residuals::new(&model, &data, start);
+                let cap = Watched::new(problem.clone()).max_evals;
+                let (_, report) = lm_solver().minimize(problem);
+                if matches!(report.termination, levenberg_marquardt::TerminationReason::LostPatience) {
+                    assert_eq!(report.number_of_evaluations, cap, "[{m}/{n}]");
+                    out_of_patience += 1;
+                } else {
+                    assert!(report.number_of_evaluations < cap, "[{m}/{n}]: {:?}", report.termination);
+                }
+            }
+        }
+        assert!(out_of_patience >= 1, "no start ran out of patience: the test does not measure the cap");
     }
 
     use crate::fit::model::{ModelParts, Term};
