@@ -866,6 +866,11 @@ mod tests {
              SamplerState m_keep_binding_1_ : register(s1, space0);\n\
              float4 f(Texture2D<float4> a, SamplerState s) { return a.SampleLevel(s, float2(0.0, 0.0), 0.0); }\n"
         );
+        // Only an index buffer, named both nagaGroup… and …SamplerIndexArray, goes: unread
+        // buffers that have one half of that name stay as they were.
+        let halves = "StructuredBuffer<uint> nagaGroup0Counts : register(t1, space0);\n\
+                      StructuredBuffer<uint> userSamplerIndexArray : register(t2, space0);\n";
+        assert_eq!(hlsl_sampler_registers(&format!("{naga_hlsl}{halves}")), format!("{out}{halves}"));
         // A heap still read elsewhere keeps its declaration.
         let shared = format!("{naga_hlsl}SamplerState g() {{ return nagaSamplerHeap[0]; }}\n");
         let out = hlsl_sampler_registers(&shared);

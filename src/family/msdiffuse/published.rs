@@ -433,6 +433,19 @@ mod tests {
     use super::*;
     use crate::validate::{extra, number_after};
 
+    /// A committed term as its doc reads it: "alpha*n_dot_h^2" → [(0, 1), (1, 2)] over the
+    /// argument names, "1" → none; a name not among the arguments, or an exponent that is not
+    /// an integer, leaves the term unread (None).
+    #[test]
+    fn terms_parse_into_argument_indices_and_powers() {
+        let names: Vec<String> = ["alpha", "n_dot_h", "l_dot_h"].map(String::from).to_vec();
+        assert_eq!(parse_term("alpha*n_dot_h^2", &names), Some(vec![(0, 1), (1, 2)]));
+        assert_eq!(parse_term("l_dot_h^3*alpha", &names), Some(vec![(2, 3), (0, 1)]));
+        assert_eq!(parse_term("1", &names), Some(vec![]));
+        assert_eq!(parse_term("gloss*alpha", &names), None);
+        assert_eq!(parse_term("alpha^x", &names), None);
+    }
+
     /// The shipped hand fit at g = 0.5, l·h = 1, n·l = 0.5, n·v = 0.8, n·h = 0.64, by hand from
     /// the talk's formula: f0 = 1; f1 = (1 − 0.75/32)(1 − 0.75·0.2⁵) = 0.9765625·0.99976 =
     /// 0.976328125; t = 0.6, f_d = 1 − 0.6·0.023671875 = 0.985796875; f_b = 3.625·2^(−15.4·0.8)
