@@ -1266,14 +1266,22 @@ mod tests {
     use super::*;
 
     /// G at subnormal d (or μv) takes its limit with a bound instead of quadrature nodes that
-    /// would need 1/d: G ≤ d/μv, so at d = 1e-310 the value is 0 within that bound; at μv =
-    /// 1e-310 with d = 0.5, G → 1.
+    /// would need 1/d: G ≤ d/μv, so at d = 1e-310 the value is 0 within that bound, with μv
+    /// = 0.5 and with μv = 1e-300 (where d/μv = 1e-10 is still far below 1); at μv = c =
+    /// 1e-310 with d = 0.5, G → 1, and the error stated must cover 1 − G, which is at least
+    /// ∫ (1 − μ/(μ + μv)) dμ = c ln((1 + c)/c) ≈ 7.1e-308 (the integrand's second factor alone;
+    /// 1 − 1e-9 for the rounding of a subnormal c, 5e-14 relative).
     #[test]
     fn g_at_subnormal_arguments_is_its_limit() {
-        let e = g(1e-310, 0.5, 1e-9);
-        assert!(e.value == 0.0 && e.error <= 1e-310 / 0.5 * (1.0 + 1e-12) && e.error > 0.0, "{e:?}");
-        let e = g(0.5, 1e-310, 1e-9);
-        assert!(e.value.is_finite() && (e.value - 1.0).abs() <= e.error.max(1e-9), "{e:?}");
+        for mu_v in [0.5, 1e-300] {
+            let e = g(1e-310, mu_v, 1e-9);
+            assert!(e.value == 0.0 && e.error <= 1e-310 / mu_v * (1.0 + 1e-12) && e.error > 0.0, "μv {mu_v:e}: {e:?}");
+        }
+        let c = 1e-310f64;
+        let e = g(0.5, c, 1e-9);
+        let least = c * ((1.0 + c).ln() - c.ln());
+        assert!(least > 7e-308, "{least:e}");
+        assert!(e.value == 1.0 && e.error >= least * (1.0 - 1e-9) && e.error <= 1.0, "{e:?}, 1 − G ≥ {least:e}");
     }
 
     /// `graded_unit_integral` against closed forms: ∫₀¹ cos μ dμ = sin 1 with the cuts given
