@@ -339,6 +339,46 @@ mod tests {
         }
     }
 
+    /// Each texel of a level is the mean of its own footprint of the level below (module doc:
+    /// 2, the 2×2 children; 4, those and one texel around them, edges clamped): a 4 × 4
+    /// texture whose sixteen lobes all differ (tilt, azimuth and roughness by texel), filtered
+    /// to 2 × 2, against the box means formed here texel by texel and taken through the same
+    /// extraction and encoding (judged by their own tests). 8-bit codes, within one: the sums
+    /// may round apart in their last bit and move a code that sits on a boundary.
+    #[test]
+    fn each_texel_is_the_mean_of_its_own_footprint() {
+        let (w, h) = (4usize, 4usize);
+        let s0: Vec<M3> = (0..w * h)
+            .map(|k| {
+                let (x, y) = ((k % w) as f64, (k / w) as f64);
+                let a = Aniso::from_alphas(0.2 + 0.1 * y, 0.1 + 0.05 * x, 0.3 * x + 0.2 * y);
+                sggx_from(direction(0.1 + 0.15 * x + 0.05 * y, 0.4 * y + 1.3 * x), a)
+            })
+            .collect();
+        for (footprint, offsets) in [(2usize, vec![0isize, 1]), (4, vec![-1, 0, 1, 2])] {
+            let (normal, aniso, _) = mip_chain(w as u32, h as u32, s0.clone(), 8, footprint, &|_| {});
+            let level = |bytes: &[u8]| ktx2::Reader::new(bytes).unwrap().levels().nth(1).unwrap().data.to_vec();
+            let (ln, la) = (level(&normal), level(&aniso));
+            for (k, (x, y)) in [(0isize, 0isize), (1, 0), (0, 1), (1, 1)].into_iter().enumerate() {
+                let mut sum = M3::zeros();
+                for dy in &offsets {
+                    for dx in &offsets {
+                        let (sx, sy) = ((2 * x + dx).clamp(0, w as isize - 1), (2 * y + dy).clamp(0, h as isize - 1));
+                        sum += s0[sy as usize * w + sx as usize];
+                    }
+                }
+                let e = extract(&(sum / (offsets.len() * offsets.len()) as f64));
+                let t = encode(e.aniso);
+                let want_n = [0.5 * e.n.x + 0.5, 0.5 * e.n.y + 0.5].map(|v| (v * 255.0).round() as i32);
+                let want_a = [t[0], t[1], t[2], 1.0].map(|v| (v * 255.0).round() as i32);
+                let got_n = &ln[2 * k..2 * k + 2];
+                let got_a = &la[4 * k..4 * k + 4];
+                let near = |got: &[u8], want: &[i32]| got.iter().zip(want).all(|(&g, &w)| (g as i32 - w).abs() <= 1);
+                assert!(near(got_n, &want_n) && near(got_a, &want_a), "footprint {footprint}, texel ({x}, {y}): {got_n:?} {got_a:?} vs {want_n:?} {want_a:?}");
+            }
+        }
+    }
+
     #[test]
     fn two_tilted_texels_filter_to_the_mixture_s_normal() {
         // A 2×1 texture of normals at ±30° about z (isotropic α = 0.3): its 1×1 level has the
