@@ -668,6 +668,13 @@ mod tests {
         assert!(["'l2'", "lsq", "minimax", "l4"].iter().all(|w| e.contains(w)), "{e}");
     }
 
+    /// A unit step at x = 0.3 sampled at 200 points of [0, 1]: some linearised starts of a
+    /// rational fitted to it crawl.
+    fn unit_step() -> Data {
+        let x: Vec<Vec<f64>> = (0..200).map(|i| vec![i as f64 / 199.0]).collect();
+        Data { y: x.iter().map(|p| if p[0] < 0.3 { 0.0 } else { 1.0 }).collect(), x }
+    }
+
     /// Starts stopped for stalling change nothing: the chosen fit is bit for bit the one of
     /// running every start in full. A unit step at x = 0.3 by a 2/3 and a 3/3 rational: some of
     /// the linearised starts crawl and are stopped. A stopped start is run again in full unless
@@ -677,8 +684,7 @@ mod tests {
     /// (~0.26–0.29) are under the chosen rss (~1.02), so those starts must have been rerun.
     #[test]
     fn stalled_starts_do_not_change_the_choice() {
-        let x: Vec<Vec<f64>> = (0..200).map(|i| vec![i as f64 / 199.0]).collect();
-        let data = Data { y: x.iter().map(|p| if p[0] < 0.3 { 0.0 } else { 1.0 }).collect(), x };
+        let data = unit_step();
         let lsq = FitOptions::default();
         let (mut left_seen, mut rerun_seen) = (0, 0);
         for (m, n) in [(2, 3), (3, 3)] {
@@ -755,8 +761,7 @@ mod tests {
     /// crawling starts include ones that run out of patience.
     #[test]
     fn the_watchs_cap_is_the_lm_runs_own() {
-        let x: Vec<Vec<f64>> = (0..200).map(|i| vec![i as f64 / 199.0]).collect();
-        let data = Data { y: x.iter().map(|p| if p[0] < 0.3 { 0.0 } else { 1.0 }).collect(), x };
+        let data = unit_step();
         let mut out_of_patience = 0;
         for (m, n) in [(2, 3), (3, 3)] {
             let model = RationalModel::rational_1d("x", m, n);

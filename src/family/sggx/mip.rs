@@ -316,6 +316,14 @@ mod tests {
         assert_eq!(count(sggx_from(direction(0.6, 0.3), Aniso::isotropic(0.9999))), (1, 1, POWER_MAX_ITER, 1, 0));
     }
 
+    /// The 8-bit codes of a texel with normal n and block a, as the two maps store them:
+    /// (n.x, n.y)/2 + ½ and [encode(a), 1], each v → round(255 v).
+    fn codes8(n: V3, a: Aniso) -> ([u8; 2], [u8; 4]) {
+        let t = encode(a);
+        let code = |v: f64| (v * 255.0).round() as u8;
+        ([0.5 * n.x + 0.5, 0.5 * n.y + 0.5].map(code), [t[0], t[1], t[2], 1.0].map(code))
+    }
+
     #[test]
     fn a_uniform_texture_keeps_its_texel_at_every_level() {
         // Every level's S is the mean of equal matrices, so every texel is the input's to the
@@ -327,9 +335,7 @@ mod tests {
         for footprint in [2, 4] {
             let (normal, aniso, r) = mip_chain(5, 3, vec![s; 15], 8, footprint, &|_| {});
             assert_eq!((r.levels, r.texels, r.not_converged, r.clamped), (3, 15 + 2 + 1, 0, 0));
-            let want_n = [0.5 * n.x + 0.5, 0.5 * n.y + 0.5].map(|v| (v * 255.0).round() as u8);
-            let t = encode(a);
-            let want_a = [t[0], t[1], t[2], 1.0].map(|v| (v * 255.0).round() as u8);
+            let (want_n, want_a) = codes8(n, a);
             let rn = ktx2::Reader::new(&normal[..]).unwrap();
             let ra = ktx2::Reader::new(&aniso[..]).unwrap();
             for (ln, la) in rn.levels().zip(ra.levels()) {
@@ -368,12 +374,10 @@ mod tests {
                     }
                 }
                 let e = extract(&(sum / (offsets.len() * offsets.len()) as f64));
-                let t = encode(e.aniso);
-                let want_n = [0.5 * e.n.x + 0.5, 0.5 * e.n.y + 0.5].map(|v| (v * 255.0).round() as i32);
-                let want_a = [t[0], t[1], t[2], 1.0].map(|v| (v * 255.0).round() as i32);
+                let (want_n, want_a) = codes8(e.n, e.aniso);
                 let got_n = &ln[2 * k..2 * k + 2];
                 let got_a = &la[4 * k..4 * k + 4];
-                let near = |got: &[u8], want: &[i32]| got.iter().zip(want).all(|(&g, &w)| (g as i32 - w).abs() <= 1);
+                let near = |got: &[u8], want: &[u8]| got.iter().zip(want).all(|(&g, &w)| g.abs_diff(w) <= 1);
                 assert!(near(got_n, &want_n) && near(got_a, &want_a), "footprint {footprint}, texel ({x}, {y}): {got_n:?} {got_a:?} vs {want_n:?} {want_a:?}");
             }
         }
