@@ -1247,18 +1247,41 @@ mod tests {
         }
     }
 
-    /// A fixed numerator coefficient of data far from one (values ~2⁻⁵⁰) holds in the data's
-    /// units: the scaled problem fixes it divided by the same power of two as the data, so the
-    /// fit of an exact rational reports the fixed value and recovers the others.
+    /// A fixed numerator coefficient of data far from one (values 2⁻⁹⁰ and 2⁸⁰, past the 2^±64
+    /// that is fitted unscaled) holds in the data's units: the scaled problem fixes it divided
+    /// by the same power of two as the data, so the fit of an exact rational reports the fixed
+    /// value and recovers the others.
     #[test]
     fn fixed_coefficients_far_from_one_hold_in_the_datas_units() {
-        let ys = 2f64.powi(-50);
-        let model = RationalModel::new(ModelParts { fixed: vec![(0, 0.2 * ys)], ..parts_1d(&["1", "x"], &["x"]) }).unwrap();
-        let x: Vec<Vec<f64>> = (0..=40).map(|i| vec![i as f64 / 20.0]).collect();
-        let data = Data { y: x.iter().map(|p| ys * (0.2 + 1.5 * p[0]) / (1.0 + 0.5 * p[0])).collect(), x };
-        let f = fit_rescaled(&model, &data, &FitOptions::default(), "fixed").unwrap();
-        assert_eq!(f.coefficients[0], 0.2 * ys, "the fixed coefficient, exactly");
-        // Exact data: the free coefficients to rounding (relative 1e-9 of their units).
-        assert!((f.coefficients[1] - 1.5 * ys).abs() < 1e-9 * ys && (f.coefficients[2] - 0.5).abs() < 1e-9, "{:?}", f.coefficients);
+        for ys in [2f64.powi(-90), 2f64.powi(80)] {
+            let model = RationalModel::new(ModelParts { fixed: vec![(0, 0.2 * ys)], ..parts_1d(&["1", "x"], &["x"]) }).unwrap();
+            let x: Vec<Vec<f64>> = (0..=40).map(|i| vec![i as f64 / 20.0]).collect();
+            let data = Data { y: x.iter().map(|p| ys * (0.2 + 1.5 * p[0]) / (1.0 + 0.5 * p[0])).collect(), x };
+            let f = fit_rescaled(&model, &data, &FitOptions::default(), "fixed").unwrap();
+            assert_eq!(f.coefficients[0], 0.2 * ys, "the fixed coefficient, exactly");
+            // Exact data: the free coefficients to rounding (relative 1e-9 of their units).
+            assert!((f.coefficients[1] - 1.5 * ys).abs() < 1e-9 * ys && (f.coefficients[2] - 0.5).abs() < 1e-9, "{:?}", f.coefficients);
+        }
+    }
+
+    /// A clamp of data far from one (2⁻⁹⁰ and 2⁸⁰) is in the data's units: the scaled problem
+    /// clamps at the clamp divided by the data's power of two. y = clamp(P/Q, 0.25, 1)·2^k with
+    /// P/Q = (0.2 + 1.5x)/(1 + 0.5x) below the clamp at x = 0 and above it past x = 0.8, and
+    /// P's constant fixed, recovers P/Q. A clamp left in the data's units would be empty, or take
+    /// the clamped samples for P/Q.
+    #[test]
+    fn a_clamp_far_from_one_holds_in_the_datas_units() {
+        for ys in [2f64.powi(-90), 2f64.powi(80)] {
+            let parts = ModelParts { fixed: vec![(0, 0.2 * ys)], clamp: Some((0.25 * ys, ys)), ..parts_1d(&["1", "x"], &["x"]) };
+            let model = RationalModel::new(parts).unwrap();
+            let x: Vec<Vec<f64>> = (0..=40).map(|i| vec![i as f64 / 20.0]).collect();
+            let data = Data { y: x.iter().map(|p| ys * ((0.2 + 1.5 * p[0]) / (1.0 + 0.5 * p[0])).clamp(0.25, 1.0)).collect(), x };
+            assert_eq!(data.y[0], 0.25 * ys, "the first sample is at the lower clamp");
+            assert!(data.y.iter().filter(|&&y| y == ys).count() > 10, "part of the samples is at the upper clamp");
+            let f = fit_rescaled(&model, &data, &FitOptions::default(), "clamped").unwrap();
+            assert_eq!(f.coefficients[0], 0.2 * ys, "the fixed coefficient, exactly");
+            // Exact data on the rows inside the clamp: rounding level (relative 1e-9 of the units).
+            assert!((f.coefficients[1] - 1.5 * ys).abs() < 1e-9 * ys && (f.coefficients[2] - 0.5).abs() < 1e-9, "{:?}", f.coefficients);
+        }
     }
 }

@@ -1465,6 +1465,36 @@ mod tests {
         assert!(t[0] > 0.0, "{t:?}");
     }
 
+    /// The parameter set's methods are P_s and R at its own (α, θf), bit for bit: α ≠ θf, so
+    /// the two swapped would differ (here α = 1.2 is outside P_s's domain altogether).
+    #[test]
+    fn fuzz_params_evaluate_at_their_own_alpha_and_theta_f() {
+        let p = FuzzParams::new(0.5, 1.2);
+        let same = |a: &Estimate, b: &Estimate| (a.value.to_bits(), a.error.to_bits()) == (b.value.to_bits(), b.error.to_bits());
+        let one = ps(0.5, 1.2, 0.7, 0.4, 1e-6);
+        assert!(one.value > 0.0 && same(&p.ps(0.7, 0.4, 1e-6), &one), "{one:?}");
+        let dirs = [(0.7, 0.4), (1.1, 2.0)];
+        let many = p.ps_directions(&dirs, 1e-6);
+        assert_eq!(many.len(), 2);
+        for (e, &(tu, pu)) in many.iter().zip(&dirs) {
+            assert!(same(e, &ps(0.5, 1.2, tu, pu, 1e-6)), "{e:?} at ({tu}, {pu})");
+        }
+        let rr = r(0.5, 1.2, 1e-6);
+        assert!(rr.value > 0.0 && same(&p.r(1e-6), &rr), "{rr:?}");
+    }
+
+    /// `n` values from `lo` to `hi`: none, the start alone, or both ends and equal steps.
+    #[test]
+    fn linspace_gives_its_ends_and_equal_steps() {
+        assert!(linspace(0.2, 0.8, 0).is_empty());
+        assert_eq!(linspace(0.2, 0.8, 1), [0.2]);
+        let v = linspace(0.2, 0.8, 4);
+        // (hi − lo)·i/3 rounds once or twice: a few ulps of 1.
+        for (a, b) in v.iter().zip([0.2, 0.4, 0.6, 0.8]) {
+            assert!((a - b).abs() < 1e-15, "{v:?}");
+        }
+    }
+
     /// Factor on P_s's error estimate where it serves as a tolerance: the estimate is the
     /// panels' |K21 − G10| summed, and near grazing, where a cone breakpoint u·t = ±sin θf
     /// approaches the horizon, it was measured ~5x below the true error (tests/stress.rs,
@@ -1879,9 +1909,10 @@ mod tests {
         assert!(close(e3(1.0), 0.109_691_967_197_760_13), "{}", e3(1.0));
         assert_eq!(e3(0.0), 0.5);
         assert!(expn(1, 0.0).is_nan() && expn(3, -1.0).is_nan());
-        // Recurrence n E_{n+1}(x) = e^{−x} − x E_n(x), across the series/fraction switch at 1.
+        // Recurrence n E_{n+1}(x) = e^{−x} − x E_n(x), across the series/fraction switch at 1;
+        // at n = 0 it is E₀(x) = e^{−x}/x, the integral ∫₁^∞ e^{−xt} dt in closed form.
         for &x in &[1e-8, 0.01, 0.3, 0.999, 1.0, 1.001, 2.5, 10.0, 50.0] {
-            for n in 1..5u32 {
+            for n in 0..5u32 {
                 let lhs = n as f64 * expn(n + 1, x);
                 let rhs = (-x).exp() - x * expn(n, x);
                 assert!((lhs - rhs).abs() <= 1e-14 * lhs.abs().max((-x).exp()), "n={n} x={x}");

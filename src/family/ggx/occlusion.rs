@@ -794,6 +794,16 @@ mod tests {
         // cone of half-angle π/2 when θv + α_s ≤ π/2); no visibility, none.
         assert!((jimenez(0.9, 1.0, 0.3) - 1.0).abs() < 1e-12);
         assert_eq!(jimenez(0.5, 0.0, 0.5), 0.0);
+        // A mirror (r = 0, cos α_s = 2^0 = 1: no specular cone) keeps its one direction when it
+        // lies in the visibility cone, θv ≤ θc = acos sqrt(1 − V), and none when it does not:
+        // θv = 60° against θc = 90° (V = 1) and 71.6° (V = 0.9), then against θc = 18.4°
+        // (V = 0.1) and 0° (V = 0).
+        for v in [1.0, 0.9] {
+            assert_eq!(jimenez(0.5, v, 0.0), 1.0, "V = {v}");
+        }
+        for v in [0.1, 0.0] {
+            assert_eq!(jimenez(0.5, v, 0.0), 0.0, "V = {v}");
+        }
     }
 
     /// `outside_inside` and `rms_error` by hand: the mirror direction is outside the cone when

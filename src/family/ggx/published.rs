@@ -1030,4 +1030,55 @@ mod tests {
             }
         }
     }
+
+    /// The quick forms of E(n·v, α) and of each split-sum channel: eight rows each, in the
+    /// bench's order, sorted by cost with a front, and tables better at 32² than at 16². The
+    /// published Karis and MaterialX rows are their f64 errors against the integral on the quick
+    /// grid (33 × 33, [`Ctx::pick`]), re-measured here against E and [scale, bias] integrated to
+    /// 1e-10 by [`crate::family::ggx::integrals`]. They agree to the rows' reference tolerance (the spec's,
+    /// 1e-7 or tighter) plus this one.
+    #[test]
+    fn the_published_closed_forms_rows_are_their_errors_on_the_integral() {
+        use crate::family::ggx::integrals::{albedo, env, Shadowing};
+        let ctx = crate::bench::forms::testing::ctx(true, crate::family::catalog());
+        type Forms = fn(&Ctx) -> Result<Vec<FormRow>, BenchError>;
+        let sets: [(&str, Forms, &str, Option<usize>); 3] = [
+            ("ggx-albedo", albedo_forms, "ggx_albedo_rational", None),
+            ("ggx-env[scale]", scale_forms, "ggx_env_scale_rational", Some(0)),
+            ("ggx-env[bias]", bias_forms, "ggx_env_bias_rational", Some(1)),
+        ];
+        for (quantity, forms, spec, channel) in sets {
+            let rows = forms(&ctx).unwrap();
+            let names: Vec<&str> = rows.iter().map(|r| r.form.as_str()).collect();
+            assert_eq!(names.len(), 8, "{quantity}: {names:?}");
+            for want in [PUBLISHED, "Karis refit", "MaterialX", "MaterialX refit", "table 16²", "table 32²"] {
+                assert!(names.contains(&want), "{quantity}: no {want} in {names:?}");
+            }
+            let mut marked = rows.clone();
+            crate::bench::forms::mark_pareto(&mut marked);
+            marked.sort_by_key(|r| r.cost);
+            crate::bench::forms::testing::every_quantity_has_three_forms_sorted_by_cost_with_a_front(&marked, &[quantity]);
+            crate::bench::forms::testing::table_error_decreases_with_resolution(&rows, &[quantity]);
+            let spec = ctx.spec(spec).unwrap();
+            let points = pipeline::grid(&spec, &[33, 33]);
+            let truth = |alpha: f64, mu: f64| match channel {
+                None => albedo(alpha, mu, 1e-10).value,
+                Some(c) => {
+                    let e = env(alpha, mu, 0.0, Shadowing::HeightCorrelated, 1e-10);
+                    [e.scale, e.bias][c]
+                }
+            };
+            let pick = |v: [f64; 2]| channel.map_or(v[0] + v[1], |c| v[c]);
+            let published: [(&str, Box<dyn Fn(f64, f64) -> f64>); 2] = [
+                (PUBLISHED, Box::new(|mu: f64, a: f64| pick(KARIS.eval(a.sqrt(), mu)))),
+                ("MaterialX", Box::new(|mu: f64, a: f64| pick(MATERIALX.eval(mu, a)))),
+            ];
+            for (form, f) in published {
+                let max = points.iter().map(|p| (f(p[1], p[0]) - truth(p[0], p[1])).abs()).fold(0.0, f64::max);
+                let row = rows.iter().find(|r| r.form == form).unwrap();
+                assert_eq!(row.points, points.len(), "{quantity} {form}");
+                assert!((row.max_error - max).abs() <= spec.file.tolerance + 1e-10, "{quantity} {form}: {} vs {max}", row.max_error);
+            }
+        }
+    }
 }
