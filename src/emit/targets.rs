@@ -875,6 +875,11 @@ mod tests {
         let shared = format!("{naga_hlsl}SamplerState g() {{ return nagaSamplerHeap[0]; }}\n");
         let out = hlsl_sampler_registers(&shared);
         assert!(out.contains("SamplerState nagaSamplerHeap[2048]") && !out.contains("nagaComparisonSamplerHeap"));
+        // A comparison sampler is read from its own heap and bound the same way, with its type.
+        let compare = "SamplerComparisonState nagaComparisonSamplerHeap[2048]: register(s0, space1);\n\
+                       StructuredBuffer<uint> nagaGroup1SamplerIndexArray : register(t1, space255);\n\
+                       static const SamplerComparisonState m_shadow = nagaComparisonSamplerHeap[nagaGroup1SamplerIndexArray[3]];\n";
+        assert_eq!(hlsl_sampler_registers(compare), "SamplerComparisonState m_shadow : register(s3, space1);\n");
     }
 
     /// The WGSL of each argument type the keep entry point can make a value of is the type

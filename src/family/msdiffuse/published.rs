@@ -436,6 +436,17 @@ mod tests {
     /// A committed term as its doc reads it: "alpha*n_dot_h^2" → [(0, 1), (1, 2)] over the
     /// argument names, "1" → none; a name not among the arguments, or an exponent that is not
     /// an integer, leaves the term unread (None).
+    /// Without the committed slices the validation is one item that says which file to build,
+    /// measured on no points.
+    #[test]
+    fn without_the_committed_slices_the_item_names_the_missing_file() {
+        let items = items(Path::new("no-such-folder"));
+        assert_eq!(items.len(), 1);
+        let it = &items[0];
+        assert_eq!((it.name.as_str(), it.points), ("ms-diffuse slices", 0));
+        assert_eq!(it.findings, ["generated/json/ms_diffuse_slices.json is missing or unreadable: run `shadefit build --only ms_diffuse_slices`."]);
+    }
+
     #[test]
     fn terms_parse_into_argument_indices_and_powers() {
         let names: Vec<String> = ["alpha", "n_dot_h", "l_dot_h"].map(String::from).to_vec();

@@ -1091,6 +1091,18 @@ mod tests {
         assert!((tent_p.linear(x)[0] - exact).abs() < 1e-14);
     }
 
+    /// A tabulated profile is linear between its knots (|r|: radial), its last value at the last
+    /// knot itself and 0 past it (R is 0 outside the measured radius).
+    #[test]
+    fn a_tabulated_profile_is_linear_between_knots_and_zero_past_the_last() {
+        let p = Profile::Tabulated { radius_mm: vec![0.0, 1.0, 2.0], value: vec![[3.0, 6.0, 1.5], [2.0, 4.0, 1.0], [1.0, 2.0, 0.5]] };
+        // Halfway: (3 + 2)/2 and the like, exact in binary.
+        assert_eq!(p.radial(0.5), [2.5, 5.0, 1.25]);
+        assert_eq!(p.radial(-1.5), [1.5, 3.0, 0.75]);
+        assert_eq!(p.radial(2.0), [1.0, 2.0, 0.5]);
+        assert_eq!(p.radial(2.0 + 1e-12), [0.0; 3]);
+    }
+
     #[test]
     fn tabulated_normalisation_is_exact() {
         // ∫ c(1 − r/a) 2πr dr = πca²/3; piecewise-linear data integrate exactly (rounding only).
