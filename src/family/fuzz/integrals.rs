@@ -1909,6 +1909,10 @@ mod tests {
         assert!(close(e3(1.0), 0.109_691_967_197_760_13), "{}", e3(1.0));
         assert_eq!(e3(0.0), 0.5);
         assert!(expn(1, 0.0).is_nan() && expn(3, -1.0).is_nan());
+        // NaN outside the domain for every n, also where the formulas would give a number: E₀'s
+        // closed form e^{−x}/x at x = −1, and E₁₀'s series at x = −1e-3, which converges before
+        // its ln x term; NaN in, NaN out.
+        assert!(expn(0, -1.0).is_nan() && expn(10, -1e-3).is_nan() && expn(2, f64::NAN).is_nan());
         // Recurrence n E_{n+1}(x) = e^{−x} − x E_n(x), across the series/fraction switch at 1;
         // at n = 0 it is E₀(x) = e^{−x}/x, the integral ∫₁^∞ e^{−xt} dt in closed form.
         for &x in &[1e-8, 0.01, 0.3, 0.999, 1.0, 1.001, 2.5, 10.0, 50.0] {

@@ -1031,12 +1031,12 @@ mod tests {
         }
     }
 
-    /// The quick forms of E(n·v, α) and of each split-sum channel: eight rows each, in the
-    /// bench's order, sorted by cost with a front, and tables better at 32² than at 16². The
-    /// published Karis and MaterialX rows are their f64 errors against the integral on the quick
-    /// grid (33 × 33, [`Ctx::pick`]), re-measured here against E and [scale, bias] integrated to
-    /// 1e-10 by [`crate::family::ggx::integrals`]. They agree to the rows' reference tolerance (the spec's,
-    /// 1e-7 or tighter) plus this one.
+    /// The quick forms of E(n·v, α) and of each split-sum channel: eight rows each (the published
+    /// forms and their refits among them), sorted by cost with a front, and tables better at 32²
+    /// than at 16². The published Karis and MaterialX rows are their f64 errors against the
+    /// integral on the quick grid (33 × 33, [`Ctx::pick`]), re-measured here against E and
+    /// [scale, bias] integrated to 1e-10 by [`crate::family::ggx::integrals`]. They agree to the
+    /// rows' reference tolerance (the spec's) plus this one.
     #[test]
     fn the_published_closed_forms_rows_are_their_errors_on_the_integral() {
         use crate::family::ggx::integrals::{albedo, env, Shadowing};
