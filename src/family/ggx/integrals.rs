@@ -628,6 +628,17 @@ mod tests {
 
     const HC: Shadowing = Shadowing::HeightCorrelated;
 
+    /// E_avg's evaluation count is its outer rule's and every inner E's: at least one 21-point
+    /// Kronrod panel outside, and at each of its nodes (all inside (0, 1), where the smoothstep's
+    /// Jacobian is not 0) an E of at least one 21-point panel of its own: 21 + 21·21.
+    #[test]
+    fn albedo_avgs_evaluations_count_its_inner_integrals() {
+        let e = albedo(0.5, 0.5, 1e-4);
+        assert!(e.evals >= 21, "{e:?}");
+        let avg = albedo_avg(0.5, 1e-4);
+        assert!(avg.evals >= 21 + 21 * 21, "{avg:?}");
+    }
+
     /// The GGX CDF variable: ξ of a half-vector angle θ is sin²θ/(sin²θ + α² cos²θ), and
     /// `half_angle` maps ξ back to (sin²θ, cos²θ) with tan²θ = α² ξ/(1 − ξ), the GGX NDF's
     /// cumulative distribution in cos²θ (Walter et al. 2007, Eq. 35 solved for ξ). Round trips

@@ -617,6 +617,26 @@ mod tests {
         }
     }
 
+    /// `is_spd` is Sylvester's criterion on a matrix symmetric to 1e-12 of its largest entry:
+    /// an off-diagonal pair apart by 1e-13 of the scale passes and by 1e-10 fails, at scales 1e6
+    /// and 1e-6 alike; a negative first, second or third leading minor fails.
+    #[test]
+    fn is_spd_is_sylvesters_criterion_with_a_relative_symmetry_tolerance() {
+        for scale in [1e6, 1e-6] {
+            let with = |apart: f64| M3::new(1.0, 0.0, 0.0, apart, 2.0, 0.0, 0.0, 0.0, 3.0) * scale;
+            assert!(is_spd(&with(0.0)) && is_spd(&with(1e-13)), "scale {scale}");
+            assert!(!is_spd(&with(1e-10)), "scale {scale}");
+        }
+        let minors = [
+            M3::new(-1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0),
+            M3::new(1.0, 2.0, 0.0, 2.0, 1.0, 0.0, 0.0, 0.0, 1.0),
+            M3::new(1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, -1.0),
+        ];
+        for m in minors {
+            assert!(!is_spd(&m), "{m}");
+        }
+    }
+
     #[test]
     fn filtering_keeps_spd_and_a_texel_filtered_with_itself_is_unchanged() {
         // Self-filter: S′ = S, so n′ is n to the power iteration's residual (1e-14 / (1 − λ₂/λ₁),
