@@ -745,10 +745,11 @@ pub(super) mod tests {
         }
         let json = &one.artifacts.iter().find(|a| a.path.ends_with("json/msd_t.json")).unwrap().contents;
         let v: serde_json::Value = serde_json::from_slice(json).unwrap();
-        // A cell is the ms-diffuse estimate at its point (same key, cell and paths: same bits).
+        // A cell is the ms-diffuse estimate at its point (same key, cell and paths: same bits);
+        // the key is the spec's name (the module doc).
         let c = 5u64; // layer 0, row 1, column 1
         let (l, vv) = directions(t.theta_h(1), t.theta_d(1), t.phi_d).unwrap();
-        let e = brdf(&surface(0.0, TALK_F0, Specular::Gone), l, vv, Order::All, t.key(), c, 1024, true);
+        let e = brdf(&surface(0.0, TALK_F0, Specular::Gone), l, vv, Order::All, key_of("msd_t"), c, 1024, true);
         let cell = &v["slices"][c as usize];
         assert_eq!((cell[0].as_f64().unwrap(), cell[1].as_f64().unwrap()), (e.value, e.error));
         let dir = tempfile::tempdir().unwrap();
