@@ -1247,6 +1247,26 @@ mod tests {
         }
     }
 
+    /// y = (0.2 + 1.5x)/(1 + 0.5x)·ys on 41 points of [0, 2], clamped to `clamp`·ys when given,
+    /// fitted by [`fit_rescaled`] with P's constant fixed at 0.2·ys (and the clamp in the data's
+    /// units): the data, and the fit checked to hold the fixed coefficient exactly and recover
+    /// the free ones to rounding (exact data on the rows inside any clamp: relative 1e-9 of
+    /// their units).
+    fn fit_the_fixed_rational(ys: f64, clamp: Option<(f64, f64)>) -> Data {
+        let parts = ModelParts { fixed: vec![(0, 0.2 * ys)], clamp: clamp.map(|(a, b)| (a * ys, b * ys)), ..parts_1d(&["1", "x"], &["x"]) };
+        let model = RationalModel::new(parts).unwrap();
+        let x: Vec<Vec<f64>> = (0..=40).map(|i| vec![i as f64 / 20.0]).collect();
+        let y = |x: f64| {
+            let v = (0.2 + 1.5 * x) / (1.0 + 0.5 * x);
+            ys * clamp.map_or(v, |(a, b)| v.clamp(a, b))
+        };
+        let data = Data { y: x.iter().map(|p| y(p[0])).collect(), x };
+        let f = fit_rescaled(&model, &data, &FitOptions::default(), "fixed").unwrap();
+        assert_eq!(f.coefficients[0], 0.2 * ys, "the fixed coefficient, exactly");
+        assert!((f.coefficients[1] - 1.5 * ys).abs() < 1e-9 * ys && (f.coefficients[2] - 0.5).abs() < 1e-9, "{:?}", f.coefficients);
+        data
+    }
+
     /// A fixed numerator coefficient of data far from one (values 2⁻⁹⁰ and 2⁸⁰, past the 2^±64
     /// that is fitted unscaled) holds in the data's units: the scaled problem fixes it divided
     /// by the same power of two as the data, so the fit of an exact rational reports the fixed
@@ -1254,13 +1274,7 @@ mod tests {
     #[test]
     fn fixed_coefficients_far_from_one_hold_in_the_datas_units() {
         for ys in [2f64.powi(-90), 2f64.powi(80)] {
-            let model = RationalModel::new(ModelParts { fixed: vec![(0, 0.2 * ys)], ..parts_1d(&["1", "x"], &["x"]) }).unwrap();
-            let x: Vec<Vec<f64>> = (0..=40).map(|i| vec![i as f64 / 20.0]).collect();
-            let data = Data { y: x.iter().map(|p| ys * (0.2 + 1.5 * p[0]) / (1.0 + 0.5 * p[0])).collect(), x };
-            let f = fit_rescaled(&model, &data, &FitOptions::default(), "fixed").unwrap();
-            assert_eq!(f.coefficients[0], 0.2 * ys, "the fixed coefficient, exactly");
-            // Exact data: the free coefficients to rounding (relative 1e-9 of their units).
-            assert!((f.coefficients[1] - 1.5 * ys).abs() < 1e-9 * ys && (f.coefficients[2] - 0.5).abs() < 1e-9, "{:?}", f.coefficients);
+            fit_the_fixed_rational(ys, None);
         }
     }
 
@@ -1272,16 +1286,9 @@ mod tests {
     #[test]
     fn a_clamp_far_from_one_holds_in_the_datas_units() {
         for ys in [2f64.powi(-90), 2f64.powi(80)] {
-            let parts = ModelParts { fixed: vec![(0, 0.2 * ys)], clamp: Some((0.25 * ys, ys)), ..parts_1d(&["1", "x"], &["x"]) };
-            let model = RationalModel::new(parts).unwrap();
-            let x: Vec<Vec<f64>> = (0..=40).map(|i| vec![i as f64 / 20.0]).collect();
-            let data = Data { y: x.iter().map(|p| ys * ((0.2 + 1.5 * p[0]) / (1.0 + 0.5 * p[0])).clamp(0.25, 1.0)).collect(), x };
+            let data = fit_the_fixed_rational(ys, Some((0.25, 1.0)));
             assert_eq!(data.y[0], 0.25 * ys, "the first sample is at the lower clamp");
             assert!(data.y.iter().filter(|&&y| y == ys).count() > 10, "part of the samples is at the upper clamp");
-            let f = fit_rescaled(&model, &data, &FitOptions::default(), "clamped").unwrap();
-            assert_eq!(f.coefficients[0], 0.2 * ys, "the fixed coefficient, exactly");
-            // Exact data on the rows inside the clamp: rounding level (relative 1e-9 of the units).
-            assert!((f.coefficients[1] - 1.5 * ys).abs() < 1e-9 * ys && (f.coefficients[2] - 0.5).abs() < 1e-9, "{:?}", f.coefficients);
         }
     }
 }

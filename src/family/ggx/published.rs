@@ -1039,42 +1039,41 @@ mod tests {
     /// rows' reference tolerance (the spec's) plus this one.
     #[test]
     fn the_published_closed_forms_rows_are_their_errors_on_the_integral() {
+        use crate::bench::forms::testing;
         use crate::family::ggx::integrals::{albedo, env, Shadowing};
-        let ctx = crate::bench::forms::testing::ctx(true, crate::family::catalog());
-        type Forms = fn(&Ctx) -> Result<Vec<FormRow>, BenchError>;
-        let sets: [(&str, Forms, &str, Option<usize>); 3] = [
-            ("ggx-albedo", albedo_forms, "ggx_albedo_rational", None),
-            ("ggx-env[scale]", scale_forms, "ggx_env_scale_rational", Some(0)),
-            ("ggx-env[bias]", bias_forms, "ggx_env_bias_rational", Some(1)),
-        ];
-        for (quantity, forms, spec, channel) in sets {
-            let rows = forms(&ctx).unwrap();
+        let catalog = crate::family::catalog();
+        let ctx = testing::ctx(true, catalog);
+        // FORMS' sets in order: E, then the scale and bias channels.
+        let sets = [("ggx_albedo_rational", None), ("ggx_env_scale_rational", Some(0)), ("ggx_env_bias_rational", Some(1))];
+        for (set, (spec, channel)) in FORMS.iter().zip(sets) {
+            let quantity = set.quantity;
+            let rows = testing::quick(std::slice::from_ref(set), catalog);
             let names: Vec<&str> = rows.iter().map(|r| r.form.as_str()).collect();
             assert_eq!(names.len(), 8, "{quantity}: {names:?}");
             for want in [PUBLISHED, "Karis refit", "MaterialX", "MaterialX refit", "table 16²", "table 32²"] {
                 assert!(names.contains(&want), "{quantity}: no {want} in {names:?}");
             }
-            let mut marked = rows.clone();
-            crate::bench::forms::mark_pareto(&mut marked);
-            marked.sort_by_key(|r| r.cost);
-            crate::bench::forms::testing::every_quantity_has_three_forms_sorted_by_cost_with_a_front(&marked, &[quantity]);
-            crate::bench::forms::testing::table_error_decreases_with_resolution(&rows, &[quantity]);
+            testing::every_quantity_has_three_forms_sorted_by_cost_with_a_front(&rows, &[quantity]);
+            testing::table_error_decreases_with_resolution(&rows, &[quantity]);
             let spec = ctx.spec(spec).unwrap();
             let points = pipeline::grid(&spec, &[33, 33]);
-            let truth = |alpha: f64, mu: f64| match channel {
-                None => albedo(alpha, mu, 1e-10).value,
-                Some(c) => {
-                    let e = env(alpha, mu, 0.0, Shadowing::HeightCorrelated, 1e-10);
-                    [e.scale, e.bias][c]
-                }
-            };
+            let truth: Vec<f64> = points
+                .iter()
+                .map(|p| match channel {
+                    None => albedo(p[0], p[1], 1e-10).value,
+                    Some(c) => {
+                        let e = env(p[0], p[1], 0.0, Shadowing::HeightCorrelated, 1e-10);
+                        [e.scale, e.bias][c]
+                    }
+                })
+                .collect();
             let pick = |v: [f64; 2]| channel.map_or(v[0] + v[1], |c| v[c]);
             let published: [(&str, Box<dyn Fn(f64, f64) -> f64>); 2] = [
                 (PUBLISHED, Box::new(|mu: f64, a: f64| pick(KARIS.eval(a.sqrt(), mu)))),
                 ("MaterialX", Box::new(|mu: f64, a: f64| pick(MATERIALX.eval(mu, a)))),
             ];
             for (form, f) in published {
-                let max = points.iter().map(|p| (f(p[1], p[0]) - truth(p[0], p[1])).abs()).fold(0.0, f64::max);
+                let max = points.iter().zip(&truth).map(|(p, t)| (f(p[1], p[0]) - t).abs()).fold(0.0, f64::max);
                 let row = rows.iter().find(|r| r.form == form).unwrap();
                 assert_eq!(row.points, points.len(), "{quantity} {form}");
                 assert!((row.max_error - max).abs() <= spec.file.tolerance + 1e-10, "{quantity} {form}: {} vs {max}", row.max_error);

@@ -433,9 +433,6 @@ mod tests {
     use super::*;
     use crate::validate::{extra, number_after};
 
-    /// A committed term as its doc reads it: "alpha*n_dot_h^2" → [(0, 1), (1, 2)] over the
-    /// argument names, "1" → none; a name not among the arguments, or an exponent that is not
-    /// an integer, leaves the term unread (None).
     /// Without the committed slices the validation is one item that says which file to build,
     /// measured on no points.
     #[test]
@@ -447,6 +444,9 @@ mod tests {
         assert_eq!(it.findings, ["generated/json/ms_diffuse_slices.json is missing or unreadable: run `shadefit build --only ms_diffuse_slices`."]);
     }
 
+    /// A committed term as its doc reads it: "alpha*n_dot_h^2" → [(0, 1), (1, 2)] over the
+    /// argument names, "1" → none; a name not among the arguments, or an exponent that is not
+    /// an integer, leaves the term unread (None).
     #[test]
     fn terms_parse_into_argument_indices_and_powers() {
         let names: Vec<String> = ["alpha", "n_dot_h", "l_dot_h"].map(String::from).to_vec();
