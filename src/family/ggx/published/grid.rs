@@ -137,3 +137,67 @@ pub fn fresnel(above: bool) -> &'static (Vec<f64>, Vec<f64>) {
         (eta, f)
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The Fresnel-average grids are the ones the doc states, and their F_avg is each η's own:
+    /// η ≥ 1 is 513 points 1 + i/256 (exact in binary), η < 1 is 1/3 + (2/3)·i/513, the
+    /// reciprocal range [1/3, 1) without its end. The values are judged by physics, not by
+    /// the integrator: F_avg(1) = 0 (no interface), F_avg rises with |ln η| on both sides,
+    /// and the two grids' ends η = 3 and 1/3 are one interface seen from both sides, where
+    /// reciprocity (radiance scales with η²) gives 1 − F_avg(1/η) = (1 − F_avg(η))/η².
+    #[test]
+    fn fresnel_grids_are_their_stated_etas_with_reciprocal_ends() {
+        let (ea, fa) = fresnel(true);
+        let (eb, fb) = fresnel(false);
+        assert_eq!((ea.len(), fa.len(), eb.len(), fb.len()), (513, 513, 513, 513));
+        for i in 0..513 {
+            assert_eq!(ea[i], 1.0 + i as f64 / 256.0, "η ≥ 1, point {i}");
+            // A few roundings of values ≤ 1: 4e-16.
+            let want = 1.0 / 3.0 + 2.0 / 3.0 * i as f64 / 513.0;
+            assert!((eb[i] - want).abs() <= 4e-16, "η < 1, point {i}: {} vs {want}", eb[i]);
+        }
+        // Each F_avg is integrated to 1e-12 (the grid's tolerance): at η = 1 it is 0 to that.
+        assert!(fa[0].abs() <= 1e-12, "F_avg(1) = {}", fa[0]);
+        assert!(fa.windows(2).all(|w| w[1] > w[0]), "F_avg rises with η above 1");
+        assert!(fb.windows(2).all(|w| w[1] < w[0]), "F_avg falls as η rises to 1 from below");
+        // Both values carry 1e-12; (1 − F)/9 then 1.1e-13: 3e-12 bounds the difference.
+        let (inside, outside) = (1.0 - fb[0], (1.0 - fa[512]) / 9.0);
+        assert!((inside - outside).abs() <= 3e-12, "1 − F_avg(1/3) = {inside}, (1 − F_avg(3))/9 = {outside}");
+    }
+
+    /// Each target's labels say what its integral does: the axis names the coordinate whose
+    /// map to α it uses (α = r² for roughness, α itself, Black Ops II's gloss map), and the
+    /// description names the G its [scale, bias] is integrated with (the separable
+    /// Schlick–Smith only for UE4's target; both integrals are the crate's own, compared here
+    /// only to tell which one `env` took).
+    #[test]
+    fn target_labels_name_their_coordinate_and_shadowing() {
+        let (alpha, mu, y) = (0.3, 0.6, 0.5);
+        let hc = integrals::env(alpha, mu, 0.0, Shadowing::HeightCorrelated, 1e-9);
+        let sep = integrals::env(alpha, mu, 0.0, Shadowing::Separable { k: 0.15 }, 1e-9);
+        assert!((hc.scale - sep.scale).abs() > 1e-3, "the two G must differ here to tell them apart");
+        for target in [Target::RoughnessUe4, Target::Roughness, Target::Gloss, Target::Alpha] {
+            let e = env(target, alpha, mu, 1e-9);
+            let separable = e == [sep.scale, sep.bias];
+            assert!(separable || e == [hc.scale, hc.bias], "{target:?}: neither G");
+            let label = target.integral();
+            assert_eq!(label.contains("separable Schlick–Smith"), separable, "{target:?}: {label}");
+            assert_eq!(label.contains("height-correlated"), !separable, "{target:?}: {label}");
+            // The α map each axis name stands for, and the phrase the description gives it.
+            let axis = target.axis_name();
+            let (want, phrase) = match axis {
+                "roughness r" => (y * y, "α = r²"),
+                "alpha" => (y, "α as given"),
+                // α = sqrt(2/(8192^g + 2)) (Lazarov 2013, Black Ops II).
+                "gloss g" => ((2.0 / (8192f64.powf(y) + 2.0)).sqrt(), "α = sqrt(2/(8192^g + 2))"),
+                other => panic!("{target:?}: axis {other:?}"),
+            };
+            // powf and sqrt round: a few ulps of values ≤ 1.
+            assert!((target.alpha(y) - want).abs() <= 1e-15, "{target:?}: α({y}) = {} for axis {axis}", target.alpha(y));
+            assert!(label.contains(phrase), "{target:?}: {label}");
+        }
+    }
+}
