@@ -368,7 +368,8 @@ fn code<'a>(lut: &'a SkinLut, name: &'a str, layout: Layout, values: &'a [[f32; 
     }
 }
 
-/// Preview scale: at least 256 pixels across; SH rows 16 times taller than wide.
+/// Preview scale: each texel a block of whole pixels, as many as fit in 256 across (at least
+/// one); SH rows 16 times taller than wide.
 fn preview_scale(layout: Layout) -> (usize, usize) {
     let (w, _) = layout.size();
     let s = (256 / w).max(1);
@@ -536,6 +537,47 @@ mod tests {
         // Not a vacuous comparison: interpolation on these coarse grids errs by far more than
         // the bounds above, and halving the claim would be visible.
         assert!(max64 > 100.0 * bound32, "{max64:e}");
+
+        // The JSON's other figures, re-measured from its texels: their range, the f16 storage
+        // error (the spec's default format, rounded here by the `half` crate), the curvature
+        // axis (κ at t = j/(n − 1) of the spec's mapping), and each texel's quadrature estimate
+        // within the spec's tolerance.
+        let all = texels.iter().flat_map(|t| t.iter().copied());
+        let (lo, hi) = all.clone().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(x), b.max(x)));
+        assert_eq!((v["range"][0].as_f64().unwrap(), v["range"][1].as_f64().unwrap()), (lo, hi));
+        assert_eq!(v["texture"]["format"], "rgba16float");
+        let storage = all.map(|x| (half::f16::from_f64(x as f32 as f64).to_f64() - x).abs()).fold(0.0f64, f64::max);
+        // f32 → f16 and f64 → f16 of an f32 agree (f16 values are exact in f32): exact.
+        assert_eq!(v["texture"]["max_abs_storage_error"].as_f64().unwrap(), storage);
+        assert!(storage > 0.0, "f16 rounds some texel");
+        let axis = v["axes"].as_array().unwrap().iter().find(|a| a["name"] == "curvature").unwrap();
+        let kappas: Vec<f64> = axis["values"].as_array().unwrap().iter().map(|k| k.as_f64().unwrap()).collect();
+        assert_eq!(axis["count"].as_u64().unwrap() as usize, n);
+        assert_eq!(kappas, (0..n).map(|j| kappa_at(j as f64 / (n - 1) as f64)).collect::<Vec<f64>>());
+        let q = v["quadrature"]["max_error_estimate"].as_f64().unwrap();
+        assert!(q > 0.0 && q <= lut.tolerance, "quadrature estimate {q:e} against tolerance {:e}", lut.tolerance);
+
+        // The sRGB preview: each texel a block of whole pixels, as many as fit in 256 across
+        // (at least one), and for SH rows 16 times taller than wide. The PNG's size is in its
+        // IHDR chunk, big-endian at bytes 16..24.
+        let png = &built.artifacts.iter().find(|a| a.path.to_str().unwrap().ends_with(".png")).unwrap().contents;
+        let be = |at: usize| u32::from_be_bytes(png[at..at + 4].try_into().unwrap()) as usize;
+        let (pw, ph) = (be(16), be(20));
+        let s = pw / w;
+        assert!(pw == s * w && s >= 1 && (s * w <= 256 || s == 1) && (s + 1) * w > 256, "preview {pw} px across {w} texels");
+        let tall = if matches!(lut.kind, SkinLutKind::Sh) { 16 } else { 1 };
+        assert_eq!(ph, h * s * tall, "preview height");
+
+        // The code's doc says what it looks up: the function's name, the quantity, the kernel.
+        let wgsl = std::str::from_utf8(&built.artifacts.iter().find(|a| a.path.to_str().unwrap().ends_with(".wgsl")).unwrap().contents).unwrap().to_string();
+        let kernel = match lut.kind {
+            SkinLutKind::Punctual { kernel: Kernel::Linear, .. } => "linear profile on a ring",
+            SkinLutKind::Punctual { kernel: Kernel::Radial, .. } => "radial profile on a ring",
+            SkinLutKind::Sh => "radial profile on a sphere",
+        };
+        for want in [format!("`{}` looks up", lut.function), format!("quantity `{}`", lut.quantity), kernel.to_string()] {
+            assert!(wgsl.contains(&want), "the WGSL's doc lacks {want:?}");
+        }
     }
 
     #[test]
