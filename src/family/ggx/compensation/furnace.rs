@@ -62,7 +62,8 @@ impl Grid {
     }
 
     /// The largest relative asymmetry |f(o,i) − f(i,o)|/max over every pair of grid n·v at each
-    /// roughness, with its (roughness, μo, μi); None for reciprocal schemes.
+    /// roughness, with its (roughness, μo, μi): the first such pair in grid order (a pair and its
+    /// swap tie, so μo is the earlier sample); None for reciprocal schemes.
     pub fn asymmetry(&self, scheme: Scheme, f0: f64) -> Option<(f64, [f64; 3])> {
         let mut worst: Option<(f64, [f64; 3])> = None;
         for (j, &r) in self.roughness.iter().enumerate() {
@@ -453,6 +454,9 @@ mod tests {
             assert!((a - want).abs() <= 1e-12, "{s:?}: {a} vs {want}");
             // The worst pair is the row's least and greatest E, in either order.
             assert!(p[0] == at[0] && ((p[1], p[2]) == (at[1], at[2]) || (p[1], p[2]) == (at[2], at[1])), "{s:?}: {p:?} vs {at:?}");
+            // Of the two orders, which tie, the first in grid order: μo is the earlier sample.
+            let index = |m: f64| grid.mu.iter().position(|&x| x == m).unwrap();
+            assert!(index(p[1]) < index(p[2]), "{s:?}: {p:?}");
         }
         assert_eq!(grid.asymmetry(Scheme::KullaConty, 1.0), None);
     }
@@ -552,6 +556,21 @@ mod tests {
                 assert!(r.f0_range.iter().all(|&(_, hi)| hi <= 1.0 + 1e-7), "{:?}", r);
             }
         }
+        // max |albedo − Kulla–Conty's| at each F0: 0 for Kulla–Conty against itself; for the
+        // others the largest difference of the two schemes' albedos re-taken here (the same f64
+        // values: exact), and not 0 for single scattering, which lacks the F_ms (1 − E) term.
+        let kc: Vec<Vec<f64>> = F0S.iter().map(|&f0| grid.furnace(Scheme::KullaConty, f0)).collect();
+        for r in &rows {
+            for (k, &f0) in F0S.iter().enumerate() {
+                let want = grid.furnace(r.scheme, f0).iter().zip(&kc[k]).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+                assert_eq!(r.f0_vs_kc[k], want, "{:?} at F0 = {f0}", r.scheme);
+            }
+            match r.scheme {
+                Scheme::KullaConty => assert_eq!(r.f0_vs_kc, vec![0.0; F0S.len()]),
+                Scheme::Single => assert!(r.f0_vs_kc.iter().all(|&d| d > 1e-3), "{:?}", r.f0_vs_kc),
+                _ => {}
+            }
+        }
     }
 
     /// The items restate the furnace table: a summary line per scheme (its id first), then one
@@ -573,6 +592,16 @@ mod tests {
             assert_eq!((it.name.as_str(), it.source.as_str()), (format!("ggx_furnace_{}", r.scheme.id()).as_str(), r.scheme.source()));
             let extra = |k: &str| it.extra.iter().find(|e| e.0 == k).unwrap_or_else(|| panic!("{k}")).1;
             assert_eq!((it.max_abs_error, extra("f1_max_gain"), extra("f1_max_loss")), (r.f1_max_dev, r.f1_gain, r.f1_loss));
+            // The reciprocity finding: Fdez-Agüera's extra lobe, the scaling schemes' factor of
+            // the view, the others' symmetry; the printed asymmetry is the row's (3 decimals).
+            let says = |key: &str| it.findings.iter().any(|f| f.contains(key));
+            assert_eq!(says("its extra lobe"), r.scheme == Scheme::FdezAguera, "{:?}", it.findings);
+            assert_eq!(says("f_ss times a factor of the view alone"), matches!(r.scheme, Scheme::Turquin | Scheme::Cycles | Scheme::BevyOld), "{:?}", it.findings);
+            assert_eq!(says("Reciprocal: "), r.scheme.reciprocal(), "{:?}", it.findings);
+            if let Some((a, _)) = r.asymmetry {
+                let text = it.findings.iter().find(|f| f.contains(" reaches ")).unwrap();
+                assert!((crate::validate::number_after(text, " reaches ") - a).abs() <= 5e-4, "{a}: {text}");
+            }
         }
         let single = grid.furnace(Scheme::Single, 1.0);
         let (k, _) = single.iter().enumerate().fold((0, 0.0), |b, (k, &a)| if 1.0 - a > b.1 { (k, 1.0 - a) } else { b });
@@ -581,6 +610,74 @@ mod tests {
         assert!((r - points[k][0]).abs() <= 5e-3 && (m - points[k][1]).abs() <= 5e-5, "{text}: worst loss at {:?}", points[k]);
         let kc = items.iter().find(|i| i.name.ends_with("kulla_conty")).unwrap();
         assert!(kc.extra.iter().any(|e| e.0 == "f1_max_abs_dev_independent_quadrature" && e.1 < 1e-5));
+    }
+
+    /// The grid holds the integrals at α = r² (not r): E = A + B against `albedo` and E_avg
+    /// against `albedo_avg`, both at α = 0.25 for r = 0.5 (integrated separately at 1e-10 and
+    /// 1e-9). Bound: the grid's tolerances (1e-9 on A and B each, 1e-8 on E_avg) plus these.
+    #[test]
+    fn grid_inputs_are_the_integrals_at_alpha_r_squared() {
+        let grid = Grid::exact(&[0.5], &[0.3, 1.0]);
+        let want_avg = integrals::albedo_avg(0.25, 1e-9).value;
+        for (i, &m) in grid.mu.iter().enumerate() {
+            let x = grid.at(0, i);
+            let want = integrals::albedo(0.25, m, 1e-10).value;
+            assert!((x.e() - want).abs() < 2e-9 + 1e-10, "n·v = {m}: E {} vs {want}", x.e());
+            assert!((x.e_avg - want_avg).abs() < 1e-8 + 1e-9, "E_avg {} vs {want_avg}", x.e_avg);
+        }
+    }
+
+    /// The independent-quadrature check measures what it states: on a grid whose inputs are
+    /// planted (E = 0.9 at n·v = 0.2 and 0.6 at 0.8, E_avg with 1 − E_avg half the true
+    /// 1 − E_avg(0.25)), Kulla–Conty's albedo with the re-measured 2∫(1 − E)μ dμ is
+    /// E + 2(1 − E) = 2 − E, so the deviation is 1 − E: largest, 0.4, at (r = 0.5, n·v = 0.8).
+    /// Bound: the rule against 1 − E_avg (integrals at 1e-9, 1e-10) to ~1e-8 relative, times
+    /// 2(1 − E) ≤ 0.8; 1e-5 as the check's own bound.
+    #[test]
+    fn kc_quadrature_check_measures_a_planted_identity_error() {
+        let e_avg = integrals::albedo_avg(0.25, 1e-10).value;
+        let planted = 1.0 - 0.5 * (1.0 - e_avg);
+        let inputs = vec![Inputs { a: 0.5, b: 0.4, e_avg: planted }, Inputs { a: 0.4, b: 0.2, e_avg: planted }];
+        let grid = Grid { roughness: vec![0.5], mu: vec![0.2, 0.8], inputs };
+        let (dev, at) = kc_quadrature_check(&grid);
+        assert!((dev - 0.4).abs() < 1e-5, "{dev} at {at:?}");
+        assert_eq!(at, vec![0.5, 0.8]);
+    }
+
+    /// Signed extremes by hand (dyadic values, exact): v − 1 = 0, 0.25, −0.5, 0.125 gains most
+    /// (0.25) at the second point and loses most (0.5) at the third. Where nothing gains or
+    /// loses (every v exactly 1) both are 0 and have no point, which the findings print as
+    /// "nowhere".
+    #[test]
+    fn gain_loss_finds_signed_extremes_and_no_point_when_there_is_none() {
+        let points = vec![vec![0.1, 0.0], vec![0.2, 0.5], vec![0.3, 1.0], vec![0.4, 0.25]];
+        let (g, gp, l, lp) = gain_loss(&points, &[1.0, 1.25, 0.5, 1.125]);
+        assert_eq!((g, gp, l, lp), (0.25, vec![0.2, 0.5], 0.5, vec![0.3, 1.0]));
+        let (g, gp, l, lp) = gain_loss(&points, &[1.0; 4]);
+        assert_eq!((g, l), (0.0, 0.0));
+        assert_eq!((fmt_point(&gp), fmt_point(&lp)), ("nowhere".to_string(), "nowhere".to_string()));
+    }
+
+    /// A committed table is read only when its axes' counts multiply to its number of values
+    /// and it has one or two axes: a 2 × 2 table with 3 values and a 1 × 1 × 2 table (2 values,
+    /// three axes) are refused, the same 2 × 2 table with 4 values is read.
+    #[test]
+    fn table_load_refuses_shapes_that_do_not_match_their_values() {
+        let dir = std::env::temp_dir().join(format!("shadefit-furnace-load-{}", std::process::id()));
+        std::fs::create_dir_all(dir.join("json")).unwrap();
+        let axis = |n: usize| format!("{{\"count\": {n}, \"range\": [0.0, 1.0]}}");
+        let write = |name: &str, values: &str, axes: &[usize]| {
+            let axes: Vec<String> = axes.iter().map(|&n| axis(n)).collect();
+            let text = format!("{{\"values\": [{values}], \"axes\": [{}]}}", axes.join(", "));
+            std::fs::write(dir.join("json").join(format!("{name}.json")), text).unwrap();
+        };
+        write("short", "0.1, 0.2, 0.3", &[2, 2]);
+        write("three_axes", "0.1, 0.2", &[1, 1, 2]);
+        write("good", "0.1, 0.2, 0.3, 0.4", &[2, 2]);
+        let (short, three, good) = (Table::load(&dir, "short"), Table::load(&dir, "three_axes"), Table::load(&dir, "good"));
+        std::fs::remove_dir_all(&dir).unwrap();
+        assert!(short.is_none() && three.is_none(), "{short:?} {three:?}");
+        assert_eq!(good.map(|t| (t.counts, t.values.len())), Some((vec![2, 2], 4)));
     }
 
     /// The energy finding names the loss, the gain, conservation below 1e-6 and a deviation
@@ -594,6 +691,8 @@ mod tests {
             assert!(energy_finding(s, 3e-9, g, l).starts_with("Conserves energy at F = 1"), "{s:?}");
             assert!(energy_finding(s, 9.9e-7, g, l).starts_with("Conserves energy"), "{s:?}");
             assert_eq!(energy_finding(s, 2e-6, g, l), "Deviates from 1 by up to 2.00e-6 at F = 1.", "{s:?}");
+            // "Below 1e-6": the threshold itself is a deviation.
+            assert_eq!(energy_finding(s, 1e-6, g, l), "Deviates from 1 by up to 1.00e-6 at F = 1.", "{s:?}");
         }
     }
 }
