@@ -229,7 +229,8 @@ pub fn eval_kc_fms(p: &[f64], tol: f64) -> Estimate {
 /// `ggx-furnace` (alpha, n_dot_v, f0, scheme): the furnace albedo of a scheme (index into
 /// [`Scheme::ALL`]). Error: the inputs' errors times a bound on the formula's sensitivity
 /// (each scheme's albedo moves by at most a few times the change of A, B or E_avg away from
-/// E → 0; reported as 4·tol/E plus the inputs' own).
+/// E → 0; reported as 4·(error of A, B + error of E_avg)/min(E, 1 − E_avg), and 4·error/A² for
+/// bevy's 1/A).
 pub fn eval_furnace(p: &[f64], tol: f64) -> Estimate {
     let (alpha, mu, f0) = (p[0], p[1], p[2]);
     let scheme = Scheme::ALL[(p[3] as usize).min(Scheme::ALL.len() - 1)];
@@ -462,6 +463,69 @@ mod tests {
         assert!((furnace(Scheme::FdezAguera, 0.5, &x, 0.3) - (0.5 + 1.1 / 18.8)).abs() < 1e-15);
         assert!((view_factor(Scheme::Turquin, 0.5, &x).unwrap() - 1.125).abs() < 1e-15);
         assert_eq!((view_factor(Scheme::Single, 0.5, &x), view_factor(Scheme::KullaConty, 0.5, &x)), (None, None));
+    }
+
+    /// The relative asymmetry by hand: factors 0.5 and 1 differ by half the larger, in either
+    /// order; two vanishing factors (Fdez-Agüera's lobe where E = 1) are equal, so symmetric: 0,
+    /// not 0/0.
+    #[test]
+    fn asymmetry_by_hand_and_of_two_vanishing_factors() {
+        assert_eq!((asymmetry(0.5, 1.0), asymmetry(1.0, 0.5)), (0.5, 0.5));
+        assert_eq!(asymmetry(0.0, 0.0), 0.0);
+    }
+
+    /// The quantities count the evaluations of the integrals they call: `ggx-kc-fms` those of
+    /// E(μo), E(μi) and E_avg; `ggx-furnace` those of A, B and, for the schemes that read it,
+    /// E_avg (each integral re-run here: the integrators are deterministic).
+    #[test]
+    fn quantities_count_their_integrals_evaluations() {
+        let (alpha, mo, mi, tol) = (0.5, 0.3, 0.8, 1e-7);
+        let avg = integrals::albedo_avg(alpha, tol).evals;
+        let want = integrals::albedo(alpha, mo, tol).evals + integrals::albedo(alpha, mi, tol).evals + avg;
+        assert_eq!(eval_kc_fms(&[alpha, mo, mi], tol).evals, want);
+        let env = integrals::env(alpha, mo, 0.0, Shadowing::HeightCorrelated, tol).evals;
+        assert!(env > 0 && avg > 0);
+        for (k, s) in Scheme::ALL.iter().enumerate() {
+            let want = env + if matches!(s, Scheme::KullaConty | Scheme::Cycles) { avg } else { 0 };
+            assert_eq!(eval_furnace(&[alpha, mo, 0.04, k as f64], tol).evals, want, "{s:?}");
+        }
+    }
+
+    /// A scheme index past the end of `Scheme::ALL` reads the last scheme (bevy's old one).
+    #[test]
+    fn furnace_scheme_index_clamps_to_the_last() {
+        let last = eval_furnace(&[0.5, 0.3, 0.5, 5.0], 1e-8);
+        assert_eq!(Scheme::ALL[5], Scheme::BevyOld);
+        for k in [6.0, 9.0] {
+            assert_eq!(eval_furnace(&[0.5, 0.3, 0.5, k], 1e-8).value, last.value, "index {k}");
+        }
+    }
+
+    /// `ggx-furnace`'s error is the stated 4·(error of A, B + error of E_avg) over the smaller
+    /// of E and 1 − E_avg, and 4·error/A² for bevy's 1/A, with the errors those the integrals
+    /// themselves report (re-run here). At α = 0.1 the smaller divisor is 1 − E_avg, at α = 1 it
+    /// is E: both are exercised. Rounding of a few operations: 1e-12 relative.
+    #[test]
+    fn furnace_error_is_four_times_the_inputs_errors_over_the_smaller_divisor() {
+        let tol = 1e-8;
+        let mut divisors = Vec::new();
+        for (alpha, mu) in [(0.1, 0.5), (1.0, 0.9)] {
+            let r = integrals::env(alpha, mu, 0.0, Shadowing::HeightCorrelated, tol);
+            let avg = integrals::albedo_avg(alpha, tol);
+            let e = r.scale + r.bias;
+            divisors.push((e, 1.0 - avg.value));
+            assert!(r.error > 0.0 && avg.error > 0.0, "α {alpha}: {r:?} {avg:?}");
+            for s in [Scheme::KullaConty, Scheme::Cycles, Scheme::BevyOld] {
+                let k = Scheme::ALL.iter().position(|&x| x == s).unwrap() as f64;
+                let got = eval_furnace(&[alpha, mu, 0.04, k], tol);
+                let want = match s {
+                    Scheme::BevyOld => 4.0 * r.error / (r.scale * r.scale),
+                    _ => 4.0 * (r.error + avg.error) / e.min(1.0 - avg.value),
+                };
+                assert!((got.error - want).abs() <= 1e-12 * want, "{s:?} α {alpha}: {:e} vs {want:e}", got.error);
+            }
+        }
+        assert!(divisors[0].1 < divisors[0].0 && divisors[1].0 < divisors[1].1, "(E, 1 − E_avg): {divisors:?}");
     }
 
     #[test]
