@@ -801,6 +801,65 @@ mod tests {
         }
     }
 
+    /// The published constants at points worked by hand. Lagarde's exponent at α = 1/16 is
+    /// 2^(−16/16 − 1) = 1/4, so SO(n·v = 1/4, V = 1/2) = (3/4)^(1/4) − 1/2 (n·v + V ≠ 1, so the
+    /// exponent shows). Jimenez's k is −log₂ 10 to its 7 printed digits (half a unit of the
+    /// sixth decimal, 5e-7). Jimenez's multi-bounce cubic at ρ = ½: a = 1.0202 − 0.3324 =
+    /// 0.6878, b = −2.39755 + 0.6417 = −1.75585, c = 1.3776 + 0.6903 = 2.0679, so at V = ½
+    /// ((0.3439 − 1.75585)/2 + 2.0679)/2 = 0.6809625 (ρ strictly between 0 and 1, so each
+    /// coefficient's slope in ρ shows). f64 rounding of a few operations: 1e-15, 1e-12.
+    #[test]
+    fn published_constants_at_points_by_hand() {
+        let want = 0.75f64.sqrt().sqrt() - 0.5;
+        assert!((lagarde(0.25, 0.5, 1.0 / 16.0) - want).abs() < 1e-15, "{} vs {want}", lagarde(0.25, 0.5, 1.0 / 16.0));
+        assert!((JIMENEZ + 10f64.log2()).abs() < 5e-7, "{JIMENEZ}");
+        let m = jimenez_multibounce(&JIMENEZ_MULTIBOUNCE, 0.5, 0.5);
+        assert!((m - 0.6809625).abs() < 1e-12, "{m}");
+    }
+
+    /// Where the unoccluded split sum is 0 the occlusion is 0 (the doc of `so_ratio`), not
+    /// 0/0: from the integrals' estimates and from a table whose texels are all 0.
+    #[test]
+    fn occlusion_is_zero_where_the_unoccluded_sum_vanishes() {
+        let zero = EnvEstimate { scale: 0.0, bias: 0.0, error: 0.0, evals: 0 };
+        assert_eq!(so_ratio(&zero, &zero, F0), 0.0);
+        let lut = lut::plot::Committed {
+            name: "zero".into(),
+            width: 2,
+            height: 2,
+            depth: 2,
+            row: "alpha".into(),
+            layout: "scale-bias".into(),
+            values: vec![[0.0; 2]; 8],
+            error_map: vec![0.0; 8],
+        };
+        let reader = LutReader::new(lut);
+        assert_eq!(reader.so(0.5, 0.25, 0.5, F0), 0.0);
+    }
+
+    /// The typo finding's half-way points: where each reading's factor (gloss 0) is 1/2, found
+    /// here by bisection (60 halvings: exact to f64), printed to 3 decimals (5e-4) and as
+    /// θv = acos n·v to whole degrees (0.5°).
+    #[test]
+    fn the_typo_findings_half_way_points_are_where_each_factor_is_one_half() {
+        let half = |f: fn(f64, f64, f64) -> f64, rising: bool| {
+            let (mut lo, mut hi) = (0.0f64, 1.0f64);
+            for _ in 0..60 {
+                let m = 0.5 * (lo + hi);
+                if (f(1.0, 0.0, m) < 0.5) == rising { lo = m } else { hi = m }
+            }
+            0.5 * (lo + hi)
+        };
+        let (printed, corrected) = (half(cod_adjust_printed, true), half(cod_adjust_corrected, true));
+        let text = &typo_item().findings[1];
+        let at = |key: &str| number_after(text, key);
+        assert!((at("already at n·v = ") - printed).abs() <= 5e-4, "{printed}: {text}");
+        assert!((at("only below n·v = ") - corrected).abs() <= 5e-4, "{corrected}: {text}");
+        let second = &text[text.find("only below").unwrap()..];
+        assert!((at("(θv = ") - printed.acos().to_degrees()).abs() <= 0.5, "{text}");
+        assert!((number_after(second, "(θv = ") - corrected.acos().to_degrees()).abs() <= 0.5, "{text}");
+    }
+
     #[test]
     fn approximations_reach_their_limits() {
         // Lagarde: V = 1 gives 1; V = 0 and n·v < 1 give 0.
