@@ -491,6 +491,187 @@ mod tests {
         }
     }
 
+    /// Every figure of the verification re-measured by this test's own means (the 2-D twin of
+    /// the cone LUT's test): the integral by `env_with` with adaptive azimuth panels at 1e-10
+    /// (independent of the nested rules the build integrates with), the f16 texels by the
+    /// `half` crate, bilinear weights written out (clamped texel coordinates). A 6 × 5 LUT in
+    /// Filament's layout (R = bias, G = scale + bias: the encoding is judged too),
+    /// VERIFY_DENSITY (4) points a texel and axis: 24 × 20 points, 20 × 16 of them between the
+    /// outer texel centres (two points per axis end lie past them). The build's reference asks
+    /// 1e-6: every maximum, channel maximum and rms agrees within 1e-6 + 1e-10 (each point's
+    /// error moves by at most the two references' difference), the emitted f32 lookup within
+    /// 1e-6 more (f32 coordinates and arithmetic on values ≤ 2: a few ulps of 2^-23 times the
+    /// table's slope), and the texture's error at its stated worst point is its maximum. The
+    /// f16 rounding is recomputed exactly.
+    #[test]
+    fn every_verification_figure_is_re_measured() {
+        use crate::family::ggx::integrals::{Inner, Shadowing, env_with};
+        let lut = DfgLut::parse(std::path::Path::new("fits/ggx_t.toml"), &spec_text([6, 5]).replace("[6, 5]", "[6, 5]\nlayout = \"filament\"")).unwrap();
+        let (w, h) = (lut.width, lut.height);
+        let (values, _) = tabulate(&lut);
+        let m = verify(&lut, &values).unwrap();
+        let encode = |[s, b]: [f64; 2]| [b, s + b];
+        let f16 = |x: f64| f64::from(half::f16::from_f32(x as f32).to_f32());
+        let stored: Vec<[f64; 2]> = values.iter().map(|v| encode(*v).map(f16)).collect();
+        let exact: Vec<[f64; 2]> = values.iter().map(|v| encode(*v)).collect();
+        let storage = values.iter().flat_map(|v| encode(*v).map(|x| (x - f16(x)).abs())).fold(0.0, f64::max);
+        assert_eq!(m.max_abs_storage_error, storage);
+        assert!(storage > 0.0);
+        let coord = |p: f64, n: usize| {
+            let x = (p * n as f64 - 0.5).clamp(0.0, (n - 1) as f64);
+            let i = (x.floor() as usize).min(n - 2);
+            (i, x - i as f64)
+        };
+        let read = |tex: &[[f64; 2]], u: f64, t: f64| -> [f64; 2] {
+            let ((i, fx), (j, fy)) = (coord(u, w), coord(t, h));
+            std::array::from_fn(|c| {
+                let row = |j: usize| tex[j * w + i][c] * (1.0 - fx) + tex[j * w + i + 1][c] * fx;
+                row(j) * (1.0 - fy) + row(j + 1) * fy
+            })
+        };
+        let centres = |count: usize| -> Vec<f64> { (0..count).map(|k| (k as f64 + 0.5) / count as f64).collect() };
+        let (us, ts) = (centres(4 * w), centres(4 * h));
+        /// Max, per-channel max, sum of squares and count of the errors of some points.
+        #[derive(Default)]
+        struct Errors {
+            max: f64,
+            channel: [f64; 2],
+            ss: f64,
+            count: usize,
+        }
+        impl Errors {
+            fn add(&mut self, got: [f64; 2], want: [f64; 2]) {
+                for c in 0..2 {
+                    let e = (got[c] - want[c]).abs();
+                    self.channel[c] = self.channel[c].max(e);
+                    self.max = self.max.max(e);
+                    self.ss += e * e;
+                }
+                self.count += 1;
+            }
+            fn rms(&self) -> f64 {
+                (self.ss / (2 * self.count) as f64).sqrt()
+            }
+        }
+        let (mut tex, mut inner, mut interp) = (Errors::default(), Errors::default(), Errors::default());
+        let truth = |u: f64, t: f64| {
+            let r = env_with(lut.mapping.alpha(t), u, 0.0, Shadowing::HeightCorrelated, 1e-10, Inner::Adaptive);
+            encode([r.scale, r.bias])
+        };
+        for &t in &ts {
+            for &u in &us {
+                let want = truth(u, t);
+                let got = read(&stored, u, t);
+                tex.add(got, want);
+                let between = |p: f64, n: usize| p > 0.5 / n as f64 && p < 1.0 - 0.5 / n as f64;
+                if between(u, w) && between(t, h) {
+                    inner.add(got, want);
+                }
+                interp.add(read(&exact, u, t), want);
+            }
+        }
+        assert_eq!((m.points, tex.count, inner.count), (24 * 20, 24 * 20, 20 * 16));
+        let bound = 1e-6 + 1e-10;
+        for (what, claimed, measured) in [
+            ("texture max", m.texture.max_abs_error, tex.max),
+            ("texture R max", m.texture.max_abs_error_per_channel[0], tex.channel[0]),
+            ("texture G max", m.texture.max_abs_error_per_channel[1], tex.channel[1]),
+            ("texture rms", m.texture.rms_error, tex.rms()),
+            ("interior max", m.texture_interior.max_abs_error, inner.max),
+            ("interior rms", m.texture_interior.rms_error, inner.rms()),
+            ("interpolation max", m.interpolation.max_abs_error, interp.max),
+            ("interpolation rms", m.interpolation.rms_error, interp.rms()),
+            ("f32 lookup max", m.lookup_f32.max_abs_error, tex.max),
+            ("f32 lookup rms", m.lookup_f32.rms_error, tex.rms()),
+        ] {
+            let slack = if what.starts_with("f32") { 2.0 * bound } else { bound };
+            assert!((claimed - measured).abs() <= slack, "{what}: claimed {claimed:e}, re-measured {measured:e}");
+            assert!(measured > 100.0 * slack, "{what}: not a vacuous comparison ({measured:e})");
+        }
+        // The interior leaves out the clamped border, where filtering is worst: a smaller max.
+        assert!(inner.max < tex.max && inner.rms() != tex.rms(), "{} vs {}", inner.max, tex.max);
+        let p = &m.texture.worst_point;
+        let e = read(&stored, p[0], p[1]).iter().zip(truth(p[0], p[1])).map(|(g, t)| (g - t).abs()).fold(0.0, f64::max);
+        assert!((e - m.texture.max_abs_error).abs() <= bound, "at {p:?}: {e:e} vs {:e}", m.texture.max_abs_error);
+        assert!(m.reference_max_error_estimate > 0.0 && m.reference_max_error_estimate <= VERIFY_TOLERANCE, "{}", m.reference_max_error_estimate);
+        assert_eq!((m.density, m.reference_tolerance), (VERIFY_DENSITY, VERIFY_TOLERANCE));
+    }
+
+    /// The accumulator's figures by hand. Three points, errors (0.5, 0), (0, 0.5) and (0.25, 0):
+    /// the largest 0.5 first reached at the first point, which stays the worst point when the
+    /// second ties it (the first point reaching the maximum is stated, as in a scan); each
+    /// channel's largest 0.5; rms over 3 points × 2 channels √(0.5625/6). Each `add` returns its
+    /// point's larger channel error (what the error map keeps). All exact in binary but the
+    /// rms's square root: 1e-15.
+    #[test]
+    fn the_accumulator_keeps_the_first_worst_point_and_counts_both_channels() {
+        let mut a = Accumulator::new();
+        let steps = [a.add([1.0, 0.5], [0.5, 0.5], &[0.1]), a.add([0.0, 0.0], [0.0, -0.5], &[0.2]), a.add([0.25, 0.0], [0.0, 0.0], &[0.3])];
+        assert_eq!(steps, [0.5, 0.5, 0.25]);
+        let m = a.finish(3);
+        assert_eq!((m.max_abs_error, m.worst_point, m.max_abs_error_per_channel), (0.5, vec![0.1], [0.5, 0.5]));
+        assert!((m.rms_error - (0.5625f64 / 6.0).sqrt()).abs() < 1e-15, "{}", m.rms_error);
+        // No point at all: a zero maximum, no worst point.
+        let none = Accumulator::new().finish(1);
+        assert_eq!((none.max_abs_error, none.worst_point.len(), none.rms_error), (0.0, 0, 0.0));
+    }
+
+    /// The row mapping as the emitted files' docs and the JSON state it, each formula evaluated
+    /// here at every row of a 7-row table and compared with the row's α: t = (j + ½)/7 and
+    /// α = t² (perceptual), α = t, α = sqrt(2/(1 + 2^(18 t))) (gloss, with the gloss family's
+    /// exponent 18). 1e-15 relative: the same few roundings in another order.
+    #[test]
+    fn the_mapping_docs_state_each_rows_coordinate_and_alpha() {
+        let cases: [(&str, &str, &str, fn(f64) -> f64); 3] = [
+            ("perceptual", "roughness r = (j + 0.5)/7, α = r²", "alpha = t^2", |t| t * t),
+            ("alpha", "α = (j + 0.5)/7", "alpha = t", |t| t),
+            ("gloss", "gloss g = (j + 0.5)/7, α = sqrt(2/(1 + 2^(18 g)))", "alpha = sqrt(2/(1 + 2^(18 t))) (gloss)", |t| (2.0 / (1.0 + (18.0 * t).exp2())).sqrt()),
+        ];
+        for (name, doc, json, alpha) in cases {
+            let text = spec_text([10, 7]).replace("resolution", &format!("roughness_mapping = \"{name}\"\nresolution"));
+            let lut = DfgLut::parse(std::path::Path::new("fits/ggx_t.toml"), &text).unwrap();
+            assert_eq!((mapping_doc(&lut).as_str(), alpha_of_t(lut.mapping)), (doc, json), "{name}");
+            for j in 0..7 {
+                let t = (j as f64 + 0.5) / 7.0;
+                assert!((lut.alpha(j) - alpha(t)).abs() <= 1e-15 * alpha(t), "{name} row {j}: {} vs {}", lut.alpha(j), alpha(t));
+            }
+        }
+    }
+
+    /// The PNG preview draws each texel as an s × s block, s the largest whole scale that keeps
+    /// the longer side within 256 pixels (25 for 10 × 7: 250 × 175), with row 0 at the top,
+    /// R and G the stored channels sRGB-encoded (IEC 61966-2-1, 8 bits), B = 0. Within one
+    /// level: the 8-bit rounding of the same encoding.
+    #[test]
+    fn the_preview_draws_each_texel_as_a_block_within_256_pixels() {
+        let spec = Spec::parse(std::path::Path::new("fits/ggx_t.toml"), spec_text([10, 7]), crate::family::catalog()).unwrap();
+        let built = build(&spec, Mode::Fit, Path::new("")).unwrap();
+        let file = |suffix: &str| &built.artifacts.iter().find(|a| a.path.to_str().unwrap().ends_with(suffix)).unwrap().contents;
+        let json: Value = serde_json::from_slice(file(".json")).unwrap();
+        let values: Vec<[f64; 2]> = serde_json::from_value(json["values"].clone()).unwrap();
+        let (w, h) = (10, 7);
+        let s = (1..).take_while(|s| w.max(h) * s <= 256).last().unwrap();
+        let mut reader = png::Decoder::new(std::io::Cursor::new(&file(".png")[..])).read_info().unwrap();
+        assert_eq!((reader.info().width, reader.info().height), ((w * s) as u32, (h * s) as u32));
+        let mut px = vec![0; reader.output_buffer_size().unwrap()];
+        reader.next_frame(&mut px).unwrap();
+        let srgb = |x: f64| {
+            let e = if x <= 0.0031308 { 12.92 * x } else { 1.055 * x.powf(1.0 / 2.4) - 0.055 };
+            e.clamp(0.0, 1.0) * 255.0
+        };
+        for j in 0..h {
+            for i in 0..w {
+                // Scale-bias layout: R = scale, G = bias.
+                let v = values[j * w + i];
+                for (x, y) in [(i * s, j * s), (i * s + s - 1, j * s + s - 1)] {
+                    let p = &px[3 * (y * w * s + x)..3 * (y * w * s + x) + 3];
+                    let ok = (p[0] as f64 - srgb(v[0])).abs() <= 1.0 && (p[1] as f64 - srgb(v[1])).abs() <= 1.0 && p[2] == 0;
+                    assert!(ok, "texel ({i}, {j}) at pixel ({x}, {y}): {p:?} for {v:?}");
+                }
+            }
+        }
+    }
+
     /// Bilinear filtering of texels that are linear in the texel index, f(i, j) = i + 10j (and
     /// 2i − j), returns the same linear function at the texel-space point (u·w − ½, t·h − ½),
     /// clamped to the edge texels outside their centres.
