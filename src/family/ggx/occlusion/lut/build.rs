@@ -373,6 +373,8 @@ mod tests {
         let (us, ts, cs) = (centres(2 * w), centres(2 * h), centres(2 * (d - 1)));
         let err = |got: [f64; 2], want: [f64; 2]| (got[0] - want[0]).abs().max((got[1] - want[1]).abs());
         let (mut tex, mut inner, mut interp, mut ss, mut inner_points) = (0.0f64, 0.0f64, 0.0f64, 0.0, 0);
+        let (mut inner_ss, mut interp_ss) = (0.0, 0.0);
+        let sq = |got: [f64; 2], want: [f64; 2]| (got[0] - want[0]).powi(2) + (got[1] - want[1]).powi(2);
         for &c in &cs {
             for &t in &ts {
                 for &u in &us {
@@ -385,9 +387,11 @@ mod tests {
                     let between = |p: f64, n: usize| p > 0.5 / n as f64 && p < 1.0 - 0.5 / n as f64;
                     if between(u, w) && between(t, h) {
                         inner = inner.max(e);
+                        inner_ss += sq(got, want);
                         inner_points += 1;
                     }
                     interp = interp.max(err(read(&exact, u, t, c), want));
+                    interp_ss += sq(read(&exact, u, t, c), want);
                 }
             }
         }
@@ -399,7 +403,9 @@ mod tests {
             ("texture max", m.texture.max_abs_error, tex),
             ("texture rms", m.texture.rms_error, rms),
             ("interior max", m.texture_interior.max_abs_error, inner),
+            ("interior rms", m.texture_interior.rms_error, (inner_ss / (2 * inner_points) as f64).sqrt()),
             ("interpolation max", m.interpolation.max_abs_error, interp),
+            ("interpolation rms", m.interpolation.rms_error, (interp_ss / (2 * points) as f64).sqrt()),
             ("f32 lookup max", m.lookup_f32.max_abs_error, tex),
         ] {
             let slack = if what.starts_with("f32") { 2.0 * bound } else { bound };
@@ -410,6 +416,46 @@ mod tests {
         assert!(inner < tex, "{inner:e} vs {tex:e}");
         assert!(m.reference_max_error_estimate > 0.0 && m.reference_max_error_estimate <= VERIFY_TOLERANCE, "{}", m.reference_max_error_estimate);
         assert_eq!((m.density, m.reference_tolerance), (VERIFY_DENSITY, VERIFY_TOLERANCE));
+    }
+
+    /// The PNG preview sets the slices side by side, cos θc = 0 first: texel (i, j) of slice k
+    /// is the s × s block at column k·w + i, row j (row 0 at the top), s the largest whole scale
+    /// that keeps the longer side within 1024 pixels (113 for 3 slices of 3 × 2: 1017 × 226);
+    /// R and G are the stored channels sRGB-encoded (IEC 61966-2-1, 8 bits), B = 0. Within one
+    /// level: the 8-bit rounding of the same encoding.
+    #[test]
+    fn the_preview_sets_the_slices_side_by_side() {
+        let text = super::super::spec::tests::SPEC.replace("[8, 4, 3]", "[3, 2, 3]");
+        let spec = Spec::parse(Path::new("fits/ggx_c.toml"), text, crate::family::catalog()).unwrap();
+        let built = build(&spec, Mode::Fit, Path::new("")).unwrap();
+        let file = |suffix: &str| &built.artifacts.iter().find(|a| a.path.to_str().unwrap().ends_with(suffix)).unwrap().contents;
+        let json: Value = serde_json::from_slice(file(".json")).unwrap();
+        let values: Vec<[f64; 2]> = serde_json::from_value(json["values"].clone()).unwrap();
+        let (w, h, d) = (3, 2, 3);
+        let s = (1..).take_while(|s| (w * d).max(h) * s <= 1024).last().unwrap();
+        let mut reader = png::Decoder::new(std::io::Cursor::new(&file(".png")[..])).read_info().unwrap();
+        assert_eq!((reader.info().width, reader.info().height), ((w * d * s) as u32, (h * s) as u32));
+        let mut px = vec![0; reader.output_buffer_size().unwrap()];
+        reader.next_frame(&mut px).unwrap();
+        let srgb = |x: f64| {
+            let e = if x <= 0.0031308 { 12.92 * x } else { 1.055 * x.powf(1.0 / 2.4) - 0.055 };
+            e.clamp(0.0, 1.0) * 255.0
+        };
+        let row = w * d * s;
+        for k in 0..d {
+            for j in 0..h {
+                for i in 0..w {
+                    // Scale-bias layout: R = scale, G = bias.
+                    let v = values[(k * h + j) * w + i];
+                    let x0 = (k * w + i) * s;
+                    for (x, y) in [(x0, j * s), (x0 + s - 1, j * s + s - 1)] {
+                        let p = &px[3 * (y * row + x)..3 * (y * row + x) + 3];
+                        let ok = (p[0] as f64 - srgb(v[0])).abs() <= 1.0 && (p[1] as f64 - srgb(v[1])).abs() <= 1.0 && p[2] == 0;
+                        assert!(ok, "texel ({i}, {j}, {k}) at pixel ({x}, {y}): {p:?} for {v:?}");
+                    }
+                }
+            }
+        }
     }
 
     /// The quadrature a cone LUT reports is that of its slices, each the 2-D table's own: the
