@@ -104,18 +104,71 @@ pub fn exact(nov: f64, alpha: f64, tol: f64) -> [f64; 2] {
 mod tests {
     use super::*;
 
+    /// The regenerated table, computed once for the tests that read it.
+    fn shared_table() -> &'static Table {
+        static T: std::sync::OnceLock<Table> = std::sync::OnceLock::new();
+        T.get_or_init(table)
+    }
+
     #[test]
     fn table_texel_estimates_the_integral_at_its_alpha() {
         // Texel (64, 62): n·v = 64.5/128, perceptual r = 63.5/128 (row_roughness), so α = r².
         // Against the height-correlated integral at that (n·v, α) to 1e-9. 5e-3: a 1024-point
         // Hammersley estimate of this smooth mid-range integrand (the mirror test above shows
         // the estimator's form is exact at α → 0); stored f64 before the f16 rounding.
-        let t = table();
+        let t = shared_table();
         let (i, j) = (64, 62);
         let r = (j as f64 + 1.5) / SIZE as f64;
         let want = exact((i as f64 + 0.5) / SIZE as f64, r * r, 1e-9);
         let got = t.f64s[j * SIZE + i];
         assert!((got[0] - want[0]).abs() < 5e-3 && (got[1] - want[1]).abs() < 5e-3, "{got:?} vs {want:?}");
+    }
+
+    /// The table's layout as the module doc states it: texel (i, j) at `[j·128 + i]` is the
+    /// estimator (1024 samples) at n·v = (i + ½)/128 and α = r², r = row_roughness(j), and
+    /// its f16 value is that rounded to nearest. Exact: the same computation. Texels at the
+    /// four corners and two inside (i ≠ j, so a swapped axis shows).
+    #[test]
+    fn table_texels_are_the_estimator_at_their_own_coordinates() {
+        let t = shared_table();
+        assert_eq!((t.f64s.len(), t.f16s.len()), (SIZE * SIZE, SIZE * SIZE));
+        for (i, j) in [(0, 0), (127, 0), (0, 127), (127, 127), (37, 101), (90, 12)] {
+            let r = row_roughness(j, SIZE);
+            let want = dfv_multiscatter((i as f64 + 0.5) / SIZE as f64, r * r, SAMPLES);
+            assert_eq!(t.f64s[j * SIZE + i], want, "texel ({i}, {j})");
+            assert_eq!(t.f16s[j * SIZE + i], want.map(|x| half::f16::from_f64(x).to_f64()), "texel ({i}, {j})");
+        }
+    }
+
+    /// The estimator with one and two Hammersley points, worked out from the module doc's
+    /// formulas. Point 0, u = (0, 0): cos²θ = 1, so H = n, L is V's mirror, NoL = VoH = NoV,
+    /// NoH = 1, and E = 4·Vis(NoV, NoV)·NoV², bias = E·(1 − NoV)⁵. Point 1 of two, u = (½, ½):
+    /// φ = π, cos²θ = ½/(1 + (α + 1)(α − 1)/2) = 1/(1 + α²), H = (−sin θ, 0, cos θ); at
+    /// NoV = 0.6, α = 0.3, VoH = 0.6 cos θ − 0.8 sin θ ≈ 0.345 and NoL = 2 VoH cos θ − 0.6
+    /// ≈ 0.0606 > 0, so it counts, with weight Vis·NoL·VoH/NoH; the sum is scaled by 4/n. In a
+    /// cone NoL ≥ 0.5 only point 0 counts. 1e-12: the same few operations in another order
+    /// (and sin π ≈ 1.2e-16 in H's y, which V's zero y drops).
+    #[test]
+    fn one_and_two_point_estimates_are_their_samples_by_hand() {
+        let vis = |nov: f64, nol: f64, a: f64| 0.5 / (nol * (nov * nov * (1.0 - a * a) + a * a).sqrt() + nov * (nol * nol * (1.0 - a * a) + a * a).sqrt());
+        let (nov, a) = (0.6, 0.3);
+        let fc = |voh: f64| (1.0 - voh).powi(5);
+        let w0 = vis(nov, nov, a) * nov * nov;
+        let (ct, st) = ((1.0 / (1.0 + a * a)).sqrt(), (a * a / (1.0 + a * a)).sqrt());
+        let voh = nov * ct - 0.8 * st;
+        let nol = 2.0 * voh * ct - nov;
+        assert!(nol > 0.05 && nol < 0.5, "{nol}");
+        let w1 = vis(nov, nol, a) * nol * voh / ct;
+        let close = |got: [f64; 2], want: [f64; 2]| (got[0] - want[0]).abs() < 1e-12 && (got[1] - want[1]).abs() < 1e-12;
+        for (n, cone, want) in [
+            (1, 0.0, [4.0 * w0 * fc(nov), 4.0 * w0]),
+            (2, 0.0, [2.0 * (w0 * fc(nov) + w1 * fc(voh)), 2.0 * (w0 + w1)]),
+            (2, 0.5, [2.0 * w0 * fc(nov), 2.0 * w0]),
+        ] {
+            let got = dfv_multiscatter_in_cone(nov, a, n, cone);
+            assert!(close(got, want), "{n} points, cone {cone}: {got:?} vs {want:?}");
+        }
+        assert_eq!(dfv_multiscatter(nov, a, 2), dfv_multiscatter_in_cone(nov, a, 2, 0.0));
     }
 
     #[test]
