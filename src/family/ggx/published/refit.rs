@@ -233,6 +233,94 @@ mod tests {
         assert_eq!((x, cost), (centre.to_vec(), 0.0));
     }
 
+    /// Each round of the restarted Nelder–Mead starts from the axis simplex the doc states: the
+    /// best point so far and, per coordinate, that point moved up by the round's step times the
+    /// coordinate's magnitude, or by a tenth of the step where the coordinate is 0. From
+    /// (2, 0, −4) the first round (step 10 %) evaluates (2.2, 0, −4), (2, 0.01, −4) and
+    /// (2, 0, −3.6) before any other point (the start, then the simplex's vertices): here the
+    /// points are built with the same f64 operations, so they compare exactly.
+    #[test]
+    fn each_round_starts_from_the_stated_axis_simplex() {
+        let log = std::sync::Mutex::new(Vec::<Vec<f64>>::new());
+        let bowl = |p: &[f64]| {
+            log.lock().unwrap().push(p.to_vec());
+            (p[0] - 1.0).powi(2) + (p[1] - 0.5).powi(2) + (p[2] + 3.0).powi(2)
+        };
+        let x0 = [2.0, 0.0, -4.0];
+        nelder_mead(bowl, &x0);
+        let log = log.into_inner().unwrap();
+        let first: &[Vec<f64>] = &log[..5];
+        let step = 0.1;
+        let vertices = [vec![2.0 + step * 2.0, 0.0, -4.0], vec![2.0, 0.0 + step * 0.1, -4.0], vec![2.0, 0.0, -4.0 + step * 4.0]];
+        assert_eq!(first[0], x0.to_vec());
+        for v in &vertices {
+            assert!(first.contains(v), "{v:?} not among the first evaluations {first:?}");
+        }
+    }
+
+    /// Flipping the sign of any one committed refit constant never lowers that form's max error
+    /// on its grid (the refits are minimax: a constant on the wrong side of zero would be a
+    /// better start), and raises it for most constants: a lost minus sign in a pasted constant
+    /// shows wherever the objective can see it. It leaves the max error unchanged only where
+    /// the worst point is out of the constant's reach (Karis's c0 multiplies r, and a worst
+    /// point at r = 0 does not move with it). Karis (UE4's G and height-correlated), Lazarov and
+    /// Kulla–Conty's branches, every constant; each form's max error through its own `eval`
+    /// against the grid's integrals.
+    #[test]
+    fn a_sign_slip_in_any_committed_constant_raises_its_max_error() {
+        let c = &COMMITTED;
+        let karis = |target: Target, k: &Karis| -> (Vec<f64>, Box<dyn Fn(&[f64]) -> f64>) {
+            let g = grid::standard(target);
+            (k.params(), Box::new(move |p: &[f64]| g.max_error(|m, r| Karis::from_params(p).eval(r, m))))
+        };
+        let kc = |above: bool| -> Box<dyn Fn(&[f64]) -> f64> {
+            Box::new(move |p: &[f64]| {
+                let k = if above { KullaConty { above: [p[0], p[1]], below: c.kulla_conty.below } } else { KullaConty { above: c.kulla_conty.above, below: [p[0], p[1], p[2], p[3]] } };
+                let (e, f) = grid::fresnel(above);
+                e.iter().zip(f).map(|(&x, &t)| (k.eval(x) - t).abs()).fold(0.0f64, f64::max)
+            })
+        };
+        let g = grid::standard(Target::Gloss);
+        let cases: Vec<(&str, Vec<f64>, Box<dyn Fn(&[f64]) -> f64>)> = vec![
+            ("karis_ue4", karis(Target::RoughnessUe4, &c.karis_ue4).0, karis(Target::RoughnessUe4, &c.karis_ue4).1),
+            ("karis_hc", karis(Target::Roughness, &c.karis_hc).0, karis(Target::Roughness, &c.karis_hc).1),
+            ("lazarov", c.lazarov.params(), Box::new(move |p: &[f64]| g.max_error(|m, gl| Lazarov::from_params(p).eval(gl, m)))),
+            ("kulla_conty above", c.kulla_conty.above.to_vec(), kc(true)),
+            ("kulla_conty below", c.kulla_conty.below.to_vec(), kc(false)),
+        ];
+        for (name, p, max) in &cases {
+            let at = max(p);
+            let mut raised = 0;
+            for i in 0..p.len() {
+                let mut q = p.clone();
+                q[i] = -q[i];
+                let flipped = max(&q);
+                assert!(flipped >= at, "{name} constant {i} ({}): flipped {flipped:e}, committed {at:e}", p[i]);
+                raised += usize::from(flipped > at);
+            }
+            assert!(2 * raised > p.len(), "{name}: {raised} of {} flips raise the max error", p.len());
+        }
+    }
+
+    /// The model the MaterialX refit solves is MaterialX's form: with the published constants
+    /// of a channel (numerator row entries, then the denominator's but its constant 1) it gives
+    /// `MaterialX::eval`'s value of that channel, and it is clamped to [0, 1] as the source's
+    /// `clamp`: a numerator of constant 2 reads 1, of constant −1 reads 0. 1e-12: the same
+    /// sums in another order, on values of the constants' size (≤ 60).
+    #[test]
+    fn the_materialx_model_is_the_forms_rational_clamped_to_the_unit_interval() {
+        let model = materialx_model();
+        for ch in 0..2 {
+            let c = DVector::from_vec((0..9).map(|k| MATERIALX.r[k][ch]).chain((1..9).map(|k| MATERIALX.r[k][ch + 2])).collect());
+            for (m, a) in [(0.1, 0.2), (0.5, 0.5), (0.9, 0.7), (0.3, 0.95)] {
+                let (got, want) = (model.eval_clamped(&c, &[m, a]), MATERIALX.eval(m, a)[ch]);
+                assert!((got - want).abs() < 1e-12, "channel {ch} at ({m}, {a}): {got} vs {want}");
+            }
+        }
+        let constant = |v: f64| DVector::from_vec((0..17).map(|k| if k == 0 { v } else { 0.0 }).collect());
+        assert_eq!((model.eval_clamped(&constant(2.0), &[0.5, 0.5]), model.eval_clamped(&constant(-1.0), &[0.5, 0.5])), (1.0, 0.0));
+    }
+
     /// Kulla–Conty's refit from the published constants: each branch's max error on its η
     /// grid, measured through the form (`KullaConty::eval`: (η − 1)/(a₀ + a₁η) for η ≥ 1,
     /// b₀ + b₁η + b₂η² + b₃η³ below), not through the solver's objective, is below the
