@@ -1262,7 +1262,7 @@ mod r_horizon;
 
 #[cfg(test)]
 #[allow(clippy::needless_range_loop)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     /// G at subnormal d (or μv) takes its limit with a bound instead of quadrature nodes that
@@ -2043,7 +2043,7 @@ mod tests {
     // Published constants (supplemental material, Appendices A, C, E, G), transcribed as printed.
 
     /// Listing 1: per i = 0..5, [t_i, p_i (13), q_i (13)].
-    const PUB_PS: [[f64; 27]; 6] = [
+    pub(crate) const PUB_PS: [[f64; 27]; 6] = [
         [
             0.13756974,
             0.089967924,
@@ -2220,9 +2220,9 @@ mod tests {
         ],
     ];
     /// Listing 3 (G̃), Listing 4 (Q̃), Listing 5 (R̃: t, p (13), q (3)).
-    const PUB_G: [f64; 4] = [-0.94634516, 0.41691235, 0.70663116, -0.26154413];
-    const PUB_Q: [f64; 2] = [-1.7280754, 1.2661427];
-    const PUB_R: [f64; 17] = [
+    pub(crate) const PUB_G: [f64; 4] = [-0.94634516, 0.41691235, 0.70663116, -0.26154413];
+    pub(crate) const PUB_Q: [f64; 2] = [-1.7280754, 1.2661427];
+    pub(crate) const PUB_R: [f64; 17] = [
         -0.26805773,
         0.30887989,
         0.077007705,
