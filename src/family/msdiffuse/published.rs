@@ -764,4 +764,98 @@ mod tests {
         let tail = &f[f.find(", rms ").unwrap()..];
         assert!((number_after(tail, ", rms ") - rr).abs() <= 5e-4 * rr && (number_after(tail, " (") - rr / rms).abs() <= 5e-3, "{f}");
     }
+
+    /// The shipped hand fit where l·h ≠ 1, so that f₀'s Schlick-like term and f_b's factor l·h
+    /// both count (the points above have l·h = 1): g = 0.5, l·h = 0.5, n·l = 0.5, n·v = 0.8,
+    /// n·h = 0.64, by hand from the talk's formula: f0 = 0.5 + 0.5⁵ = 0.53125; f1 = 0.976328125
+    /// as above; t = 0.6, f_d = 0.53125 + 0.6·0.445078125 = 0.798296875; f_b = 3.625·0.5·2^−12.32
+    /// = 3.5447733e-4. Total 0.79865135233.
+    #[test]
+    fn hand_fit_where_l_dot_h_is_not_one() {
+        let c = Cosines { n_dot_l: 0.5, n_dot_v: 0.8, n_dot_h: 0.64, l_dot_h: 0.5, l_dot_v: 0.0 };
+        let v = hand_fit(0.5, &c);
+        // The digits kept by hand: 1e-10.
+        assert!((v - 0.79865135233).abs() < 1e-10, "{v}");
+    }
+
+    /// The cosines of a slice point against the half/difference frame's closed forms: v is l
+    /// mirrored about h (v = 2(l·h)h − l), so l·v = 2cos²θd − 1 = cos 2θd whatever θh and φd, and
+    /// l + v = 2cos θd h gives n·l + n·v = 2 cos θd cos θh; n·h = cos θh, l·h = cos θd. At φd off
+    /// 0, π/2 and π and θh > 0 every product in l·v is non-zero and n·l ≠ n·v.
+    #[test]
+    fn cosines_follow_the_half_and_difference_frame() {
+        for (th, td, pd) in [(0.3, 0.5, 1.0), (0.7, 0.2, 2.5), (0.5, 0.6, 0.4), (0.2, 0.9, 2.0)] {
+            let c = Cosines::at(th, td, pd).expect("above the horizon");
+            // A few roundings of unit vectors' products: 1e-14.
+            assert!((c.l_dot_v - (2.0 * td).cos()).abs() < 1e-14, "θh {th} θd {td} φd {pd}: l·v {} vs {}", c.l_dot_v, (2.0 * td).cos());
+            assert!((c.n_dot_l + c.n_dot_v - 2.0 * td.cos() * th.cos()).abs() < 1e-14, "θh {th} θd {td} φd {pd}: {c:?}");
+            assert!((c.n_dot_l - c.n_dot_v).abs() > 1e-3, "θh {th} θd {td} φd {pd}: {c:?}");
+            assert_eq!((c.n_dot_h, c.l_dot_h), (th.cos(), td.cos()));
+        }
+    }
+
+    /// ∫₀^{π/2} f by Simpson's rule on `n` panels of each of [0, split] and [split, π/2].
+    fn simpson_split(split: f64, n: usize, f: impl Fn(f64) -> f64) -> f64 {
+        let piece = |a: f64, b: f64| {
+            let h = (b - a) / n as f64;
+            (0..=n).map(|i| f(a + i as f64 * h) * if i == 0 || i == n { 1.0 } else if i % 2 == 1 { 4.0 } else { 2.0 }).sum::<f64>() * h / 3.0
+        };
+        piece(0.0, split) + piece(split, FRAC_PI_2)
+    }
+
+    /// EON's single-scattering lobe (Portsmouth, Kutz & Hill 2025) at ρ = 1: π f_ss = A (1 + r
+    /// s/t), s = l·v − μi μo, t = max(μi, μo) where s > 0 and 1 elsewhere, A = 1/(1 + (½ −
+    /// 2/(3π)) r). Its albedo by the test's own quadrature: s = sin θi sin θo cos φ, so over φ
+    /// the lobe integrates to 2π + 2 r sin θi sin θo (1/max(μi, μo) − 1), and E(μi) = A [1 +
+    /// (2 r sin θi/π) ∫₀^{π/2} sin²θ cos θ (1/max(μi, cos θ) − 1) dθ], the integrand smooth on
+    /// each side of θ = θi (Simpson, 400 panels each: error ~1e-13).
+    fn lobe_albedo(mu: f64, r: f64) -> f64 {
+        let a = 1.0 / (1.0 + (0.5 - 2.0 / (3.0 * PI)) * r);
+        let ti = mu.acos();
+        let inner = simpson_split(ti, 400, |t| t.sin().powi(2) * t.cos() * (1.0 / mu.max(t.cos()) - 1.0));
+        a * (1.0 + 2.0 * r * ti.sin() / PI * inner)
+    }
+
+    /// EON's lobe albedo E_FON(μ), its closed form in `e_fon` against the test's quadrature of
+    /// the lobe; and EON itself at ρ = 1 as the lobe plus the energy it loses, A (1 + r s/t) +
+    /// (1 − E(μo))(1 − E(μi))/(1 − Ē), with Ē = 2∫₀¹ E(μ) μ dμ also by quadrature (the
+    /// multiple-scattering albedo ρ_ms is 1 at ρ = 1). Light and view off each other's plane
+    /// both ways (s > 0 and s < 0) and μi ≠ μo. Bound 1e-9: the quadratures' ~1e-12, divided by
+    /// 1 − Ē ≥ 0.05 at these r.
+    #[test]
+    fn eon_is_its_lobe_plus_the_energy_the_lobe_loses() {
+        for r in [0.3, 0.7, 1.0] {
+            for mu in [0.1, 0.4, 0.8, 1.0] {
+                let (got, want) = (e_fon(mu, r), lobe_albedo(mu, r));
+                assert!((got - want).abs() <= 1e-10, "r {r} μ {mu}: E_FON {got} vs {want}");
+            }
+            let avg = 2.0 * simpson_split(std::f64::consts::FRAC_PI_4, 100, |t| lobe_albedo(t.cos(), r) * t.cos() * t.sin());
+            assert!(1.0 - avg >= 0.05, "r {r}: Ē {avg}");
+            for (mi, mo, cos_phi) in [(0.8f64, 0.3f64, 0.6), (0.3, 0.8, -0.5), (0.5, 0.9, 0.2), (0.9, 0.2, -0.9)] {
+                let (si, so) = ((1.0 - mi * mi).sqrt(), (1.0 - mo * mo).sqrt());
+                let s = si * so * cos_phi;
+                let c = Cosines { n_dot_l: mi, n_dot_v: mo, n_dot_h: 0.0, l_dot_h: 0.0, l_dot_v: s + mi * mo };
+                let t = if s > 0.0 { mi.max(mo) } else { 1.0 };
+                let a = 1.0 / (1.0 + (0.5 - 2.0 / (3.0 * PI)) * r);
+                let want = a * (1.0 + r * s / t) + (1.0 - lobe_albedo(mo, r)) * (1.0 - lobe_albedo(mi, r)) / (1.0 - avg);
+                assert!((eon(r, &c) - want).abs() <= 1e-9, "r {r} μi {mi} μo {mo} cos φ {cos_phi}: {} vs {want}", eon(r, &c));
+            }
+        }
+    }
+
+    /// The committed rational as `CommittedRational` evaluates it (f64 arithmetic on the JSON's
+    /// f32 coefficients, inputs clamped to the axes, the result to the model's clamp) against the
+    /// emitted Rust function of the runtime crate, a separate rendering of the same
+    /// coefficients in f32: inside the axes and past them (α and n·h below their lower ends,
+    /// which both clamp). Bound 1e-4: f32 rounding of 23 terms of size ≤ 4 (≲ 1e-5 in P and
+    /// Q) over Q, which these points keep away from its lower bound 0.0033.
+    #[test]
+    fn the_committed_rational_evaluates_as_the_emitted_code() {
+        use shadefit_runtime::ms_diffuse_rational::ms_diffuse_rational as emitted;
+        let fit = CommittedRational::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("generated")).expect("generated/json/ms_diffuse_rational.json");
+        for (alpha, nh, lh) in [(0.5, 0.7, 0.6), (0.05, 0.9, 0.3), (1.0, 0.4, 0.95), (0.2, 0.05, 0.5), (0.001, 0.5, 0.8), (0.8, 1.0, 1.0)] {
+            let (got, want) = (fit.eval(alpha, nh, lh), emitted(alpha as f32, nh as f32, lh as f32) as f64);
+            assert!(want > 0.1 && (got - want).abs() <= 1e-4, "α {alpha} n·h {nh} l·h {lh}: {got} vs the emitted {want}");
+        }
+    }
 }
