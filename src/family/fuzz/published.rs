@@ -356,8 +356,8 @@ mod tests {
         assert!(swapped.0 <= max, "rows 3 and 4 exchanged: max {:e} above the floor's {max:e}", swapped.0);
         // The committed refit's errors and the finding that states them beside the table's.
         let (rmax, rrms, smax, srms) = (refit.0, (refit.1 / n as f64).sqrt(), swapped.0, (swapped.1 / n as f64).sqrt());
-        close("refit max", extra("refit_max_abs_error"), rmax);
-        close("refit rms", extra("refit_rms_error"), rrms);
+        close("refit max", crate::validate::extra(ps, "refit_max_abs_error"), rmax);
+        close("refit rms", crate::validate::extra(ps, "refit_rms_error"), rrms);
         let f = ps.findings.iter().find(|f| f.starts_with("shadefit's refit")).expect("the refit's finding");
         // Printed to 4 significant digits ({:.3e}, 5e-4 relative) and ratios to hundredths.
         let tail = &f[f.find("max ").unwrap()..];
@@ -426,6 +426,17 @@ mod tests {
         for k in 0..13 {
             assert!((got[k] - want[k]).abs() < 1e-15, "feature {k}: {} vs {}", got[k], want[k]);
         }
+    }
+
+    /// Listing 3's G̃ at μv = 0.3, d = 0.2, by hand from the listing: c₀ + 0.3·c₁ = −0.821271455,
+    /// numerator 0.2·(1 + 0.3·(−0.821271455)) = 0.1507237127; c₂ + 0.09·c₃ = 0.6830921883,
+    /// denominator 0.2 + 0.3·0.6830921883 = 0.40492765649; G̃ = 0.372223804139. And past the
+    /// published d ≤ 0.5, d = 0.9 reads d = 0.5: 0.37680928175/0.70492765649 = 0.534536102082.
+    #[test]
+    fn listing_3_at_a_hand_computed_point() {
+        // The digits kept by hand: 1e-12.
+        assert!((published_g(0.3, 0.2) - 0.372223804139).abs() <= 1e-12, "{}", published_g(0.3, 0.2));
+        assert!((published_g(0.3, 0.9) - 0.534536102082).abs() <= 1e-12, "{}", published_g(0.3, 0.9));
     }
 
     /// Listing 4's Q̃ against Q = 2·E₃(d), E₃ by the test's own quadrature, at 11 points of
