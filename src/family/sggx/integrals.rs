@@ -449,7 +449,8 @@ pub struct Distance {
     pub tv: f64,
     /// √∫(p − q)².
     pub l2: f64,
-    /// max |p − q| on the rule's nodes, and where (θ, φ).
+    /// max |p − q| on the rule's nodes, and where (θ, φ): the first node, in the rule's order,
+    /// that reaches it.
     pub max: f64,
     pub worst: (f64, f64),
     /// ∫D of each.
@@ -619,7 +620,7 @@ mod tests {
 
     /// `is_spd` is Sylvester's criterion on a matrix symmetric to 1e-12 of its largest entry:
     /// an off-diagonal pair apart by 1e-13 of the scale passes and by 1e-10 fails, at scales 1e6
-    /// and 1e-6 alike; a negative first, second or third leading minor fails.
+    /// and 1e-6 alike; a negative or zero first, second or third leading minor fails.
     #[test]
     fn is_spd_is_sylvesters_criterion_with_a_relative_symmetry_tolerance() {
         for scale in [1e6, 1e-6] {
@@ -631,6 +632,13 @@ mod tests {
             M3::new(-1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0),
             M3::new(1.0, 2.0, 0.0, 2.0, 1.0, 0.0, 0.0, 0.0, 1.0),
             M3::new(1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, -1.0),
+            // Zero minors fail: the third (det 0), and the first or second even where the
+            // asymmetry the tolerance admits (1e-14, 1e-13 of the scale 1) makes the later
+            // minors positive: s₀₀ = 0 with second minor 1e-28 and det 1e-28; a singular leading
+            // block [[1, 1], [1, 1]] with det 1e-26 (each exact in f64, nalgebra's cofactor sums).
+            M3::new(1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0),
+            M3::new(0.0, -1e-14, 0.0, 1e-14, 1.0, 0.0, 0.0, 0.0, 1.0),
+            M3::new(1.0, 1.0, 0.0, 1.0, 1.0, 1e-13, 1e-13, 0.0, 0.0),
         ];
         for m in minors {
             assert!(!is_spd(&m), "{m}");
@@ -763,6 +771,8 @@ mod tests {
             let d = decode_course(encode(a), ALPHA_MIN);
             assert!(d.aniso().max_diff(&a) < 1e-12, "{:?} vs {a:?}", d.aniso());
             assert!((d.alpha_t_sqr - at.max(ab).powi(2)).abs() < 1e-12);
+            // α_t α_b, the product of the two roots (the same 1e-12 of rounding).
+            assert!((d.alpha_tb - at * ab).abs() < 1e-12, "α_t α_b {} vs {}", d.alpha_tb, at * ab);
             assert!((d.cos * d.cos + d.sin * d.sin - 1.0).abs() < 1e-12);
         }
         // Channels in [0, 1] always decode to a positive semi-definite matrix: |2y − 1| ≤ 1 gives
@@ -786,8 +796,9 @@ mod tests {
         // Sxy = 0 exactly, Sxx < Syy (α 0.25 along t_n, 0.5 along b_n): cos ψ = 0, so sin ψ must
         // be ±1 (HLSL's sign(0) = 0 would give a zero tangent). Exact: the channels 0.25, 0.5,
         // 0.5 and every operation on them are exact in binary.
+        // Sign(0) = +1 (the listing's Sign as read here, and the emitted decoder's): sin ψ = +1.
         let d = decode_course(encode(Aniso { sxx: 0.0625, sxy: 0.0, syy: 0.25 }), ALPHA_MIN);
-        assert_eq!((d.cos, d.sin.abs()), (0.0, 1.0));
+        assert_eq!((d.cos, d.sin), (0.0, 1.0));
         assert_eq!((d.alpha_t_sqr, d.alpha_b_sqr), (0.25, 0.0625));
     }
 
@@ -835,5 +846,157 @@ mod tests {
         let two = Lean::filter(&[(3.0, direction(0.5, 0.0), a), (1.0, direction(0.5, PI), a)]).unwrap();
         let want = V3::new((0.5f64).tan() / 2.0, 0.0, 1.0).normalize();
         assert!((two.normal() - want).norm() < 1e-15, "{} vs {want}", two.normal());
+    }
+
+    /// A power iteration cut off at POWER_MAX_ITER reports the residual of its last iterate,
+    /// ‖S n − λn‖/λ with λ = nᵀS n (recomputed here), and `extract` the off-block column of that
+    /// n over λ: the column (M_nᵀ S n)₀,₁ is M_nᵀ r for r = S n − λn ⊥ n, so its largest entry
+    /// lies in [‖r‖/√2, ‖r‖]. The lobe (α = 0.99999: the residual shrinks by α² a step, ≈ 1.6
+    /// million steps to converge, ≈ e^-2 of the way at the cut) is scaled by 4 so that λ ≈ 4 and
+    /// a missing division by λ shows; 4 is
+    /// a power of two, so the iterates, and the block divided by its (3, 3) entry, are exactly
+    /// those of the unscaled lobe.
+    #[test]
+    fn a_cut_off_iteration_reports_its_own_residual_and_off_block_column() {
+        let s1 = sggx_from(direction(0.6, 0.3), Aniso::isotropic(0.99999));
+        let s = s1 * 4.0;
+        let e = extract(&s);
+        let p = e.power;
+        assert!(!p.converged && p.iterations == POWER_MAX_ITER, "{p:?}");
+        let sn = s * p.n;
+        let lambda = p.n.dot(&sn);
+        let residual = (sn - lambda * p.n).norm() / lambda;
+        // λ: one dot product (1e-15 relative). The residual (≈ 2e-6: the start's distance from n
+        // is itself ≈ 1 − α²): r ≈ 7e-6 from entries ≈ 4 rounded to ≈ 1e-15 each, so ≈ 1e-9
+        // relative; bound 1e-6 (the mutants are off by factors ≥ 4).
+        assert!((p.lambda / lambda - 1.0).abs() < 1e-15 && (lambda - 4.0).abs() < 1e-3, "λ {} vs {lambda}", p.lambda);
+        assert!(residual > 1e-7 && (p.residual / residual - 1.0).abs() < 1e-6, "residual {} vs {residual}", p.residual);
+        // The column through M_nᵀ S M_n rounds apart from r by the same ≈ 1e-9 relative.
+        assert!(e.off_block > residual / 2f64.sqrt() * (1.0 - 1e-6) && e.off_block < residual * (1.0 + 1e-6), "off-block {} vs residual {residual}", e.off_block);
+        let e1 = extract(&s1);
+        assert_eq!((e.n, e.aniso), (e1.n, e1.aniso));
+    }
+
+    /// The block is normalised by the projected area along n′ (the module doc): two isotropic
+    /// α = 0.3 lobes at ±30° about z filter to S′ = α²I + (1 − α²)·mean(n nᵀ) = diag(α² + ¼(1 −
+    /// α²), α², α² + ¾(1 − α²)) = diag(0.3175, 0.09, 0.7725), whose dominant axis is z with
+    /// λ = 0.7725; M_z is the identity, so the block is diag(0.3175, 0.09)/0.7725 (1e-12: a
+    /// few roundings of entries ≤ 1; the off-diagonal entries cancel to rounding).
+    #[test]
+    fn the_extracted_block_is_divided_by_the_normals_projected_area() {
+        let a = Aniso::isotropic(0.3);
+        let tilt = std::f64::consts::FRAC_PI_6;
+        let f = filter(&[(1.0, sggx_from(direction(tilt, 0.0), a)), (1.0, sggx_from(direction(tilt, PI), a))]);
+        let e = extract(&f);
+        assert!((e.n - V3::z()).norm() < 1e-12 && (e.power.lambda - 0.7725).abs() < 1e-12, "{:?}", e.power);
+        let want = Aniso { sxx: 0.3175 / 0.7725, sxy: 0.0, syy: 0.09 / 0.7725 };
+        assert!(e.aniso.max_diff(&want) < 1e-12, "{:?} vs {want:?}", e.aniso);
+    }
+
+    /// `quantize` returns the nearest of the 2^b values k/(2^b − 1): every 8-bit code k/255
+    /// comes back exactly, and so does a value 0.3/255 either side of it; values outside
+    /// [0, 1] clamp to the ends; at 16 bits the step is 1/65535.
+    #[test]
+    fn quantize_rounds_to_the_nearest_unorm_code() {
+        for k in 0..=255u32 {
+            let code = k as f64 / 255.0;
+            let near = [code, (k as f64 + 0.3) / 255.0, (k as f64 - 0.3).max(0.0) / 255.0];
+            assert_eq!(quantize(near, 8), [code; 3], "code {k}");
+        }
+        assert_eq!(quantize([-0.2, 1.7, 0.5], 8), [0.0, 1.0, 128.0 / 255.0]);
+        assert_eq!(quantize([1000.4 / 65535.0, 0.0, 1.0], 16), [1000.0 / 65535.0, 0.0, 1.0]);
+    }
+
+    /// LEAN's slope covariance: one tilted texel gives back its own block as A (its second
+    /// moment s sᵀ + B/2 less μμᵀ, times 2), and its D is the GGX slope distribution centred on
+    /// the normal's slope, written out here with the 2×2 inverse and determinant of B:
+    /// 1/(π √|B| (1 + (s − μ)ᵀB⁻¹(s − μ))² m_z⁴), mirrored below the horizon. Two texels at
+    /// ±0.5 rad about x with weights 3 and 1 (slopes ±t, t = tan 0.5) add twice the slopes'
+    /// variance, 2(t² − (t/2)²) = 1.5 t², along x. 1e-14: rounding of a difference of
+    /// second moments ≈ 1.
+    #[test]
+    fn lean_covariance_is_the_blocks_plus_twice_the_slopes() {
+        let (n, b) = (direction(0.7, 2.0), Aniso::from_alphas(0.4, 0.15, 0.5));
+        let lean = Lean::filter(&[(1.0, n, b)]).unwrap();
+        assert!((lean.a - b.matrix()).amax() < 1e-14, "{} vs {}", lean.a, b.matrix());
+        let det = b.sxx * b.syy - b.sxy * b.sxy;
+        let mu = (n.x / n.z, n.y / n.z);
+        for m in [n, direction(0.9, 2.3), direction(0.3, -1.0)] {
+            let (sx, sy) = (m.x / m.z - mu.0, m.y / m.z - mu.1);
+            let q = 1.0 + (b.syy * sx * sx - 2.0 * b.sxy * sx * sy + b.sxx * sy * sy) / det;
+            let want = 1.0 / (PI * det.sqrt() * q * q * m.z.powi(4));
+            // A rational expression of a few terms: 1e-12 relative.
+            assert!((Lean::d(&lean, &m) / want - 1.0).abs() < 1e-12, "{m}: {} vs {want}", Lean::d(&lean, &m));
+            assert_eq!(Ndf::d(&lean, &-m), Lean::d(&lean, &m));
+        }
+        let a = Aniso::isotropic(0.2);
+        let t = (0.5f64).tan();
+        let two = Lean::filter(&[(3.0, direction(0.5, 0.0), a), (1.0, direction(0.5, PI), a)]).unwrap();
+        let want = Matrix2::new(0.04 + 1.5 * t * t, 0.0, 0.0, 0.04);
+        assert!((two.a - want).amax() < 1e-14, "{} vs {want}", two.a);
+    }
+
+    /// A mixture's D is the weight-normalised sum of its lobes' (weights 1 and 3: a quarter and
+    /// three quarters), and its projected area the same mean of the lobes' √(ωᵀSω); the sphere
+    /// rule's ∫⟨ω, m⟩₊ D dm of the mixture is that area. The lobes (α ≥ 0.3) span > 40 nodes per
+    /// α on this rule; the kink of ⟨·⟩₊ makes it first order there (2e-6 at twice the panels in
+    /// the normalisation test, so ≈ 4e-6 here); bound 1e-4.
+    #[test]
+    fn a_mixture_is_the_weighted_mean_of_its_lobes() {
+        let (n1, a1) = texel(0.3, 0.2, 0.5, 0.3, 0.4);
+        let (n2, a2) = texel(1.0, 2.5, 0.8, 0.4, -1.0);
+        let (s1, s2) = (sggx_from(n1, a1), sggx_from(n2, a2));
+        let (l1, l2) = (Lobe::new(s1).unwrap(), Lobe::new(s2).unwrap());
+        let mix = Mixture { lobes: vec![(1.0, l1), (3.0, l2)] };
+        for m in [direction(0.3, 0.2), direction(1.0, 2.5), direction(2.0, -1.0)] {
+            let want = 0.25 * l1.d(&m) + 0.75 * l2.d(&m);
+            assert!((Ndf::d(&mix, &m) / want - 1.0).abs() < 1e-14, "{m}");
+        }
+        let rule = SphereRule::new(48, 96, 8);
+        for w in [direction(0.9, -1.0), V3::z()] {
+            let want = 0.25 * w.dot(&(s1 * w)).sqrt() + 0.75 * w.dot(&(s2 * w)).sqrt();
+            assert!((mix.projected_area(&w) / want - 1.0).abs() < 1e-14, "{w}");
+            let area = rule.integrate(|m| Ndf::d(&mix, m) * m.dot(&w).max(0.0));
+            assert!((area - want).abs() < 1e-4, "{w}: ∫ {area} vs {want}");
+        }
+    }
+
+    /// Where |p − q| ties across nodes, the worst point is the first node, in the rule's order,
+    /// that reaches the maximum: against a step (3 above the horizon, 1 below) every node
+    /// above has one value of |p − q| and every node below another; the worst is the first
+    /// node of the larger group, found here from |1/m_a − D_b/m_b| at the masses `distance`
+    /// reports (checked by the test above).
+    #[test]
+    fn the_worst_point_of_tied_nodes_is_the_first() {
+        let rule = SphereRule::new(8, 16, 8);
+        let step = Field(|m: &V3| if m.z > 0.0 { 3.0 } else { 1.0 });
+        let d = distance(&Field(|_: &V3| 1.0), &step, &rule);
+        let (ma, mb) = d.mass;
+        let e = |m: &V3| (1.0 / ma - step.d(m) / mb).abs();
+        let first = rule.points.iter().position(|(m, _)| e(m) == d.max).unwrap();
+        let ties = rule.points.iter().filter(|(m, _)| e(m) == d.max).count();
+        assert!(ties > 1, "no tie");
+        let m = rule.points[first].0;
+        assert_eq!(d.worst, (m.z.clamp(-1.0, 1.0).acos(), m.y.atan2(m.x)), "first of {ties} tied nodes is {first}");
+    }
+
+    /// `Rng` is xorshift64* (Vigna 2016: x ^= x >> 12, x ^= x << 25, x ^= x >> 27, output the
+    /// top 53 bits of x·0x2545F4914F6CDD1D). From x = 1: 1 >> 12 = 0, then 1 ^ 2²⁵, and
+    /// (2²⁵ + 1) >> 27 = 0, so x₁ = 2²⁵ + 1; then x ^= x >> 12 adds 2¹³, x ^= x << 25 adds 2⁵⁰ +
+    /// 2³⁸ and cancels 2²⁵, x ^= x >> 27 adds 2²³ + 2¹¹: x₂ = 2⁵⁰ + 2³⁸ + 2²³ + 2¹³ + 2¹¹ + 1.
+    /// The next two states and the outputs are Python's integer arithmetic of the same steps.
+    #[test]
+    fn rng_is_xorshift64_star() {
+        let mut rng = Rng(1);
+        let outputs: Vec<f64> = (0..4).map(|_| rng.next()).collect();
+        let mut states = Vec::new();
+        let mut rng = Rng(1);
+        for _ in 0..4 {
+            rng.next();
+            states.push(rng.0);
+        }
+        assert_eq!(states, [(1u64 << 25) + 1, (1u64 << 50) + (1 << 38) + (1 << 23) + (1 << 13) + (1 << 11) + 1, 0xd004003202803, 0x200340a005480e81]);
+        let want = [2529537253518747u64, 6045066965290796, 6537840858852963, 2733948884444000].map(|k| k as f64 / (1u64 << 53) as f64);
+        assert_eq!(outputs, want);
     }
 }
