@@ -302,7 +302,9 @@ mod tests {
     ///   the encoding clamps it;
     /// - a tilted lobe of α = 0.9999: the residual shrinks by λ₂/λ₁ = α² a step, so reaching
     ///   POWER_TOL would take ln(1e-14)/ln(α²) ≈ 161 000 steps, past POWER_MAX_ITER (100 000):
-    ///   not converged, and the block (within e^-20 of the converged one) stays under 1.
+    ///   not converged, and the block (within e^-20 of the converged one) stays under 1;
+    /// - an α = 1 lobe (S = I): its block's eigenvalue is exactly 1, which the encoding stores
+    ///   (√1 = 1), so it is not counted as clamped.
     #[test]
     fn the_report_counts_unconverged_and_clamped_texels() {
         use super::super::integrals::{Aniso, POWER_MAX_ITER, direction};
@@ -314,6 +316,7 @@ mod tests {
         let predicted = (1e-14f64).ln() / (0.9999f64 * 0.9999).ln();
         assert!(predicted > 1.5 * POWER_MAX_ITER as f64, "{predicted}");
         assert_eq!(count(sggx_from(direction(0.6, 0.3), Aniso::isotropic(0.9999))), (1, 1, POWER_MAX_ITER, 1, 0));
+        assert_eq!(count(M3::identity()), (1, 1, 0, 0, 0));
     }
 
     /// The 8-bit codes of a texel with normal n and block a, as the two maps store them:
@@ -346,7 +349,8 @@ mod tests {
     }
 
     /// Each texel of a level is the mean of its own footprint of the level below (module doc:
-    /// 2, the 2×2 children; 4, those and one texel around them, edges clamped): a 4 × 4
+    /// 2, the 2×2 children; 4, those and one texel around them, edges clamped; any even
+    /// footprint f is the f × f box, (f − 2)/2 texels around the children: 6 here): a 4 × 4
     /// texture whose sixteen lobes all differ (tilt, azimuth and roughness by texel), filtered
     /// to 2 × 2, against the box means formed here texel by texel and taken through the same
     /// extraction and encoding (judged by their own tests). 8-bit codes, within one: the sums
@@ -361,7 +365,7 @@ mod tests {
                 sggx_from(direction(0.1 + 0.15 * x + 0.05 * y, 0.4 * y + 1.3 * x), a)
             })
             .collect();
-        for (footprint, offsets) in [(2usize, vec![0isize, 1]), (4, vec![-1, 0, 1, 2])] {
+        for (footprint, offsets) in [(2usize, vec![0isize, 1]), (4, vec![-1, 0, 1, 2]), (6, vec![-2, -1, 0, 1, 2, 3])] {
             let (normal, aniso, _) = mip_chain(w as u32, h as u32, s0.clone(), 8, footprint, &|_| {});
             let level = |bytes: &[u8]| ktx2::Reader::new(bytes).unwrap().levels().nth(1).unwrap().data.to_vec();
             let (ln, la) = (level(&normal), level(&aniso));
