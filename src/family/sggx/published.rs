@@ -485,16 +485,17 @@ mod tests {
     }
 
     /// The random footprints spread over their ranges, not just stay inside them: 2, 3 and 4
-    /// texels each on about a third of 64 cases (binomial: 21.3 ± 3.8; at least 10 each), and
-    /// the tilt θ/(π/3), the azimuth φ/2π and the larger α's axis mod π over π (ψ uniform on
-    /// [0, π), the axis ψ or ψ + π/2) each within the Kolmogorov–Smirnov distance of uniform
-    /// that a fair sample stays under at the 1% level, 1.63/√N (N ≈ 190 texels).
+    /// texels each on about a third of 4096 cases (binomial: 1365 ± 30; at least 1200 each),
+    /// and the tilt θ/(π/3), the azimuth φ/2π and the larger α's axis mod π over π (ψ uniform
+    /// on [0, π), the axis ψ or ψ + π/2) each within the Kolmogorov–Smirnov distance of
+    /// uniform that a fair sample stays under at the 1% level, 1.63/√N (N ≈ 12 000 texels:
+    /// 0.015, small enough to see a skew of ψ that the mix of ψ and ψ + π/2 halves).
     #[test]
     fn random_cases_spread_over_their_ranges() {
-        let cases = random_cases(64, 7);
+        let cases = random_cases(4096, 7);
         for k in 2..=4 {
             let count = cases.iter().filter(|c| c.texels.len() == k).count();
-            assert!(count >= 10, "{count} footprints of {k} texels");
+            assert!(count >= 1200, "{count} footprints of {k} texels");
         }
         let texels: Vec<&(f64, V3, Aniso)> = cases.iter().flat_map(|c| &c.texels).collect();
         let ks = |name: &str, mut u: Vec<f64>| {
