@@ -409,8 +409,32 @@ pub fn lut_built(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
+
+    /// Filament's layout of a texel (scale, bias): [bias, scale + bias].
+    pub(crate) fn filament([s, b]: [f64; 2]) -> [f64; 2] {
+        [b, s + b]
+    }
+
+    /// Texels in Filament's layout, exact and as f16 stores them (rounded by the `half` crate,
+    /// through f32 as the texture is written), with the largest rounding: what the LUTs'
+    /// verification tests re-measure their claims from.
+    pub(crate) fn filament_texels(values: &[[f64; 2]]) -> (Vec<[f64; 2]>, Vec<[f64; 2]>, f64) {
+        let f16 = |x: f64| f64::from(half::f16::from_f32(x as f32).to_f32());
+        let exact: Vec<[f64; 2]> = values.iter().map(|v| filament(*v)).collect();
+        let stored: Vec<[f64; 2]> = exact.iter().map(|v| v.map(f16)).collect();
+        let storage = exact.iter().flat_map(|v| v.map(|x| (x - f16(x)).abs())).fold(0.0, f64::max);
+        (exact, stored, storage)
+    }
+
+    /// A linear sampler along an axis of n texels at texture coordinate p (texel centres, clamp
+    /// to edge): the lower texel of the pair and the upper one's weight.
+    pub(crate) fn coord(p: f64, n: usize) -> (usize, f64) {
+        let x = (p * n as f64 - 0.5).clamp(0.0, (n - 1) as f64);
+        let i = (x.floor() as usize).min(n - 2);
+        (i, x - i as f64)
+    }
 
     /// A DFG LUT spec `ggx_t` of the default quantity at `resolution` (n·v × rows).
     fn spec_text([w, h]: [usize; 2]) -> String {
@@ -510,18 +534,9 @@ mod tests {
         let (w, h) = (lut.width, lut.height);
         let (values, _) = tabulate(&lut);
         let m = verify(&lut, &values).unwrap();
-        let encode = |[s, b]: [f64; 2]| [b, s + b];
-        let f16 = |x: f64| f64::from(half::f16::from_f32(x as f32).to_f32());
-        let stored: Vec<[f64; 2]> = values.iter().map(|v| encode(*v).map(f16)).collect();
-        let exact: Vec<[f64; 2]> = values.iter().map(|v| encode(*v)).collect();
-        let storage = values.iter().flat_map(|v| encode(*v).map(|x| (x - f16(x)).abs())).fold(0.0, f64::max);
+        let (exact, stored, storage) = filament_texels(&values);
         assert_eq!(m.max_abs_storage_error, storage);
         assert!(storage > 0.0);
-        let coord = |p: f64, n: usize| {
-            let x = (p * n as f64 - 0.5).clamp(0.0, (n - 1) as f64);
-            let i = (x.floor() as usize).min(n - 2);
-            (i, x - i as f64)
-        };
         let read = |tex: &[[f64; 2]], u: f64, t: f64| -> [f64; 2] {
             let ((i, fx), (j, fy)) = (coord(u, w), coord(t, h));
             std::array::from_fn(|c| {
@@ -556,7 +571,7 @@ mod tests {
         let (mut tex, mut inner, mut interp) = (Errors::default(), Errors::default(), Errors::default());
         let truth = |u: f64, t: f64| {
             let r = env_with(lut.mapping.alpha(t), u, 0.0, Shadowing::HeightCorrelated, 1e-10, Inner::Adaptive);
-            encode([r.scale, r.bias])
+            filament([r.scale, r.bias])
         };
         for &t in &ts {
             for &u in &us {

@@ -262,6 +262,7 @@ pub fn build(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::family::ggx::lut::build::tests::{coord, filament, filament_texels};
 
     /// The verification samples the cone cosine between the slices, at the centres of
     /// VERIFY_DENSITY (2) intervals in each: 0.25 and 0.75 on a 2 × 2 × 2 LUT. With slice 1's
@@ -343,18 +344,9 @@ mod tests {
         let (w, h, d) = (lut.base.width, lut.base.height, lut.depth);
         let (values, _) = tabulate(&lut);
         let m = verify(&lut, &values).unwrap();
-        let encode = |[s, b]: [f64; 2]| [b, s + b];
-        let f16 = |x: f64| f64::from(half::f16::from_f32(x as f32).to_f32());
-        let stored: Vec<[f64; 2]> = values.iter().map(|v| encode(*v).map(f16)).collect();
-        let exact: Vec<[f64; 2]> = values.iter().map(|v| encode(*v)).collect();
-        let storage = values.iter().flat_map(|v| encode(*v).map(|x| (x - f16(x)).abs())).fold(0.0, f64::max);
+        let (exact, stored, storage) = filament_texels(&values);
         assert_eq!(m.max_abs_storage_error, storage);
         assert!(storage > 0.0);
-        let coord = |p: f64, n: usize| {
-            let x = (p * n as f64 - 0.5).clamp(0.0, (n - 1) as f64);
-            let i = (x.floor() as usize).min(n - 2);
-            (i, x - i as f64)
-        };
         let read = |tex: &[[f64; 2]], u: f64, t: f64, c: f64| -> [f64; 2] {
             let ((i, fx), (j, fy)) = (coord(u, w), coord(t, h));
             let z = c * (d - 1) as f64;
@@ -379,7 +371,7 @@ mod tests {
             for &t in &ts {
                 for &u in &us {
                     let r = env_with(lut.base.mapping.alpha(t), u, c, Shadowing::HeightCorrelated, 1e-10, Inner::Adaptive);
-                    let want = encode([r.scale, r.bias]);
+                    let want = filament([r.scale, r.bias]);
                     let got = read(&stored, u, t, c);
                     let e = err(got, want);
                     tex = tex.max(e);
