@@ -604,4 +604,97 @@ mod tests {
             assert!((mean - want).abs() < 5.0 * se + 1e-6 / area, "alpha {alpha} wz {wz}: {mean} vs {want} (se {se})");
         }
     }
+
+    /// The visible-normal sampler has no preferred azimuth: turning the view about the normal
+    /// turns each sample with it, draw for draw (Heitz 2018's frame (t1, t2, v_h) is built from
+    /// the stretched view and turns with it; the stretch by α commutes with the turn). The moment
+    /// test above uses views in the x–z plane, where every y term is a zero: here views off it,
+    /// above and below the horizon. Bound: a few roundings of unit vectors, 1e-13.
+    #[test]
+    fn visible_normals_turn_with_the_view_about_the_normal() {
+        let turn = |v: V3, phi: f64| {
+            let (s, c) = phi.sin_cos();
+            [c * v[0] - s * v[1], s * v[0] + c * v[1], v[2]]
+        };
+        for (alpha, wi) in [(0.5, normalize([0.3, 0.5, 0.8])), (0.8, normalize([-0.6, 0.4, -0.3])), (0.3, normalize([0.1, -0.9, 0.4])), (1.4, normalize([0.7, 0.2, -0.6]))] {
+            for phi in [0.9, 2.6, -1.7] {
+                for (u1, u2) in [(0.1, 0.2), (0.5, 0.7), (0.9, 0.45), (0.33, 0.95)] {
+                    let want = turn(sample_vndf(alpha, wi, u1, u2), phi);
+                    let got = sample_vndf(alpha, turn(wi, phi), u1, u2);
+                    assert!((0..3).all(|k| (got[k] - want[k]).abs() < 1e-13), "α {alpha} wi {wi:?} φ {phi} u ({u1}, {u2}): {got:?} vs {want:?}");
+                }
+            }
+        }
+    }
+
+    /// F0 = 0 is no interface: no light is reflected specularly, so what becomes of that share
+    /// cannot matter. The two conventions are then one walk, path for path and bit for bit
+    /// (Gone keeps (1 − 0)·ρ·(1 − 0) = ρ of the weight, Walks ρ·(1 − 0) = ρ; neither adds a
+    /// mirror term), at ρ = 0.8 and α 0.2 and 1.
+    #[test]
+    fn without_an_interface_the_specular_conventions_are_one_walk() {
+        let bits = |r: PathResult| (r.nee.to_bits(), r.nee_single.to_bits(), r.escaped.to_bits(), r.order);
+        for alpha in [0.2, 1.0] {
+            let at = |specular| Surface { alpha, rho: 0.8, f0: 0.0, specular };
+            for (wi, wo) in [(normalize([0.6, 0.0, 0.8]), normalize([-0.3, 0.4, 0.5])), (normalize([0.1, -0.2, 0.3]), [0.0, 0.0, 1.0])] {
+                for sample in 0..2000 {
+                    let gone = at(Specular::Gone).path(wi, Some(wo), &mut PathRng::new(3, 0, sample));
+                    let walks = at(Specular::Walks).path(wi, Some(wo), &mut PathRng::new(3, 0, sample));
+                    assert_eq!(bits(gone), bits(walks), "α {alpha} wi {wi:?} path {sample}: {gone:?} vs {walks:?}");
+                }
+            }
+        }
+    }
+
+    /// Each diffuse event keeps the share ρ of what reaches it: with ρ = ½ a path is the same
+    /// walk (its directions do not depend on ρ), its escape weight 2^−order of that at ρ = 1
+    /// (every event diffuses in the Gone convention) and its first next-event estimate half of
+    /// it; its whole next-event sum lies between 2^−order and ½ of that at ρ = 1. Scaling by a
+    /// power of two is exact in floating point: bit for bit. F0 0 and 0.04.
+    #[test]
+    fn each_diffuse_event_keeps_rho_of_the_weight() {
+        for f0 in [0.0, 0.04] {
+            let at = |rho| Surface { alpha: 0.6, rho, f0, specular: Specular::Gone };
+            let (wi, wo) = (normalize([0.5, 0.1, 0.6]), normalize([-0.2, -0.3, 0.7]));
+            let mut longer = 0;
+            for sample in 0..2000 {
+                let one = at(1.0).path(wi, Some(wo), &mut PathRng::new(9, 4, sample));
+                let half = at(0.5).path(wi, Some(wo), &mut PathRng::new(9, 4, sample));
+                let scale = 0.5f64.powi(one.order as i32);
+                assert_eq!(half.order, one.order, "F0 {f0} path {sample}");
+                assert_eq!(half.escaped, one.escaped * scale, "F0 {f0} path {sample}: {half:?} vs {one:?}");
+                assert_eq!(half.nee_single, 0.5 * one.nee_single, "F0 {f0} path {sample}: {half:?} vs {one:?}");
+                // The sum over k of 2^−k times event k's estimate, rounded: bounds widened by 1e-15.
+                assert!(half.nee >= scale * one.nee * (1.0 - 1e-15) && half.nee <= 0.5 * one.nee * (1.0 + 1e-15), "F0 {f0} path {sample}: {half:?} vs {one:?}");
+                longer += (one.order > 1) as u32;
+            }
+            assert!(longer > 100, "F0 {f0}: {longer} paths of two events or more");
+        }
+    }
+
+    /// A walk that never leaves is cut: the event past the MAX_ORDER-th ends it (order
+    /// MAX_ORDER + 1, nothing escapes). A ray without a direction (NaN) is such a walk: it
+    /// neither rises nor falls, so it meets the surface at its own height every time.
+    #[test]
+    fn a_walk_that_never_leaves_is_cut_after_max_order_events() {
+        let s = Surface { alpha: 0.5, rho: 1.0, f0: 0.0, specular: Specular::Gone };
+        let r = s.path([f64::NAN; 3], None, &mut PathRng::new(1, 1, 1));
+        assert_eq!((r.order, r.escaped), (MAX_ORDER + 1, 0.0), "{r:?}");
+    }
+
+    /// The mirror phase at its boundaries. Facets are those with h_z ≥ 0, D = α²/π at the
+    /// horizon: for wi + wo horizontal (h = x) the phase is its limit from above (wo tilted by
+    /// 1e-9: D and F move by O(1e-9), bound 1e-6 relative), not 0. And a flat microsurface (α =
+    /// 0) shows no area to a view below its horizon (A(wi) = (1 + Λ) wi_z = 0): nothing to
+    /// reflect, 0.
+    #[test]
+    fn the_mirror_phase_at_horizontal_facets_and_for_an_unseen_plane() {
+        let (wi, wo) = ([0.6, 0.0, -0.8], [0.6, 0.0, 0.8]);
+        for alpha in [0.3, 1.0] {
+            let at = specular_phase(alpha, 0.04, wi, wo);
+            let above = specular_phase(alpha, 0.04, wi, normalize([0.6, 0.0, 0.8 + 1e-9]));
+            assert!(above > 0.0 && (at - above).abs() <= 1e-6 * above, "α {alpha}: {at} vs {above}");
+        }
+        assert_eq!(specular_phase(0.0, 0.04, [0.8, 0.0, -0.6], [0.6, 0.0, 0.8]), 0.0);
+    }
 }
