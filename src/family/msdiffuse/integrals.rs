@@ -497,4 +497,145 @@ mod tests {
         assert_eq!(seq.value.to_bits(), par.value.to_bits());
         assert_eq!(seq.error.to_bits(), par.error.to_bits());
     }
+
+    /// Rusinkiewicz's coordinates by their definition: h = (sin θh, 0, cos θh); in the frame
+    /// (t, b, h) about it, t = (cos θh, 0, −sin θh) (x turned by θh about y) and b = y, the
+    /// light is d = (sin θd cos φd, sin θd sin φd, cos θd) and the view its mirror image about h,
+    /// (−d_t, −d_b, d_h); both unit. The mirror test above reads only l·h and the direction of
+    /// l + v, which do not see d's azimuth nor the length of v. And a point by hand: θh = 0,
+    /// θd = π/3, φd = π/2 gives l = (0, √3/2, ½), v = (0, −√3/2, ½). Products of a few
+    /// rounded sines and cosines: 1e-15.
+    #[test]
+    fn directions_are_rusinkiewiczs_coordinates() {
+        for (th, td, pd) in [(0.3, 0.7, 1.1), (0.9, 0.4, 2.8), (0.2, 1.1, 0.4), (1.2, 0.1, 3.0), (0.6, 0.6, 0.0)] {
+            let (l, v) = directions(th, td, pd).unwrap();
+            let (t, b, h) = ([th.cos(), 0.0, -th.sin()], [0.0, 1.0, 0.0], [th.sin(), 0.0, th.cos()]);
+            let dot = |a: V3, c: V3| a[0] * c[0] + a[1] * c[1] + a[2] * c[2];
+            let d = [td.sin() * pd.cos(), td.sin() * pd.sin(), td.cos()];
+            for (what, got, want) in [
+                ("l·t", dot(l, t), d[0]),
+                ("l·b", dot(l, b), d[1]),
+                ("l·h", dot(l, h), d[2]),
+                ("v·t", dot(v, t), -d[0]),
+                ("v·b", dot(v, b), -d[1]),
+                ("v·h", dot(v, h), d[2]),
+                ("|l|²", dot(l, l), 1.0),
+                ("|v|²", dot(v, v), 1.0),
+            ] {
+                assert!((got - want).abs() < 1e-15, "({th}, {td}, {pd}): {what} = {got}, want {want}");
+            }
+        }
+        let (l, v) = directions(0.0, PI / 3.0, PI / 2.0).unwrap();
+        let r3 = 3.0f64.sqrt() / 2.0;
+        for (got, want) in l.iter().chain(&v).zip([0.0, r3, 0.5, 0.0, -r3, 0.5]) {
+            assert!((got - want).abs() < 1e-15, "{l:?} {v:?}");
+        }
+    }
+
+    /// The direction at cosine μ in the x–z plane, by hand: (0.8, 0, 0.6) at μ = 0.6 (3-4-5:
+    /// a rounding of 0.36 and of its root), the normal at μ = 1, and a cosine past 1 keeps its
+    /// z with no x (the clamp of 1 − μ²).
+    #[test]
+    fn at_cosine_by_hand() {
+        let a = at_cosine(0.6);
+        assert!((a[0] - 0.8).abs() < 1e-15 && a[1] == 0.0 && a[2] == 0.6, "{a:?}");
+        assert_eq!(at_cosine(1.0), [0.0, 0.0, 1.0]);
+        assert_eq!(at_cosine(1.0 + 1e-12), [0.0, 0.0, 1.0 + 1e-12]);
+    }
+
+    /// Two samples are the fewest with a standard error: 1 and 3 have mean 2, sample variance
+    /// ((1 − 2)² + (3 − 2)²)/1 = 2 and standard error √(2/2) = 1, exactly in f64.
+    #[test]
+    fn two_samples_have_a_standard_error() {
+        let mut s = Sums::default();
+        s.add(1.0);
+        s.add(3.0);
+        assert_eq!((s.mean(), s.se()), (2.0, 1.0));
+    }
+
+    /// `chunked` hands each path index to exactly one chunk: [0, 1024), [1024, 2048), … with
+    /// the last one shorter (a single empty chunk for no paths), listed here by hand. Every
+    /// chunk sums its indices, so the total holds n = paths, Σ i = P(P − 1)/2 and Σ i² =
+    /// (P − 1)P(2P − 1)/6 (integers below 2^53: exact), sequential and parallel.
+    #[test]
+    fn chunks_cover_every_path_once() {
+        let cases: [(u64, &[(u64, u64)]); 6] = [
+            (0, &[(0, 0)]),
+            (1, &[(0, 1)]),
+            (1023, &[(0, 1023)]),
+            (1024, &[(0, 1024)]),
+            (1025, &[(0, 1024), (1024, 1025)]),
+            (3000, &[(0, 1024), (1024, 2048), (2048, 3000)]),
+        ];
+        for (paths, want) in cases {
+            for parallel in [false, true] {
+                let seen = std::sync::Mutex::new(Vec::new());
+                let sums = chunked(paths, parallel, |a, b| {
+                    seen.lock().unwrap().push((a, b));
+                    let mut t = Sums::default();
+                    for i in a..b {
+                        t.add(i as f64);
+                    }
+                    t
+                });
+                let mut ranges = seen.into_inner().unwrap();
+                ranges.sort();
+                assert_eq!(ranges, want, "{paths} paths, parallel {parallel}");
+                let p = paths as f64;
+                let hand = Sums { n: paths, s: p * (p - 1.0) / 2.0, s2: (p - 1.0) * p * (2.0 * p - 1.0) / 6.0 };
+                assert_eq!(sums, hand, "{paths} paths, parallel {parallel}");
+            }
+        }
+    }
+
+    /// The BRDF is zero unless both directions are above the horizon, whichever of the two is
+    /// not (and on it: cos θ = 0).
+    #[test]
+    fn single_scattering_vanishes_unless_both_directions_are_above() {
+        let (up, down, flat) = (at_cosine(0.6), [0.8, 0.0, -0.6], [1.0, 0.0, 0.0]);
+        for (l, v) in [(up, down), (down, up), (up, flat), (flat, up), (down, down)] {
+            assert_eq!(single_scattering(0.5, TALK_F0, l, v, 1e-8).value, 0.0, "l {l:?} v {v:?}");
+        }
+    }
+
+    /// At F0 = 0.5 half the light a facet meets at normal incidence is mirrored, so in the
+    /// walking convention the mirror events carry much of what a diffused path does next: the
+    /// escape weights and the next events (diffuse and mirror terms) must still estimate the
+    /// same albedo, within 4 combined standard errors (seeds fixed). At F0 = 0.04 the mirror
+    /// share is too small for this balance to see a wrong mirror term.
+    #[test]
+    fn strong_fresnel_walks_keep_the_albedo_balance() {
+        for (g, mu) in [(0.0, 0.4), (0.3, 0.8)] {
+            let s = surface(g, 0.5, Specular::Walks);
+            let v = at_cosine(mu);
+            let a = albedo(&s, v, KEY, 6, 1 << 15, true);
+            let b = albedo_by_next_events(&s, v, KEY, 7, 1 << 16, true);
+            let k = 4.0 * (a.error.powi(2) + b.error.powi(2)).sqrt();
+            assert!((a.value - b.value).abs() < k, "g {g} mu {mu}: {} ± {} vs {} ± {}", a.value, a.error, b.value, b.error);
+        }
+    }
+
+    /// The smooth limit (α = 1e-5: one event, see `smooth_limit_is_the_lambertian_plane`) with
+    /// absorption and Fresnel. At ρ = ½ the BRDF π f/ρ is still (1 − F(n·l))(1 − F(n·v)) (the
+    /// estimate divides by ρ; within 4 standard errors plus 1e-6), and at F0 = 0 every path
+    /// leaves with the weight ρ = ½ exactly (albedo ½, error 0). By the next events, at ρ = 1
+    /// and F0 = 0.04, the albedo is (1 − F(n·v))·2∫(1 − F(μ))μ dμ = (1 − F(n·v))(1 − F0)(1 −
+    /// 2/42) (∫(1 − μ)⁵μ dμ = B(2, 6) = 1/42), within 4 standard errors plus 1e-6.
+    #[test]
+    fn smooth_limit_with_absorption_and_fresnel() {
+        let plane = |rho, f0| Surface { alpha: 1e-5, rho, f0, specular: Specular::Gone };
+        for (tl, tv) in [(0.5, 1.0), (1.3, 0.2)] {
+            let (l, v) = (at_cosine(f64::cos(tl)), [-f64::sin(tv), 0.0, f64::cos(tv)]);
+            let e = brdf(&plane(0.5, TALK_F0), l, v, Order::All, 24, 0, 1 << 12, true);
+            let want = (1.0 - fresnel(TALK_F0, l[2])) * (1.0 - fresnel(TALK_F0, v[2]));
+            assert!((e.value - want).abs() < 4.0 * e.error + 1e-6, "({tl}, {tv}): {} ± {} vs {want}", e.value, e.error);
+        }
+        for mu in [0.9, 0.3] {
+            let e = albedo(&plane(0.5, 0.0), at_cosine(mu), KEY, 8, 1 << 12, true);
+            assert_eq!((e.value, e.error), (0.5, 0.0), "mu {mu}");
+            let n = albedo_by_next_events(&plane(1.0, TALK_F0), at_cosine(mu), KEY, 9, 1 << 16, true);
+            let want = (1.0 - fresnel(TALK_F0, mu)) * (1.0 - TALK_F0) * (1.0 - 2.0 / 42.0);
+            assert!((n.value - want).abs() < 4.0 * n.error + 1e-6, "mu {mu}: {} ± {} vs {want}", n.value, n.error);
+        }
+    }
 }
