@@ -333,7 +333,8 @@ pub fn spec_file(path: &Path, text: &str) -> Result<Option<SpecFile>, SpecError>
     t.spec_file(path, text).map(Some)
 }
 
-/// Statistics of a set of cells.
+/// Statistics of a set of cells: the largest standard error, the rms one and the number of
+/// the first cell with the largest.
 fn stats(cells: &[Cell]) -> (f64, f64, usize) {
     let mut worst = (0.0f64, 0usize);
     let mut ss = 0.0;
@@ -759,6 +760,161 @@ pub(super) mod tests {
         for (a, b) in one.artifacts.iter().zip(&again.artifacts) {
             assert!(a.path == b.path && a.contents == b.contents, "{} differs when re-rendered", a.path.display());
         }
+    }
+
+    /// Every cell of a table is the walk at its stated point, the numbering of the module doc
+    /// worked out here by hand: slice cell c = (k·H + j)·W + i at gloss k/(G − 1), θh = (i +
+    /// ½)/W·π/2, θd = (j + ½)/H·π/2 and the default φd = π/2; then albedo cell n + k·A + a at
+    /// n·v = (a + ½)/A; then MERL cell n + G·A + k·CELLS + m at the centre of MERL's cell m.
+    /// Each keyed by the spec's name and its own number, with its paths: bit for bit. The
+    /// earlier test read one slice cell (c = 5, where c/W = c mod W and c/(W·H) = c/(W + H))
+    /// and no albedo cell; the MERL tests had one layer, where every layer index is 0.
+    #[test]
+    fn every_cell_is_the_walk_at_its_stated_point() {
+        let same = |got: Cell, want: crate::integrate::Estimate, c: u64| {
+            assert_eq!((got.value.to_bits(), got.se.to_bits()), (want.value.to_bits(), want.error.to_bits()), "cell {c}: {got:?} vs {want:?}");
+        };
+        let t = Table::from_spec(&spec(SPEC)).unwrap(); // 4 × 3 × 2, A = 3, 1024 paths
+        let key = key_of("msd_t");
+        let mut c = 0u64;
+        for k in 0..2 {
+            let s = surface(k as f64, TALK_F0, Specular::Gone);
+            for j in 0..3 {
+                for i in 0..4 {
+                    let (th, td) = ((i as f64 + 0.5) / 4.0 * FRAC_PI_2, (j as f64 + 0.5) / 3.0 * FRAC_PI_2);
+                    let (l, v) = directions(th, td, FRAC_PI_2).unwrap();
+                    same(t.cell(c), brdf(&s, l, v, Order::All, key, c, 1024, false), c);
+                    c += 1;
+                }
+            }
+        }
+        for k in 0..2 {
+            for a in 0..3 {
+                let s = surface(k as f64, TALK_F0, Specular::Gone);
+                same(t.cell(c), albedo(&s, at_cosine((a as f64 + 0.5) / 3.0), key, c, 1024, false), c);
+                c += 1;
+            }
+        }
+        let text = SPEC.replace("[4, 3, 2]", "[2, 2, 2]").replace("albedo_resolution = 3", "albedo_resolution = 2\nmerl_paths = 2");
+        let t = Table::from_spec(&spec(&text)).unwrap();
+        for k in 0..2usize {
+            let s = surface(k as f64, TALK_F0, Specular::Gone);
+            for m in [0usize, 1234, 90 * 180 * 45 + 180 * 30 + 90] {
+                let c = (8 + 4 + k * merl::CELLS + m) as u64;
+                let (th, td, pd) = merl::cell_angles(m);
+                let got = t.cell(c);
+                match directions(th, td, pd) {
+                    Some((l, v)) => {
+                        let e = brdf(&s, l, v, Order::All, key, c, 2, false);
+                        assert_eq!((got.value, got.se), (e.value / PI / merl::SCALES[0], e.error / PI / merl::SCALES[0]), "layer {k} MERL cell {m}");
+                    }
+                    None => assert_eq!((got.value, got.se), (-1.0, 0.0), "layer {k} MERL cell {m}"),
+                }
+            }
+        }
+    }
+
+    /// MERL's layout has 90·90·180 = 1 458 000 cells a layer: a table with MERL files counts
+    /// that many per gloss layer after its slices and albedo (3 layers of 2 × 2 and 2 albedo
+    /// columns: 12 + 6 + 4 374 000), one without counts none.
+    #[test]
+    fn merl_cells_are_a_files_cells_per_layer() {
+        let text = SPEC.replace("[4, 3, 2]", "[2, 2, 3]").replace("albedo_resolution = 3", "albedo_resolution = 2");
+        let t = Table::from_spec(&spec(&text)).unwrap();
+        assert_eq!((t.slice_cells(), t.albedo_cells(), t.merl_cells(), t.cells()), (12, 6, 0, 18));
+        let t = Table::from_spec(&spec(&text.replace("albedo_resolution = 2", "albedo_resolution = 2\nmerl_paths = 2"))).unwrap();
+        assert_eq!((t.merl_cells(), t.cells()), (4_374_000, 4_374_018));
+    }
+
+    /// A cell whose value or standard error is not finite is refused, naming the spec and the
+    /// cell's number; both halves of a cell are checked, slices and albedo alike.
+    #[test]
+    fn non_finite_cells_are_refused_by_number() {
+        let s = spec(SPEC);
+        let t = Table::from_spec(&s).unwrap();
+        let n = (t.slice_cells() + t.albedo_cells()) as usize;
+        for (k, bad) in [(7, Cell { value: 1.0, se: f64::INFINITY }), (25, Cell { value: f64::NAN, se: 0.01 }), (3, Cell { value: f64::NEG_INFINITY, se: 0.01 }), (12, Cell { value: 1.0, se: f64::NAN })] {
+            let mut cells = vec![Cell { value: 1.0, se: 0.01 }; n];
+            cells[k] = bad;
+            match render(&s, &t, &cells) {
+                Err(BuildError::NonFinite { spec, at }) => assert_eq!((spec.as_str(), at), ("msd_t", vec![k as f64])),
+                other => panic!("cell {k} {bad:?}: {:?}", other.map(|b| b.name)),
+            }
+        }
+    }
+
+    /// The atlas is W texels wide and H·G tall (KTX 2.0 header: pixelWidth at byte 20,
+    /// pixelHeight at 24, little-endian), and the PNG preview shows R/2, sRGB-encoded, as the
+    /// JSON states: texel (i, row r) fills the 64 × 64 block at (64 i, 64 r). Values 0.2 to
+    /// 1.35, so R/2 differs from R (and from R mod 2) in every 8-bit code.
+    #[test]
+    fn the_atlas_is_layers_of_rows_and_the_preview_shows_half_the_value() {
+        let s = spec(SPEC);
+        let t = Table::from_spec(&s).unwrap();
+        let n = (t.slice_cells() + t.albedo_cells()) as usize;
+        let cells: Vec<Cell> = (0..n).map(|k| Cell { value: 0.2 + 0.05 * k as f64, se: 0.01 }).collect();
+        let built = render(&s, &t, &cells).unwrap();
+        let file = |end: &str| built.artifacts.iter().find(|a| a.path.ends_with(end)).unwrap().contents.clone();
+        let ktx2 = file("data/msd_t.ktx2");
+        let le = |i: usize| u32::from_le_bytes(ktx2[i..i + 4].try_into().unwrap());
+        assert_eq!((le(20), le(24)), (4, 6));
+        let png = file("data/msd_t.png");
+        let mut reader = png::Decoder::new(std::io::Cursor::new(&png[..])).read_info().unwrap();
+        let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+        reader.next_frame(&mut buf).unwrap();
+        for r in 0..6 {
+            for i in 0..4 {
+                let want = crate::emit::texture::srgb8(cells[r * 4 + i].value / 2.0);
+                let p = &buf[((64 * r + 10) * 256 + 64 * i + 10) * 3..][..3];
+                assert_eq!(p, [want; 3], "texel ({i}, {r})");
+            }
+        }
+    }
+
+    /// The runtime module states the atlas size (4 × 3 × 2) and maps an angle to [0, 1] by
+    /// 2/π, written as the f32 nearest 0.6366197723… (6.3661975e-1), in both languages.
+    #[test]
+    fn the_module_states_the_atlas_size_and_the_angle_scale() {
+        let s = spec(SPEC);
+        let t = Table::from_spec(&s).unwrap();
+        let n = (t.slice_cells() + t.albedo_cells()) as usize;
+        let built = render(&s, &t, &vec![Cell { value: 1.0, se: 0.01 }; n]).unwrap();
+        let text = |end: &str| String::from_utf8(built.artifacts.iter().find(|a| a.path.ends_with(end)).unwrap().contents.to_vec()).unwrap();
+        let (wgsl, rust) = (text("wgsl/msd_t.wgsl"), text("src/msd_t.rs"));
+        assert!(wgsl.contains("MSD_T_SIZE: vec3<u32> = vec3<u32>(4u, 3u, 2u);"), "{wgsl}");
+        assert!(wgsl.contains("acos(clamp(n_dot_h, 0f, 1f)) * 6.3661975e-1;") && wgsl.contains("acos(clamp(l_dot_h, 0f, 1f)) * 6.3661975e-1;"), "{wgsl}");
+        assert!(rust.contains("MSD_T_SIZE: [u32; 3] = [4, 3, 2];"), "{rust}");
+        assert!(rust.contains("n_dot_h.clamp(0.0, 1.0).acos() * 6.3661975e-1;") && rust.contains("l_dot_h.clamp(0.0, 1.0).acos() * 6.3661975e-1;"), "{rust}");
+    }
+
+    /// The common spec a table offers states its grid and its settings: gloss over [0, 1] in
+    /// G layers, θh and θd over their first and last cell centres, the convention as
+    /// specular_walks 0 (gone) or 1 (walks), and the tolerance of a cell, 1/√paths (1/32 at
+    /// 1024 paths, exact).
+    #[test]
+    fn the_common_spec_states_the_grid_the_convention_and_the_tolerance() {
+        for (specular, walks) in [("gone", 0.0), ("walks", 1.0)] {
+            let s = spec(&SPEC.replace("paths = 1024", &format!("paths = 1024\nspecular = \"{specular}\"")));
+            let axis = |name: &str| s.file.axis.iter().find(|a| a.name == name).unwrap().clone();
+            assert_eq!(s.file.tolerance, 1.0 / 32.0);
+            assert_eq!((axis("gloss").range, axis("gloss").count), ([0.0, 1.0], 2));
+            assert_eq!((axis("theta_h").range, axis("theta_h").count), ([0.5 / 4.0 * FRAC_PI_2, 3.5 / 4.0 * FRAC_PI_2], 4));
+            assert_eq!((axis("theta_d").range, axis("theta_d").count), ([0.5 / 3.0 * FRAC_PI_2, 2.5 / 3.0 * FRAC_PI_2], 3));
+            assert_eq!(axis("specular_walks").range, [walks, walks], "{specular}");
+        }
+    }
+
+    /// Of several cells with the largest standard error, the first in the slices' order is
+    /// the worst: cells 5 and 17 at 0.05, the 22 others at 0.01 (rms √((22·1e-4 + 2·25e-4)/24)
+    /// = √3e-4, a few roundings).
+    #[test]
+    fn the_worst_cell_is_the_first_of_the_largest() {
+        let mut cells = vec![Cell { value: 1.0, se: 0.01 }; 24];
+        cells[5].se = 0.05;
+        cells[17].se = 0.05;
+        let (max, rms, worst) = stats(&cells);
+        assert_eq!((max, worst), (0.05, 5));
+        assert!((rms - 3e-4f64.sqrt()).abs() <= 1e-15, "{rms}");
     }
 }
 
