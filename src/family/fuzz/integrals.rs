@@ -2513,4 +2513,59 @@ pub(crate) mod tests {
             );
         }
     }
+
+    /// Outside the domain every entry point answers the invalid estimate (value NaN, error ∞,
+    /// no evaluations) instead of a number: α ∉ (0, 1] (0, −0.5, the double just above 1, 1.5,
+    /// NaN), a non-finite θf, θu or φu alone, and G, Q at a negative or NaN argument. Where the
+    /// formulas would run on they give numbers or at least spend evaluations (at α = 0.5 a NaN
+    /// angle leaves no piece and a finite error floor), so the three fields are all checked.
+    /// In a batch an invalid direction does not spoil the valid ones beside it.
+    #[test]
+    fn inputs_outside_the_domain_give_the_invalid_estimate() {
+        let invalid = |e: &Estimate| e.value.is_nan() && e.error == f64::INFINITY && e.evals == 0;
+        let (t, u, v) = (sph(0.9, 0.0), sph(0.7, 0.4), sph(2.0, 1.0));
+        for alpha in [0.0, -0.5, 1f64.next_up(), 1.5, f64::NAN] {
+            assert!(sggx_phase(alpha, t, u, v).is_nan(), "p at α = {alpha}");
+            assert!(invalid(&ps(alpha, 0.9, 0.7, 0.4, 1e-6)), "P_s at α = {alpha}");
+            assert!(ps_directions(alpha, 0.9, &[(0.7, 0.4)], 1e-6).iter().all(invalid), "P_s batch at α = {alpha}");
+            assert!(invalid(&r(alpha, 0.9, 1e-6)), "R at α = {alpha}");
+        }
+        // The smallest α is inside: a finite, positive phase function.
+        assert!(sggx_phase(1e-3, t, u, v) > 0.0);
+        for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+            assert!(invalid(&ps(0.5, bad, 0.7, 0.4, 1e-6)), "θf {bad}");
+            assert!(invalid(&ps(0.5, 0.9, bad, 0.4, 1e-6)), "θu {bad}");
+            assert!(invalid(&ps(0.5, 0.9, 0.7, bad, 1e-6)), "φu {bad}");
+            assert!(ps_directions(0.5, bad, &[(0.7, 0.4)], 1e-6).iter().all(invalid), "batch θf {bad}");
+            assert!(invalid(&r(0.5, bad, 1e-6)), "R θf {bad}");
+            let batch = ps_directions(0.5, 0.9, &[(bad, 0.4), (0.7, bad), (0.7, 0.4)], 1e-6);
+            assert!(invalid(&batch[0]) && invalid(&batch[1]), "batch direction {bad}: {batch:?}");
+            let one = ps(0.5, 0.9, 0.7, 0.4, 1e-6);
+            assert_eq!(batch[2].value.to_bits(), one.value.to_bits(), "batch beside {bad}");
+        }
+        // (−0.1, 0) and (0, −0.5): the limits G(d, 0) = 1 and G(0, μv) = 0 hold only inside.
+        for (d, mu_v) in [(-0.1, 0.5), (0.1, -0.5), (f64::NAN, 0.5), (0.1, f64::NAN), (-0.1, 0.0), (0.0, -0.5)] {
+            assert!(invalid(&g(d, mu_v, 1e-9)), "G({d}, {mu_v})");
+            assert!(g_exact(d, mu_v).is_nan(), "closed-form G({d}, {mu_v})");
+        }
+        for d in [-1.0, -1e-300, f64::NAN] {
+            assert!(invalid(&q(d, 1e-9)), "Q({d})");
+        }
+    }
+
+    /// At v = −u the half vector is undefined and the doc gives the limit along the specular
+    /// cone, h ⟂ t: D_F = 1/(πα), so p = 1/(πα · 4σ_F(u)), σ_F(u) = sqrt(1 − (u·t)²(1 − α²)).
+    /// By hand at α = 0.5, t = n, u·t = 0.8: σ_F = sqrt(1 − 0.64·0.75) = sqrt(0.52). Nearby
+    /// backward directions on the cone (v·t = −u·t) have the same value. A few roundings: 1e-14
+    /// relative.
+    #[test]
+    fn sggx_phase_at_the_backward_direction_is_its_specular_cone_limit() {
+        let (alpha, t, u) = (0.5, [0.0, 0.0, 1.0], [0.6, 0.0, 0.8]);
+        let want = 1.0 / (PI * alpha * 4.0 * 0.52f64.sqrt());
+        let got = sggx_phase(alpha, t, u, [-0.6, 0.0, -0.8]);
+        assert!((got - want).abs() <= 1e-14 * want, "p(u, −u) = {got}, limit {want}");
+        // On the cone v·t = −0.8 a little way round from −u: h ⟂ t exactly.
+        let near = sggx_phase(alpha, t, u, [-0.6 * 1e-4f64.cos(), -0.6 * 1e-4f64.sin(), -0.8]);
+        assert!((near - want).abs() <= 1e-14 * want, "p next to −u = {near}, limit {want}");
+    }
 }
