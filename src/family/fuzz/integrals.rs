@@ -2568,4 +2568,51 @@ pub(crate) mod tests {
         let near = sggx_phase(alpha, t, u, [-0.6 * 1e-4f64.cos(), -0.6 * 1e-4f64.sin(), -0.8]);
         assert!((near - want).abs() <= 1e-14 * want, "p next to −u = {near}, limit {want}");
     }
+
+    /// G at the smallest normal arguments is integrated to the asked tolerance; only subnormal
+    /// ones take the limit (`g`'s comment: there the nodes would need 1/d or 1/μv). At
+    /// μv = 2⁻¹⁰²², d = 2μv (d/μv = 2), G = 1 − e^{−2}E₂(d) + … ≈ 1 − e^{−2} by the closed form,
+    /// which has no cancellation here (rounding ~1e-15, and the O(c ln c) terms ~1e-305): the
+    /// default tolerance bounds the difference, where the limit would give 1, off by
+    /// e^{−2} ≈ 0.135. At d = 2⁻¹⁰²², μv = ½, G = (d/μv)(1 − (d/2) ln(1/d) + O(d)) (module
+    /// doc) ≈ 2d: integrated (evaluations spent), within its estimate of it in absolute terms.
+    #[test]
+    fn g_at_the_smallest_normal_arguments_is_integrated() {
+        let c = f64::MIN_POSITIVE;
+        let e = g(2.0 * c, c, DEFAULT_TOL);
+        let want = g_exact(2.0 * c, c);
+        assert!((want - (1.0 - (-2f64).exp())).abs() < 1e-12, "closed form {want}");
+        assert!((e.value - want).abs() <= DEFAULT_TOL && e.error <= DEFAULT_TOL, "{e:?} vs {want}");
+        let d = f64::MIN_POSITIVE;
+        let e = g(d, 0.5, DEFAULT_TOL);
+        assert!(e.evals > 0 && (e.value - 2.0 * d).abs() <= e.error && e.error <= DEFAULT_TOL, "{e:?}");
+    }
+
+    /// With both arguments subnormal and equal, d = μv = c = 1e-310, G → 1 − e^{−1} as c → 0
+    /// (closed form: e^{−d/c} E₂(d) → e^{−1}, the other terms are O(c ln c) ≈ 7e-308). The limit
+    /// returned is 1, the nearer of 0 and 1, and its error is the bound of `g`'s comment,
+    /// c (1 − ln c) + e^{−d/c} + c E₁(d (1 + c)/c) = e^{−1} + 7e-308: at least 1 − G = e^{−1}
+    /// and, e^{−1} being the whole of it in f64, no more (2 ulps for exp's rounding).
+    #[test]
+    fn g_with_both_arguments_subnormal_states_the_documented_bound() {
+        let c = 1e-310;
+        let e = g(c, c, DEFAULT_TOL);
+        let bound = (-1f64).exp();
+        assert!(e.value == 1.0, "{e:?}");
+        assert!((e.error - bound).abs() <= 2.0 * f64::EPSILON * bound, "{e:?}, 1 − G = e⁻¹ = {bound}");
+    }
+
+    /// Q's error covers the rounding of its logarithmic node placement: at d = 2e-205 (the case
+    /// of `q`'s comment) the nodes above μ = d come from exp of values down to ln d ≈ −471, each
+    /// perturbed by ~471 ulps, and the quadrature estimate alone was below the actual error
+    /// against 2E₃(d) (E₃ by its series: a few ulps of Q ≈ 1, 1e-15).
+    #[test]
+    fn q_error_covers_the_node_rounding_at_tiny_density() {
+        for d in [2e-205, 1e-100, 1e-30] {
+            let e = q(d, DEFAULT_TOL);
+            let want = q_exact(d);
+            assert!((e.value - want).abs() <= e.error + 1e-15 && e.error <= DEFAULT_TOL, "d = {d:e}: {e:?} vs {want}");
+            assert!(e.error >= 8.0 * f64::EPSILON * (1.0 - d.ln()), "d = {d:e}: {e:?}");
+        }
+    }
 }
