@@ -2615,4 +2615,62 @@ pub(crate) mod tests {
             assert!(e.error >= 8.0 * f64::EPSILON * (1.0 - d.ln()), "d = {d:e}: {e:?}");
         }
     }
+
+    /// `evals` counts integrand evaluations (module doc): every piece of P_s and every inner
+    /// w-integration of R is an adaptive G10/K21 run of 21 evaluations per panel and 42 per
+    /// bisection, so the counts are positive multiples of 21; the doc's orders (60–250 per P_s,
+    /// ~10⁴ per R at the default tolerance) bound them within a factor 40 and 10; a tighter
+    /// tolerance takes no fewer. Lights: ordinary, grazing, below the horizon; directions that
+    /// coincide in a batch report the count of the one integration they share.
+    #[test]
+    fn ps_and_r_count_their_evaluations() {
+        for &(al, tf, tu, pu) in &[(0.3, 0.9, 0.7, 0.4), (0.15, 1.2, 1.55, 0.3), (0.5, 0.3, 2.0, 1.0), (0.8, 0.0, 0.4, 0.0)] {
+            let (loose, dflt) = (ps(al, tf, tu, pu, 1e-5), ps(al, tf, tu, pu, DEFAULT_TOL));
+            for e in [&loose, &dflt] {
+                assert!(e.evals >= 21 && e.evals % 21 == 0 && e.evals <= 10_000, "α={al} θf={tf} θu={tu} φu={pu}: {e:?}");
+            }
+            assert!(loose.evals <= dflt.evals, "{loose:?} {dflt:?}");
+        }
+        let batch = ps_directions(0.3, 0.9, &[(0.0, 0.0), (0.0, 1.0)], DEFAULT_TOL);
+        assert!(batch[0].evals == batch[1].evals && batch[0].evals >= 21, "{batch:?}");
+        for &(al, tf) in &[(0.3, 0.9), (0.15, 0.0), (0.6, FRAC_PI_2)] {
+            let (loose, dflt) = (r(al, tf, 1e-6), r(al, tf, DEFAULT_TOL));
+            for e in [&loose, &dflt] {
+                assert!(e.evals >= 21 && e.evals % 21 == 0 && e.evals <= 100_000, "α={al} θf={tf}: {e:?}");
+            }
+            assert!(loose.evals <= dflt.evals, "{loose:?} {dflt:?}");
+        }
+    }
+
+    /// R's error estimate bounds its actual error at a loose tolerance too: at 1e-5 against
+    /// 1e-12 the difference stays within the two estimates (the 1e-12 floor alone would not
+    /// cover it), and the estimate itself meets the asked tolerance.
+    #[test]
+    fn r_estimates_are_honest_at_a_loose_tolerance() {
+        for &(al, tf) in &[(0.15, 0.1), (0.35, 0.8), (0.6, 1.5), (0.05, 1.2)] {
+            let (d, t) = (r(al, tf, 1e-5), r(al, tf, 1e-12));
+            assert!(d.error <= 1e-5 && (d.value - t.value).abs() <= d.error + t.error, "α={al} θf={tf}: {d:?} vs {t:?}");
+        }
+    }
+
+    /// `graded_unit_integral` splits at interior cuts only: cuts at 0 and 1 are no cuts, and
+    /// with none the one piece is `crate::integrate::adaptive` over [0, 1] at the whole
+    /// tolerance (tol / number of pieces), the same bits and evaluations. The integrand
+    /// 1/(μ + 0.01) needs bisections, and over tolerances 1e-6 … 1e-13 halving any of them
+    /// changes the panels taken at least once (the direct counts must differ between the two).
+    #[test]
+    fn graded_unit_integral_cuts_only_inside_the_unit_interval() {
+        let f = |mu: f64| 1.0 / (mu + 0.01);
+        let mut halving_shows = false;
+        for tol in [1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12, 1e-13] {
+            let tl = Tolerance { abs: tol, rel: 0.0, max_panels: MAX_PANELS };
+            let direct = adaptive(0.0, 1.0, tl, f);
+            halving_shows |= adaptive(0.0, 1.0, Tolerance { abs: 0.5 * tol, ..tl }, f).evals != direct.evals;
+            for cuts in [&[][..], &[0.0], &[1.0], &[0.0, 1.0, 0.0]] {
+                let e = graded_unit_integral(cuts, tol, f);
+                assert_eq!((e.value.to_bits(), e.error.to_bits(), e.evals), (direct.value.to_bits(), direct.error.to_bits(), direct.evals), "tol {tol:e}, cuts {cuts:?}");
+            }
+        }
+        assert!(halving_shows, "no tolerance here tells a halved share from the whole");
+    }
 }
