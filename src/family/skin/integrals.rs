@@ -1617,4 +1617,211 @@ mod tests {
             Err(ProfileError::NoMassWithinReach { .. })
         ));
     }
+
+    /// A Gaussian profile's support is 9σ of its widest term with a nonzero weight: a term
+    /// weighted 0 in every channel does not widen it, one nonzero channel is enough (9·√1 = 9,
+    /// 9·√4 = 18 by hand); a table's is its last radius.
+    #[test]
+    fn support_is_nine_sigma_of_the_widest_weighted_term() {
+        let g = |v: f64, w: [f64; 3]| Gaussian { variance_mm2: v, weight: w };
+        assert_eq!(Profile::Gaussians(vec![g(1.0, [1.0; 3]), g(100.0, [0.0; 3])]).support_mm(), 9.0);
+        assert_eq!(Profile::Gaussians(vec![g(1.0, [1.0; 3]), g(4.0, [0.0, 1.0, 0.0])]).support_mm(), 18.0);
+        assert_eq!(tent(1.0, 2.5).support_mm(), 2.5);
+    }
+
+    /// A radius that goes back names the radius before it (2 mm), not itself (1.5 mm).
+    #[test]
+    fn a_decreasing_radius_names_the_previous_one() {
+        let p = Profile::Tabulated { radius_mm: vec![0.0, 2.0, 1.5], value: vec![[1.0; 3]; 3] };
+        let e = p.validate().unwrap_err();
+        assert_eq!(e, ProfileError::NonMonotoneRadius { index: 2, previous_mm: 2.0, radius_mm: 1.5 });
+        assert!(e.to_string().contains("not greater than radius 1 (2 mm)"), "{e}");
+    }
+
+    /// A three-segment table (first radius 0.5 mm, held below it), with the profile's radial
+    /// values integrated by the test piece by piece between the knots, where R is smooth.
+    fn three_segments() -> (Profile, [f64; 4]) {
+        let p = Profile::Tabulated {
+            radius_mm: vec![0.5, 1.0, 2.5],
+            value: vec![[2.0, 1.0, 3.0], [1.5, 1.0, 0.5], [0.0, 0.2, 0.0]],
+        };
+        (p, [0.0, 0.5, 1.0, 2.5])
+    }
+
+    /// A table's line profile P(x) = ∫ R(√(x² + y²)) dy over several segments (the Abel sums
+    /// beyond the first, where the segment starts past |x|), against the test's quadrature of
+    /// R along the line, split where the line crosses a knot.
+    #[test]
+    fn a_tabulated_line_profile_is_the_line_integral_over_every_segment() {
+        let (p, knots) = three_segments();
+        let tol = Tolerance { abs: 1e-14, rel: 1e-14, max_panels: 5000 };
+        for x in [0.0, 0.3, 0.5, 0.7, 1.0, 1.2, 2.0, 2.6] {
+            let lin = p.linear(x);
+            let mut ys: Vec<f64> = knots.iter().filter(|&&s| s > x).map(|&s| ((s - x) * (s + x)).sqrt()).collect();
+            ys.insert(0, 0.0);
+            for c in 0..3 {
+                let brute: f64 = ys
+                    .windows(2)
+                    .map(|w| 2.0 * adaptive(w[0], w[1], tol, |y| p.radial((x * x + y * y).sqrt())[c]).value)
+                    .sum();
+                // Quadrature to 1e-14 per smooth piece, values ≤ 3 over ≤ 2.5 mm: 1e-11.
+                assert!((lin[c] - brute).abs() < 1e-11, "x {x} channel {c}: {} vs {brute}", lin[c]);
+            }
+        }
+    }
+
+    /// A table's mass within s, ∫_0^s R(r) 2πr dr, over several segments (segments that start
+    /// past r = 0), against the test's quadrature between the knots.
+    #[test]
+    fn a_tabulated_mass_within_is_the_integral_over_every_segment() {
+        let (p, knots) = three_segments();
+        let tol = Tolerance { abs: 1e-14, rel: 1e-14, max_panels: 5000 };
+        for s in [0.3, 0.5, 0.8, 1.0, 1.7, 2.5, 4.0] {
+            let m = p.mass_within(s);
+            for c in 0..3 {
+                let brute: f64 = knots
+                    .windows(2)
+                    .filter(|w| w[0] < s)
+                    .map(|w| adaptive(w[0], w[1].min(s), tol, |r| p.radial(r)[c] * 2.0 * PI * r).value)
+                    .sum();
+                // Quadrature to 1e-14 per smooth piece of a quadratic in r: 1e-12.
+                assert!((m[c] - brute).abs() < 1e-12, "s {s} channel {c}: {} vs {brute}", m[c]);
+            }
+        }
+    }
+
+    /// A flat disk profile (R = 1 within a, 0 beyond) on a ring of angle x = κu: D is the
+    /// average of max(cos(θ + x), 0) over |x| ≤ X, X = 2·asin(aκ/2) (π once aκ ≥ 2), in closed
+    /// form: the lobe [−π/2, π/2] gives sin(min(θ + X, π/2)) − sin(max(θ − X, −π/2)) when not
+    /// empty, the lobe from 3π/2 gives sin(θ + X) + 1 when θ + X > 3π/2. On either side of every
+    /// kink of the clamp, over n·l ∈ [−1, 1] and rings shorter and longer than the disk.
+    #[test]
+    fn a_flat_disk_on_a_ring_is_the_clamped_cosine_average() {
+        let nls: Vec<f64> = (0..=40).map(|i| -1.0 + i as f64 / 20.0).collect();
+        for (a, kappa) in [(0.5, 1.0), (1.0, 0.5), (0.6, 1.0), (1.5, 1.0), (1.99, 1.0), (3.0, 1.0), (0.25, 4.0)] {
+            let disk = Profile::Tabulated { radius_mm: vec![0.0, a], value: vec![[1.0, 2.0, 0.5]; 2] };
+            let got = punctual_grid_estimates(&disk, Kernel::Radial, &nls, &[kappa], DEFAULT_TOLERANCE).unwrap();
+            let big_x = if a * kappa >= 2.0 { PI } else { 2.0 * (0.5 * a * kappa).asin() };
+            for (i, &nl) in nls.iter().enumerate() {
+                let theta = nl.acos();
+                let lo = (theta - big_x).max(-PI / 2.0);
+                let hi = (theta + big_x).min(PI / 2.0);
+                let mut integral = if hi > lo { hi.sin() - lo.sin() } else { 0.0 };
+                if theta + big_x > 1.5 * PI {
+                    integral += (theta + big_x).sin() + 1.0;
+                }
+                let exact = integral / (2.0 * big_x);
+                for c in 0..3 {
+                    let e = got[i][c];
+                    // The requested 1e-10, which the estimate must cover and honour; the closed
+                    // form rounds at ~1e-16.
+                    assert!((e.value - exact).abs() <= 1e-10, "a {a} κ {kappa} n·l {nl} channel {c}: {} vs {exact}", e.value);
+                    assert!((e.value - exact).abs() <= e.error + 1e-15 && e.error <= 1e-10, "a {a} κ {kappa} n·l {nl} channel {c}: error {:e}", e.error);
+                }
+            }
+        }
+    }
+
+    /// Lit from behind (n·l = −1) on a ring that spans less than a quarter turn (X = 2·asin(1/4)
+    /// = 0.505 < π/2), both clamped cosines are 0 everywhere: D is 0 exactly, with no error, and
+    /// the only evaluations counted are the ring's normalisation.
+    #[test]
+    fn a_ring_lit_only_from_behind_spends_nothing_on_the_numerator() {
+        let disk = Profile::Tabulated { radius_mm: vec![0.0, 0.5], value: vec![[1.0; 3]; 2] };
+        let k = PreparedKernel::new(&disk, Kernel::Radial);
+        let ring = Ring::new(&k, 1.0, DEFAULT_TOLERANCE).unwrap();
+        let d = ring.eval(-1.0, DEFAULT_TOLERANCE);
+        for c in 0..3 {
+            assert!(ring.den[c].evals > 0);
+            assert_eq!((d[c].value, d[c].error, d[c].evals), (0.0, 0.0, ring.den[c].evals), "channel {c}");
+        }
+    }
+
+    /// D and k_l are ratios of two integrals of the profile: scaling every weight by 2¹⁰ or
+    /// 2⁻¹⁰ (exact in binary) scales numerators, denominators and their error targets exactly,
+    /// so values, error estimates and evaluation counts stay the same bit for bit.
+    #[test]
+    fn a_power_of_two_scale_of_the_profile_changes_no_bit() {
+        let scaled = |p: &Profile, f: f64| match p {
+            Profile::Gaussians(gs) => Profile::Gaussians(gs.iter().map(|g| Gaussian { weight: g.weight.map(|w| f * w), ..*g }).collect()),
+            Profile::Tabulated { radius_mm, value } => {
+                Profile::Tabulated { radius_mm: radius_mm.clone(), value: value.iter().map(|v| v.map(|x| f * x)).collect() }
+            }
+        };
+        let loose = Tolerance { abs: 1e-6, rel: 0.0, max_panels: 2000 };
+        let mut nonzero_errors = 0;
+        for p in [default_skin_profile(), three_segments().0] {
+            for f in [1024.0, 1.0 / 1024.0] {
+                let q = scaled(&p, f);
+                for (kappa, nl) in [(0.3, 0.2), (1.0, -0.1), (3.0, 0.7)] {
+                    for tol in [DEFAULT_TOLERANCE, loose] {
+                        for kernel in [Kernel::Linear, Kernel::Radial] {
+                            let a = punctual(&p, kernel, kappa, nl, tol).unwrap();
+                            let b = punctual(&q, kernel, kappa, nl, tol).unwrap();
+                            assert_eq!(a, b, "{kernel:?} κ {kappa} n·l {nl} scale {f}");
+                            nonzero_errors += a.iter().filter(|e| e.error > 0.0).count();
+                        }
+                        for band in [1, 2] {
+                            let a = sh_band(&p, kappa, band, tol).unwrap();
+                            let b = sh_band(&q, kappa, band, tol).unwrap();
+                            assert_eq!(a, b, "band {band} κ {kappa} scale {f}");
+                            nonzero_errors += a.iter().filter(|e| e.error > 0.0).count();
+                        }
+                    }
+                }
+            }
+        }
+        // The comparison must hold error estimates that are not all 0.
+        assert!(nonzero_errors > 0);
+    }
+
+    /// The LUT grids, by hand: n·l column i of 65 is −1 + i/32, κ row j of 64 is κ_max·j/63
+    /// (3·21/63 = 1), the sqrt mapping puts t at κ_max·t² and t = 1 at κ_max exactly.
+    #[test]
+    fn lut_grids_sit_where_their_docs_say() {
+        assert_eq!([0, 16, 32, 48, 64].map(|i| lut_n_dot_l(i, 65)), [-1.0, -0.5, 0.0, 0.5, 1.0]);
+        assert_eq!([0, 1].map(|i| lut_n_dot_l(i, 2)), [-1.0, 1.0]);
+        assert_eq!([0, 21, 63].map(|j| lut_curvature(j, 64, 3.0)), [0.0, 1.0, 3.0]);
+        assert_eq!(CurvatureMapping::Sqrt.from_unit(0.5), 0.25);
+        assert_eq!(CurvatureMapping::Linear.from_unit(0.5), 0.5);
+        assert_eq!(mapped_curvature(0.5, 4.0, CurvatureMapping::Sqrt), 1.0);
+        assert_eq!(mapped_curvature(0.25, 16.0, CurvatureMapping::Sqrt), 1.0);
+        assert_eq!(mapped_curvature(0.5, 4.0, CurvatureMapping::Linear), 2.0);
+        assert_eq!(mapped_curvature(0.0, 4.0, CurvatureMapping::Sqrt), 0.0);
+        assert_eq!(mapped_curvature(1.0, 0.3, CurvatureMapping::Sqrt), 0.3);
+    }
+
+    /// k_0 and κ = 0 are 1 by definition (module docs): exact estimates, nothing integrated,
+    /// from `sh_band` and from `sh_bands_estimates` alike; band 1 at κ > 0 is integrated.
+    #[test]
+    fn sh_band_zero_and_flat_spheres_integrate_nothing() {
+        let p = default_skin_profile();
+        let exact = [Estimate::exact(1.0); 3];
+        assert_eq!(sh_band(&p, 0.0, 2, DEFAULT_TOLERANCE).unwrap(), exact);
+        assert_eq!(sh_band(&p, 0.5, 0, DEFAULT_TOLERANCE).unwrap(), exact);
+        let rows = sh_bands_estimates(&p, &[0.0, 0.5], &[0, 1], DEFAULT_TOLERANCE).unwrap();
+        assert_eq!((rows[0][0], rows[0][1], rows[1][0]), (exact, exact, exact));
+        assert!(rows[1][1].iter().all(|e| e.evals > 0 && e.value < 1.0));
+    }
+
+    /// A sphere of radius 1 mm reaches chords ≤ 2 mm; a profile that is zero out to 5 mm has no
+    /// mass there, and k_l is refused as D is (rather than 0/0).
+    #[test]
+    fn a_sphere_that_reaches_no_profile_mass_is_refused() {
+        let far = Profile::Tabulated { radius_mm: vec![5.0, 6.0], value: vec![[0.0; 3], [1.0; 3]] };
+        assert!(matches!(sh_band(&far, 1.0, 1, DEFAULT_TOLERANCE), Err(ProfileError::NoMassWithinReach { channel: 0, .. })));
+        assert!(matches!(sh_bands_estimates(&far, &[1.0], &[2], DEFAULT_TOLERANCE), Err(ProfileError::NoMassWithinReach { channel: 0, .. })));
+    }
+
+    /// The flat test is κ·max(support, 1 mm) < 1e-200, strictly: the support scales the
+    /// threshold above 1 mm only, and the product 1e-200 itself is not flat.
+    #[test]
+    fn flatness_is_curvature_times_the_support_below_1e_200() {
+        assert!(is_flat(0.0, 24.5));
+        assert!(is_flat(1e-201, 1.0));
+        assert!(is_flat(1e-201, 0.5));
+        assert!(!is_flat(1e-201, 100.0));
+        assert!(!is_flat(1e-200, 0.5));
+        assert!(!is_flat(1e-200, 1.0));
+    }
 }
