@@ -316,4 +316,38 @@ mod tests {
             assert!((back - g).abs() < 1e-10, "g={g} back={back}");
         }
     }
+    /// Where the secant step rounds onto an end of the bracket, the steps bisect. On a step
+    /// function, h = 1 below 0.75 and −1e-17 from 0.75 on, every secant point
+    /// b − h_b (b − a)/(h_b − h_a) is b less at most 1e-17 · (b − a), below half an ulp of b, so
+    /// it rounds to b and each step is a plain bisection (traced by hand: 0.5, 0.75, then a
+    /// climbs). The bracket [0.75 − 2⁻ʲ, 0.75] stops at the first width ≤ 2ε·0.75 = 3.3e-16,
+    /// j = 52: 2 + 52 evaluations, the root 0.75 − 2⁻⁵³ (the midpoint, exact in binary). The
+    /// mirror, h = 1e-17 below 0.25 and −1 from 0.25 on, rounds onto a: the bracket
+    /// [0.25 − 2⁻ʲ, 0.25] stops at 2⁻ʲ ≤ 2ε·0.25 = 2⁻⁵³, 2 + 53 evaluations, root 0.25 − 2⁻⁵⁴.
+    #[test]
+    fn illinois_bisects_where_the_secant_rounds_onto_an_end() {
+        let (g, evals) = illinois(|g: f64| if g < 0.75 { 1.0 } else { -1e-17 });
+        assert_eq!((g, evals), (0.75 - 2f64.powi(-53), 54));
+        let (g, evals) = illinois(|g: f64| if g < 0.25 { 1e-17 } else { -1.0 });
+        assert_eq!((g, evals), (0.25 - 2f64.powi(-54), 55));
+    }
+
+    /// The Illinois steps against hand and traced counts. A linear h = 1/8 − g/2: the first
+    /// secant point 1 − (−3/8)·1/(−1/2) = 1/4 is exact in binary and h(1/4) = 0: 3 evaluations,
+    /// the root 1/4 exactly. On h = 1/4 − g² (root ½) and h = e^(−8g) − ½ (root ln 2 / 8, the
+    /// other end goes stale) the steps, traced in IEEE double outside this crate, take 12 and 14
+    /// evaluations; halving the wrong end, or not halving, or a stale end never halved takes 4
+    /// to 186 instead. The roots: within 2 ulps of ½ and of ln 2 / 8 (the stop is at ≤ two
+    /// float spacings, and h's rounding moves the sign change by about one).
+    #[test]
+    fn illinois_takes_the_traced_steps_on_closed_form_roots() {
+        assert_eq!(illinois(|g: f64| 0.125 - 0.5 * g), (0.25, 3));
+        let (g, evals) = illinois(|g: f64| 0.25 - g * g);
+        assert!((g - 0.5).abs() <= 2.0 * f64::EPSILON * 0.5, "g = {g}");
+        assert_eq!(evals, 12, "h = 1/4 − g²");
+        let (g, evals) = illinois(|g: f64| (-8.0 * g).exp() - 0.5);
+        let root = std::f64::consts::LN_2 / 8.0;
+        assert!((g - root).abs() <= 2.0 * f64::EPSILON * root, "g = {g}, want {root}");
+        assert_eq!(evals, 14, "h = e^(−8g) − ½");
+    }
 }
