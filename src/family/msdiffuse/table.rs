@@ -577,15 +577,21 @@ pub(super) mod tests {
         bad(("quantity = \"ms-diffuse\"", "quantity = \"ms-diffuse-albedo\""), 3, "quantity", "tabulates 'ms-diffuse'");
     }
 
+    /// The test spec's table rendered from cells of the given values (standard error 0.01),
+    /// without simulating them, with those cells.
+    fn rendered(value: impl Fn(usize) -> f64) -> (Built, Vec<Cell>) {
+        let s = spec(SPEC);
+        let t = Table::from_spec(&s).unwrap();
+        let n = (t.slice_cells() + t.albedo_cells()) as usize;
+        let cells: Vec<Cell> = (0..n).map(|k| Cell { value: value(k), se: 0.01 }).collect();
+        (render(&s, &t, &cells).unwrap(), cells)
+    }
+
     #[test]
     fn png_preview_is_256_pixels_across_a_layer() {
         // Texels of a 4 × 3 layer are scaled by ⌊256/4⌋ = 64: the preview is 256 wide and
         // 2 layers × 3 rows × 64 = 384 tall. The cells need not be simulated to be rendered.
-        let s = spec(SPEC);
-        let t = Table::from_spec(&s).unwrap();
-        let n = (t.slice_cells() + t.albedo_cells()) as usize;
-        let cells: Vec<Cell> = (0..n).map(|k| Cell { value: 1.0 + 0.01 * k as f64, se: 0.01 }).collect();
-        let built = render(&s, &t, &cells).unwrap();
+        let (built, _) = rendered(|k| 1.0 + 0.01 * k as f64);
         let png = &built.artifacts.iter().find(|a| a.path.ends_with("data/msd_t.png")).unwrap().contents;
         // PNG: 8-byte signature, IHDR length and type, then width and height big-endian.
         assert_eq!(&png[12..16], b"IHDR");
@@ -849,11 +855,7 @@ pub(super) mod tests {
     /// 1.35, so R/2 differs from R (and from R mod 2) in every 8-bit code.
     #[test]
     fn the_atlas_is_layers_of_rows_and_the_preview_shows_half_the_value() {
-        let s = spec(SPEC);
-        let t = Table::from_spec(&s).unwrap();
-        let n = (t.slice_cells() + t.albedo_cells()) as usize;
-        let cells: Vec<Cell> = (0..n).map(|k| Cell { value: 0.2 + 0.05 * k as f64, se: 0.01 }).collect();
-        let built = render(&s, &t, &cells).unwrap();
+        let (built, cells) = rendered(|k| 0.2 + 0.05 * k as f64);
         let file = |end: &str| built.artifacts.iter().find(|a| a.path.ends_with(end)).unwrap().contents.clone();
         let ktx2 = file("data/msd_t.ktx2");
         let le = |i: usize| u32::from_le_bytes(ktx2[i..i + 4].try_into().unwrap());
@@ -875,10 +877,7 @@ pub(super) mod tests {
     /// 2/π, written as the f32 nearest 0.6366197723… (6.3661975e-1), in both languages.
     #[test]
     fn the_module_states_the_atlas_size_and_the_angle_scale() {
-        let s = spec(SPEC);
-        let t = Table::from_spec(&s).unwrap();
-        let n = (t.slice_cells() + t.albedo_cells()) as usize;
-        let built = render(&s, &t, &vec![Cell { value: 1.0, se: 0.01 }; n]).unwrap();
+        let (built, _) = rendered(|_| 1.0);
         let text = |end: &str| String::from_utf8(built.artifacts.iter().find(|a| a.path.ends_with(end)).unwrap().contents.to_vec()).unwrap();
         let (wgsl, rust) = (text("wgsl/msd_t.wgsl"), text("src/msd_t.rs"));
         assert!(wgsl.contains("MSD_T_SIZE: vec3<u32> = vec3<u32>(4u, 3u, 2u);"), "{wgsl}");
