@@ -299,13 +299,18 @@ mod tests {
     }
 
     /// The evaluator's sum Σ c_k b_k with b = (1, u, u²·v) at (u, v) = (0.5, 4) and c = (1, 2, 3):
-    /// 1 + 2·0.5 + 3·(0.25·4) = 5, exact in f32.
+    /// 1 + 2·0.5 + 3·(0.25·4) = 5, exact in f32; in f32 and as the emitted WGSL text (its
+    /// coefficients and arguments written as literals, folded by naga), every factor of a
+    /// monomial multiplied in (3·0.5 alone would give 3.5).
     #[test]
     fn basis_sum_multiplies_each_monomials_arguments() {
         let args = vec!["u".to_string(), "v".to_string()];
         let terms: Vec<Term> = ["1", "u", "u^2*v"].iter().map(|s| Term::parse(s, &args).unwrap()).collect();
         assert_eq!(basis_sum_f32(&terms, &[1.0, 2.0, 3.0], &[0.5, 4.0]), 5.0);
         assert_eq!(basis_sum_f32(&terms[1..], &[2.0, 3.0], &[0.5, 4.0]), 4.0);
+        let (c, a) = ([1.0, 2.0, 3.0], [0.5, 4.0]);
+        let text = basis_sum(&terms, &|k| wlit(c[k]), &|i| wlit(a[i]));
+        assert_eq!(crate::emit::fixtures::naga_folded_f32("", &text), 5.0, "{text}");
     }
 
     /// Two fields (n₀ + n₁o)/(1 + d₀o) of the outer input o ∈ [0, 1] and the evaluator

@@ -1,6 +1,7 @@
 //! Functions of every body shape, for the emitters' tests: a fit with a denominator and a
 //! clamp, one without either, a one- and a two-axis table; the points they are run at (inside,
-//! on and outside the domain, ±inf, NaN); and what the build's f32 evaluators give there.
+//! on and outside the domain, ±inf, NaN); what the build's f32 evaluators give there; and the
+//! value naga's constant evaluator folds a WGSL expression to.
 
 use super::rust::table_eval_f32;
 use super::wgsl::{Body, Function};
@@ -50,6 +51,16 @@ impl Four {
             Function { module: "m_t2", name: "m_t2", args: &self.a2, derived: &[], domain: &D2, body: Body::Table { values: &self.t2, counts: &[3, 4] } },
         ]
     }
+}
+
+/// The f32 that naga's constant evaluator folds the WGSL expression `expr` to (`const v: f32 =
+/// EXPR;` after the declarations `decls`), for judging emitted expressions without a GPU.
+pub fn naga_folded_f32(decls: &str, expr: &str) -> f32 {
+    let src = format!("{decls}const v: f32 = {expr};\n");
+    let m = naga::front::wgsl::parse_str(&src).unwrap_or_else(|e| panic!("{}", e.emit_to_string(&src)));
+    let c = m.constants.iter().find(|(_, c)| c.name.as_deref() == Some("v")).unwrap().1;
+    let naga::Expression::Literal(naga::Literal::F32(v)) = m.global_expressions[c.init] else { panic!("{src} is not folded to a literal") };
+    v
 }
 
 /// The points `f` is run at: every value of [`XS`] for each argument, all combinations.

@@ -293,7 +293,7 @@ mod tests {
     use super::*;
 
     /// Every shape of derived feature, rendered and evaluated by naga's constant evaluator
-    /// (`const d = <expression of x0>;` with x0 a constant): the value is the feature's own f32
+    /// (`const v = <expression of x0>;` with x0 a constant): the value is the feature's own f32
     /// evaluation (`Derived::eval_f32`) at x0 = 0.3.
     #[test]
     fn derived_features_evaluate_in_naga_as_in_f32() {
@@ -301,12 +301,7 @@ mod tests {
         for text in ["x", "0.5 - x", "0.25 + x", "2*x", "1 + 3*x", "1 - 2*x", "0 - x", "cos(x)", "sin(x)"] {
             let d = crate::fit::model::Derived::parse("d", text, &inputs).unwrap();
             let expr = derived_expr(&d, &lit, &|fun, v| format!("{fun}({v})"));
-            let src = format!("const x0: f32 = 0.3;\nconst d: f32 = {expr};\n");
-            let m = naga::front::wgsl::parse_str(&src).unwrap_or_else(|e| panic!("{}", e.emit_to_string(&src)));
-            let c = m.constants.iter().find(|(_, c)| c.name.as_deref() == Some("d")).unwrap().1;
-            let naga::Expression::Literal(naga::Literal::F32(got)) = m.global_expressions[c.init] else {
-                panic!("{text}: {src} is not folded to a literal")
-            };
+            let got = crate::emit::fixtures::naga_folded_f32("const x0: f32 = 0.3;\n", &expr);
             let want = d.eval_f32(&[0.3]);
             // One f32 operation or two (exact agreement), or naga's cos/sin against Rust's f32
             // ones: a few ulps of values ≤ 1.6.
