@@ -420,6 +420,16 @@ mod tests {
         assert_eq!(word(2) >> 16, 24 + 16 * samples, "{samples} samples");
     }
 
+    /// The formats' names are the WebGPU specification's `GPUTextureFormat` values, which the
+    /// spec files also take (serde's lowercase names).
+    #[test]
+    fn texture_formats_are_named_as_webgpu_names_them() {
+        for (format, webgpu) in [(TextureFormat::Rgba16float, "rgba16float"), (TextureFormat::Rgba32float, "rgba32float")] {
+            assert_eq!(format.name(), webgpu);
+            assert_eq!(serde_json::to_string(&format).unwrap(), format!("\"{webgpu}\""));
+        }
+    }
+
     #[test]
     fn ktx2_reads_back_with_the_ktx2_crate() {
         // The VkFormat of each, as the ktx2 crate names Vulkan's enumerants (97 and 109), and
@@ -603,8 +613,9 @@ mod tests {
         // 5×3 → 2×1 → 1×1; RG8, RGBA8, RG16 and RGBA16: the ktx2 crate's reader
         // (independent) finds the format, the three levels in order and the codes
         // (round(v · (2^bits − 1))). VkFormat enumerants from the Vulkan specification:
-        // R8G8_UNORM 16, R8G8B8A8_UNORM 37, R16G16_UNORM 77, R16G16B16A16_UNORM 91.
-        for (channels, bits, vk) in [(2usize, 8u32, 16u32), (4, 8, 37), (2, 16, 77), (4, 16, 91)] {
+        // R8G8_UNORM 16, R8G8B8A8_UNORM 37, R16G16_UNORM 77, R16G16B16A16_UNORM 91; typeSize
+        // (KTX 2.0 §3.3) the bytes of one channel, 1 for the 8-bit formats and 2 for the 16-bit.
+        for (channels, bits, vk, type_size) in [(2usize, 8u32, 16u32, 1u32), (4, 8, 37, 1), (2, 16, 77, 2), (4, 16, 91, 2)] {
             let sizes = [(5u32, 3u32), (2, 1), (1, 1)];
             let levels: Vec<UnormLevel> = sizes
                 .iter()
@@ -615,6 +626,7 @@ mod tests {
             let r = ktx2::Reader::new(&bytes[..]).expect("a valid KTX2 file");
             let hd = r.header();
             assert_eq!(hd.format.map(|f| f.value()), Some(vk));
+            assert_eq!(hd.type_size, type_size);
             assert_eq!((hd.pixel_width, hd.pixel_height, hd.level_count), (5, 3, 3));
             // The DFD's integer samples (KDF 1.3 §5): no qualifiers, lower 0, upper 2^bits − 1.
             let basic = r.basic_dfd().expect("a basic DFD block");
