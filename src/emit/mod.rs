@@ -352,6 +352,49 @@ mod tests {
         assert!(!staging.exists());
     }
 
+    /// A `.staging` that cannot be removed (here a file where the folder would be) is an error
+    /// naming it: only a missing folder is nothing to remove, and a transaction does not begin
+    /// over what it cannot clear.
+    #[test]
+    fn a_staging_path_that_cannot_be_removed_is_an_error() {
+        let d = tempfile::tempdir().unwrap();
+        let staging = d.path().join(STAGING_DIR);
+        std::fs::write(&staging, "not a folder").unwrap();
+        let e = Transaction::begin(d.path()).err().expect("a transaction begun over a .staging file");
+        assert_eq!(e.path, staging.display().to_string(), "{e}");
+        assert_eq!(std::fs::read_to_string(&staging).unwrap(), "not a folder");
+    }
+
+    /// Set in the environment of the child process of `fault_points_are_read_from_the_environment`.
+    const FAULT_CHILD: &str = "SHADEFIT_TEST_FAULT_CHILD";
+
+    /// A transaction takes its fault points from the environment when it begins: none in an
+    /// ordinary run, and the numbers given in `SHADEFIT_FAULT_AFTER_SWAPS` (3) and
+    /// `SHADEFIT_ABORT_AFTER_SWAPS` (5) in the child process that the next test starts.
+    #[test]
+    fn fault_points_follow_the_environment() {
+        let d = tempfile::tempdir().unwrap();
+        let tx = Transaction::begin(d.path()).unwrap();
+        let want = if std::env::var_os(FAULT_CHILD).is_some() { (Some(3), Some(5)) } else { (None, None) };
+        assert_eq!((tx.fail_after, tx.abort_after), want);
+    }
+
+    /// Runs `fault_points_follow_the_environment` again in a child process of this test
+    /// binary, with both fault variables set (the environment of a test process is not
+    /// changed in place: other tests read it concurrently).
+    #[test]
+    fn fault_points_are_read_from_the_environment() {
+        let out = std::process::Command::new(std::env::current_exe().unwrap())
+            .args(["--exact", "emit::tests::fault_points_follow_the_environment"])
+            .env(FAULT_CHILD, "1")
+            .env("SHADEFIT_FAULT_AFTER_SWAPS", "3")
+            .env("SHADEFIT_ABORT_AFTER_SWAPS", "5")
+            .output()
+            .unwrap();
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        assert!(out.status.success() && stdout.contains("1 passed"), "{stdout}{}", String::from_utf8_lossy(&out.stderr));
+    }
+
     /// The header every emitted file opens with: generator and how to regenerate, the spec,
     /// the input hash and the measured error, one a line; a spec made in memory (a `shadefit`
     /// command, e.g. `fit --emit`) points to the command instead of `shadefit build`.
