@@ -632,6 +632,7 @@ mod tests {
         let bytes = &spv.contents;
         let has = |needle: &[u8]| bytes.windows(needle.len()).any(|w| w == needle);
         assert!(has(b"emitted_f"), "no OpName of the function");
+        assert!(has(b"m_keep_all\0"), "no OpEntryPoint named m_keep_all (NAME_keep_all)");
         assert!(has(b"return x * 2.0"), "no OpSource text");
     }
 
@@ -655,6 +656,8 @@ mod tests {
             assert!(ep.contains(call), "no '{call}' in {ep}");
         }
         assert!(ep.contains("var k_keep_binding_0: texture_2d<f32>;") && ep.contains("var k_keep_binding_1: sampler;"), "{ep}");
+        // Named after the module, NAME_keep_all.
+        assert!(ep.contains("@fragment\nfn k_keep_all() {\n"), "{ep}");
     }
 
     /// The C header holds every named constant with its values read back bit for bit, scalars,
@@ -880,6 +883,17 @@ mod tests {
                        StructuredBuffer<uint> nagaGroup1SamplerIndexArray : register(t1, space255);\n\
                        static const SamplerComparisonState m_shadow = nagaComparisonSamplerHeap[nagaGroup1SamplerIndexArray[3]];\n";
         assert_eq!(hlsl_sampler_registers(compare), "SamplerComparisonState m_shadow : register(s3, space1);\n");
+        // Group and binding are the decimal numbers of WGSL's @group(G) @binding(B): a global
+        // read through an index that is not one (a letter, nothing) stays as it was, and so do
+        // the declarations it reads.
+        for (group, binding) in [("X", "1"), ("0", "")] {
+            let odd = format!(
+                "SamplerState nagaSamplerHeap[2048]: register(s0, space0);\n\
+                 StructuredBuffer<uint> nagaGroup{group}SamplerIndexArray : register(t0, space255);\n\
+                 static const SamplerState m_odd = nagaSamplerHeap[nagaGroup{group}SamplerIndexArray[{binding}]];\n"
+            );
+            assert_eq!(hlsl_sampler_registers(&odd), odd, "group '{group}', binding '{binding}'");
+        }
     }
 
     /// The WGSL of each argument type the keep entry point can make a value of is the type
