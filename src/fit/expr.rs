@@ -208,8 +208,9 @@ mod tests {
 
     /// The emitted tree evaluates the model for every shape of term: a constant, a lone
     /// variable, a power, a cross term, tied terms with and without a constant (1 + x, x + y²),
-    /// a lead term, a factor and an offset; against the model's own f64 evaluation
-    /// (`eval_full`, which sums basis values, not the tree) at points across the unit square.
+    /// a sum of constants (1 + 1, whose coefficient counts twice), a lead term, a factor and an
+    /// offset; against the model's own f64 evaluation (`eval_full`, which sums basis values, not
+    /// the tree) at points across the unit square.
     #[test]
     fn the_emitted_tree_evaluates_the_model_for_every_term_shape() {
         use crate::fit::model::ModelParts;
@@ -217,7 +218,7 @@ mod tests {
         let t = |s: &str| Term::parse(s, &f).unwrap();
         let m = RationalModel::new(ModelParts {
             inputs: f.clone(),
-            numerator: vec![t("1"), t("x"), t("1 + x"), t("x + y^2"), t("x*y")],
+            numerator: vec![t("1"), t("x"), t("1 + x"), t("x + y^2"), t("x*y"), t("1 + 1")],
             denominator: vec![t("y"), t("1 + x*y"), t("x^2")],
             lead: Some(t("1 + y")),
             offset: 0.25,
@@ -225,7 +226,7 @@ mod tests {
             ..ModelParts::default()
         })
         .unwrap();
-        let c = DVector::from_vec(vec![0.5, -1.25, 0.75, 2.0, -0.5, 0.3, 0.2, -0.1]);
+        let c = DVector::from_vec(vec![0.5, -1.25, 0.75, 2.0, -0.5, 0.125, 0.3, 0.2, -0.1]);
         let (num, den) = f32_arrays(&m, &c);
         let e = model_expr(&m);
         for (x, y) in [(0.0, 0.0), (0.3, 0.8), (1.0, 0.5), (0.7, 1.0)] {
