@@ -525,28 +525,60 @@ mod tests {
         assert!(r.num[1..].iter().zip(&rounded(&fixed, &f.coefficients).0[1..]).any(|(a, b)| a != b));
     }
 
-    /// The search never takes a denominator coefficient the proof cannot pass, the first one
-    /// included: c/(1 + d·x) on the box [0, 1] from d = −1 + 2^-24 (denominator ≥ 2^-24 there),
-    /// with data of d = −1 − 2^-23 sampled on [0, ½] only. Two ulps down, d = −1 − 2^-23, fits
-    /// the data exactly but has a pole at x = 1 − 2^-23 inside the box; d = −1 reaches 0 at
-    /// x = 1. So d must stay where it is, though the objective pulls it down.
-    #[test]
-    fn the_search_keeps_the_first_denominator_coefficient_provable() {
+    /// c/(1 + Σ d_j·t_j(x)) of one input x, the denominator terms t_j given, with `fixed`
+    /// coefficients (c first).
+    fn over_denominator(den: &[&str], fixed: Vec<(usize, f64)>) -> RationalModel {
         let feats = vec!["x".to_string()];
         let terms = |ts: &[&str]| ts.iter().map(|t| Term::parse(t, &feats).unwrap()).collect::<Vec<_>>();
-        let m = RationalModel::new(ModelParts { inputs: feats.clone(), numerator: terms(&["1"]), denominator: terms(&["x"]), ..ModelParts::default() })
-            .unwrap();
+        RationalModel::new(ModelParts { inputs: feats.clone(), numerator: terms(&["1"]), denominator: terms(den), fixed, ..ModelParts::default() }).unwrap()
+    }
+
+    /// The search never takes a denominator coefficient the proof cannot pass, the first one
+    /// and a later one alike: c/(1 + d·x^p) on the box [0, 1], for p = 1 (d the first
+    /// denominator coefficient) and p = 2 (d the second, the first, of x, fixed at 0), from
+    /// d = −1 + 2^-24 (denominator ≥ 2^-24 there), with data of d = −1 − 2^-23 sampled where
+    /// x^p ∈ [0, ½] only. Two ulps down, d = −1 − 2^-23, fits the data exactly but has a pole
+    /// inside the box (at x = (1 + 2^-23)^(−1/p) < 1); d = −1 reaches 0 at x = 1. So d must stay
+    /// where it is, though the objective pulls it down.
+    #[test]
+    fn the_search_keeps_every_denominator_coefficient_provable() {
         let pole = -1.0 - 2f64.powi(-23);
-        let d = samples(0.0, 0.5, 65, |x| 1.0 / (1.0 + pole * x));
-        let start = DVector::from_vec(vec![1.0, -1.0 + 2f64.powi(-24)]);
-        for objective in [Objective::Minimax, Objective::Lsq] {
-            let r = round_and_reoptimise(&m, &start, &d, &[(0.0, 1.0)], &RoundOptions::new(objective, None), "pole").unwrap();
-            assert!(r.den[0] > -1.0, "{objective:?}: d = {} leaves no positive denominator on [0, 1]", r.den[0]);
-            assert!(matches!(prove_denominator_positive(&m, &widen(&r.num, &r.den), &[(0.0, 1.0)]), Positivity::Proven { .. }));
-            // Not vacuous: the data would rather have the pole's coefficient.
-            let f = |dd: f32| (0..d.y.len()).map(|i| (1.0 / (1.0 + dd as f64 * d.x[i][0]) - d.y[i]).abs()).fold(0.0, f64::max);
-            assert!(f(pole as f32) < f(r.den[0]), "{objective:?}");
+        let d0 = -1.0 + 2f64.powi(-24);
+        for (den, fixed, p, start) in [(&["x"][..], vec![], 1, vec![1.0, d0]), (&["x", "x^2"][..], vec![(1, 0.0)], 2, vec![1.0, 0.0, d0])] {
+            let m = over_denominator(den, fixed);
+            let d = samples(0.0, 0.5f64.powf(1.0 / p as f64), 65, |x| 1.0 / (1.0 + pole * x.powi(p)));
+            let start = DVector::from_vec(start);
+            for objective in [Objective::Minimax, Objective::Lsq] {
+                let r = round_and_reoptimise(&m, &start, &d, &[(0.0, 1.0)], &RoundOptions::new(objective, None), "pole").unwrap();
+                let last = *r.den.last().unwrap();
+                assert!(last > -1.0, "x^{p}, {objective:?}: d = {last} leaves no positive denominator on [0, 1]");
+                assert!(matches!(prove_denominator_positive(&m, &widen(&r.num, &r.den), &[(0.0, 1.0)]), Positivity::Proven { .. }));
+                // Not vacuous: the data would rather have the pole's coefficient (measured: with
+                // the proof skipped, the least-squares search takes d = −1 for x²).
+                let f = |dd: f32| (0..d.y.len()).map(|i| (1.0 / (1.0 + dd as f64 * d.x[i][0].powi(p)) - d.y[i]).abs()).fold(0.0, f64::max);
+                assert!(f(pole as f32) < f(last), "x^{p}, {objective:?}");
+            }
         }
+    }
+
+    /// A denominator coefficient moves where that improves the fit and the proof passes, as far
+    /// as the move cap and no farther, and every candidate is counted. 1/(1 + d·x) with the
+    /// numerator fixed at 1, from d = 0.5, on 33 samples of d* = 0.5 + 2^-10 over [0, 1]
+    /// (denominator ≥ 1 on the box for every candidate): d* is 2^14 ulps (2^-24 each in
+    /// [0.5, 1)) above the start, and each step up lowers every residual, so the search takes
+    /// the largest, +64 ulps = 2^-18, in its first sweep (its 14 candidates ±1, ±2, …, ±64 all
+    /// within the cap) and nothing in its second, where of the moves from there only the 7
+    /// down (−1 … −64 ulps, back to at most the start) are within the cap: 1 + 14 + 7
+    /// evaluations in 2 sweeps, counted by hand.
+    #[test]
+    fn a_denominator_coefficient_moves_to_the_cap_and_every_candidate_counts() {
+        let m = over_denominator(&["x"], vec![(0, 1.0)]);
+        let target = 0.5 + 2f64.powi(-10);
+        let d = samples(0.0, 1.0, 33, |x| 1.0 / (1.0 + target * x));
+        let r = round_and_reoptimise(&m, &DVector::from_vec(vec![1.0, 0.5]), &d, &[(0.0, 1.0)], &RoundOptions::new(Objective::Lsq, None), "cap")
+            .unwrap();
+        assert_eq!((r.num.as_slice(), r.den.as_slice()), (&[1.0f32][..], &[0.5 + 2f32.powi(-18)][..]), "{r:?}");
+        assert_eq!((r.sweeps, r.evaluations), (2, 22));
     }
 
     #[test]
