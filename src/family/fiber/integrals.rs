@@ -346,4 +346,110 @@ mod tests {
         let m = mean(k, 1.0, TOL).value;
         assert!((m - (1.0 + 2.0 * k * 2.0 / 3.0)).abs() <= 3.0 * k * k, "{m}");
     }
+
+    /// N = (1 − k²) M and r_c = 1/N(k, 1) at k = −1/2, by hand: m = 1/2, F(1/2) = ln 1.5 − 1/3
+    /// = 0.405465108 − 0.333333333 = 0.0721317748, M(k, 1) = 2F/m² = 0.5770651, 1 − k² = 3/4, so
+    /// N(k, 1) = 0.4327906 and r_c = 2.3105860; at u ⟂ t N = (3/4) M(k, 0), M(k, 0) from the
+    /// I₁, I₂ closed form. Bounds: ln 1.5 − 1/3 to an ulp of 0.4 (1e-16 on F = 0.07, 2e-15
+    /// relative), so 1e-14 relative on N and r_c; at c = 0 the 1e-13 tolerance (times 3/4)
+    /// plus the closed form's 1.2e-14 (`edges_match_their_closed_forms`).
+    #[test]
+    fn norm_and_the_conservative_r_at_k_minus_one_half_by_hand() {
+        let k = -0.5;
+        assert_eq!(one_minus_k2(k), 0.75);
+        let n_parallel = 0.75 * 2.0 * (1.5f64.ln() - 1.0 / 3.0) / 0.25;
+        assert!((n_parallel - 0.4327906).abs() < 1e-7 && (1.0 / n_parallel - 2.3105860).abs() < 1e-7, "{n_parallel}");
+        let e = norm(k, 1.0, TOL);
+        assert!((e.value / n_parallel - 1.0).abs() <= 1e-14, "N(k, 1) = {}", e.value);
+        assert!((conservative_r(k) * n_parallel - 1.0).abs() <= 1e-14, "r_c = {}", conservative_r(k));
+        let e = norm(k, 0.0, TOL);
+        assert!((e.value - 0.75 * mean_perpendicular(k)).abs() <= 0.75 * (TOL + 1.2e-14), "N(k, 0) = {}", e.value);
+    }
+
+    /// The belt's initial panels follow the rule of `belt_panels`: edges at π/2 − 4ʲ arcsin c
+    /// while 4ʲ arcsin c < π/4, only for c ≥ 1e-6. At c = 1e-4: 4⁶ arcsin c = 0.4096 < π/4 <
+    /// 4⁷ arcsin c = 1.64, seven edges and eight panels; c = 1/2: arcsin c = π/6 < π/4 < 4π/6,
+    /// one edge at π/3; c = 0.9 (arcsin c = 1.12 > π/4) and c = 1e-7 (below 1e-6): one panel.
+    /// (4ʲ d is exact in binary, so the edges are compared exactly.) And `mean` counts 21
+    /// evaluations per K21 panel plus one for the cap's closed form: at tolerance 1e-2 no panel
+    /// is bisected (a K21 panel of this analytic integrand is far within it), so the count is
+    /// 21 × panels + 1; at c = 1 the cap alone, one.
+    #[test]
+    fn the_belt_starts_on_its_graded_panels_and_counts_the_cap_as_one_evaluation() {
+        let a = 1e-4f64.asin();
+        let mut edges = vec![0.0];
+        edges.extend((0..7).rev().map(|j| FRAC_PI_2 - 4f64.powi(j) * a));
+        edges.push(FRAC_PI_2);
+        let want: Vec<(f64, f64)> = edges.windows(2).map(|w| (w[0], w[1])).collect();
+        assert_eq!(belt_panels(1e-4), want);
+        assert_eq!(belt_panels(0.5), vec![(0.0, FRAC_PI_2 - 0.5f64.asin()), (FRAC_PI_2 - 0.5f64.asin(), FRAC_PI_2)]);
+        for c in [0.9, 1e-7, 0.0] {
+            assert_eq!(belt_panels(c), vec![(0.0, FRAC_PI_2)], "c = {c}");
+        }
+        for (c, panels) in [(1e-4, 8), (0.5, 2), (0.9, 1), (0.0, 1)] {
+            assert_eq!(mean(-0.9, c, 1e-2).evals, 21 * panels + 1, "c = {c}");
+        }
+        assert_eq!(mean(-0.9, 1.0, 1e-2).evals, 1);
+    }
+
+    /// The belt is asked for tol/scale (M's error is scale times the belt's, scale = 4s²/π =
+    /// 4/π at u ⟂ t): at a tolerance 1/1.2 of an estimate the engine reported, the estimate
+    /// must still be within it. Asking the belt for tol (or tol·scale) would accept the stage
+    /// that reported E = 1.2 tol. Each estimate also bounds the error against the closed form
+    /// M(k, 0) (whose cancellation costs ≤ 1.2e-14 at m = 0.9).
+    #[test]
+    fn mean_meets_a_tolerance_just_below_a_reported_estimate() {
+        let k = -0.9;
+        let mut tol = 1e-6;
+        for _ in 0..6 {
+            let e = mean(k, 0.0, tol);
+            assert!(e.error <= tol, "tol {tol:e}: estimate {:e}", e.error);
+            assert!((e.value - mean_perpendicular(k)).abs() <= e.error + 1.2e-14, "tol {tol:e}: {e:?}");
+            tol = e.error / 1.2;
+        }
+    }
+
+    /// M = M_cap + M_belt (module doc): the cap's closed form with its few ulps (8ε·M_cap), plus
+    /// 4s²/π times the belt integral on its panels by the engine, value and estimate, and the
+    /// engine's evaluations plus one for the cap. At k = −0.99, c = 0.3 and tolerance 1e-2
+    /// nothing is bisected (two K21 panels, 43 evaluations), and the belt's raw |K21 − G10|
+    /// is above 5e-13 (at 1e-12 `mean` bisects once), so a lost or negated belt estimate shows.
+    /// The same operations in the same order: exact.
+    #[test]
+    fn mean_is_the_cap_plus_the_belt_with_both_estimates() {
+        let (k, c) = (-0.99, 0.3);
+        let scale = 4.0 * (1.0 - c) * (1.0 + c) / PI;
+        let loose = Options::scalar(Tolerance { abs: 1.0, rel: 0.0, max_panels: MAX_PANELS });
+        let belt = integrate(&belt_panels(c), &loose, |psi| [belt_integrand(k, c, psi)]);
+        let e = mean(k, c, 1e-2);
+        assert!(belt.evals == 42 && belt.error > 5e-13, "{belt:?}");
+        assert_eq!(e.evals, belt.evals + 1);
+        assert_eq!(e.value, cap(k, c) + scale * belt.value[0]);
+        assert_eq!(e.error, 8.0 * f64::EPSILON * cap(k, c) + scale * belt.error);
+    }
+
+    /// N's tolerance is on N = (1 − k²) M: M is asked only for tol/(1 − k²), 50× looser at
+    /// k = −0.99, so N costs fewer evaluations than M at the same tolerance (asking M for tol,
+    /// or tol·(1 − k²), would cost as many or more), and still meets it.
+    #[test]
+    fn norm_asks_the_mean_only_for_what_n_needs() {
+        for (k, c) in [(-0.99, 0.3)] {
+            let (n, m) = (norm(k, c, 1e-12), mean(k, c, 1e-12));
+            assert!(n.error <= 1e-12 && n.evals < m.evals, "k = {k}, c = {c}: {n:?} vs {m:?}");
+        }
+    }
+
+    /// With one Gauss node (x = 0, weight 2) the product rule is the midpoint rule in β and γ
+    /// (γ = π/2, inner sum 2): at k = 0 (integrand 1/4π) a β panel [a, b] contributes
+    /// 2·((b − a)/2)·sin((a + b)/2)·(π/2)·2/(2π) = ((b − a)/2) sin((a + b)/2). At c = √3/2 the
+    /// conical point is β* = 2 arccos c = π/3: unsplit (π/2) sin(π/2) = π/2 = 1.5708; split
+    /// (π/6) sin(π/6) + (π/3) sin(2π/3) = π/12 + π√3/6 = 1.1687. Rounding: 1e-15.
+    #[test]
+    fn the_product_rule_with_one_node_is_the_midpoint_rule_split_at_the_conical_point() {
+        let c = 3f64.sqrt() / 2.0;
+        let unsplit = mean_sphere_product(0.0, c, 1, false);
+        let split = mean_sphere_product(0.0, c, 1, true);
+        assert!((unsplit - FRAC_PI_2).abs() <= 1e-15, "{unsplit}");
+        assert!((split - (PI / 12.0 + PI * 3f64.sqrt() / 6.0)).abs() <= 1e-15, "{split}");
+    }
 }
