@@ -729,6 +729,108 @@ mod tests {
         assert!((KULLA_CONTY.eval(0.5) - 0.790181875).abs() < 1e-12);
     }
 
+    /// Where `published_forms_at_hand_computed_points` does not reach: Karis where the min
+    /// takes r.x², Lazarov at half gloss and where exp2 wins, MaterialX's bias channel and PR
+    /// #826's constants (`MATERIALX_826`), all by hand from the printed constants.
+    #[test]
+    fn published_forms_at_hand_computed_points_off_the_first_ones() {
+        // Karis at r = 0.5, n·v = 0: r = (0.5, 0.02875, 0.754, −0.029), min(0.25, 2⁰ = 1) = 0.25,
+        // a004 = 0.25·0.5 + 0.02875 = 0.15375, A = 0.754 − 1.04·0.15375 = 0.5941, B = 1.04·0.15375
+        // − 0.029 = 0.1309 (exact decimals; 1e-15 for the roundings of values ≤ 1).
+        let [a, b] = KARIS.eval(0.5, 0.0);
+        assert!((a - 0.5941).abs() < 1e-15 && (b - 0.1309).abs() < 1e-15, "{a} {b}");
+        // Lazarov at g = 0.5, n·v = 0: t = (0.5/0.96, 0.2375, (0.5·0.0175 − 0.015)/0.96, 0.875)
+        // = (0.5208333, 0.2375, −0.0065104, 0.875); a0 = 0.5208333·min(0.2375, 1) − 0.0065104
+        // = 0.1171875 (= 0.1125/0.96 exactly), A = 0.875 − a0 = 0.7578125. 1e-15: roundings.
+        let [a, b] = LAZAROV.eval(0.5, 0.0);
+        assert!((b - 0.1171875).abs() < 1e-15 && (a - 0.7578125).abs() < 1e-15, "{a} {b}");
+        // At g = 1, n·v = 1: 2^−9.28 = 2^−9·2^−0.28 = 0.001953125·0.8235910 = 0.0016086 < 0.475,
+        // a0 = 1.0416667·0.0016086 + 0.0026042 = 0.0042798, A = 0.9957202. 1e-7: hand digits.
+        let [a, b] = LAZAROV.eval(1.0, 1.0);
+        assert!((b - 0.0042798).abs() < 1e-7 && (a - 0.9957202).abs() < 1e-7, "{a} {b}");
+        // MaterialX's bias at x = y = 1, the column sums: r.y = 0.9345 − 2.323 + 2.229 − 3.748
+        // + 1.424 − 0.7684 + 1.436 + 0.2913 + 0.6286 = 0.104, r.w = 1 + 0.2281 + 15.94 − 55.83
+        // + 13.08 + 41.26 + 54.9 + 300.2 − 285.1 = 85.6781, B = 0.0012138 (inside the clamp).
+        // Nine terms up to 300 round to ≤ 3e-13 in r.y, 3.5e-15 in B: 1e-14.
+        let [_, b] = MATERIALX.eval(1.0, 1.0);
+        assert!((b - 0.104 / 85.6781).abs() < 1e-14 && (b - 0.0012138).abs() < 1e-7, "{b}");
+        // PR #826's set: row 0 alone at x = y = 0, the column sums at x = y = 1:
+        // r.x = 0.10031 − 0.63301 + 9.74995 − 2.02075 + 29.38247 − 8.24713 − 26.5151 + 19.98406
+        // − 5.41717 = 16.38363, r.y = 0.9345 − 2.32352 + 2.22823 − 3.74584 + 1.4245 − 0.76829
+        // + 1.43366 + 0.2906 + 0.62933 = 0.10317, r.z = 1 − 1.76427 + 8.26501 + 11.5484 + 28.99991
+        // − 7.50867 − 36.16186 + 15.85408 + 33.4155 = 53.6481, r.w = 1 + 0.22797 + 15.93688
+        // − 55.82466 + 13.07919 + 41.25882 + 54.86775 + 300.10923 − 284.73288 = 85.9223: A =
+        // 0.3053907, B = 0.0012007 (1e-14 and 1e-12 for the sums' roundings as above).
+        assert_eq!(MATERIALX_826.eval(0.0, 0.0), [0.10031, 0.9345]);
+        let [a, b] = MATERIALX_826.eval(1.0, 1.0);
+        assert!((a - 16.38363 / 53.6481).abs() < 1e-14 && (a - 0.3053907).abs() < 1e-7, "{a}");
+        assert!((b - 0.10317 / 85.9223).abs() < 1e-14 && (b - 0.0012007).abs() < 1e-7, "{b}");
+    }
+
+    /// The Karis item's identity finding: A + B = r.z + r.w = 1.04 − 0.572 r + 0.022 r − 0.04
+    /// = 1 − 0.55 r for every n·v (the a004 terms cancel), so the printed largest |A + B − (1 −
+    /// 0.55 r)| over the grid is rounding: three operations on values ≤ 1.1, ≤ 1e-15.
+    #[test]
+    fn the_karis_identity_finding_prints_a_rounding_sized_residual() {
+        let item = karis_items().into_iter().find(|i| i.name.starts_with("ggx-env-ue4: Karis")).expect("the Karis item");
+        let text = item.findings.iter().find(|f| f.starts_with("A + B = r.z + r.w")).expect("the identity finding");
+        let residual = number_after(text, "(1 − 0.55 r)| ≤ ");
+        assert!((0.0..=1e-15).contains(&residual), "{text}");
+    }
+
+    /// The Filament item, re-measured texel by texel: every fourth column c (n·v at the texel
+    /// centre) of every row j, both channels (bias, E), the stored f16 texel at [j·128 +
+    /// cols[c]] against the integral at the shader's roughness (grid row j, checked against a
+    /// direct integral in `filament_measures_are_at_the_texels_coordinates`): its point count,
+    /// its largest |texel − integral| and where (the same differences, so exact).
+    #[test]
+    fn the_filament_item_is_the_f16_texels_against_the_integral_as_sampled() {
+        let item = items(Path::new("generated")).into_iter().find(|i| i.name.starts_with("ggx-env: Filament")).expect("the Filament item");
+        let fm = filament_measures();
+        let n = filament::SIZE;
+        let (mut max, mut worst) = (0.0f64, vec![]);
+        for j in 0..n {
+            for (c, &i) in fm.cols.iter().enumerate() {
+                for ch in 0..2 {
+                    let e = (fm.table.f16s[j * n + i][ch] - fm.exact(c, j)[ch]).abs();
+                    if e > max {
+                        (max, worst) = (e, vec![fm.mu[c], fm.grid.y[j], ch as f64]);
+                    }
+                }
+            }
+        }
+        assert_eq!(item.points, 2 * n * n / 4);
+        assert_eq!((item.max_abs_error, &item.worst_point), (max, &worst));
+        assert_eq!(max, extra(&item, "bias_as_sampled_max_abs_error").max(extra(&item, "E_as_sampled_max_abs_error")));
+    }
+
+    /// The bevy item's `compensation_1_over_a_max_rel_error`, re-measured: bevy's factor 1/A
+    /// against Turquin's 1/E at F0 = 1, relative, is |E/A − 1| with Karis's A and the grid's
+    /// integral E = A + B; its largest over the grid's nodes. 1e-12 relative: the same
+    /// quotients formed in another order.
+    #[test]
+    fn the_compensation_error_is_the_largest_e_over_a_minus_one() {
+        let (item, _) = bevy_finding("Energy compensation");
+        let hc = grid::standard(Target::Roughness);
+        let want = hc.points().zip(&hc.values).map(|((m, r), t)| ((t[0] + t[1]) / KARIS.eval(r, m)[0] - 1.0).abs()).fold(0.0f64, f64::max);
+        let got = extra(&item, "compensation_1_over_a_max_rel_error");
+        assert!(want > 1.0 && (got - want).abs() <= 1e-12 * want, "item {got}, re-measured {want}");
+    }
+
+    /// The figures: one error map per published pair form (Karis against each G, Lazarov,
+    /// MaterialX) and Filament's LUT, each as PNG and SVG under its stem.
+    #[test]
+    fn figures_draws_each_forms_error_map() {
+        let dir = tempfile::tempdir().unwrap();
+        let files = figures(dir.path(), Path::new("generated")).unwrap();
+        for stem in ["ggx_karis_errors", "ggx_bevy_errors", "ggx_lazarov_errors", "ggx_materialx_errors", "ggx_filament_lut_errors"] {
+            for ext in ["png", "svg"] {
+                let path = dir.path().join(format!("{stem}.{ext}"));
+                assert!(files.contains(&path) && std::fs::metadata(&path).unwrap().len() > 0, "{path:?} in {files:?}");
+            }
+        }
+    }
+
     #[test]
     fn karis_scale_plus_bias_is_linear_in_roughness() {
         // A + B = r.z + r.w = 1 − 0.55 r for every n·v: exact up to rounding of a few
