@@ -393,7 +393,7 @@ pub struct PointData {
 #[derive(Debug, Clone, Copy)]
 pub struct FieldOptions {
     pub objective: Objective,
-    /// Outer reweighting iterations (minimax, l4).
+    /// Outer reweighting iterations (minimax, l4; l4 at most 12).
     pub outer_iters: usize,
     /// LM iterations per outer iteration (each starts from the previous optimum, and the
     /// reweighting only needs to move it, not converge it).
@@ -443,7 +443,7 @@ fn sample_errors(fields: &Fields<'_>, theta: &DVector<f64>, data: &[PointData]) 
 
 /// One reweighting step of [`fit_fields`]'s outer loop from the residuals `res` of the current
 /// θ: Lawson's weights (L4: a damped step towards e²), the weighted systems, a warm-started joint solve. `None` when
-/// the weights degenerate or the solve fails (the loop stops); otherwise (residual
+/// the weights degenerate (all 0, or one not finite) or the solve fails (the loop stops); otherwise (residual
 /// evaluations, max error, rms error, residuals) at the new θ.
 fn outer_step(
     fields: &mut Fields<'_>,
@@ -569,7 +569,8 @@ pub fn fit_fields(
     let systems: Vec<Reduced> = data.par_iter().map(|d| reduce(&d.design, &d.y, None)).collect();
     // Candidate starts per field: the linearised ones (polynomial, Loeb, Sanathanan–Koerner)
     // of the field fitted alone; every field takes the candidate of the same index (or its
-    // last one), and the joint cost picks the set.
+    // last one), and the joint cost picks the set (of sets of equal cost the first: the
+    // polynomial start, every denominator 1, before the rational ones).
     let mut per_field = Vec::with_capacity(models.len());
     for (k, m) in models.iter().enumerate() {
         let d = Data {
@@ -793,6 +794,81 @@ mod tests {
         assert_eq!(start_set(&per_field, 0).as_slice(), [1.0, 2.0, -1.0, 7.0]);
         assert_eq!(start_set(&per_field, 1).as_slice(), [3.0, 4.0, -1.0, 8.0]);
         assert_eq!(start_set(&per_field, 2).as_slice(), [5.0, 6.0, -1.0, 8.0]);
+    }
+
+    /// One field a₀/(1 + b·x) on ĉ = 1/(1 + x) at x = 0, ¼, ½, ¾, 1 (a basis of one column of
+    /// ones), and a grid point whose basis is 0 (condition ∞, so it takes no part in the starts)
+    /// with the sample 2⁴⁰: no field reaches it, and its 2⁸⁰ in every cost absorbs the other
+    /// points' squares (< 1, below half its ulp 2²⁸), so every start set and every trial of a
+    /// joint solve cost the same, bit for bit. Returns the model, the grid and the data, and the
+    /// five ĉ as data of the field alone.
+    fn absorbed() -> ([RationalModel; 1], Vec<Vec<f64>>, Vec<PointData>, Data) {
+        let xs = [0.0, 0.25, 0.5, 0.75, 1.0];
+        let point = |b: f64, y: f64| PointData { design: DMatrix::from_element(1, 1, b), y: DVector::from_element(1, y) };
+        let mut data: Vec<PointData> = xs.iter().map(|&x| point(1.0, 1.0 / (1.0 + x))).collect();
+        data.push(point(0.0, 2f64.powi(40)));
+        let x: Vec<Vec<f64>> = xs.iter().chain(&[0.5]).map(|&v| vec![v]).collect();
+        let alone = Data { x: x[..5].to_vec(), y: xs.iter().map(|x| 1.0 / (1.0 + x)).collect() };
+        ([RationalModel::rational_1d("x", 0, 1)], x, data, alone)
+    }
+
+    /// Of start sets whose joint costs tie, the first is kept: the polynomial start (every
+    /// denominator 1) before the rational ones. On [`absorbed`] every trial of the joint solve is
+    /// refused, so the fit is the start set chosen: the least-squares constant, a₀ the mean of
+    /// the ĉ and b = 0, where the rational starts, (a₀, b) ≈ (1, 1), fit the ĉ exactly.
+    #[test]
+    fn of_start_sets_of_equal_joint_cost_the_first_is_kept() {
+        let (model, x, data, alone) = absorbed();
+        let fit = fit_fields(&model, &x, &data, &FieldOptions::default(), "tie").unwrap();
+        let mean = alone.y.iter().sum::<f64>() / 5.0;
+        let c = &fit.coefficients[0];
+        // The SVD solve of a column of ones: rounding of a five-term mean, ~1e-16 of values ~0.7.
+        assert!((c[0] - mean).abs() < 1e-14 && c[1].abs() < 1e-14, "({}, {}), expected ({mean}, 0)", c[0], c[1]);
+        // Not vacuous: the last start set is another, (a₀, b) ≈ (1, 1), at the same cost, bit for bit.
+        let systems: Vec<Reduced> = data.iter().map(|d| reduce(&d.design, &d.y, None)).collect();
+        let probe = Fields::new(&model, &x, systems, DVector::zeros(0));
+        let starts = linearised_starts(&model[0], &alone, "tie").unwrap();
+        let last = starts.last().unwrap();
+        // 1/(1 + x) is the model itself: the linearised solve recovers it to rounding.
+        assert!((last[0] - 1.0).abs() < 1e-9 && (last[1] - 1.0).abs() < 1e-9, "{last}");
+        assert_eq!(probe.cost(last), probe.cost(&starts[0]));
+    }
+
+    /// Minimax on [`absorbed`]: every joint solve refuses each trial (1 + 34 evaluations, λ from
+    /// 1e-4 by 4 a refusal up to 1e16), the max error stays 2⁴⁰, so no outer iteration improves
+    /// on the start and the search ends after PATIENCE of them, with the start (the first set)
+    /// kept. The evaluations are those of the first solve and of each outer one.
+    #[test]
+    fn outer_iterations_that_do_not_improve_end_the_search_after_the_patience() {
+        let (model, x, data, alone) = absorbed();
+        let opts = FieldOptions { objective: Objective::Minimax, ..FieldOptions::default() };
+        let fit = fit_fields(&model, &x, &data, &opts, "tie").unwrap();
+        let trials = std::iter::successors(Some(1e-4f64), |l| Some(l * 4.0)).take_while(|&l| l < 1e16).count();
+        assert_eq!(trials, 34);
+        assert_eq!((fit.outer_iterations, fit.lm_evaluations), (PATIENCE, (1 + PATIENCE) * (1 + trials)));
+        assert_eq!(fit.max_abs_error, 2f64.powi(40));
+        let c = &fit.coefficients[0];
+        // As in the test above: the least-squares constant, to rounding.
+        let mean = alone.y.iter().sum::<f64>() / 5.0;
+        assert!((c[0] - mean).abs() < 1e-14 && c[1].abs() < 1e-14, "({}, {}), expected ({mean}, 0)", c[0], c[1]);
+    }
+
+    /// Lawson's weights degenerate where every residual is 0 (all weights 0) or one is infinite:
+    /// the outer step gives up (None) rather than dividing by the top weight.
+    #[test]
+    fn an_outer_step_on_degenerate_weights_gives_up() {
+        let (x, data) = problem();
+        let models: Vec<RationalModel> = OFFSETS.iter().map(|&o| field(o)).collect();
+        let systems: Vec<Reduced> = data.iter().map(|d| reduce(&d.design, &d.y, None)).collect();
+        let theta = DVector::from_vec(TRUE.iter().flatten().copied().collect());
+        let opts = FieldOptions { objective: Objective::Minimax, ..FieldOptions::default() };
+        for bad in [0.0, f64::INFINITY] {
+            let mut fields = Fields::new(&models, &x, systems.clone(), theta.clone());
+            let mut res: Vec<DVector<f64>> = data.iter().map(|d| DVector::zeros(d.y.len())).collect();
+            res[3][5] = bad;
+            let mut w: Vec<Vec<f64>> = data.iter().map(|d| vec![1.0; d.y.len()]).collect();
+            assert!(outer_step(&mut fields, &mut w, &res, &data, &opts, "degenerate").is_none(), "a residual {bad}");
+        }
     }
 
     #[test]
@@ -1155,6 +1231,8 @@ mod tests {
         assert!(lsq_rms < mm_rms && lsq_rms < l4_rms, "rms: lsq {lsq_rms}, minimax {mm_rms}, l4 {l4_rms}");
         assert!(l44 < lsq4 && l44 < mm4, "Σe⁴: l4 {l44}, lsq {lsq4}, minimax {mm4}");
         assert!(mm.outer_iterations > 0 && l4.outer_iterations > 0 && lsq.outer_iterations == 0);
+        // L4's outer iterations are capped at 12 (its damped steps settle within about 10).
+        assert!(l4.outer_iterations <= 12, "L4: {} outer iterations", l4.outer_iterations);
         // Each LM solve evaluates the cost at its start and at one trial step at least: the
         // first solve, then one an outer iteration.
         for (name, f) in [("lsq", &lsq), ("minimax", &mm), ("l4", &l4)] {

@@ -15,9 +15,12 @@ pub struct FitReport {
     pub rms_error: f64,
     /// Max |residual| / |y| over samples with y ≠ 0.
     pub max_rel_error: f64,
+    /// The first sample of the largest |residual| (the first NaN residual, if any), and its
+    /// residual.
     pub worst_point: Vec<f64>,
     pub worst_residual: f64,
-    /// σ_max/σ_min of the Jacobian in the free parameters at the solution.
+    /// σ_max/σ_min of the Jacobian in the free parameters at the solution (∞ when σ_min is 0,
+    /// a Jacobian of zeros included).
     pub condition_number: f64,
     pub iterations: usize,
     pub evaluations: usize,
@@ -103,5 +106,28 @@ mod tests {
         let p = Residuals::new(&model, &nan, theta.clone());
         let r = FitReport::measure(&p, &nan, &theta, &opts, 0, 0);
         assert!(r.worst_residual.is_nan() && r.max_abs_error.is_nan() && r.worst_point == vec![1.0], "{r:?}");
+    }
+
+    /// Two residuals of the largest size, 8 and −8 (r = f − y with f = 1 + x on x = 0…4 and
+    /// y = (1, −6, 5, 12, 0): r = (0, 8, −2, −8, 5)): the worst is the first, at x = 1. A model
+    /// c·x on samples at x = 0 has a Jacobian of zeros (every σ is 0): its condition is ∞.
+    #[test]
+    fn the_worst_point_is_the_first_of_a_tie_and_a_zero_jacobian_is_infinitely_conditioned() {
+        let model = RationalModel::rational_1d("x", 1, 0);
+        let data = Data { x: (0..5).map(|i| vec![i as f64]).collect(), y: vec![1.0, -6.0, 5.0, 12.0, 0.0] };
+        let theta = DVector::from_vec(vec![1.0, 1.0]);
+        let r = FitReport::measure(&Residuals::new(&model, &data, theta.clone()), &data, &theta, &FitOptions::default(), 0, 0);
+        assert_eq!((r.worst_point.clone(), r.worst_residual), (vec![1.0], 8.0));
+        let f = vec!["x".to_string()];
+        let cx = RationalModel::new(crate::fit::model::ModelParts {
+            inputs: f.clone(),
+            numerator: vec![crate::fit::model::Term::parse("x", &f).unwrap()],
+            ..Default::default()
+        })
+        .unwrap();
+        let at0 = Data { x: vec![vec![0.0], vec![0.0]], y: vec![1.0, 2.0] };
+        let theta = DVector::from_vec(vec![3.0]);
+        let r = FitReport::measure(&Residuals::new(&cx, &at0, theta.clone()), &at0, &theta, &FitOptions::default(), 0, 0);
+        assert_eq!(r.condition_number, f64::INFINITY);
     }
 }
