@@ -985,6 +985,65 @@ mod tests {
         assert!(m.max_abs_error < 1e-8, "minimax max {}", m.max_abs_error);
     }
 
+    /// The Jacobian of `r` at θ by central differences of step 1e-6.
+    fn central_jacobian(r: impl Fn(&DVector<f64>) -> DVector<f64>, theta: &DVector<f64>) -> DMatrix<f64> {
+        let h = 1e-6;
+        let mut j = DMatrix::zeros(r(theta).len(), theta.len());
+        for p in 0..theta.len() {
+            let (mut tp, mut tm) = (theta.clone(), theta.clone());
+            tp[p] += h;
+            tm[p] -= h;
+            j.set_column(p, &((r(&tp) - r(&tm)) / (2.0 * h)));
+        }
+        j
+    }
+
+    /// Fields with two denominator terms, and a denominator exactly at Q_MIN: the normal
+    /// equations are still the dense products of the residuals, extended by a barrier row
+    /// Q_PENALTY·(Q_MIN − Q) only where Q is below Q_MIN. Field 0 is P2/Q2 with
+    /// Q = 1 − 0.97x², below Q_MIN at x = 1 only (0.03; 0.12 at x = 0.95); field 1 is
+    /// (a₀ + a₁x)/(x + b·x²) at b = 0, whose Q = x is Q_MIN itself at the grid point 1/20 = 0.05
+    /// (both rounded to the same double), so no barrier row there. Grid: problem's, without x = 0.
+    #[test]
+    fn normal_equations_hold_for_two_denominator_terms_and_no_barrier_at_q_min() {
+        let f = vec!["x".to_string()];
+        let t = |s: &str| Term::parse(s, &f).unwrap();
+        let parts = |numerator: Vec<Term>, denominator: Vec<Term>, lead: Option<Term>| {
+            RationalModel::new(ModelParts { inputs: f.clone(), numerator, denominator, lead, ..ModelParts::default() }).unwrap()
+        };
+        let models = vec![
+            parts(vec![t("1"), t("x"), t("x^2")], vec![t("x"), t("x^2")], None),
+            parts(vec![t("1"), t("x")], vec![t("x^2")], Some(t("x"))),
+            field(0.0),
+        ];
+        let (x, data) = problem();
+        let (x, data) = (&x[1..], &data[1..]);
+        assert_eq!(x[0][0], Q_MIN);
+        let systems: Vec<Reduced> = data.iter().map(|d| reduce(&d.design, &d.y, None)).collect();
+        let theta = DVector::from_vec(vec![0.01, 0.0, 0.0, 0.0, -0.97, 0.1, 0.2, 0.0, 0.3, -0.2, 0.1, 0.4]);
+        let fl = Fields::new(&models, x, systems, theta.clone());
+        // The barrier row of field 0 at x = 1, its Q written out from the model's form.
+        let extended = |t: &DVector<f64>| {
+            let mut r: Vec<f64> = fl.residuals_at(t).iter().copied().collect();
+            r.push(Q_PENALTY * (Q_MIN - (1.0 + t[3] + t[4])));
+            DVector::from_vec(r)
+        };
+        let r0 = extended(&theta);
+        let j = central_jacobian(extended, &theta);
+        let (a, g, cost) = fl.normal_equations(&theta);
+        let (dense, grad) = (j.tr_mul(&j), j.tr_mul(&r0));
+        // Central differences of rationals whose denominators stay ≥ 0.03 at the grid (the
+        // barrier row is linear, exact): truncation ~h²·f‴ and rounding ~1e-16/h of entries up to
+        // ~5e4, far below 1e-6 of the entries' scale.
+        assert!((&a - &dense).amax() <= 1e-6 * dense.amax(), "JᵀJ off by {:e} of {:e}", (&a - &dense).amax(), dense.amax());
+        assert!((&g - &grad).amax() <= 1e-6 * grad.amax(), "Jᵀr off by {:e} of {:e}", (&g - &grad).amax(), grad.amax());
+        assert!((cost - r0.norm_squared()).abs() <= 1e-12 * cost, "cost {cost} vs {}", r0.norm_squared());
+        // Field 1's b–b entry on its own scale (Σ_g Σ_j u_j²·(a₀ + a₁x)² ≈ 3): a barrier row at Q = Q_MIN would add
+        // (Q_PENALTY·0.05²)² = 0.0625 to it.
+        let b = 7;
+        assert!((a[(b, b)] - dense[(b, b)]).abs() <= 1e-6 * dense[(b, b)], "b–b entry {} vs {}", a[(b, b)], dense[(b, b)]);
+    }
+
     #[test]
     fn normal_equations_are_the_dense_product_at_any_thread_count() {
         let (x, data) = problem();
@@ -993,15 +1052,8 @@ mod tests {
         let theta = DVector::from_iterator(12, (0..12).map(|i| 0.3 * ((i as f64) * 1.7).sin()));
         let f = Fields::new(&models, &x, systems, theta.clone());
         // Dense J by central differences of the residuals R_g c(x_g; θ) − z_g.
-        let (np, h) = (f.n_params(), 1e-6);
         let r0 = f.residuals_at(&theta);
-        let mut j = DMatrix::zeros(r0.len(), np);
-        for p in 0..np {
-            let (mut tp, mut tm) = (theta.clone(), theta.clone());
-            tp[p] += h;
-            tm[p] -= h;
-            j.set_column(p, &((f.residuals_at(&tp) - f.residuals_at(&tm)) / (2.0 * h)));
-        }
+        let j = central_jacobian(|t| f.residuals_at(t), &theta);
         let (a, g, cost) = f.normal_equations(&theta);
         let dense = j.tr_mul(&j);
         let grad = j.tr_mul(&r0);
@@ -1154,14 +1206,7 @@ mod tests {
         };
         let r0 = extended(&theta);
         assert_eq!(r0.len(), 21 * 3 + 3, "three barrier residuals");
-        let (np, h) = (f.n_params(), 1e-6);
-        let mut j = DMatrix::zeros(r0.len(), np);
-        for p in 0..np {
-            let (mut tp, mut tm) = (theta.clone(), theta.clone());
-            tp[p] += h;
-            tm[p] -= h;
-            j.set_column(p, &((extended(&tp) - extended(&tm)) / (2.0 * h)));
-        }
+        let j = central_jacobian(extended, &theta);
         let (a, g, cost) = f.normal_equations(&theta);
         let (dense, grad) = (j.tr_mul(&j), j.tr_mul(&r0));
         // Central differences of rationals whose poles stay ≥ 0.02 from the grid (the barrier
