@@ -33,7 +33,7 @@ use serde::Serialize;
 
 /// Relative singular-value cut-off of the minimum-norm stage-1 coefficients.
 pub const RCOND: f64 = 1e-12;
-/// Grid points whose stage-1 condition number exceeds this are left out of the starting fits
+/// Grid points whose stage-1 condition number is not below this are left out of the starting fits
 /// (their ĉ are not determined to better than ~1e-9·cond by data accurate to ~1e-9).
 pub const START_COND: f64 = 1e5;
 
