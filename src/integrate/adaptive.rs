@@ -653,6 +653,62 @@ mod tests {
         }
     }
 
+    /// QUADPACK's qk21 rescales the raw difference only when both it and resasc are non-zero
+    /// (`if (resasc /= 0 .and. abserr /= 0)`), then floors the estimate at 50 ε resabs; the
+    /// values worked out by hand.
+    #[test]
+    fn quadpack_error_rescales_only_when_both_parts_are_non_zero() {
+        // resasc = 0: the raw difference stands (above the floor 50 ε · 1 ≈ 1.1e-14).
+        assert_eq!(quadpack_error(1e-3, 0.0, 1.0), 1e-3);
+        // raw = 0: nothing to rescale, the floor alone.
+        assert_eq!(quadpack_error(0.0, 1.0, 1.0), 50.0 * f64::EPSILON);
+        // Both non-zero: 1 · (200 · 2e-4 / 1)^1.5 = 0.04^1.5 = 0.008, to the rounding of the
+        // product and of powf (a few ulps of 0.008, each 1.7e-18).
+        assert!((quadpack_error(2e-4, 1.0, 1.0) - 0.008).abs() <= 1e-17);
+    }
+
+    /// Per component, a component is done when its summed error is ≤ its target: an error of
+    /// exactly 0 meets a target of 0, so a zero integrand (K21 and G10 both exactly 0) is one
+    /// panel even where error-free panels would be bisected (without stop_when_exhausted).
+    /// And stop_when_non_finite stops on a non-finite error only: a finite run goes on to its
+    /// tolerance.
+    #[test]
+    fn per_component_targets_are_met_at_equality_and_finite_errors_do_not_stop() {
+        let zero = Options { stop_when_exhausted: false, ..Options::per_component([0.0], 0.0, 10) };
+        let est = integrate(&[(0.0, 1.0)], &zero, |_| [0.0]);
+        assert_eq!((est.evals, est.value[0], est.error), (21, 0.0, 0.0));
+        let f = peak(1e-3);
+        let opts = Options { stop_when_non_finite: true, ..Options::per_component([1e-9], 0.0, 5000) };
+        let est = integrate(&[(0.0, 1.0)], &opts, |x| [f(x)]);
+        assert!(est.error <= 1e-9 && est.evals > 21, "{est:?}");
+        assert!((est.value[0] - peak_exact(1e-3, 0.0, 1.0)).abs() <= est.error, "{est:?}");
+    }
+
+    /// A power-of-two scale of the integrand scales every node value, panel value and error
+    /// estimate by the same power exactly (QUADPACK's ratio 200 raw/resasc is unchanged), so a
+    /// run to a relative tolerance alone, whose target rel·|V| scales the same way, takes the
+    /// same decisions: the same evaluations, the value and error scaled bit for bit. For each
+    /// control: weighted (raw and QUADPACK estimates) and per component.
+    #[test]
+    fn a_power_of_two_scale_changes_no_decision_of_a_relative_run() {
+        let f = peak(1e-3);
+        let s = 2f64.powi(40);
+        let weighted = |estimate| Options { estimate, control: Control::Weighted { weights: [1.0], abs: 0.0, rel: 1e-10 }, ..Options::quadpack([1.0], 0.0, 5000) };
+        let runs = [
+            ("scalar", Options::scalar(Tolerance { abs: 0.0, rel: 1e-10, max_panels: 5000 })),
+            ("weighted raw", weighted(PanelError::Raw)),
+            ("weighted quadpack", weighted(PanelError::Quadpack)),
+            ("per-component raw", Options::per_component([0.0], 1e-10, 5000)),
+        ];
+        for (name, opts) in runs {
+            let one = integrate(&[(0.0, 1.0)], &opts, |x| [f(x)]);
+            let scaled = integrate(&[(0.0, 1.0)], &opts, |x| [s * f(x)]);
+            assert!(one.evals > 21 && one.error <= 1e-10 * one.value[0], "{name}: {one:?}");
+            assert_eq!(scaled.evals, one.evals, "{name}");
+            assert_eq!((scaled.value[0], scaled.error), (s * one.value[0], s * one.error), "{name}");
+        }
+    }
+
     #[test]
     fn peaked_integrands_meet_the_tolerance_and_the_estimate_bounds_the_error() {
         for eps in [1e-1, 1e-2, 1e-3, 1e-4] {

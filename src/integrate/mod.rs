@@ -200,6 +200,20 @@ mod tests {
         }
     }
 
+    /// For odd n, P_n is odd, so 0 is a root exactly: the middle node is 0 (Newton from the
+    /// rounding of cos(π/2) can end on a subnormal of either sign, e.g. at n = 89), and every
+    /// other node is the negation of its mirror, with the same weight.
+    #[test]
+    fn odd_rules_have_their_middle_node_at_zero() {
+        for n in (1..=141).step_by(2) {
+            let (x, w) = gauss_legendre(n);
+            assert_eq!(x[n / 2], 0.0, "n={n}");
+            for i in 0..n {
+                assert_eq!((x[i], w[i]), (-x[n - 1 - i], w[n - 1 - i]), "n={n}, node {i}");
+            }
+        }
+    }
+
     /// One degree past exactness the rule's error is the Gauss remainder, in closed form for
     /// x^{2n}: ∫ − Q = 2^{2n+1} (n!)⁴ / ((2n + 1) ((2n)!)²) = 2^{2n+1} / ((2n + 1) C(2n, n)²)
     /// (Abramowitz & Stegun 25.4.30 with f^{(2n)} = (2n)!).
