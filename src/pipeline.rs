@@ -1197,6 +1197,8 @@ mod tests {
         assert!(text.contains("\"values\": [0.5, -1.25e-7, 3.0]"), "{text}");
         assert!(text.contains("[1.0, 2.0]") && text.contains("[3.0, 4.0]"), "{text}");
         assert!(text.ends_with("}\n"));
+        // A number array at the top level too: its `[` is the first line.
+        assert_eq!(compact_json(&json!([0.5, 2.0, -3.0])), "[0.5, 2.0, -3.0]\n");
     }
 
     /// Arrays that are not all numbers are left as serde_json's pretty printer writes them:

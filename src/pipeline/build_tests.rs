@@ -460,6 +460,30 @@ fn a_fields_builds_rounding_report_is_its_errors_on_the_fitting_samples() {
     assert!(e32 > 1e-9 && e32 < 1e-5, "{e32}");
 }
 
+/// The Rust module of a fields spec states each field's f64 coefficients split as its model
+/// is, the numerator's terms and then the denominator's: here one and one (P_k = a_k,
+/// Q_k = 1 + d_k·o), each constant the JSON's coefficient of that term.
+#[test]
+fn a_fields_modules_f64_coefficients_split_at_the_numerator() {
+    let text = FIELDS.replace("numerator = [\"1\", \"o\"]", "numerator = [\"1\"]");
+    assert_ne!(text, FIELDS);
+    let s = spec_in(&text, &Catalog { quantities: vec![&FIELDS_Q], kinds: vec![] });
+    let b = build_spec(&s, Mode::Fit, tempfile::tempdir().unwrap().path(), &|_| None).unwrap();
+    let j = json_of(&b);
+    let module = String::from_utf8(file(&b, "src/quad_fields.rs").to_vec()).unwrap();
+    for k in 0..3 {
+        let c = floats(&j["fields"][k]["coefficients"]);
+        assert_eq!(c.len(), 2, "field {k}");
+        for (part, v) in [("NUM", c[0]), ("DEN", c[1])] {
+            let decl = format!("pub const QUAD_FIELDS_{part}{k}_F64: [f64; 1] = [");
+            let at = module.find(&decl).unwrap_or_else(|| panic!("no '{decl}' in\n{module}")) + decl.len();
+            // One Rust literal, `1.5e0_f64`, on its own line: the exact f64.
+            let literal = module[at..at + module[at..].find(']').unwrap()].trim().trim_end_matches(',').trim_end_matches("_f64");
+            assert_eq!(literal.parse::<f64>().ok(), Some(v), "field {k} {part}: {literal}");
+        }
+    }
+}
+
 /// The inner variable v = (1 + 3o)·u: the stage-1 design [1, v, v²] on the 9 inner samples
 /// changes with o, so its condition number does.
 static SCALED: crate::quantity::InnerBasis = crate::quantity::InnerBasis {
