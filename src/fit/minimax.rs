@@ -5,8 +5,9 @@
 //!
 //!   min t   subject to   −t ≤ r_i + J_i δ ≤ t,   |δ_j| ≤ ρ·s_j
 //!
-//! is a small LP (solved with `microlp`). The step is accepted when the true max|r| falls by at
-//! least a tenth of the predicted fall; ρ grows after good steps and shrinks after bad ones.
+//! is a small LP (solved with `microlp`). The step is accepted when the true max|r| falls by more
+//! than a tenth of the predicted fall; ρ doubles (up to 1) after a step at the region's edge
+//! whose fall is more than 3/4 of the prediction, and shrinks by 4 after a refused one.
 //! Near a strongly unique minimax point (equioscillation) the iteration converges
 //! quadratically; it stops when the predicted fall is below 1e-15 relative or ρ underflows.
 
@@ -298,7 +299,7 @@ mod tests {
         }
     }
 
-    /// A step is taken only when the max residual falls by at least a tenth of what the LP
+    /// A step is taken only when the max residual falls by more than a tenth of what the LP
     /// predicted. With a Jacobian that points the wrong way every step climbs, so the trust
     /// region shrinks until the solver gives up, where it started, its max residual unchanged.
     #[test]
@@ -381,6 +382,50 @@ mod tests {
         let st = res.state();
         assert_eq!((st.get_param().map(|t| t[0]), st.get_cost()), (Some(0.75), 0.75));
         assert_eq!(res.solver().rho, 0.5);
+    }
+
+    /// One residual with a ledge: r = t from t = 9 up, `below` under it (the Jacobian 1).
+    fn ledge(below: f64) -> impl Fn(&DVector<f64>) -> DVector<f64> {
+        move |t: &DVector<f64>| DVector::from_element(1, if t[0] >= 9.0 { t[0] } else { below })
+    }
+
+    /// One iteration of the solver from t = 10 with ρ = `rho`: (t, max |r|, ρ) after it.
+    fn one_step(below: f64, rho: f64) -> (f64, f64, f64) {
+        let res = argmin::core::Executor::new(Toy(ledge(below), unit), SlpMinimax { rho, converged: false })
+            .configure(|s| s.param(DVector::from_element(1, 10.0)).max_iters(1))
+            .run()
+            .unwrap();
+        let st = res.state();
+        (st.get_param().unwrap()[0], st.get_cost(), res.solver().rho)
+    }
+
+    /// The ratio tests are strict, at exactly representable ties. From t = 10 (r = 10) with
+    /// ρ = 1 the LP steps to t = 0 (a predicted fall of 10); r = 9 there is a fall of 1, a
+    /// ratio of exactly 0.1: not more than a tenth, refused. Within ρ = 1/4 the step to 7.5
+    /// (predicted fall 2.5) falls to r = 9, a ratio of 0.4: taken, ρ kept. With ρ = 1/2 the
+    /// step to 5 predicts a fall of 5; r = 6.25 there is a fall of 3.75, a ratio of exactly
+    /// 3/4 at the region's edge: taken, but not more than 3/4, so ρ stays 1/2. All values are
+    /// dyadic or exact quotients (1/10 and 3.75/5 round to the literals 0.1 and 0.75).
+    #[test]
+    fn the_ratio_tests_are_strict() {
+        assert_eq!(one_step(9.0, 1.0), (7.5, 9.0, 0.25));
+        assert_eq!(one_step(6.25, 0.5), (5.0, 6.25, 0.5));
+    }
+
+    /// A good step inside the trust region leaves ρ as it is: r = t − 0.9 from t = 1 with
+    /// ρ = 1/4 (a bound of 1/4) steps by −0.1 to the optimum, far from the edge (0.99 · 1/4),
+    /// with the fall the LP predicted (a ratio of 1); ρ stays 1/4.
+    #[test]
+    fn a_good_step_inside_the_region_does_not_grow_it() {
+        let shifted = |t: &DVector<f64>| DVector::from_element(1, t[0] - 0.9);
+        let res = argmin::core::Executor::new(Toy(shifted, unit), SlpMinimax { rho: 0.25, converged: false })
+            .configure(|s| s.param(DVector::from_element(1, 1.0)).max_iters(1))
+            .run()
+            .unwrap();
+        let st = res.state();
+        // The LP's solution holds to its feasibility tolerance (1e-7 of data of order one).
+        assert!((st.get_param().unwrap()[0] - 0.9).abs() < 1e-6 && st.get_cost() < 1e-6, "{:?}", st.get_param());
+        assert_eq!(res.solver().rho, 0.25);
     }
 
     /// One residual r = t with its Jacobian 1: the minimax optimum is t = 0, reached by one
@@ -510,3 +555,4 @@ mod tests {
         assert!(m < lawson, "polished {m:e}, Lawson {lawson:e}");
     }
 }
+

@@ -731,18 +731,19 @@ mod tests {
         let model = RationalModel::rational_1d("x", 1, 0);
         let x: Vec<Vec<f64>> = (0..4).map(|i| vec![i as f64]).collect();
         let data = Data { y: x.iter().map(|p| 1.0 + p[0]).collect(), x };
-        let step = |history: Vec<(usize, f64)>| {
+        let at = |history: Vec<(usize, f64)>, rss: f64, max_evals: usize| {
             let w = Watched {
                 inner: Residuals::new(&model, &data, DVector::from_vec(vec![0.5, 0.5])),
-                max_evals: 1300,
+                max_evals,
                 evals: std::cell::Cell::new(300),
-                last: std::cell::Cell::new(1.0),
+                last: std::cell::Cell::new(rss),
                 history: std::cell::RefCell::new(history),
                 stalled: std::cell::Cell::new(None),
             };
             let jacobian = w.jacobian();
             (jacobian.is_none(), w.stalled.get(), w.history.borrow().len())
         };
+        let step = |history| at(history, 1.0, 1300);
         // Stopped: no Jacobian, REACH·rss as the lower bound, the step not recorded.
         assert_eq!(step(vec![(0, 1.0 + 2.9e-7)]), (true, Some(0.1), 1));
         assert_eq!(step(vec![(0, 1.0 + 3.1e-7)]), (false, None, 2));
@@ -752,6 +753,12 @@ mod tests {
         // threshold is δ < 2e-7 (SHARE·rss·200/1000).
         assert_eq!(step(vec![(100, 1.0 + 1.9e-7)]), (true, Some(0.1), 1));
         assert_eq!(step(vec![(100, 1.0 + 2.1e-7)]), (false, None, 2));
+        // "Less than" a share, strictly: rss 1e6 (SHARE·rss is 1 exactly in f64), a fall of 1
+        // over 256 evaluations and 256 left reaches exactly that share (all powers of two and
+        // 1e6 ± 1: exact), so the run goes on.
+        assert_eq!(Stall::SHARE * 1e6, 1.0);
+        assert_eq!(at(vec![(44, 1e6 + 1.0)], 1e6, 556), (false, None, 2));
+        assert_eq!(at(vec![(44, 1e6 + 1.0 - 2f64.powi(-20))], 1e6, 556), (true, Some(1e5), 1));
     }
 
     /// The watch's cap is the LM run's own: an unwatched run that ends for lack of patience
@@ -846,7 +853,10 @@ mod tests {
     /// ripple), and so is its report. Values of 2^±1000 with inputs in units of one scale the
     /// values alone: fitted as given, their squares would overflow or underflow the residual
     /// sums (their sum of squares, 2^±2000 times the unit one, is outside f64 itself and is
-    /// not compared).
+    /// not compared). Inputs far from one with values of order one scale the inputs alone. The
+    /// threshold is 2^64 either way: values 2^±64 (0.84 · 2^±64 rounds to ±64 in log2) are
+    /// rescaled, so θ (the scaled problem's) is the unit fit's bit for bit; values 2^±63 are
+    /// fitted as given, bit for bit [`fit`]'s fit of them, θ in their own units.
     #[test]
     fn rescaled_fits_are_the_unit_fit_times_powers_of_two() {
         let model = RationalModel::new(parts_1d(&["1", "x", "x^2"], &["x", "x^2"])).unwrap();
@@ -857,9 +867,10 @@ mod tests {
         for objective in [Objective::Lsq, Objective::Minimax] {
             let opts = FitOptions { objective, ..FitOptions::default() };
             let a = fit(&model, &unit, &opts, "unit").unwrap();
-            for (ky, kx) in [(80, 70), (1000, 0), (-1000, 0)] {
+            for (ky, kx) in [(80, 70), (1000, 0), (-1000, 0), (0, 70), (64, 0), (-64, 0)] {
                 let scaled = Data { x: t.iter().map(|&t| vec![t * p2(kx)]).collect(), y: unit.y.iter().map(|v| v * p2(ky)).collect() };
                 let b = fit_rescaled(&model, &scaled, &opts, "scaled").unwrap();
+                assert_eq!(bits(&b.theta), bits(&a.theta), "2^{ky}, 2^{kx}: {objective:?} θ is the scaled problem's");
                 let powers = [ky, ky - kx, ky - 2 * kx, -kx, -2 * kx];
                 for (k, p) in powers.iter().enumerate() {
                     assert_eq!(b.coefficients[k], a.coefficients[k] * p2(*p), "2^{ky}, 2^{kx}: {objective:?} coefficient {k}");
@@ -877,6 +888,15 @@ mod tests {
                 }
                 assert_eq!(rb.worst_point, vec![ra.worst_point[0] * p2(kx)], "2^{ky}, 2^{kx}: {objective:?}");
                 assert_eq!(rb.max_rel_error, ra.max_rel_error, "2^{ky}, 2^{kx}: {objective:?}");
+            }
+            for ky in [63, -63] {
+                let near = Data { x: unit.x.clone(), y: unit.y.iter().map(|v| v * p2(ky)).collect() };
+                let (b, c) = (fit_rescaled(&model, &near, &opts, "near").unwrap(), fit(&model, &near, &opts, "near").unwrap());
+                assert_eq!((bits(&b.theta), bits(&b.coefficients)), (bits(&c.theta), bits(&c.coefficients)), "2^{ky}: {objective:?}");
+                // θ in the data's units: the constant coefficient is of order 2^ky, not of one
+                // (the unit fit's is 0.5 · 1, so a factor 2 either way is far from both).
+                let ratio = b.theta[0] / a.theta[0] / p2(ky);
+                assert!((0.5..2.0).contains(&ratio), "2^{ky}: {objective:?} θ₀ {:e} vs unit {:e}", b.theta[0], a.theta[0]);
             }
         }
     }
@@ -924,6 +944,12 @@ mod tests {
         assert_eq!(pick(&[done(false, 0.5), done(false, 0.2), None, Some(Outcome::Stalled { lower: 0.0 })]), Some((false, 0.2, 0.2)));
         assert_eq!(pick(&[done(true, 1.0), done(true, 3.0), done(true, 2.0)]), Some((true, 1.0, 1.0)));
         assert_eq!(pick(&[None, Some(Outcome::Stalled { lower: 0.0 })]), None);
+        // A tie in rss and validity goes to the earlier start (θ tells the two apart).
+        let mut later = done(true, 1.0);
+        if let Some(Outcome::Done(_, f)) = &mut later {
+            f.theta[0] = 7.0;
+        }
+        assert_eq!(pick(&[done(false, 0.5), done(true, 1.0), later]), Some((true, 1.0, 1.0)));
     }
 
     /// The first start is the least-squares polynomial (Q ≡ 1): on samples of a quadratic it is
@@ -972,6 +998,34 @@ mod tests {
                 for (j, (got, w)) in c.iter().zip(want).enumerate() {
                     assert!((got - w).abs() < 1e-8 * w.abs().max(1.0), "{what} start {k}, coefficient {j}: {got} vs {w}");
                 }
+            }
+        }
+    }
+
+    /// Loeb's linearisation of f = offset + factor·P/(lead + D) is (y − offset)·(lead + D) =
+    /// factor·P: on samples of such an exact rational (offset 0.5, factor 1 + x, lead 1 + x²,
+    /// P = 1 + 2x, D = 0.5x, on 41 points of [0, 2]) it is consistent, so every reweighted
+    /// start is the rational itself. Taken as y + offset, or with the lead dividing instead of
+    /// multiplying, the system is inconsistent and its solution is not the rational.
+    #[test]
+    fn the_linearised_starts_take_the_offset_factor_and_lead_as_the_model_does() {
+        let f = vec!["x".to_string()];
+        let term = |t: &str| Term::parse(t, &f).unwrap();
+        let model = RationalModel::new(ModelParts {
+            offset: 0.5,
+            factor: Some(term("1 + x")),
+            lead: Some(term("1 + x^2")),
+            ..parts_1d(&["1", "x"], &["x"])
+        })
+        .unwrap();
+        let x: Vec<Vec<f64>> = (0..=40).map(|i| vec![i as f64 / 20.0]).collect();
+        let data = Data { y: x.iter().map(|p| 0.5 + (1.0 + p[0]) * (1.0 + 2.0 * p[0]) / (1.0 + p[0] * p[0] + 0.5 * p[0])).collect(), x };
+        let starts = linearised_starts(&model, &data, "olf").unwrap();
+        assert_eq!(starts.len(), 7);
+        for (k, s) in starts.iter().enumerate().skip(1) {
+            // SVD solves of a consistent 41×3 system, condition ~10 after scaling: ~1e-14.
+            for (c, w) in model.full(s).iter().zip([1.0, 2.0, 0.5]) {
+                assert!((c - w).abs() < 1e-9, "start {k}: {s:?}");
             }
         }
     }
@@ -1054,6 +1108,48 @@ mod tests {
         assert!(k >= 2 && lawson.report.evaluations > 2, "{k} polish iterations after {} evaluations", lawson.report.evaluations);
         assert_eq!(polished.report.iterations, lawson.report.iterations);
         assert_eq!(polished.report.evaluations, lawson.report.evaluations + k);
+    }
+
+    /// Lawson's weights are w_i·|r_i| normalised: on data the least-squares fit reproduces
+    /// exactly (all zeros, fitted by the zero rational: its residuals are exactly 0) there is
+    /// nothing to weight, and the iteration stops before any weighted solve. The minimax fit
+    /// without polish then reports the one least-squares run it starts with: that of
+    /// [`fit_from`] from the least-squares optimum.
+    #[test]
+    fn exact_zeros_take_no_lawson_step() {
+        let model = RationalModel::rational_1d("x", 2, 1);
+        let x: Vec<Vec<f64>> = (0..=10).map(|i| vec![i as f64 / 10.0]).collect();
+        let data = Data { y: vec![0.0; x.len()], x };
+        let lsq = fit(&model, &data, &FitOptions::default(), "zero").unwrap();
+        assert_eq!(lsq.report.max_abs_error, 0.0, "the residuals are exactly zero: {:?}", lsq.coefficients);
+        let again = fit_from(&model, &data, lsq.theta.clone(), &FitOptions::default(), "zero").unwrap();
+        let minimax = fit(&model, &data, &FitOptions { objective: Objective::Minimax, polish_iters: 0, ..FitOptions::default() }, "zero").unwrap();
+        assert_eq!((minimax.report.iterations, minimax.report.evaluations), (again.report.iterations, again.report.evaluations));
+    }
+
+    /// Lawson keeps the best iterate and stops 25 iterations after the last one that lowered
+    /// the max error by more than 1e-9 of it. A constant fitted to y = ±1 alternating on 10
+    /// points: the least-squares optimum is 0 exactly, every residual has |r| = 1, so every
+    /// weighting is uniform and every weighted solve returns 0, max error 1: no iterate
+    /// improves, and exactly 25 weighted solves follow the first. Each is LM from the optimum
+    /// with uniform weights, counted here by running one; the report adds them all up.
+    #[test]
+    fn lawson_stops_25_iterations_after_its_last_improvement() {
+        let model = RationalModel::rational_1d("x", 0, 0);
+        let x: Vec<Vec<f64>> = (0..10).map(|i| vec![i as f64]).collect();
+        let data = Data { y: (0..10).map(|i| if i % 2 == 0 { 1.0 } else { -1.0 }).collect(), x };
+        let zero = DVector::from_element(1, 0.0);
+        let opts = FitOptions { objective: Objective::Minimax, polish_iters: 0, ..FitOptions::default() };
+        let mut p = Residuals::new(&model, &data, zero.clone());
+        let (theta, iters, evals) = minimax(&mut p, &opts, "alternating").unwrap();
+        assert_eq!(theta, zero);
+        let mut q = Residuals::new(&model, &data, zero.clone());
+        let (t0, it0, ev0) = least_squares(&mut q, LsqSolver::Lm, "alternating").unwrap();
+        q.set_weights(&[0.1; 10]);
+        let (t1, it1, ev1) = least_squares(&mut q, LsqSolver::Lm, "alternating").unwrap();
+        assert_eq!((t0, t1), (zero.clone(), zero), "the optimum is 0 for every weighting");
+        assert!(it1 >= 1 && ev1 >= 1);
+        assert_eq!((iters, evals), (it0 + 25 * it1, ev0 + 25 * ev1));
     }
 
     /// No samples at all is its own error, not an underdetermined fit, for every objective.
@@ -1198,15 +1294,17 @@ mod tests {
         assert!(max < 0.9 * lsq.report.max_abs_error, "max {max} vs least squares {} (unconstrained {})", lsq.report.max_abs_error, free.1);
     }
 
-    /// A clamped model is fitted on the samples strictly inside the clamp: y = clamp(P/Q, 0, 1)
-    /// with P/Q above 1 on part of the range recovers P/Q.
+    /// A clamped model is fitted on the samples strictly inside the clamp: y = clamp(P/Q, 0.5, 1)
+    /// with P/Q below 0.5 at x ≤ 0.2 and above 1 past x = 0.8 recovers P/Q.
     #[test]
     fn a_clamped_model_recovers_the_rational_inside_the_clamp() {
-        let model = RationalModel::new(ModelParts { clamp: Some((0.0, 1.0)), ..parts_1d(&["1", "x"], &["x"]) }).unwrap();
+        let model = RationalModel::new(ModelParts { clamp: Some((0.5, 1.0)), ..parts_1d(&["1", "x"], &["x"]) }).unwrap();
         let exact = |x: f64| (0.2 + 1.5 * x) / (1.0 + 0.5 * x);
         let x: Vec<Vec<f64>> = (0..=40).map(|i| vec![i as f64 / 20.0]).collect();
-        let data = Data { y: x.iter().map(|p| exact(p[0]).clamp(0.0, 1.0)).collect(), x };
-        assert!(data.y.iter().filter(|&&y| y == 1.0).count() > 10, "part of the samples is at the clamp");
+        let data = Data { y: x.iter().map(|p| exact(p[0]).clamp(0.5, 1.0)).collect(), x };
+        assert!(data.y.iter().filter(|&&y| y == 1.0).count() > 10, "part of the samples is at the upper clamp");
+        // x = 0, 0.05, …, 0.2: P/Q(0.2) = 0.5/1.1 < 0.5 < P/Q(0.25) = 0.575/1.125.
+        assert_eq!(data.y.iter().filter(|&&y| y == 0.5).count(), 5, "samples at the lower clamp");
         let f = fit(&model, &data, &FitOptions::default(), "clamped").unwrap();
         // Exact data on the rows that carry information: rounding level.
         for (c, w) in f.coefficients.iter().zip([0.2, 1.5, 0.5]) {
@@ -1244,6 +1342,49 @@ mod tests {
             // Exact data; LM scales its columns, so the raw units cost it little: 1e-9 relative
             // is far inside the misfit of the scaled model (order one in the values).
             assert!((c - w).abs() <= 1e-9 * w.abs(), "{c:e} vs {w:e}");
+        }
+    }
+
+    /// A model with a derived feature is fitted as given, whatever its inputs' units: u = b·x is
+    /// not scaled by a power of two with x (b is fixed in the model), so inputs 2^70 are not
+    /// rescaled and the fit is bit for bit [`fit`]'s. Here u = 1e-21·x puts u in [0, 2.4] and
+    /// the data is the exact rational (1 + 2u)/(1 + 0.5u), recovered. Rescaling x would leave u
+    /// of order 1e-21 and (1 + a·u)/(1 + b·u) nearly constant: the data could not be fitted.
+    #[test]
+    fn a_model_with_a_derived_feature_is_fitted_in_its_inputs_units() {
+        let xs = 2f64.powi(70);
+        let inputs = vec!["x".to_string()];
+        let derived = vec![crate::fit::model::Derived::parse("u", "1e-21*x", &inputs).unwrap()];
+        let features = vec!["x".to_string(), "u".to_string()];
+        let terms = |ts: &[&str]| ts.iter().map(|t| Term::parse(t, &features).unwrap()).collect::<Vec<_>>();
+        let model = RationalModel::new(ModelParts { inputs, derived, numerator: terms(&["1", "u"]), denominator: terms(&["u"]), ..ModelParts::default() }).unwrap();
+        let x: Vec<Vec<f64>> = (0..=40).map(|i| vec![xs * i as f64 / 20.0]).collect();
+        let data = Data { y: x.iter().map(|p| (1.0 + 2e-21 * p[0]) / (1.0 + 0.5e-21 * p[0])).collect(), x };
+        let opts = FitOptions::default();
+        let (f, g) = (fit_rescaled(&model, &data, &opts, "derived").unwrap(), fit(&model, &data, &opts, "derived").unwrap());
+        assert_eq!((bits(&f.theta), bits(&f.coefficients)), (bits(&g.theta), bits(&g.coefficients)));
+        // Exact data, condition ~10 in u: recovered to rounding (1e-9 is far inside the misfit
+        // of a fit on rescaled inputs, order one).
+        for (c, w) in f.coefficients.iter().zip([1.0, 2.0, 0.5]) {
+            assert!((c - w).abs() < 1e-9, "{:?}", f.coefficients);
+        }
+    }
+
+    /// An offset of data far from one (values 2⁻⁹⁰ and 2⁸⁰) is in the data's units: y = ys·(0.5 +
+    /// (0.2 + 1.5x)/(1 + 0.5x)) with the model's offset 0.5·ys recovers P/Q with P times ys.
+    /// The scaled problem's offset is 0.5 (the offset over the same power of two as the data);
+    /// left in the data's units it would be off by a factor 2^±80 or more, and no P/Q fits.
+    #[test]
+    fn an_offset_far_from_one_holds_in_the_datas_units() {
+        for ys in [2f64.powi(-90), 2f64.powi(80)] {
+            let model = RationalModel::new(ModelParts { offset: 0.5 * ys, ..parts_1d(&["1", "x"], &["x"]) }).unwrap();
+            let x: Vec<Vec<f64>> = (0..=40).map(|i| vec![i as f64 / 20.0]).collect();
+            let data = Data { y: x.iter().map(|p| ys * (0.5 + (0.2 + 1.5 * p[0]) / (1.0 + 0.5 * p[0]))).collect(), x };
+            let f = fit_rescaled(&model, &data, &FitOptions::default(), "offset").unwrap();
+            // Exact data, condition ~10: rounding, relative 1e-9 of each coefficient's units.
+            for (c, w) in f.coefficients.iter().zip([0.2 * ys, 1.5 * ys, 0.5]) {
+                assert!((c - w).abs() < 1e-9 * w.abs(), "values × {ys:e}: {:?}", f.coefficients);
+            }
         }
     }
 
@@ -1292,3 +1433,4 @@ mod tests {
         }
     }
 }
+
