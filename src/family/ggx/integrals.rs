@@ -748,12 +748,15 @@ mod tests {
     /// (height-correlated; Λ by the textbook form) or k/(1 − k) (separable); none when
     /// q_max ≤ 16 q_pole. The panels tile [0, φmax]. The breakpoints' q are recovered as
     /// cos φ − κ: a few ulps of 1 absolute, ≤ 1e-9 relative for q ≥ 1e-6 (q_pole here ≥ 1e-5).
+    /// The views include ones where μvΛ(μv) is not small against μv (α = 0.1, μv = 0.05) and a
+    /// separable k whose k/(1 − k) is 5 % above k; 399 half-vector angles a view put breakpoints
+    /// near both ends of (q_pole, 16 q_pole], so a pole distance a few percent off is seen.
     #[test]
     fn phi_panels_cut_sixteen_fold_down_to_the_poles_distance() {
         let (mut cut, mut uncut) = (0, 0);
-        for shadowing in [HC, Shadowing::Separable { k: 0.001 }] {
-            for alpha in [1e-3, 1e-2] {
-                for mu in [0.2f64, 0.7] {
+        for shadowing in [HC, Shadowing::Separable { k: 0.001 }, Shadowing::Separable { k: 0.05 }] {
+            for alpha in [1e-3, 1e-2, 0.1] {
+                for mu in [0.05f64, 0.2, 0.7] {
                     for c in [0.0, 0.3] {
                         let view = View::new(alpha, mu, c, shadowing);
                         let sin_v = (1.0 - mu * mu).sqrt();
@@ -764,15 +767,15 @@ mod tests {
                             }
                             Shadowing::Separable { k } => k / (1.0 - k),
                         };
-                        for j in 1..40 {
-                            let (sh, ch) = (0.5 * PI * j as f64 / 40.0).sin_cos();
+                        for j in 1..400 {
+                            let (sh, ch) = (0.5 * PI * j as f64 / 400.0).sin_cos();
                             let kappa = view.kappa(sh, ch);
                             if !(kappa > -1.0 && kappa < 1.0) {
                                 continue;
                             }
                             let phi_max = kappa.acos();
                             let panels = view.phi_panels(sh, ch, kappa, phi_max);
-                            let what = format!("{shadowing:?} α={alpha} μv={mu} c={c} θh at {j}/40 of π/2: {panels:?}");
+                            let what = format!("{shadowing:?} α={alpha} μv={mu} c={c} θh at {j}/400 of π/2: {panels:?}");
                             assert_eq!((panels[0].0, panels[panels.len() - 1].1), (0.0, phi_max), "{what}");
                             assert!(panels.windows(2).all(|w| w[0].1 == w[1].0 && w[0].0 < w[0].1), "{what}");
                             let q_max = 1.0 - kappa;
@@ -975,5 +978,161 @@ mod tests {
         // η = 1: no reflection; η → ∞: total reflection.
         assert!(f_avg_dielectric(1.0, 1e-14).value.abs() < 1e-14);
         assert!(f_avg_dielectric(1e6, 1e-12).value > 0.999);
+    }
+
+    /// A non-positive or NaN tolerance means [`DEFAULT_TOL`] (its doc): the same estimate, bit
+    /// for bit, as asking for it. A positive one is taken as given: 1e-4 is met with fewer
+    /// evaluations than the default's 1e-10.
+    #[test]
+    fn non_positive_and_nan_tolerances_mean_the_default() {
+        let at = |tol: f64| env(0.5, 0.5, 0.2, HC, tol);
+        let default = at(DEFAULT_TOL);
+        let loose = at(1e-4);
+        assert!(loose.error <= 1e-4 && loose.evals < default.evals, "{loose:?} vs {default:?}");
+        for tol in [f64::NAN, -1.0, 0.0] {
+            assert_eq!(at(tol), default, "tol {tol}");
+        }
+    }
+
+    /// E = scale + bias, each within env's error, so E's error is twice it, and `albedo` asks env
+    /// for half its own tolerance: E is within `tol`, and within its error of the truth. At
+    /// (α, μ) = (1, 1) the truth is 1 − ln 2 (`albedo_normal_rough`); at (0.1, 0.3) it is the
+    /// integral with the adaptive azimuth rule at 1e-12 (independent of the nested rules), whose
+    /// own 1e-12 (twice, for the sum) is added to the bound.
+    #[test]
+    fn albedo_is_within_its_tolerance_and_its_error_of_the_truth() {
+        let reference = env_with(0.1, 0.3, 0.0, HC, 1e-12, Inner::Adaptive);
+        for (alpha, mu, truth) in [(1.0, 1.0, albedo_normal_rough()), (0.1, 0.3, reference.scale + reference.bias)] {
+            for tol in [1e-6, 1e-9] {
+                let e = albedo(alpha, mu, tol);
+                assert!(e.error <= tol, "α {alpha}, μ {mu}, tol {tol}: {e:?}");
+                assert!((e.value - truth).abs() <= e.error + 2e-12, "α {alpha}, μ {mu}, tol {tol}: {e:?} vs {truth}");
+            }
+        }
+    }
+
+    /// α = 0 is the mirror limit exactly (module doc): l = mirror(v), μl = μv, Schlick's weight
+    /// (1 − μv)⁵, so (scale, bias) = (1 − (1 − μv)⁵, (1 − μv)⁵) where the mirror direction is in
+    /// the cone (μv ≥ c, its edge included), else nothing. By hand, exact in binary: μv = ½
+    /// gives bias 1/32 and scale 31/32; μv = 0 at c = 0 (the horizon) bias 1 and scale 0.
+    #[test]
+    fn alpha_zero_is_the_mirror_limit_in_and_out_of_the_cone() {
+        let mirror = |mu: f64, c: f64| {
+            let r = env(0.0, mu, c, HC, 1e-10);
+            (r.scale, r.bias, r.error)
+        };
+        assert_eq!(mirror(0.5, 0.0), (31.0 / 32.0, 1.0 / 32.0, 0.0));
+        assert_eq!(mirror(0.5, 0.5), (31.0 / 32.0, 1.0 / 32.0, 0.0));
+        assert_eq!(mirror(0.0, 0.0), (0.0, 1.0, 0.0));
+        assert_eq!(mirror(0.5, 0.6), (0.0, 0.0, 0.0));
+    }
+
+    /// env counts every evaluation, the azimuth integrands' included. At μv = 1 (sin θv = 0)
+    /// the azimuth integrand does not depend on φ and covers [0, π] at every outer node (all
+    /// inside θh ∈ (0, π/4), where μl > 0 for every φ): the nested trapezoid takes N = 4 (5
+    /// nodes) and N = 8 (4 new ones), which agree, so a node costs 1 + 9 evaluations and a
+    /// 21-point Kronrod panel 210; with the adaptive azimuth rule one G10/K21 panel on [0, π]
+    /// converges at once, 1 + 21 a node and 462 a panel. Both cover the same outer panels.
+    #[test]
+    fn env_counts_the_evaluations_of_its_inner_integrals() {
+        for tol in [1e-3, 1e-10] {
+            let nested = env(0.5, 1.0, 0.0, HC, tol).evals;
+            let adaptive = env_with(0.5, 1.0, 0.0, HC, tol, Inner::Adaptive).evals;
+            assert!(nested > 0 && nested % 210 == 0, "tol {tol}: {nested} evaluations (nested)");
+            assert!(adaptive > 0 && adaptive % 462 == 0, "tol {tol}: {adaptive} evaluations (adaptive)");
+            assert_eq!(nested / 210, adaptive / 462, "tol {tol}: outer panels");
+        }
+    }
+
+    /// F_avg's estimate adds up its pieces (two for η < 1, split at the critical angle): at
+    /// least one 21-point panel each, at most `MAX_PANELS` each (a bisection adds 42
+    /// evaluations), and an error estimate that is positive (a quadrature of a non-polynomial
+    /// is not certified exact) and within the tolerance.
+    #[test]
+    fn dielectric_average_adds_up_its_pieces_evaluations_and_errors() {
+        for eta in [1.0 / 1.5, 1.5] {
+            let pieces = if eta < 1.0 { 2 } else { 1 };
+            let r = f_avg_dielectric(eta, 1e-10);
+            assert!(r.evals >= 21 * pieces && r.evals <= pieces * (21 + 42 * MAX_PANELS as u64), "η {eta}: {r:?}");
+            assert!(r.error > 0.0 && r.error <= 1e-10, "η {eta}: {r:?}");
+        }
+    }
+
+    /// The outer segments are the ones `segments` documents. Read back in θh (ξ through the GGX
+    /// CDF's inverse tan θ = α sqrt(ξ/(1 − ξ)), to 1e-12: ξ ≤ 100/101 there), each piece [p, q]
+    /// with q > p is tiled in order by segments of positive length whose interior ends are
+    /// exactly the geometric breakpoints p + 4ʲd_p and q − 4ʲd_q (j ≥ 1, d = min(θ, π/2 − θ) of
+    /// that end, while 4ʲd < (q − p)/2) and θ* = atan(10α) when inside; a segment is in ξ
+    /// exactly when it ends at or below θ*, and goes through the smoothstep exactly when it
+    /// touches p or q. An empty piece has no segment.
+    #[test]
+    fn segments_cut_at_the_kinks_geometric_steps_and_theta_star() {
+        // Ends by hand: (0, π/4) none inside (θ* = atan 5 above it); (0.1, 1.2) 0.5 and θ* =
+        // atan ½; (0, 1.5) θ* = atan 0.01 and 1.5 − 4·(π/2 − 1.5); (0.3, 1.55) 1.55 − 4d and
+        // 1.55 − 16d, d = π/2 − 1.55; (0.01, 1) 0.05 and 0.17; (0.2, 0.5) and (0.5, 1.3) none;
+        // the empty and the reversed piece nothing.
+        let cases: [(&[(f64, f64)], f64); 7] = [
+            (&[(0.0, 0.25 * PI)], 0.5),
+            (&[(0.1, 1.2)], 0.05),
+            (&[(0.0, 1.5)], 1e-3),
+            (&[(0.3, 1.55)], 0.01),
+            (&[(0.01, 1.0)], 0.2),
+            (&[(0.2, 0.5), (0.5, 1.3)], 0.02),
+            (&[(0.7, 0.7), (0.9, 0.4)], 0.3),
+        ];
+        let mut ends_seen = 0;
+        for (pieces, alpha) in cases {
+            let theta_star = (10.0 * alpha).atan();
+            let segs = segments(pieces, alpha);
+            let what = format!("{pieces:?} α {alpha}: {segs:?}");
+            let theta = |x: f64, in_xi: bool| if in_xi { (alpha * (x / (1.0 - x)).sqrt()).atan() } else { x };
+            let mut k = 0;
+            for &(p, q) in pieces.iter().filter(|(p, q)| q > p) {
+                let mut want = vec![p, q];
+                for (end, dir) in [(p, 1.0), (q, -1.0)] {
+                    let d = end.min(0.5 * PI - end);
+                    let mut j = 1;
+                    while d > 0.0 && 4f64.powi(j) * d < 0.5 * (q - p) {
+                        want.push(end + dir * 4f64.powi(j) * d);
+                        j += 1;
+                    }
+                }
+                if theta_star > p && theta_star < q {
+                    want.push(theta_star);
+                }
+                want.sort_by(f64::total_cmp);
+                ends_seen += want.len();
+                for w in want.windows(2) {
+                    let seg = segs.get(k).unwrap_or_else(|| panic!("{what}: no segment for {w:?}"));
+                    k += 1;
+                    let (a, b) = (theta(seg.a, seg.in_xi), theta(seg.b, seg.in_xi));
+                    assert!(seg.b > seg.a, "{what}: segment {k} is empty");
+                    assert!((a - w[0]).abs() <= 1e-12 && (b - w[1]).abs() <= 1e-12, "{what}: segment {k} spans θ ({a}, {b}), want {w:?}");
+                    assert_eq!(seg.in_xi, w[1] <= theta_star, "{what}: segment {k}'s variable");
+                    assert_eq!(seg.smooth, w[0] == p || w[1] == q, "{what}: segment {k}'s smoothstep");
+                }
+            }
+            assert_eq!(k, segs.len(), "{what}: segments past the pieces");
+        }
+        assert_eq!(ends_seen, 2 + 4 + 4 + 4 + 4 + 2 + 2);
+    }
+
+    /// At n·v = 0 (c = 0) the height-correlated pole is on μl = 0 itself (its distance
+    /// μv(α/2)/(μv + μvΛ(μv)) is 0), and κ = 0 (φmax = π/2) at every θh: the breakpoints
+    /// cos φ = 16⁻ʲ go on until the loop's 24 steps end, the last ones rounding onto φmax
+    /// (acos 16⁻¹⁴ rounds to π/2). The panels still tile [0, φmax], none of them empty, with
+    /// one panel a breakpoint below φmax: acos 16⁻ʲ for j = 1..13, and the last to φmax.
+    #[test]
+    fn phi_panels_stay_non_empty_when_the_pole_reaches_the_horizon() {
+        let view = View::new(0.3, 0.0, 0.0, HC);
+        for theta_h in [0.2, 0.7, 1.3] {
+            let (sh, ch) = f64::sin_cos(theta_h);
+            let kappa = view.kappa(sh, ch);
+            assert_eq!(kappa, 0.0);
+            let phi_max = kappa.acos();
+            let panels = view.phi_panels(sh, ch, kappa, phi_max);
+            assert_eq!((panels[0].0, panels[panels.len() - 1].1, panels.len()), (0.0, phi_max, 14), "θh {theta_h}: {panels:?}");
+            assert!(panels.windows(2).all(|w| w[0].1 == w[1].0) && panels.iter().all(|p| p.0 < p.1), "θh {theta_h}: {panels:?}");
+        }
     }
 }
