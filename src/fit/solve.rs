@@ -1110,6 +1110,12 @@ mod tests {
         assert_eq!(polished.report.evaluations, lawson.report.evaluations + k);
     }
 
+    /// A rational of degrees (2, 1) in x and eleven samples of zero on [0, 1].
+    fn zero_data() -> (RationalModel, Data) {
+        let x: Vec<Vec<f64>> = (0..=10).map(|i| vec![i as f64 / 10.0]).collect();
+        (RationalModel::rational_1d("x", 2, 1), Data { y: vec![0.0; x.len()], x })
+    }
+
     /// Lawson's weights are w_i·|r_i| normalised: on data the least-squares fit reproduces
     /// exactly (all zeros, fitted by the zero rational: its residuals are exactly 0) there is
     /// nothing to weight, and the iteration stops before any weighted solve. The minimax fit
@@ -1117,9 +1123,7 @@ mod tests {
     /// [`fit_from`] from the least-squares optimum.
     #[test]
     fn exact_zeros_take_no_lawson_step() {
-        let model = RationalModel::rational_1d("x", 2, 1);
-        let x: Vec<Vec<f64>> = (0..=10).map(|i| vec![i as f64 / 10.0]).collect();
-        let data = Data { y: vec![0.0; x.len()], x };
+        let (model, data) = zero_data();
         let lsq = fit(&model, &data, &FitOptions::default(), "zero").unwrap();
         assert_eq!(lsq.report.max_abs_error, 0.0, "the residuals are exactly zero: {:?}", lsq.coefficients);
         let again = fit_from(&model, &data, lsq.theta.clone(), &FitOptions::default(), "zero").unwrap();
@@ -1230,9 +1234,7 @@ mod tests {
     /// numerator 0, the denominator free but finite), and the report says zero error.
     #[test]
     fn all_zero_data_fits_the_zero_rational() {
-        let model = RationalModel::rational_1d("x", 2, 1);
-        let x: Vec<Vec<f64>> = (0..=10).map(|i| vec![i as f64 / 10.0]).collect();
-        let data = Data { y: vec![0.0; x.len()], x };
+        let (model, data) = zero_data();
         let f = fit_rescaled(&model, &data, &FitOptions::default(), "zero").unwrap();
         assert!(f.coefficients.iter().all(|c| c.is_finite()), "{:?}", f.coefficients);
         // Exact data: the numerator's least-squares solution is 0 to rounding.
