@@ -487,7 +487,8 @@ fn outer_step(
 /// forming JᵀJ with a blocked product is far cheaper than a column-pivoted QR of J each
 /// iteration, and the Marquardt scaling keeps the solve well-posed. A trial is taken only when
 /// it lowers the cost; each refused trial multiplies λ (from 1e-4) by 4, and a point no trial
-/// improves before λ reaches 1e16 ends the solve. Returns the number of residual evaluations
+/// improves before λ reaches 1e16 ends the solve, as do three steps taken in a row that each
+/// lower the cost by less than 1e-10 of it. Returns the number of residual evaluations
 /// (the start's and every trial's).
 fn solve_joint(fields: &mut Fields<'_>, max_iters: usize, what: &str) -> Result<usize, FitError> {
     let mut theta = fields.theta.clone();
@@ -851,6 +852,36 @@ mod tests {
         // As in the test above: the least-squares constant, to rounding.
         let mean = alone.y.iter().sum::<f64>() / 5.0;
         assert!((c[0] - mean).abs() < 1e-14 && c[1].abs() < 1e-14, "({}, {}), expected ({mean}, 0)", c[0], c[1]);
+    }
+
+    /// The small-step stop of [`solve_joint`]: three accepted steps in a row that each lower
+    /// the cost by less than 1e-10 of it end the solve. Two constant fields c = (c₀, c₁) at a
+    /// point with R = [[1, b], [b, 1]], z = 0, b = 1 − h, h = 2⁻¹⁰, and a point with R = 0,
+    /// z = (S, 0), S = 128, that no field reaches. From c = t·(1, −1) the cost is 2h²t² + S²
+    /// (R c = t·h·(1, −1)), and (1, −1) is an eigenvector of JᵀJ = RᵀR (eigenvalue
+    /// 1 + b² − 2b = h²) with the diagonal D = 1 + b², so the step solving
+    /// (JᵀJ + λD) δ = −Jᵀr keeps c on the line and scales t by λ/(μ + λ), μ = h²/(1 + b²)
+    /// ≈ 4.77e-7. λ = 1e-4, 1e-4/3, 1e-4/9 give 1 − (λ/(μ + λ))² ≈ 9.5e-3, 2.8e-2, 8.1e-2 of
+    /// the soft part 2h² = 2⁻¹⁹, itself 2⁻³³ ≈ 1.2e-10 of the cost: gains ≈ 1.1e-12, 3.3e-12,
+    /// 9e-12, each below 1e-10 and far above the cost's rounding (1.1e-16), so each trial is
+    /// taken. The solve stops after the third: 1 + 3 evaluations, of 11 iterations allowed,
+    /// with t = Π λ/(μ + λ).
+    #[test]
+    fn three_small_gains_in_a_row_end_the_joint_solve() {
+        let models = [RationalModel::rational_1d("x", 0, 0), RationalModel::rational_1d("x", 0, 0)];
+        let h = 2f64.powi(-10);
+        let b = 1.0 - h;
+        let point = |r: DMatrix<f64>, z: [f64; 2]| Reduced { rtr: r.tr_mul(&r), r, z: DVector::from_row_slice(&z), floor: 0.0 };
+        let systems = vec![point(DMatrix::from_row_slice(2, 2, &[1.0, b, b, 1.0]), [0.0, 0.0]), point(DMatrix::zeros(2, 2), [128.0, 0.0])];
+        let x = vec![vec![0.0], vec![0.0]];
+        let mut fields = Fields::new(&models, &x, systems, DVector::from_row_slice(&[1.0, -1.0]));
+        assert_eq!(solve_joint(&mut fields, 11, "small steps").unwrap(), 4);
+        let mu = h * h / (1.0 + b * b);
+        let t: f64 = [1e-4, 1e-4 / 3.0, 1e-4 / 9.0].iter().map(|l| l / (mu + l)).product();
+        let c = &fields.theta;
+        // Cholesky of JᵀJ + λD, condition ≈ 2/(h² + 2λ) ≤ 1e4, on entries ~2 rounded to ε:
+        // ~1e-12 of t a step; 1e-9 bounds three (and t ≈ 0.94).
+        assert!((c[0] - t).abs() < 1e-9 && (c[1] + t).abs() < 1e-9, "{c}, expected ±{t}");
     }
 
     /// Lawson's weights degenerate where every residual is 0 (all weights 0) or one is infinite:

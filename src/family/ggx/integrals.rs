@@ -639,6 +639,21 @@ mod tests {
         assert!(avg.evals >= 21 + 21 * 21, "{avg:?}");
     }
 
+    /// E_avg's error and count add its inner E's to the outer rule's. At α = 0 every E is the
+    /// mirror limit, exact (error 0) with no evaluation, and the outer integrand 2·E·μ·dμ/dt is
+    /// a degree-5 polynomial in t (E = 1 to rounding), which the first G10/K21 panel on [0, 1]
+    /// integrates to rounding: 21 evaluations and E_avg = 2∫₀¹ μ dμ = 1. At α = ½ the first
+    /// panel's centre t = ½ is a node, at μ = ½·½·(3 − 1) = ½, so the reported error is at least
+    /// that inner E's own (the outer error is not negative).
+    #[test]
+    fn albedo_avgs_error_and_count_add_the_inner_integrals() {
+        let exact = albedo_avg(0.0, 1e-6);
+        // The 21-term Kronrod sum of values ≤ 3 rounds to a few ε.
+        assert!(exact.evals == 21 && (exact.value - 1.0).abs() < 1e-14, "{exact:?}");
+        let (avg, mid) = (albedo_avg(0.5, 1e-4), albedo(0.5, 0.5, 0.5e-4));
+        assert!(mid.error > 0.0 && avg.error >= mid.error, "E_avg {avg:?}, E(½) {mid:?}");
+    }
+
     /// The GGX CDF variable: ξ of a half-vector angle θ is sin²θ/(sin²θ + α² cos²θ), and
     /// `half_angle` maps ξ back to (sin²θ, cos²θ) with tan²θ = α² ξ/(1 − ξ), the GGX NDF's
     /// cumulative distribution in cos²θ (Walter et al. 2007, Eq. 35 solved for ξ). Round trips
