@@ -813,6 +813,13 @@ mod tests {
         ([RationalModel::rational_1d("x", 0, 1)], x, data, alone)
     }
 
+    /// (a₀, b) is the least-squares constant of [`absorbed`]'s ĉ: a₀ their mean, b = 0.
+    fn is_the_least_squares_constant(c: &DVector<f64>, alone: &Data) {
+        let mean = alone.y.iter().sum::<f64>() / 5.0;
+        // The SVD solve of a column of ones: rounding of a five-term mean, ~1e-16 of values ~0.7.
+        assert!((c[0] - mean).abs() < 1e-14 && c[1].abs() < 1e-14, "({}, {}), expected ({mean}, 0)", c[0], c[1]);
+    }
+
     /// Of start sets whose joint costs tie, the first is kept: the polynomial start (every
     /// denominator 1) before the rational ones. On [`absorbed`] every trial of the joint solve is
     /// refused, so the fit is the start set chosen: the least-squares constant, a₀ the mean of
@@ -821,10 +828,7 @@ mod tests {
     fn of_start_sets_of_equal_joint_cost_the_first_is_kept() {
         let (model, x, data, alone) = absorbed();
         let fit = fit_fields(&model, &x, &data, &FieldOptions::default(), "tie").unwrap();
-        let mean = alone.y.iter().sum::<f64>() / 5.0;
-        let c = &fit.coefficients[0];
-        // The SVD solve of a column of ones: rounding of a five-term mean, ~1e-16 of values ~0.7.
-        assert!((c[0] - mean).abs() < 1e-14 && c[1].abs() < 1e-14, "({}, {}), expected ({mean}, 0)", c[0], c[1]);
+        is_the_least_squares_constant(&fit.coefficients[0], &alone);
         // Not vacuous: the last start set is another, (a₀, b) ≈ (1, 1), at the same cost, bit for bit.
         let systems: Vec<Reduced> = data.iter().map(|d| reduce(&d.design, &d.y, None)).collect();
         let probe = Fields::new(&model, &x, systems, DVector::zeros(0));
@@ -848,10 +852,7 @@ mod tests {
         assert_eq!(trials, 34);
         assert_eq!((fit.outer_iterations, fit.lm_evaluations), (PATIENCE, (1 + PATIENCE) * (1 + trials)));
         assert_eq!(fit.max_abs_error, 2f64.powi(40));
-        let c = &fit.coefficients[0];
-        // As in the test above: the least-squares constant, to rounding.
-        let mean = alone.y.iter().sum::<f64>() / 5.0;
-        assert!((c[0] - mean).abs() < 1e-14 && c[1].abs() < 1e-14, "({}, {}), expected ({mean}, 0)", c[0], c[1]);
+        is_the_least_squares_constant(&fit.coefficients[0], &alone);
     }
 
     /// The small-step stop of [`solve_joint`]: three accepted steps in a row that each lower

@@ -375,28 +375,25 @@ mod tests {
     /// so the region doubles to 1/2.
     #[test]
     fn a_refused_step_is_retried_in_a_smaller_region() {
-        let res = argmin::core::Executor::new(Toy(cliff, unit), SlpMinimax { rho: 1.0, converged: false })
-            .configure(|s| s.param(DVector::from_element(1, 1.0)).max_iters(1))
+        let (t, cost, rho) = one_iteration(cliff, 1.0, 1.0);
+        assert_eq!((t, cost), (0.75, 0.75));
+        assert_eq!(rho, 0.5);
+    }
+
+    /// One iteration of the solver on one residual `r` (Jacobian 1) from t = `t0` with ρ =
+    /// `rho`: (t, max |r|, ρ) after it.
+    fn one_iteration(r: impl Fn(&DVector<f64>) -> DVector<f64>, t0: f64, rho: f64) -> (f64, f64, f64) {
+        let res = argmin::core::Executor::new(Toy(r, unit), SlpMinimax { rho, converged: false })
+            .configure(|s| s.param(DVector::from_element(1, t0)).max_iters(1))
             .run()
             .unwrap();
         let st = res.state();
-        assert_eq!((st.get_param().map(|t| t[0]), st.get_cost()), (Some(0.75), 0.75));
-        assert_eq!(res.solver().rho, 0.5);
+        (st.get_param().unwrap()[0], st.get_cost(), res.solver().rho)
     }
 
     /// One residual with a ledge: r = t from t = 9 up, `below` under it (the Jacobian 1).
     fn ledge(below: f64) -> impl Fn(&DVector<f64>) -> DVector<f64> {
         move |t: &DVector<f64>| DVector::from_element(1, if t[0] >= 9.0 { t[0] } else { below })
-    }
-
-    /// One iteration of the solver from t = 10 with ρ = `rho`: (t, max |r|, ρ) after it.
-    fn one_step(below: f64, rho: f64) -> (f64, f64, f64) {
-        let res = argmin::core::Executor::new(Toy(ledge(below), unit), SlpMinimax { rho, converged: false })
-            .configure(|s| s.param(DVector::from_element(1, 10.0)).max_iters(1))
-            .run()
-            .unwrap();
-        let st = res.state();
-        (st.get_param().unwrap()[0], st.get_cost(), res.solver().rho)
     }
 
     /// The ratio tests are strict, at exactly representable ties. From t = 10 (r = 10) with
@@ -408,8 +405,8 @@ mod tests {
     /// dyadic or exact quotients (1/10 and 3.75/5 round to the literals 0.1 and 0.75).
     #[test]
     fn the_ratio_tests_are_strict() {
-        assert_eq!(one_step(9.0, 1.0), (7.5, 9.0, 0.25));
-        assert_eq!(one_step(6.25, 0.5), (5.0, 6.25, 0.5));
+        assert_eq!(one_iteration(ledge(9.0), 10.0, 1.0), (7.5, 9.0, 0.25));
+        assert_eq!(one_iteration(ledge(6.25), 10.0, 0.5), (5.0, 6.25, 0.5));
     }
 
     /// A good step inside the trust region leaves ρ as it is: r = t − 0.9 from t = 1 with
@@ -417,15 +414,10 @@ mod tests {
     /// with the fall the LP predicted (a ratio of 1); ρ stays 1/4.
     #[test]
     fn a_good_step_inside_the_region_does_not_grow_it() {
-        let shifted = |t: &DVector<f64>| DVector::from_element(1, t[0] - 0.9);
-        let res = argmin::core::Executor::new(Toy(shifted, unit), SlpMinimax { rho: 0.25, converged: false })
-            .configure(|s| s.param(DVector::from_element(1, 1.0)).max_iters(1))
-            .run()
-            .unwrap();
-        let st = res.state();
+        let (t, cost, rho) = one_iteration(|t: &DVector<f64>| DVector::from_element(1, t[0] - 0.9), 1.0, 0.25);
         // The LP's solution holds to its feasibility tolerance (1e-7 of data of order one).
-        assert!((st.get_param().unwrap()[0] - 0.9).abs() < 1e-6 && st.get_cost() < 1e-6, "{:?}", st.get_param());
-        assert_eq!(res.solver().rho, 0.25);
+        assert!((t - 0.9).abs() < 1e-6 && cost < 1e-6, "t {t}, max |r| {cost}");
+        assert_eq!(rho, 0.25);
     }
 
     /// One residual r = t with its Jacobian 1: the minimax optimum is t = 0, reached by one
@@ -439,13 +431,7 @@ mod tests {
     /// optimum exactly (ratio 1, at the bound), and ρ stays 1.
     #[test]
     fn the_trust_region_never_grows_past_one() {
-        let res = argmin::core::Executor::new(Toy(line, unit), SlpMinimax { rho: 1.0, converged: false })
-            .configure(|s| s.param(DVector::from_element(1, 4.0)).max_iters(1))
-            .run()
-            .unwrap();
-        let st = res.state();
-        assert_eq!((st.get_param().map(|t| t[0]), st.get_cost()), (Some(0.0), 0.0));
-        assert_eq!(res.solver().rho, 1.0);
+        assert_eq!(one_iteration(line, 4.0, 1.0), (0.0, 0.0, 1.0));
     }
 
     /// max|r| counts a NaN residual as infinite (f64::max would skip it), so a step into a
