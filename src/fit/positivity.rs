@@ -390,6 +390,56 @@ mod tests {
         assert!(lower > MIN_BOUND && lower <= *above, "{lower:e}");
     }
 
+    /// A box whose plain interval bound lands exactly on the threshold still takes the
+    /// mean-value form (the module doc: a leaf's bound is the larger of the two). Q = x − k·x²
+    /// (a lead term x, x² at coefficient −k) on [2e-12, 3e-12] is concave, so its minimum is at
+    /// an end: about 1.556e-12 at 2e-12 (2e-12 at 3e-12) for the k ≈ 1.11e11 that puts the
+    /// plain bound x_lo − k·x_hi² at 1e-12. The mean-value form, Q(m) + Q′(F)·(F − m) with
+    /// Q(m) ≈ 1.806e-12, Q′ = 1 − 2k·x ∈ [⅓, 5⁄9] on the box and |F − m| ≤ 5e-13, is about
+    /// 1.528e-12 less its roundings: above the threshold and below the minimum. So the box is settled at once, with that bound. One k within a few
+    /// ulps of (x_lo − 1e-12)/x_hi² gives a plain bound equal to the f64 1e-12 (each ulp of k
+    /// moves k·x_hi² by under an ulp of 1e-12, and the outward roundings by a few).
+    #[test]
+    fn a_plain_bound_exactly_at_the_threshold_still_takes_the_mean_value_form() {
+        use crate::fit::model::{ModelParts, Term};
+        let f = vec!["x".to_string()];
+        let m = RationalModel::new(ModelParts {
+            inputs: f.clone(),
+            numerator: vec![Term::parse("1", &f).unwrap()],
+            denominator: vec![Term::parse("x^2", &f).unwrap()],
+            lead: Some(Term::parse("x", &f).unwrap()),
+            ..ModelParts::default()
+        })
+        .unwrap();
+        let (lo, hi) = (2e-12, 3e-12);
+        // The plain interval bound: the lead term's range plus the x² term's range times −k,
+        // each from the box's outward-rounded powers of x.
+        let plain = |k: f64| {
+            let mut pows = [Iv(0.0, 0.0); 3];
+            powers(Iv(lo, hi), &mut pows);
+            let lead = term_range_in(m.lead.as_ref().unwrap(), &pows, &[0]);
+            lead.add(term_range_in(&m.denominator[0], &pows, &[0]).scale(-k)).0
+        };
+        let k0 = (lo - MIN_BOUND) / (hi * hi);
+        let start = (0..64).fold(k0, |k, _| k.next_down());
+        let k = std::iter::successors(Some(start), |k: &f64| Some(k.next_up()))
+            .take(129)
+            .find(|&k| plain(k) == MIN_BOUND)
+            .expect("no k within 64 ulps of k0 puts the plain bound at exactly 1e-12: the test does not reach the threshold");
+        let c = DVector::from_vec(vec![1.0, -k]);
+        let q = |x: f64| x - k * x * x;
+        let minimum = q(lo).min(q(hi));
+        let b = bound(&m, &c, &[(lo, hi)], &[2], &mut Scratch::new(&[2]));
+        // Above the threshold by the mean-value form (≈ 1.528e-12 less roundings of a few ulps,
+        // ~1e-27 each); below Q's minimum, ≈ 1.556e-12 at x_lo, by 2.8e-14, where Q's f64
+        // values are within ~1e-27 of the real ones.
+        assert!(b > 1.5e-12 && b < minimum, "bound {b:e}, minimum {minimum:e}");
+        match prove_denominator_positive(&m, &c, &[(lo, hi)]) {
+            Positivity::Proven { lower, boxes } => assert!(boxes == 1 && lower == b, "{boxes} boxes, lower {lower:e}"),
+            p => panic!("not proven: {p:?}"),
+        }
+    }
+
     #[test]
     fn tangent_roots_and_near_tangents() {
         // Q = (4(x − ½)² + ε)/(1 + ε) = 1 − 4x/(1+ε) + 4x²/(1+ε): minimum ε/(1+ε) at x = ½.
