@@ -362,6 +362,20 @@ mod tests {
         }
     }
 
+    /// The model 1 / (x + b·x²): a lead term x and one denominator term x².
+    fn lead_x_over_x2() -> RationalModel {
+        use crate::fit::model::{ModelParts, Term};
+        let f = vec!["x".to_string()];
+        RationalModel::new(ModelParts {
+            inputs: f.clone(),
+            numerator: vec![Term::parse("1", &f).unwrap()],
+            denominator: vec![Term::parse("x^2", &f).unwrap()],
+            lead: Some(Term::parse("x", &f).unwrap()),
+            ..ModelParts::default()
+        })
+        .unwrap()
+    }
+
     /// The threshold is strict where the bound lands on it exactly: Q = x (a lead term x, and
     /// x² at coefficient 0) on [a, 1], with a a few ulps above 1e-12, has the rigorous bound
     /// a rounded down a few times, so one a in the first 64 ulps gives a bound equal to the
@@ -370,16 +384,7 @@ mod tests {
     /// term Q's bound is 1 + Σ…, a multiple of 2⁻⁵³, which 1e-12 is not.)
     #[test]
     fn a_bound_exactly_at_the_threshold_is_no_proof() {
-        use crate::fit::model::{ModelParts, Term};
-        let f = vec!["x".to_string()];
-        let m = RationalModel::new(ModelParts {
-            inputs: f.clone(),
-            numerator: vec![Term::parse("1", &f).unwrap()],
-            denominator: vec![Term::parse("x^2", &f).unwrap()],
-            lead: Some(Term::parse("x", &f).unwrap()),
-            ..ModelParts::default()
-        })
-        .unwrap();
+        let m = lead_x_over_x2();
         let c = DVector::from_vec(vec![1.0, 0.0]);
         let whole_box = |a: f64| bound(&m, &c, &[(a, 1.0)], &[2], &mut Scratch::new(&[2]));
         let ends: Vec<f64> = std::iter::successors(Some(MIN_BOUND), |a| Some(a.next_up())).take(64).collect();
@@ -396,21 +401,13 @@ mod tests {
     /// an end: about 1.556e-12 at 2e-12 (2e-12 at 3e-12) for the k ≈ 1.11e11 that puts the
     /// plain bound x_lo − k·x_hi² at 1e-12. The mean-value form, Q(m) + Q′(F)·(F − m) with
     /// Q(m) ≈ 1.806e-12, Q′ = 1 − 2k·x ∈ [⅓, 5⁄9] on the box and |F − m| ≤ 5e-13, is about
-    /// 1.528e-12 less its roundings: above the threshold and below the minimum. So the box is settled at once, with that bound. One k within a few
-    /// ulps of (x_lo − 1e-12)/x_hi² gives a plain bound equal to the f64 1e-12 (each ulp of k
-    /// moves k·x_hi² by under an ulp of 1e-12, and the outward roundings by a few).
+    /// 1.528e-12 less its roundings: above the threshold and below the minimum. So the box is
+    /// settled at once, with that bound. One k within a few ulps of (x_lo − 1e-12)/x_hi² gives
+    /// a plain bound equal to the f64 1e-12 (each ulp of k moves k·x_hi² by under an ulp of
+    /// 1e-12, and the outward roundings by a few).
     #[test]
     fn a_plain_bound_exactly_at_the_threshold_still_takes_the_mean_value_form() {
-        use crate::fit::model::{ModelParts, Term};
-        let f = vec!["x".to_string()];
-        let m = RationalModel::new(ModelParts {
-            inputs: f.clone(),
-            numerator: vec![Term::parse("1", &f).unwrap()],
-            denominator: vec![Term::parse("x^2", &f).unwrap()],
-            lead: Some(Term::parse("x", &f).unwrap()),
-            ..ModelParts::default()
-        })
-        .unwrap();
+        let m = lead_x_over_x2();
         let (lo, hi) = (2e-12, 3e-12);
         // The plain interval bound: the lead term's range plus the x² term's range times −k,
         // each from the box's outward-rounded powers of x.
