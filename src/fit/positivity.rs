@@ -410,13 +410,12 @@ mod tests {
         let m = lead_x_over_x2();
         let (lo, hi) = (2e-12, 3e-12);
         // The plain interval bound: the lead term's range plus the x² term's range times −k,
-        // each from the box's outward-rounded powers of x.
-        let plain = |k: f64| {
-            let mut pows = [Iv(0.0, 0.0); 3];
-            powers(Iv(lo, hi), &mut pows);
-            let lead = term_range_in(m.lead.as_ref().unwrap(), &pows, &[0]);
-            lead.add(term_range_in(&m.denominator[0], &pows, &[0]).scale(-k)).0
-        };
+        // each from the box's outward-rounded powers of x (the same for every k).
+        let mut pows = [Iv(0.0, 0.0); 3];
+        powers(Iv(lo, hi), &mut pows);
+        let lead = term_range_in(m.lead.as_ref().unwrap(), &pows, &[0]);
+        let square = term_range_in(&m.denominator[0], &pows, &[0]);
+        let plain = |k: f64| lead.add(square.scale(-k)).0;
         let k0 = (lo - MIN_BOUND) / (hi * hi);
         let start = (0..64).fold(k0, |k, _| k.next_down());
         let k = std::iter::successors(Some(start), |k: &f64| Some(k.next_up()))
