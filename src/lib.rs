@@ -6,6 +6,7 @@ pub mod fit;
 pub mod integrate;
 pub mod family;
 pub mod quantity;
+pub mod shading;
 pub mod bench;
 pub mod build;
 pub mod cli;

@@ -29,6 +29,7 @@ pub(crate) mod build_tests;
 pub mod committed;
 pub mod data;
 pub mod fields;
+pub mod module;
 
 /// Project paths: specs in `fits/`, outputs in `generated/`.
 #[derive(Debug, Clone)]

@@ -422,7 +422,7 @@ fn multibounce_item() -> Item {
 /// [0, 1], where α below the smoothest row reads the smoothest row, as a sampler would).
 pub fn row_of_alpha(row: &str, alpha: f64) -> f64 {
     match row {
-        "gloss" => crate::family::gloss::integrals::gloss_from_alpha(alpha).clamp(0.0, 1.0),
+        "gloss" => crate::shading::roughness::gloss_from_alpha(alpha).clamp(0.0, 1.0),
         "alpha" => alpha,
         _ => alpha.sqrt(),
     }
@@ -675,7 +675,7 @@ mod tests {
         assert_eq!(row_of_alpha("alpha", 0.3), 0.3);
         assert_eq!(row_of_alpha("roughness", 0.25), 0.5);
         let g = row_of_alpha("gloss", 0.3);
-        let back = crate::family::gloss::integrals::alpha_from_gloss(g);
+        let back = crate::shading::roughness::alpha_from_gloss(g);
         assert!((0.0..=1.0).contains(&g) && (back - 0.3).abs() < 1e-12, "g={g} back={back}");
     }
 

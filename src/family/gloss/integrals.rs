@@ -34,18 +34,8 @@
 
 use crate::integrate::{adaptive, Estimate, Tolerance};
 
-/// Exponent scale of the WWII gloss parameterisation.
-const GLOSS_EXPONENT: f64 = 18.0;
-
-/// GGX α for gloss g (WWII parameterisation).
-pub fn alpha_from_gloss(g: f64) -> f64 {
-    (2.0 / (1.0 + (GLOSS_EXPONENT * g).exp2())).sqrt()
-}
-
-/// Gloss for GGX α ∈ (0, 1] (inverse of [`alpha_from_gloss`]).
-pub fn gloss_from_alpha(alpha: f64) -> f64 {
-    (2.0 / (alpha * alpha) - 1.0).log2() / GLOSS_EXPONENT
-}
+/// GGX α for gloss g and back (WWII parameterisation), from the shading layer.
+pub use crate::shading::roughness::{alpha_from_gloss, gloss_from_alpha};
 
 /// 1 − L(α), accurate to a few ulps of itself for every α ∈ (0, 1].
 pub fn one_minus_length(alpha: f64) -> f64 {

@@ -22,7 +22,7 @@
 //!   against the F0 = 0 slices.
 
 use super::integrals::TALK_F0;
-use crate::family::gloss::integrals::alpha_from_gloss;
+use crate::shading::roughness::alpha_from_gloss;
 use crate::fit::{FitOptions, Objective, fit_rescaled};
 use crate::validate::Item;
 use serde_json::Value;

@@ -411,7 +411,7 @@ pub fn render(spec: &Spec, t: &Table, cells: &[Cell]) -> Result<Built, BuildErro
         "specular": specular,
         "phi_d": t.phi_d,
         "gloss": glosses,
-        "alpha": glosses.iter().map(|&g| crate::family::gloss::integrals::alpha_from_gloss(g)).collect::<Vec<_>>(),
+        "alpha": glosses.iter().map(|&g| crate::shading::roughness::alpha_from_gloss(g)).collect::<Vec<_>>(),
         "axes": [
             {"name": "theta_h", "texture_axis": "x", "count": w, "texel_centres": "theta_h = (i + 0.5)/width * pi/2"},
             {"name": "theta_d", "texture_axis": "y within a layer", "count": h, "texel_centres": "theta_d = (j + 0.5)/height * pi/2"},

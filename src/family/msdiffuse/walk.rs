@@ -6,7 +6,7 @@
 //! seed that hashes (k, c, s) with the same finaliser. The bits of a path depend on nothing but
 //! those three numbers: not on the thread, the shard or the order in which paths run.
 
-use crate::family::ggx::integrals::lambda;
+use crate::shading::trowbridge_reitz::{self, lambda};
 use std::f64::consts::PI;
 
 type V3 = [f64; 3];
@@ -74,7 +74,7 @@ fn basis(n: V3) -> (V3, V3) {
     ([1.0 + sign * n[0] * n[0] * a, sign * b, -sign * n[0]], [b, sign + n[1] * n[1] * a, -n[1]])
 }
 
-/// Smith Λ of GGX for any direction: Λ(ω) for ω_z > 0 (`ggx::integrals::lambda`), and
+/// Smith Λ of GGX for any direction: Λ(ω) for ω_z > 0 (`shading::trowbridge_reitz::lambda`), and
 /// Λ(ω) = −1 − Λ(−ω) below the horizon (Heitz et al. 2016, §4.1). Infinite at ω_z = 0.
 #[inline]
 pub fn lambda_any(alpha: f64, wz: f64) -> f64 {
@@ -131,14 +131,6 @@ pub fn schlick(f0: f64, c: f64) -> f64 {
 #[inline]
 pub fn fresnel(f0: f64, c: f64) -> f64 {
     if f0 > 0.0 { schlick(f0, c) } else { 0.0 }
-}
-
-/// GGX D(m) at cos θm = c.
-#[inline]
-fn ggx_d(alpha: f64, c: f64) -> f64 {
-    let a2 = alpha * alpha;
-    let t = 1.0 + (a2 - 1.0) * c * c;
-    a2 / (PI * t * t)
 }
 
 /// What happens to the share F of the light that a microfacet reflects specularly.
@@ -302,7 +294,7 @@ pub fn specular_phase(alpha: f64, f0: f64, wi: V3, wo: V3) -> f64 {
     if !(area > 0.0) {
         return 0.0;
     }
-    ggx_d(alpha, h[2]) * schlick(f0, c) / (4.0 * area)
+    trowbridge_reitz::d(alpha, h[2]) * schlick(f0, c) / (4.0 * area)
 }
 
 #[cfg(test)]
@@ -493,21 +485,21 @@ mod tests {
     fn ggx_d_is_normalised_with_its_closed_form_ends() {
         let tol = crate::integrate::Tolerance { abs: 1e-12, rel: 0.0, max_panels: 1000 };
         for alpha in [0.2, 0.5, 1.0, 1.7] {
-            let sum = crate::integrate::adaptive(0.0, 1.0, tol, |t| PI * ggx_d(alpha, t.sqrt())).value;
+            let sum = crate::integrate::adaptive(0.0, 1.0, tol, |t| PI * trowbridge_reitz::d(alpha, t.sqrt())).value;
             assert!((sum - 1.0).abs() < 1e-10, "α {alpha}: {sum}");
             let a2 = alpha * alpha;
             // At the pole 1 + (α² − 1) cancels to α²: the rounding of α² − 1 (an ulp of 1) is
             // relative 2⁻⁵³/α² in it and twice that in its square, plus a few roundings.
             let pole_tol = 4.0 * f64::EPSILON / a2 + 1e-15;
-            let pole = ggx_d(alpha, 1.0) * PI * a2;
+            let pole = trowbridge_reitz::d(alpha, 1.0) * PI * a2;
             assert!((pole - 1.0).abs() < pole_tol, "α {alpha}: {pole}");
-            assert!((ggx_d(alpha, 0.0) * PI / a2 - 1.0).abs() < 1e-15, "α {alpha}");
+            assert!((trowbridge_reitz::d(alpha, 0.0) * PI / a2 - 1.0).abs() < 1e-15, "α {alpha}");
         }
     }
 
     /// Unit vector (sin θ cos φ, sin θ sin φ, cos θ).
     fn dir(theta: f64, phi: f64) -> V3 {
-        crate::family::sggx::integrals::direction(theta, phi).into()
+        crate::shading::direction(theta, phi)
     }
 
     /// With F = 1 (f0 = 1) the mirror phase function is a distribution over wo: by wo = 2(wi·h)h −

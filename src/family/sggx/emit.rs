@@ -21,7 +21,7 @@
 use super::integrals::{ALPHA_MIN, Aniso, d_burley, decode_course, direction};
 use crate::emit::{f32_literal, header_lines};
 use crate::family::SpecKind;
-use crate::family::ggx::published::emit::{module_built, module_json};
+use crate::pipeline::module::{module_built, module_json};
 use crate::pipeline::{BuildError, Built, Mode, committed_json_with_hash, fmt_err, input_hash, spec_rel_path};
 use crate::spec::{KindDef, Spec, SpecError, SpecFile, module_spec_file};
 use serde_json::json;

@@ -98,9 +98,7 @@ pub fn sggx_from(n: V3, a: Aniso) -> M3 {
 
 /// A unit vector from spherical angles (θ from z, φ from x).
 pub fn direction(theta: f64, phi: f64) -> V3 {
-    let (st, ct) = theta.sin_cos();
-    let (sp, cp) = phi.sin_cos();
-    V3::new(st * cp, st * sp, ct)
+    V3::from(crate::shading::direction(theta, phi))
 }
 
 /// The weighted mean Σ wᵢ Sᵢ / Σ wᵢ.

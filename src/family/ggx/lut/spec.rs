@@ -87,7 +87,7 @@ impl RoughnessMapping {
         match self {
             RoughnessMapping::Perceptual => t * t,
             RoughnessMapping::Alpha => t,
-            RoughnessMapping::Gloss => crate::family::gloss::integrals::alpha_from_gloss(t),
+            RoughnessMapping::Gloss => crate::shading::roughness::alpha_from_gloss(t),
         }
     }
 }

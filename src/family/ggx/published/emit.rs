@@ -23,10 +23,11 @@
 use super::forms::{KARIS, KULLA_CONTY, Karis, KullaConty, LAZAROV, Lazarov, MATERIALX, MaterialX};
 use super::grid::{self, Target};
 use super::refit::{self, Refits};
-use crate::emit::{Artifact, GENERATOR, f32_literal, header_lines};
+use crate::emit::{GENERATOR, f32_literal, header_lines};
 use crate::family::SpecKind;
 use crate::fit::positivity::{Positivity, prove_denominator_positive};
-use crate::pipeline::{BuildError, Built, Mode, Verification, compact_json, committed_json_with_hash, fmt_err, hex, spec_rel_path};
+use crate::pipeline::module::{module_built, module_json};
+use crate::pipeline::{BuildError, Built, Mode, committed_json_with_hash, fmt_err, hex, spec_rel_path};
 use crate::validate;
 use crate::spec::{KindDef, Spec, SpecError, SpecFile};
 use nalgebra::DVector;
@@ -243,38 +244,6 @@ fn build(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> {
     json.insert("forms".into(), rows.iter().map(row_json).collect::<Vec<_>>().into());
     // The forms' errors pooled (each row is on its own grid and quantity; the per-form figures are in the JSON).
     Ok(module_built(&name, wgsl, rust, json, points, max, rms))
-}
-
-/// The provenance every module JSON of the family starts with; the caller adds its own keys.
-pub(crate) fn module_json(spec: &Spec, hash: &str, kind: &str) -> serde_json::Map<String, Value> {
-    let v = json!({
-        "generator": GENERATOR,
-        "spec": spec_rel_path(spec),
-        "input_hash": hash,
-        "name": spec.file.name,
-        "kind": kind,
-        "quantity": spec.file.quantity,
-        "description": spec.file.description,
-        "function_prefix": spec.file.emit.function,
-    });
-    match v {
-        Value::Object(m) => m,
-        _ => unreachable!("a JSON object literal"),
-    }
-}
-
-/// A module's three files (WGSL, Rust, JSON) with its pooled max and rms error over `points`.
-pub(crate) fn module_built(name: &str, wgsl: String, rust: String, json: serde_json::Map<String, Value>, points: usize, max: f64, rms: f64) -> Built {
-    Built {
-        name: name.to_string(),
-        artifacts: vec![
-            Artifact { path: format!("wgsl/{name}.wgsl").into(), contents: wgsl.into_bytes() },
-            Artifact { path: format!("src/{name}.rs").into(), contents: rust.into_bytes() },
-            Artifact { path: format!("json/{name}.json").into(), contents: (compact_json(&Value::Object(json)) + "\n").into_bytes() },
-        ],
-        verification: Verification { points, max_abs_error: max, rms_error: rms, worst_point: vec![], max_abs_error_f32: max, rms_error_f32: rms, max_abs_error_in_parameter: None },
-        fit: None,
-    }
 }
 
 /// The two languages a module is written in (shared with the family's other emitted modules).
