@@ -180,3 +180,102 @@ fn only_the_family_folders_name_a_family() {
     // The check can fail: a planted mention is found.
     assert!(has_word("see the gloss-length fit", "gloss") && !has_word("glossary", "gloss"));
 }
+
+/// The module path of a file of `src/` (`family/ggx/lut/spec.rs` → family, ggx, lut, spec;
+/// `mod.rs` names its folder).
+fn module_path(path: &Path) -> Vec<String> {
+    let rel = path.strip_prefix(src()).unwrap();
+    let mut out: Vec<String> = rel.components().map(|c| c.as_os_str().to_str().unwrap().to_string()).collect();
+    let last = out.pop().unwrap();
+    let stem = last.strip_suffix(".rs").unwrap_or(&last).to_string();
+    if stem != "mod" && stem != "lib" && stem != "main" {
+        out.push(stem);
+    }
+    out
+}
+
+/// The families a file names by path: `crate::family::NAME` and `super::…::NAME` chains that
+/// climb out of its own family folder into `family`.
+fn families_named(path: &Path, text: &str, families: &[String]) -> BTreeSet<String> {
+    let module = module_path(path);
+    let mut out = BTreeSet::new();
+    let ident = |s: &str| s.chars().take_while(|c| c.is_alphanumeric() || *c == '_').collect::<String>();
+    for (i, _) in text.match_indices("crate::family::") {
+        if text[..i].ends_with('$') || text[..i].ends_with("::") {
+            continue;
+        }
+        let rest = &text[i + "crate::family::".len()..];
+        if let Some(group) = rest.strip_prefix('{') {
+            let end = group.find('}').unwrap_or(group.len());
+            out.extend(group[..end].split(',').map(|p| ident(p.trim())));
+        } else {
+            out.insert(ident(rest));
+        }
+    }
+    for (i, _) in text.match_indices("super::") {
+        if text[..i].ends_with("::") {
+            continue;
+        }
+        let mut rest = &text[i..];
+        let mut up = 0;
+        while let Some(r) = rest.strip_prefix("super::") {
+            up += 1;
+            rest = r;
+        }
+        if up <= module.len() && module[..module.len() - up] == ["family".to_string()] {
+            out.insert(ident(rest));
+        }
+    }
+    out.retain(|n| families.contains(n));
+    out
+}
+
+#[test]
+fn no_family_imports_another_family() {
+    let families: Vec<String> = shadefit::family::families().iter().map(|f| f.name.to_string()).collect();
+    let mut files = Vec::new();
+    rust_files(&src().join("family"), &mut files);
+    let mut found = Vec::new();
+    for f in &files {
+        let module = module_path(f);
+        let Some(own) = module.get(1) else { continue };
+        let text = std::fs::read_to_string(f).unwrap();
+        for other in families_named(f, &text, &families) {
+            if &other != own {
+                found.push(format!("{} names family '{other}'", f.strip_prefix(src()).unwrap().display()));
+            }
+        }
+    }
+    assert!(found.is_empty(), "families import each other (shared terms belong in the shading layer or a stage):\n{}", found.join("\n"));
+    // The check can fail: planted paths of another family are found, one's own and a stage are not.
+    let fams = ["ggx".to_string(), "gloss".to_string()];
+    let at = src().join("family/ggx/lut/spec.rs");
+    let named = |t: &str| families_named(&at, t, &fams).into_iter().collect::<Vec<_>>();
+    assert_eq!(named("use crate::family::gloss::integrals::x;"), ["gloss"]);
+    assert_eq!(named("use crate::family::{gloss, Family};"), ["gloss"]);
+    assert_eq!(named("super::super::super::gloss::integrals::x"), ["gloss"]);
+    assert!(named("super::super::integrals::env; crate::family::ggx::lut; crate::shading::roughness").iter().all(|n| n == "ggx"));
+}
+
+/// Lines of a file before its first `#[cfg(test)]` item at the top level (all of it when it
+/// has none).
+fn lines_before_tests(text: &str) -> usize {
+    text.lines().take_while(|l| !l.starts_with("#[cfg(test)]")).count()
+}
+
+#[test]
+fn no_source_file_is_longer_than_1200_lines_before_its_tests() {
+    let mut files = Vec::new();
+    rust_files(&src(), &mut files);
+    let mut long: Vec<String> = files
+        .iter()
+        .filter_map(|f| {
+            let n = lines_before_tests(&std::fs::read_to_string(f).unwrap());
+            (n > 1200).then(|| format!("{}: {n} lines", f.strip_prefix(src()).unwrap().display()))
+        })
+        .collect();
+    long.sort();
+    assert!(long.is_empty(), "files to split along their concerns:\n{}", long.join("\n"));
+    assert_eq!(lines_before_tests("a\nb\n#[cfg(test)]\nmod tests {}\n"), 2);
+    assert_eq!(lines_before_tests("a\n    #[cfg(test)]\nb\n"), 3);
+}

@@ -11,6 +11,7 @@ pub mod model;
 pub mod positivity;
 pub mod problem;
 pub mod report;
+pub mod simplex;
 pub mod solve;
 
 pub use model::{Pin, RationalModel, Term};

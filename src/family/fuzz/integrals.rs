@@ -182,7 +182,7 @@
 
 #![allow(clippy::excessive_precision)]
 
-use crate::integrate::{Estimate, Options, Tolerance, adaptive, integrate};
+use crate::integrate::{Estimate, Options, integrate};
 use rayon::prelude::*;
 use std::f64::consts::{FRAC_PI_2, PI};
 
@@ -1078,184 +1078,10 @@ pub fn r_grid(alphas: &[f64], thetas: &[f64], tol: f64) -> Vec<Estimate> {
 }
 
 // ---------------------------------------------------------------------------------------------
-// G, Q and the exponential integrals.
+// G, Q and the exponential integrals: `integrals/layer.rs`.
 
-/// ∫ f over [0, 1] split at the given interior points: the first piece linear, the others in
-/// x = ln μ (features at the scale of each cut then span O(1) in x), each by the adaptive
-/// G10/K21 of `crate::integrate` at tol / (number of pieces).
-fn graded_unit_integral(cuts: &[f64], tol: f64, f: impl Fn(f64) -> f64) -> Estimate {
-    let mut pts = vec![0.0];
-    let mut sorted: Vec<f64> = cuts.iter().copied().filter(|&c| c > 0.0 && c < 1.0).collect();
-    sorted.sort_by(|a, b| a.total_cmp(b));
-    sorted.dedup();
-    pts.extend(sorted);
-    pts.push(1.0);
-    let tl = Tolerance { abs: tol / (pts.len() - 1) as f64, rel: 0.0, max_panels: MAX_PANELS };
-    let mut out = Estimate::exact(0.0);
-    for w in pts.windows(2) {
-        let e = if w[0] == 0.0 {
-            adaptive(0.0, w[1], tl, &f)
-        } else {
-            let (l0, span) = (w[0].ln(), (w[1] / w[0]).ln());
-            adaptive(0.0, 1.0, tl, |x| {
-                let mu = (l0 + span * x).exp();
-                f(mu) * mu * span
-            })
-        };
-        out.value += e.value;
-        out.error += e.error;
-        out.evals += e.evals;
-    }
-    out
-}
-
-/// G(d, μv) by adaptive quadrature of ∫₀¹ (1 − e^{−d(1/μv + 1/μ)}) μ/(μ + μv) dμ.
-///
-/// The range is split at μ = d and μ = μv (the scales of e^{−d/μ} and of μ/(μ + μv)) and
-/// graded logarithmically above the first cut. G(d, 0) = 1 (the limit μv → 0, d > 0);
-/// G(0, μv) = 0. NaN for d < 0 or μv < 0.
-pub fn g(d: f64, mu_v: f64, tol: f64) -> Estimate {
-    if !(d >= 0.0 && mu_v >= 0.0) {
-        return invalid();
-    }
-    if d == 0.0 {
-        return Estimate::exact(0.0);
-    }
-    if mu_v == 0.0 {
-        return Estimate::exact(1.0);
-    }
-    // Subnormal arguments: the graded nodes would need 1/d or 1/μv, which overflow. Take the
-    // limit with a bound on the distance to it. The integrand (1 − e^{−d(1/μv + 1/μ)})·μ/(μ + μv)
-    // is at most d/μv, so G ≤ d/μv; and 1 − G ≤ c ln((1 + c)/c) + e^{−d/c} E₂(d) + c E₁(d(1 + c)/c)
-    // from the closed form ([`g_exact`], c = μv; E₂ ≤ 1, E₁(x) ≤ e^{−x} ln(1 + 1/x)).
-    if d < f64::MIN_POSITIVE || mu_v < f64::MIN_POSITIVE {
-        let to_zero = (d / mu_v).min(1.0);
-        let c = mu_v;
-        let to_one = c * (1.0 - c.ln()) + (-d / c).exp() + c * expn(1, d * (1.0 + c) / c);
-        return if to_zero <= to_one {
-            Estimate { value: 0.0, error: to_zero, evals: 0 }
-        } else {
-            Estimate { value: 1.0, error: to_one.min(1.0), evals: 0 }
-        };
-    }
-    let mut e = graded_unit_integral(&[d, mu_v], clean_tol(tol), |mu| {
-        if mu <= 0.0 {
-            return 0.0;
-        }
-        -(-d * (1.0 / mu_v + 1.0 / mu)).exp_m1() * mu / (mu + mu_v)
-    });
-    // Rounding: the logarithmic pieces place their nodes through exp of values up to
-    // ln(1/min(d, μv)), which perturbs the sample points by that many ulps (seen as G exceeding
-    // 1 by 3e-14 at μv = 1e-300); the quadrature estimate does not include it.
-    e.error += 8.0 * f64::EPSILON * (1.0 + d.min(mu_v).recip().ln().max(0.0));
-    e
-}
-
-/// G(d, μv) in closed form (see the module doc), for d > 0, μv > 0:
-/// 1 − c ln((1+c)/c) − e^{−d/c} E₂(d) + c e^{−d/c} E₁(d) − c E₁(d(1+c)/c), c = μv.
-/// Absolute rounding error ≲ 1e-15·(1 + |ln d|); limits as in [`g`].
-pub fn g_exact(d: f64, mu_v: f64) -> f64 {
-    if !(d >= 0.0 && mu_v >= 0.0) {
-        return f64::NAN;
-    }
-    if d == 0.0 {
-        return 0.0;
-    }
-    if mu_v == 0.0 {
-        return 1.0;
-    }
-    let c = mu_v;
-    let ed = (-d / c).exp();
-    1.0 - c * (1.0 / c).ln_1p() - ed * expn(2, d) + c * ed * expn(1, d)
-        - c * expn(1, d * (1.0 + c) / c)
-}
-
-/// Q(d) = 2 ∫₀¹ e^{−d/μ} μ dμ by adaptive quadrature (split at μ = d, graded logarithmically
-/// above it). NaN for d < 0 or NaN.
-pub fn q(d: f64, tol: f64) -> Estimate {
-    if d.is_nan() || d < 0.0 {
-        return invalid();
-    }
-    let mut e = graded_unit_integral(&[d], clean_tol(tol), |mu| {
-        if mu <= 0.0 { 0.0 } else { 2.0 * (-d / mu).exp() * mu }
-    });
-    // Rounding of the logarithmic node placement, as in `g`: for d < 1 the nodes above μ = d come
-    // from exp of values up to ln(1/d), perturbed by that many ulps (seen as Q(2e-205) off by
-    // 1.6e-14 against an estimate of 1.2e-14); the quadrature estimate does not include it.
-    if d > 0.0 && d < 1.0 {
-        e.error += 8.0 * f64::EPSILON * (1.0 - d.ln());
-    }
-    e
-}
-
-/// Q(d) = 2 E₃(d) exactly.
-pub fn q_exact(d: f64) -> f64 {
-    2.0 * e3(d)
-}
-
-/// E₃(x) = ∫₁^∞ e^{−xt} t^{−3} dt.
-pub fn e3(x: f64) -> f64 {
-    expn(3, x)
-}
-
-/// Exponential integral E_n(x) = ∫₁^∞ e^{−xt} t^{−n} dt for x ≥ 0 (x > 0 when n ≤ 1), to a few
-/// ulps relative: power series for x ≤ 1, modified-Lentz continued fraction beyond
-/// (Numerical Recipes §6.3). E_n(0) = 1/(n − 1) for n ≥ 2. NaN outside the domain.
-pub fn expn(n: u32, x: f64) -> f64 {
-    const EULER: f64 = 0.577_215_664_901_532_9;
-    const EPS: f64 = 1e-17;
-    if x.is_nan() || x < 0.0 || (x == 0.0 && n <= 1) {
-        return f64::NAN;
-    }
-    if x == f64::INFINITY {
-        return 0.0;
-    }
-    if n == 0 {
-        return (-x).exp() / x;
-    }
-    let nm1 = (n - 1) as f64;
-    if x == 0.0 {
-        return 1.0 / nm1;
-    }
-    if x > 1.0 {
-        let tiny = 1e-300;
-        let mut b = x + n as f64;
-        let mut c = 1.0 / tiny;
-        let mut d = 1.0 / b;
-        let mut h = d;
-        for i in 1..1000 {
-            let fi = i as f64;
-            let an = -fi * (nm1 + fi);
-            b += 2.0;
-            d = 1.0 / (an * d + b);
-            c = b + an / c;
-            let del = c * d;
-            h *= del;
-            if (del - 1.0).abs() < EPS {
-                break;
-            }
-        }
-        h * (-x).exp()
-    } else {
-        let mut ans = if n == 1 { -x.ln() - EULER } else { 1.0 / nm1 };
-        let mut fact = 1.0;
-        for i in 1..1000u32 {
-            let fi = i as f64;
-            fact *= -x / fi;
-            let del = if i != n - 1 {
-                -fact / (fi - nm1)
-            } else {
-                let psi = -EULER + (1..n).map(|k| 1.0 / k as f64).sum::<f64>();
-                fact * (-x.ln() + psi)
-            };
-            ans += del;
-            if del.abs() < ans.abs() * EPS {
-                break;
-            }
-        }
-        ans
-    }
-}
+mod layer;
+pub use layer::{e3, expn, g, g_exact, q, q_exact};
 
 #[cfg(test)]
 mod r_horizon;
@@ -1264,6 +1090,7 @@ mod r_horizon;
 #[allow(clippy::needless_range_loop)]
 pub(crate) mod tests {
     use super::*;
+    use crate::integrate::{adaptive, Tolerance};
 
     /// G at subnormal d (or μv) takes its limit with a bound instead of quadrature nodes that
     /// would need 1/d: G ≤ d/μv, so at d = 1e-310 the value is 0 within that bound, with μv
@@ -1282,24 +1109,6 @@ pub(crate) mod tests {
         let least = c * ((1.0 + c).ln() - c.ln());
         assert!(least > 7e-308, "{least:e}");
         assert!(e.value == 1.0 && e.error >= least * (1.0 - 1e-9) && e.error <= 1.0, "{e:?}, 1 − G ≥ {least:e}");
-    }
-
-    /// `graded_unit_integral` against closed forms: ∫₀¹ cos μ dμ = sin 1 with the cuts given
-    /// unsorted, repeated and partly outside (0, 1) (its pieces must tile [0, 1] once), and
-    /// ∫₀¹ μ/(μ + c) dμ = 1 − c ln((1 + c)/c) at c = 1e-3, the near-pole scale the logarithmic
-    /// grading is for, cut at c. Each within its own error estimate, which honours the asked
-    /// 1e-12 (the closed forms: a few ulps of 1, far below it).
-    #[test]
-    fn graded_unit_integral_tiles_the_unit_interval_once() {
-        let e = graded_unit_integral(&[0.7, 0.01, 0.3, 1.5, -1.0, 0.3, 0.0, 1.0], 1e-12, f64::cos);
-        let want = 1f64.sin();
-        assert!(e.error <= 1e-12 && (e.value - want).abs() <= e.error.max(1e-15), "{e:?} vs {want}");
-        let c = 1e-3;
-        let e = graded_unit_integral(&[c], 1e-12, |mu| mu / (mu + c));
-        let want = 1.0 - c * ((1.0 + c) / c).ln();
-        assert!(e.error <= 1e-12 && (e.value - want).abs() <= e.error.max(1e-15), "{e:?} vs {want}");
-        let whole = graded_unit_integral(&[], 1e-12, |mu| mu / (mu + c));
-        assert!((whole.value - want).abs() <= whole.error.max(1e-15), "{whole:?} vs {want}");
     }
 
     /// `atan_unit` against the platform's arctan on 20 001 points of [−1, 1], both sides of the
@@ -2667,7 +2476,7 @@ pub(crate) mod tests {
             let direct = adaptive(0.0, 1.0, tl, f);
             halving_shows |= adaptive(0.0, 1.0, Tolerance { abs: 0.5 * tol, ..tl }, f).evals != direct.evals;
             for cuts in [&[][..], &[0.0], &[1.0], &[0.0, 1.0, 0.0]] {
-                let e = graded_unit_integral(cuts, tol, f);
+                let e = crate::integrate::graded_unit_integral(cuts, tol, MAX_PANELS, f);
                 assert_eq!((e.value.to_bits(), e.error.to_bits(), e.evals), (direct.value.to_bits(), direct.error.to_bits(), direct.evals), "tol {tol:e}, cuts {cuts:?}");
             }
         }

@@ -199,7 +199,7 @@ fn rms_error(pts: &[[f64; 3]], refs: &[[f64; 4]], so: impl Fn(f64, f64, f64) -> 
 /// gives SO ≈ 0) and every (a, b) returns ≈ 1 there (the form tends to 1 as V → 1), so its
 /// constants are fitted for the least rms instead.
 pub fn refits() -> ([f64; 2], f64) {
-    use super::published::refit::nelder_mead;
+    use crate::fit::simplex::nelder_mead;
     let pts = grid();
     let refs = reference(&pts);
     let (l, _) = nelder_mead(|p| rms_error(&pts, &refs, |r, mu, v| lagarde_with([p[0], p[1]], mu, v, r * r)), &LAGARDE);
@@ -382,7 +382,7 @@ pub fn jimenez_multibounce(p: &[f64], v: f64, albedo: f64) -> f64 {
 /// The multi-bounce item: Jimenez's fit against COD: WWII's interreflection model, and the
 /// same cubic refitted (minimax) to that model.
 fn multibounce_item() -> Item {
-    use super::published::refit::nelder_mead;
+    use crate::fit::simplex::nelder_mead;
     // V and ρ at 65 uniform points each, [0, 1]² (the model is smooth: a uniform grid suffices).
     let pts: Vec<Vec<f64>> = (0..=64).flat_map(|i| (0..=64).map(move |j| vec![i as f64 / 64.0, j as f64 / 64.0])).collect();
     let truth: Vec<f64> = pts.iter().map(|p| if p[0] == 0.0 { 0.0 } else { interreflected(p[0], p[1]) }).collect();
