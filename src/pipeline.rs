@@ -966,9 +966,9 @@ pub fn runtime_index_with_scenes(specs: &[Spec], scenes: &[SceneIndex]) -> Artif
     Artifact { path: "src/emitted.rs".into(), contents: s.into() }
 }
 
-/// Feature family of a spec: the quantity name up to its first '-'.
+/// The runtime feature of a spec's module: its family's (`Family::feature`, through the catalog).
 pub fn family(spec: &Spec) -> &str {
-    spec.file.quantity.split('-').next().unwrap_or("core")
+    spec.feature
 }
 
 /// Compare artifacts with the files under `root`: the paths that differ or are missing.

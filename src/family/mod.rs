@@ -99,6 +99,9 @@ pub fn commands_help() -> String {
 /// What a family offers. Plain data and function pointers.
 pub struct Family {
     pub name: &'static str,
+    /// The runtime crate's cargo feature that gates the family's emitted modules
+    /// (`generated/Cargo.toml` declares it).
+    pub feature: &'static str,
     pub doc: &'static str,
     /// Quantities `eval` serves and specs sample.
     pub quantities: &'static [QuantityDef],
@@ -133,6 +136,7 @@ pub fn catalog() -> &'static Catalog {
     CATALOG.get_or_init(|| Catalog {
         quantities: FAMILIES.iter().flat_map(|f| f.quantities.iter()).collect(),
         kinds: FAMILIES.iter().flat_map(|f| f.spec_kinds.iter().map(|k| &k.spec)).collect(),
+        features: FAMILIES.iter().flat_map(|f| f.quantities.iter().map(|q| (q.name, f.feature))).collect(),
     })
 }
 

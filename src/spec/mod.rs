@@ -324,6 +324,8 @@ pub struct KindDef {
 pub struct Catalog {
     pub quantities: Vec<&'static QuantityDef>,
     pub kinds: Vec<&'static KindDef>,
+    /// (quantity, the runtime crate's feature of the family that serves it).
+    pub features: Vec<(&'static str, &'static str)>,
 }
 
 impl Catalog {
@@ -335,6 +337,11 @@ impl Catalog {
 
     pub fn kind(&self, name: &str) -> Option<&'static KindDef> {
         self.kinds.iter().copied().find(|k| k.name == name)
+    }
+
+    /// The runtime feature of the family serving quantity `name` ("core" when none is named).
+    pub fn feature(&self, name: &str) -> &'static str {
+        self.features.iter().find(|f| f.0 == name).map_or("core", |f| f.1)
     }
 }
 
@@ -605,6 +612,8 @@ pub struct Spec {
     /// For a spec made in memory rather than read from fits/ (a fit of the user's own data):
     /// what its generated files name as their spec, e.g. the command that made them.
     pub origin: Option<String>,
+    /// The runtime crate's feature that gates the spec's module (its quantity's family's).
+    pub feature: &'static str,
 }
 
 /// How a spec evaluates its quantity at a point of its axes: the channel it takes, and the
@@ -825,7 +834,7 @@ impl Spec {
         if file.kind == Kind::Table && file.axis.len() > 2 {
             return Err(at("axis", "tables have one or two axes".into()));
         }
-        Ok(Spec { path: path.to_path_buf(), text, file, quantity, model, channel, origin: None })
+        Ok(Spec { path: path.to_path_buf(), text, file, quantity, model, channel, origin: None, feature: catalog.feature(quantity.name) })
     }
 }
 

@@ -58,6 +58,7 @@ pub static QUANTITIES: &[QuantityDef] = &[
 /// The fiber family's descriptor (registered in `crate::family::FAMILIES`).
 pub static FAMILY: Family = Family {
     name: "fiber",
+    feature: "fiber",
     doc: "Ghost of Tsushima Schlick fiber phase function: its normalisation and the conservative r(k)",
     quantities: QUANTITIES,
     spec_kinds: &[],

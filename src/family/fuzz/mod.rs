@@ -128,6 +128,7 @@ pub static QUANTITIES: &[QuantityDef] = &[
 /// The fuzz family's descriptor (registered in `crate::family::FAMILIES`).
 pub static FAMILY: Family = Family {
     name: "fuzz",
+    feature: "fuzz",
     doc: "Ghost of Tsushima asperity scattering: P_s, G, Q, R and Listings 1–5",
     quantities: QUANTITIES,
     spec_kinds: &[],

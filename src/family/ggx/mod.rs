@@ -216,6 +216,7 @@ fn figures(out: &Path, generated: &Path) -> Result<Vec<PathBuf>, PlotError> {
 /// The GGX split-sum family's descriptor (registered in `crate::family::FAMILIES`).
 pub static FAMILY: Family = Family {
     name: "ggx",
+    feature: "ggx",
     doc: "GGX split-sum: DFG scale/bias (with a visibility cone), E(mu), E_avg, Fresnel averages, energy compensation",
     quantities: QUANTITIES,
     spec_kinds: &[lut::DFG_LUT, published::emit::REFITS, occlusion::emit::OCCLUSION, occlusion::lut::CONE_LUT],

@@ -77,6 +77,7 @@ pub static QUANTITIES: &[QuantityDef] = &[
 /// The gloss family's descriptor (registered in `crate::family::FAMILIES`).
 pub static FAMILY: Family = Family {
     name: "gloss",
+    feature: "gloss",
     doc: "COD: WWII gloss ↔ GGX average normal length, its inverse and the gloss-combine table",
     quantities: QUANTITIES,
     spec_kinds: &[],

@@ -116,6 +116,7 @@ pub static QUANTITIES: &[QuantityDef] = &[
 /// The msdiffuse family's descriptor (registered in `crate::family::FAMILIES`).
 pub static FAMILY: Family = Family {
     name: "msdiffuse",
+    feature: "ms",
     doc: "Call of Duty: WWII multiple-scattering diffuse BRDF: Lambertian microfacets on GGX, Heitz 2016's walk",
     quantities: QUANTITIES,
     spec_kinds: &[table::TABLE],

@@ -137,6 +137,7 @@ pub static QUANTITIES: &[QuantityDef] = &[
 /// The sggx family's descriptor (registered in `crate::family::FAMILIES`).
 pub static FAMILY: Family = Family {
     name: "sggx",
+    feature: "sggx",
     doc: "Ghost of Tsushima SGGX filtering and storage of anisotropic GGX roughness",
     quantities: QUANTITIES,
     spec_kinds: &[emit::DECODE],

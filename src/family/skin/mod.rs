@@ -132,6 +132,7 @@ fn eval_with_options(q: &QuantityDef, p: &[f64], o: &EvalOptions) -> Result<Opti
 /// The skin family's descriptor (registered in `crate::family::FAMILIES`).
 pub static FAMILY: Family = Family {
     name: "skin",
+    feature: "skin",
     doc: "pre-integrated skin scattering: punctual and SH LUTs from a diffusion profile",
     quantities: QUANTITIES,
     spec_kinds: std::slice::from_ref(&SKIN_LUT),
