@@ -26,6 +26,8 @@ use std::path::Path;
 
 #[cfg(test)]
 pub(crate) mod build_tests;
+#[cfg(test)]
+mod lobe_tests;
 pub mod committed;
 pub mod data;
 pub mod fields;

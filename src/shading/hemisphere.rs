@@ -505,6 +505,40 @@ pub fn albedo_avg<L: Lobe>(lobe: &L, tol: f64) -> Estimate {
     Estimate { value: r.value, error: r.error + worst, evals: r.evals + n }
 }
 
+/// How the leading parameters of a quantity make a lobe (its roughness, a user parameter…):
+/// the evaluators below take the view (n·v) and the cone after them, so that a family serves a
+/// lobe's E, E_avg and split sum as quantities with no integrator code of its own.
+pub trait LobeParams {
+    type Lobe: Lobe;
+    /// How many leading parameters are the lobe's.
+    const COUNT: usize;
+    /// The lobe at those parameters (inside the quantity's domain).
+    fn lobe(p: &[f64]) -> Self::Lobe;
+}
+
+/// E at p = [lobe parameters…, n·v], to absolute tolerance `tol` (a quantity's `eval`).
+pub fn eval_albedo<P: LobeParams>(p: &[f64], tol: f64) -> Estimate {
+    albedo(&P::lobe(p), p[P::COUNT], tol)
+}
+
+/// E_avg at p = [lobe parameters…] (a quantity's `eval`).
+pub fn eval_albedo_avg<P: LobeParams>(p: &[f64], tol: f64) -> Estimate {
+    albedo_avg(&P::lobe(p), tol)
+}
+
+/// [scale, bias] at p = [lobe parameters…, n·v, cos_cone (0 when left out)] (a quantity's
+/// `eval_channels`): each channel carries the pair's error; the evaluations are counted once,
+/// on the first.
+pub fn eval_split_sum<P: LobeParams>(p: &[f64], tol: f64) -> Vec<Estimate> {
+    let r = split_sum(&P::lobe(p), p[P::COUNT], p.get(P::COUNT + 1).copied().unwrap_or(0.0), tol);
+    vec![Estimate { value: r.scale, error: r.error, evals: r.evals }, Estimate { value: r.bias, error: r.error, evals: 0 }]
+}
+
+/// Channel 0 (scale) of [`eval_split_sum`] (a vector quantity's `eval`).
+pub fn eval_split_sum_scale<P: LobeParams>(p: &[f64], tol: f64) -> Estimate {
+    eval_split_sum::<P>(p, tol)[0]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

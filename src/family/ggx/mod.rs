@@ -16,7 +16,8 @@ use crate::integrate::Estimate;
 use crate::quantity::{ParamSpec, QuantityDef};
 use crate::plot::PlotError;
 use crate::validate::Item;
-use integrals::Shadowing;
+use crate::shading::hemisphere::{eval_albedo, eval_albedo_avg, eval_split_sum, eval_split_sum_scale, LobeParams};
+use crate::shading::trowbridge_reitz::{Ggx, Shadowing};
 use std::path::{Path, PathBuf};
 
 const ALPHA: ParamSpec = ParamSpec {
@@ -64,36 +65,26 @@ fn alpha_of_roughness(r: f64) -> f64 {
 
 const ROUGHNESS_ALIAS: (ParamSpec, usize, fn(f64) -> f64) = (ROUGHNESS, 0, alpha_of_roughness);
 
-fn env_channels(p: &[f64], tol: f64, shadowing: Shadowing) -> Vec<Estimate> {
-    let r = integrals::env(p[0], p[1], p.get(2).copied().unwrap_or(0.0), shadowing, tol);
-    vec![
-        Estimate { value: r.scale, error: r.error, evals: r.evals },
-        Estimate { value: r.bias, error: r.error, evals: 0 },
-    ]
+/// The GGX lobe of the quantities: α = p[0], height-correlated Smith G2.
+struct HeightCorrelated;
+
+impl LobeParams for HeightCorrelated {
+    type Lobe = Ggx;
+    const COUNT: usize = 1;
+    fn lobe(p: &[f64]) -> Ggx {
+        Ggx::new(p[0], Shadowing::HeightCorrelated)
+    }
 }
 
-fn ggx_env_channels(p: &[f64], tol: f64) -> Vec<Estimate> {
-    env_channels(p, tol, Shadowing::HeightCorrelated)
-}
+/// UE4's image-based-lighting lobe: α = p[0], separable Schlick–Smith with k = α/2.
+struct Ue4;
 
-fn ggx_env(p: &[f64], tol: f64) -> Estimate {
-    ggx_env_channels(p, tol)[0]
-}
-
-fn ue4_channels(p: &[f64], tol: f64) -> Vec<Estimate> {
-    env_channels(p, tol, Shadowing::Separable { k: 0.5 * p[0] })
-}
-
-fn ue4_env(p: &[f64], tol: f64) -> Estimate {
-    ue4_channels(p, tol)[0]
-}
-
-fn ggx_albedo(p: &[f64], tol: f64) -> Estimate {
-    integrals::albedo(p[0], p[1], tol)
-}
-
-fn ggx_albedo_avg(p: &[f64], tol: f64) -> Estimate {
-    integrals::albedo_avg(p[0], tol)
+impl LobeParams for Ue4 {
+    type Lobe = Ggx;
+    const COUNT: usize = 1;
+    fn lobe(p: &[f64]) -> Ggx {
+        Ggx::new(p[0], Shadowing::Separable { k: 0.5 * p[0] })
+    }
 }
 
 fn fresnel_avg_schlick(p: &[f64], _tol: f64) -> Estimate {
@@ -112,10 +103,10 @@ pub static QUANTITIES: &[QuantityDef] = &[
         doc: "split-sum environment BRDF [scale, bias] (F = F0·scale + bias), lights in a cone",
         params: &[ALPHA, N_DOT_V, COS_CONE],
         aliases: &[ROUGHNESS_ALIAS],
-        eval: ggx_env,
+        eval: eval_split_sum_scale::<HeightCorrelated>,
         inverse: None,
         channels: &["scale", "bias"],
-        eval_channels: Some(ggx_env_channels),
+        eval_channels: Some(eval_split_sum::<HeightCorrelated>),
         basis: None,
     },
     QuantityDef {
@@ -123,10 +114,10 @@ pub static QUANTITIES: &[QuantityDef] = &[
         doc: "[scale, bias] with UE4's separable Schlick-Smith G (k = alpha/2), hemisphere",
         params: &[ALPHA, N_DOT_V],
         aliases: &[ROUGHNESS_ALIAS],
-        eval: ue4_env,
+        eval: eval_split_sum_scale::<Ue4>,
         inverse: None,
         channels: &["scale", "bias"],
-        eval_channels: Some(ue4_channels),
+        eval_channels: Some(eval_split_sum::<Ue4>),
         basis: None,
     },
     QuantityDef {
@@ -134,7 +125,7 @@ pub static QUANTITIES: &[QuantityDef] = &[
         doc: "directional albedo E(mu) of single-scattering GGX (F = 1)",
         params: &[ALPHA, N_DOT_V],
         aliases: &[ROUGHNESS_ALIAS],
-        eval: ggx_albedo,
+        eval: eval_albedo::<HeightCorrelated>,
         inverse: None,
         channels: &[],
         eval_channels: None,
@@ -145,7 +136,7 @@ pub static QUANTITIES: &[QuantityDef] = &[
         doc: "cosine-weighted average albedo E_avg = 2 int E(mu) mu dmu",
         params: &[ALPHA],
         aliases: &[ROUGHNESS_ALIAS],
-        eval: ggx_albedo_avg,
+        eval: eval_albedo_avg::<HeightCorrelated>,
         inverse: None,
         channels: &[],
         eval_channels: None,
