@@ -153,7 +153,23 @@ pub struct Summary {
 /// spec built. Every WGSL module is also written in `extra` targets and its spec's own
 /// (`[emit] targets`); with neither, the outputs are the WGSL modules and their siblings only.
 pub fn run(paths: &Paths, only: &[String], check: bool, extra: &[Target], tick: &(dyn Fn(usize) + Sync)) -> Result<Summary, Error> {
-    let specs = load_specs(paths, only)?;
+    run_merged(paths, only, check, extra, tick, Default::default())
+}
+
+/// [`run`] with the cells `merge` gathered, by spec name, handed to those specs' builders
+/// (`Spec::merged`).
+fn run_merged(
+    paths: &Paths,
+    only: &[String],
+    check: bool,
+    extra: &[Target],
+    tick: &(dyn Fn(usize) + Sync),
+    mut merged: std::collections::BTreeMap<String, Vec<u8>>,
+) -> Result<Summary, Error> {
+    let mut specs = load_specs(paths, only)?;
+    for s in &mut specs {
+        s.merged = merged.remove(&s.file.name).map(std::sync::Arc::new);
+    }
     let selected: Vec<&Spec> = specs.iter().filter(|s| only.is_empty() || only.contains(&s.file.name)).collect();
     let mode = if check { Mode::Committed } else { Mode::Fit };
     // One transaction for every file of the build, its lock held from here: a second build
@@ -431,6 +447,7 @@ pub fn merge(paths: &Paths, files: &[PathBuf], tick: &(dyn Fn(usize) + Sync)) ->
     }
     let names: Vec<String> = by_spec.keys().cloned().collect();
     let specs = load_specs(paths, &names)?;
+    let mut merged = std::collections::BTreeMap::new();
     for (name, mut parts) in by_spec {
         let spec = specs.iter().find(|s| s.file.name == name).expect("load_specs checked the names");
         let sh = sharding_of(spec).ok_or_else(|| Error::Shard(format!("{name}: its kind does not shard")))?;
@@ -459,9 +476,9 @@ pub fn merge(paths: &Paths, files: &[PathBuf], tick: &(dyn Fn(usize) + Sync)) ->
         if parts.len() as u64 != n {
             return Err(Error::Shard(format!("{name}: {} of {n} shards given", parts.len())));
         }
-        pipeline::set_merged(&name, payload);
+        merged.insert(name, payload);
     }
-    run(paths, &names, false, &[], tick)
+    run_merged(paths, &names, false, &[], tick, merged)
 }
 
 #[cfg(test)]

@@ -170,19 +170,9 @@ pub fn time_it<T>(min_seconds: f64, mut f: impl FnMut() -> T) -> (f64, T) {
     }
 }
 
-/// splitmix64: the fixed-seed generator of the Monte Carlo baselines and the sample subsets.
-pub struct SplitMix(pub u64);
-
-impl SplitMix {
-    pub fn next_f64(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^= z >> 31;
-        (z >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
-    }
-}
+/// splitmix64 (the one generator, `integrate::rng`): the fixed-seed generator of the Monte
+/// Carlo baselines and the sample subsets.
+pub use crate::integrate::rng::SplitMix64 as SplitMix;
 
 /// Which sections to run.
 #[derive(Debug, Clone, Copy)]

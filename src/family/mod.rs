@@ -37,7 +37,7 @@ pub struct SpecKind {
 
 /// How a spec kind's work splits into cells: their count, and the payload of a range of them
 /// (bytes that depend on the spec and the cells only). Concatenated in cell order, the payloads
-/// of every range are what the kind's builder takes from `pipeline::take_merged` in
+/// of every range are what the kind's builder takes from `Spec::merged` in
 /// `Mode::Fit` instead of computing.
 #[derive(Debug)]
 pub struct Sharding {

@@ -20,6 +20,7 @@
 //! - [`Estimate`]: value, error estimate and integrand evaluations of one integral.
 
 mod adaptive;
+pub mod rng;
 
 pub use adaptive::{Control, GaussPair, Options, PanelError, Rule, VecEstimate, integrate, quadpack_error};
 

@@ -624,16 +624,6 @@ fn the_runtime_index_calls_each_function_with_its_arity() {
     }
 }
 
-/// A payload merged from shards goes to the next build of its spec once: taken, it is gone
-/// (a later build computes), and no other spec sees it.
-#[test]
-fn a_merged_payload_is_taken_once() {
-    set_merged("merged_payload_test", vec![1, 2, 3]);
-    assert_eq!(take_merged("merged_payload_test_other"), None);
-    assert_eq!(take_merged("merged_payload_test"), Some(vec![1, 2, 3]));
-    assert_eq!(take_merged("merged_payload_test"), None);
-}
-
 /// f(o, u) with a ripple 0.02·sin(7o)·u² that no rational field of this form follows: the
 /// objectives disagree.
 static RIPPLED: crate::quantity::InnerBasis = crate::quantity::InnerBasis {

@@ -614,6 +614,9 @@ pub struct Spec {
     pub origin: Option<String>,
     /// The runtime crate's feature that gates the spec's module (its quantity's family's).
     pub feature: &'static str,
+    /// The cells of a sharded kind merged from shard files (`shadefit merge`): its builder takes
+    /// them in `Mode::Fit` instead of computing them. None when read from fits/.
+    pub merged: Option<std::sync::Arc<Vec<u8>>>,
 }
 
 /// How a spec evaluates its quantity at a point of its axes: the channel it takes, and the
@@ -834,7 +837,7 @@ impl Spec {
         if file.kind == Kind::Table && file.axis.len() > 2 {
             return Err(at("axis", "tables have one or two axes".into()));
         }
-        Ok(Spec { path: path.to_path_buf(), text, file, quantity, model, channel, origin: None, feature: catalog.feature(quantity.name) })
+        Ok(Spec { path: path.to_path_buf(), text, file, quantity, model, channel, origin: None, feature: catalog.feature(quantity.name), merged: None })
     }
 }
 

@@ -159,7 +159,7 @@ pub fn brdf(s: &Surface, l: V3, v: V3, order: Order, key: u64, cell: u64, paths:
     let sums = chunked(paths, parallel, |a, b| {
         let mut t = Sums::default();
         for i in a..b {
-            let mut rng = PathRng::new(key, cell, i);
+            let mut rng = PathRng::for_path(key, cell, i);
             let r = s.path(l, Some(v), &mut rng);
             t.add(match order {
                 Order::All => r.nee,
@@ -177,7 +177,7 @@ pub fn albedo(s: &Surface, v: V3, key: u64, cell: u64, paths: u64, parallel: boo
     let sums = chunked(paths, parallel, |a, b| {
         let mut t = Sums::default();
         for i in a..b {
-            let mut rng = PathRng::new(key, cell, i);
+            let mut rng = PathRng::for_path(key, cell, i);
             t.add(s.path(v, None, &mut rng).escaped);
         }
         t
@@ -192,8 +192,8 @@ pub fn albedo_by_next_events(s: &Surface, v: V3, key: u64, cell: u64, paths: u64
     let sums = chunked(paths, parallel, |a, b| {
         let mut t = Sums::default();
         for i in a..b {
-            let mut rng = PathRng::new(key, cell, i);
-            let (u1, u2) = (rng.next(), rng.next());
+            let mut rng = PathRng::for_path(key, cell, i);
+            let (u1, u2) = (rng.next_f64(), rng.next_f64());
             let r = u1.sqrt();
             let (sp, cp) = (2.0 * PI * u2).sin_cos();
             let oz = (1.0 - u1).sqrt();

@@ -525,8 +525,8 @@ fn module(name: &str, t: &Table, header: &[String]) -> (String, String) {
 pub fn build(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> {
     let t = Table::from_spec(spec)?;
     let cells = match mode {
-        Mode::Fit => match crate::pipeline::take_merged(&t.name) {
-            Some(bytes) => cells_of_payload(&t, &bytes)?,
+        Mode::Fit => match spec.merged.as_deref() {
+            Some(bytes) => cells_of_payload(&t, bytes)?,
             None => t.simulate(0..t.cells()),
         },
         Mode::Committed => {

@@ -11,32 +11,11 @@ use std::f64::consts::PI;
 
 type V3 = [f64; 3];
 
-/// SplitMix64's output finaliser (a bijection of u64 with full avalanche).
-#[inline]
-pub fn mix64(mut z: u64) -> u64 {
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    z ^ (z >> 31)
-}
+pub use crate::integrate::rng::mix64;
 
-const GOLDEN: u64 = 0x9e37_79b9_7f4a_7c15;
-
-/// The random numbers of one path: SplitMix64 from a seed hashed from (key, cell, sample).
-pub struct PathRng(u64);
-
-impl PathRng {
-    pub fn new(key: u64, cell: u64, sample: u64) -> Self {
-        let seed = mix64(mix64(mix64(key ^ GOLDEN).wrapping_add(cell)).wrapping_add(sample.wrapping_mul(GOLDEN)));
-        PathRng(seed)
-    }
-
-    /// A uniform number in [0, 1) with 53 random bits.
-    #[inline]
-    pub fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(GOLDEN);
-        (mix64(self.0) >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
-    }
-}
+/// The random numbers of one path: SplitMix64 from a seed hashed from (key, cell, sample)
+/// (`SplitMix64::for_path`; draws by `next_f64`).
+pub use crate::integrate::rng::SplitMix64 as PathRng;
 
 /// A 64-bit key from a text (FNV-1a, then the finaliser): spec names, quantity names.
 pub fn key_of(text: &str) -> u64 {
@@ -208,7 +187,7 @@ impl Surface {
         let mut out = PathResult::default();
         let lam_o = wo.map(|o| lambda_any(alpha, o[2]));
         loop {
-            match next_height(alpha, w[2], u, rng.next()) {
+            match next_height(alpha, w[2], u, rng.next_f64()) {
                 None => {
                     if diffused {
                         out.escaped = weight;
@@ -222,7 +201,7 @@ impl Surface {
                 return out;
             }
             let wi_local = [-w[0], -w[1], -w[2]];
-            let m = sample_vndf(alpha, wi_local, rng.next(), rng.next());
+            let m = sample_vndf(alpha, wi_local, rng.next_f64(), rng.next_f64());
             let c_in = dot(wi_local, m).max(0.0);
             let f_in = fresnel(self.f0, c_in);
             // Next-event estimate toward wo: diffuse share of this event (always), specular
@@ -247,8 +226,8 @@ impl Surface {
                 }
             }
             // The next direction.
-            let xi = rng.next();
-            let (u1, u2) = (rng.next(), rng.next());
+            let xi = rng.next_f64();
+            let (u1, u2) = (rng.next_f64(), rng.next_f64());
             match self.specular {
                 Specular::Walks if xi < f_in => {
                     // Mirror reflection about m; the weight is unchanged (chosen with probability F).
@@ -303,29 +282,16 @@ mod tests {
 
     #[test]
     fn rng_depends_on_key_cell_and_sample_only() {
-        let a: Vec<f64> = (0..4).map(|_| 0.0).scan(PathRng::new(1, 2, 3), |r, _| Some(r.next())).collect();
-        let b: Vec<f64> = (0..4).map(|_| 0.0).scan(PathRng::new(1, 2, 3), |r, _| Some(r.next())).collect();
+        let a: Vec<f64> = (0..4).map(|_| 0.0).scan(PathRng::for_path(1, 2, 3), |r, _| Some(r.next_f64())).collect();
+        let b: Vec<f64> = (0..4).map(|_| 0.0).scan(PathRng::for_path(1, 2, 3), |r, _| Some(r.next_f64())).collect();
         assert_eq!(a, b);
-        assert_ne!(PathRng::new(1, 2, 3).next(), PathRng::new(1, 2, 4).next());
-        assert_ne!(PathRng::new(1, 2, 3).next(), PathRng::new(1, 3, 3).next());
-        assert_ne!(PathRng::new(1, 2, 3).next(), PathRng::new(2, 2, 3).next());
+        assert_ne!(PathRng::for_path(1, 2, 3).next_f64(), PathRng::for_path(1, 2, 4).next_f64());
+        assert_ne!(PathRng::for_path(1, 2, 3).next_f64(), PathRng::for_path(1, 3, 3).next_f64());
+        assert_ne!(PathRng::for_path(1, 2, 3).next_f64(), PathRng::for_path(2, 2, 3).next_f64());
         // Uniform: mean of 2^16 draws within 5 standard errors (1/sqrt(12·2^16) ≈ 1.1e-3) of 1/2.
-        let mut r = PathRng::new(7, 0, 0);
-        let mean = (0..1 << 16).map(|_| r.next()).sum::<f64>() / 65536.0;
+        let mut r = PathRng::for_path(7, 0, 0);
+        let mean = (0..1 << 16).map(|_| r.next_f64()).sum::<f64>() / 65536.0;
         assert!((mean - 0.5).abs() < 5.0 * 1.13e-3, "{mean}");
-    }
-
-    /// The generator is SplitMix64 value for value: from state 0 its first four outputs are the
-    /// reference ones of Vigna's splitmix64.c (https://prng.di.unimi.it/splitmix64.c), and a
-    /// draw is an output's top 53 bits over 2^53.
-    #[test]
-    fn the_stream_is_splitmix64() {
-        let published: [u64; 4] = [0xe220_a839_7b1d_cdaf, 0x6e78_9e6a_a1b9_65f4, 0x06c4_5d18_8009_454f, 0xf88b_b8a8_724c_81ec];
-        let mut r = PathRng(0);
-        for (k, &want) in published.iter().enumerate() {
-            assert_eq!(mix64(GOLDEN.wrapping_mul(k as u64 + 1)), want, "output {k}");
-            assert_eq!(r.next(), (want >> 11) as f64 / 9_007_199_254_740_992.0, "draw {k}");
-        }
     }
 
     /// A text's key is its 64-bit FNV-1a hash (Fowler, Noll & Vo; the test vectors of the FNV
@@ -578,11 +544,11 @@ mod tests {
         // below the horizon; 2^18 samples, within 5 standard errors plus the quadrature's 1e-6.
         for (alpha, wz) in [(1.0, 0.8), (0.5, 0.3), (0.3, -0.4), (1.0, -0.9), (0.6, -0.2), (0.05, 0.05)] {
             let wi = [(1.0f64 - wz * wz).sqrt(), 0.0, wz];
-            let mut r = PathRng::new(11, 0, 0);
+            let mut r = PathRng::for_path(11, 0, 0);
             let n = 1 << 18;
             let (mut s, mut s2) = (0.0, 0.0);
             for _ in 0..n {
-                let m = sample_vndf(alpha, wi, r.next(), r.next());
+                let m = sample_vndf(alpha, wi, r.next_f64(), r.next_f64());
                 let c = dot(wi, m);
                 assert!(m[2] >= 0.0 && c >= -1e-12, "{m:?}");
                 let x = m[2];
@@ -630,8 +596,8 @@ mod tests {
             let at = |specular| Surface { alpha, rho: 0.8, f0: 0.0, specular };
             for (wi, wo) in [(normalize([0.6, 0.0, 0.8]), normalize([-0.3, 0.4, 0.5])), (normalize([0.1, -0.2, 0.3]), [0.0, 0.0, 1.0])] {
                 for sample in 0..2000 {
-                    let gone = at(Specular::Gone).path(wi, Some(wo), &mut PathRng::new(3, 0, sample));
-                    let walks = at(Specular::Walks).path(wi, Some(wo), &mut PathRng::new(3, 0, sample));
+                    let gone = at(Specular::Gone).path(wi, Some(wo), &mut PathRng::for_path(3, 0, sample));
+                    let walks = at(Specular::Walks).path(wi, Some(wo), &mut PathRng::for_path(3, 0, sample));
                     assert_eq!(bits(gone), bits(walks), "α {alpha} wi {wi:?} path {sample}: {gone:?} vs {walks:?}");
                 }
             }
@@ -650,8 +616,8 @@ mod tests {
             let (wi, wo) = (normalize([0.5, 0.1, 0.6]), normalize([-0.2, -0.3, 0.7]));
             let mut longer = 0;
             for sample in 0..2000 {
-                let one = at(1.0).path(wi, Some(wo), &mut PathRng::new(9, 4, sample));
-                let half = at(0.5).path(wi, Some(wo), &mut PathRng::new(9, 4, sample));
+                let one = at(1.0).path(wi, Some(wo), &mut PathRng::for_path(9, 4, sample));
+                let half = at(0.5).path(wi, Some(wo), &mut PathRng::for_path(9, 4, sample));
                 let scale = 0.5f64.powi(one.order as i32);
                 assert_eq!(half.order, one.order, "F0 {f0} path {sample}");
                 assert_eq!(half.escaped, one.escaped * scale, "F0 {f0} path {sample}: {half:?} vs {one:?}");
@@ -670,7 +636,7 @@ mod tests {
     #[test]
     fn a_walk_that_never_leaves_is_cut_after_max_order_events() {
         let s = Surface { alpha: 0.5, rho: 1.0, f0: 0.0, specular: Specular::Gone };
-        let r = s.path([f64::NAN; 3], None, &mut PathRng::new(1, 1, 1));
+        let r = s.path([f64::NAN; 3], None, &mut PathRng::for_path(1, 1, 1));
         assert_eq!((r.order, r.escaped), (MAX_ORDER + 1, 0.0), "{r:?}");
     }
 
