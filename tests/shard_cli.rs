@@ -91,3 +91,31 @@ fn bad_shard_sets_are_input_errors_and_write_nothing() {
     std::fs::write(p.path().join("fits/msd_s.toml"), SPEC.replace("paths = 512", "paths = 600")).unwrap();
     expect_2(&["merge", &shard(0), &shard(1), &shard(2)], "another version");
 }
+
+/// `merge` builds from the shards' cells, not by computing them again: a shard whose first
+/// cell's value is changed in its payload (one mantissa bit, the payload's size kept) merges into
+/// a JSON that differs from the single build's, and only in that value.
+#[test]
+fn merge_builds_from_the_shards_cells() {
+    let one = project(SPEC);
+    assert!(run(one.path(), &["build"]).status.success());
+    let want = std::fs::read_to_string(one.path().join("generated/json/msd_s.json")).unwrap();
+    let many = project(SPEC);
+    assert!(run(many.path(), &["build", "--shard", "0/1", "--shard-dir", "shards"]).status.success());
+    let path = std::fs::read_dir(many.path().join("shards")).unwrap().next().unwrap().unwrap().path();
+    let mut bytes = std::fs::read(&path).unwrap();
+    // The payload follows the magic line and the JSON header; a cell is its value then its
+    // standard error, f64 little-endian: byte 2 holds mantissa bits 16..23 of the value (bit 20:
+    // a relative change of 2^-32).
+    let start = bytes.iter().enumerate().filter(|(_, b)| **b == b'\n').nth(1).unwrap().0 + 1;
+    let cell = f64::from_le_bytes(bytes[start..start + 8].try_into().unwrap());
+    bytes[start + 2] ^= 0x10;
+    let changed = f64::from_le_bytes(bytes[start..start + 8].try_into().unwrap());
+    assert!(changed != cell && (changed - cell).abs() <= 2f64.powi(-31) * cell.abs(), "{cell} → {changed}");
+    std::fs::write(&path, &bytes).unwrap();
+    let r = run(many.path(), &["merge", path.to_str().unwrap()]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let got = std::fs::read_to_string(many.path().join("generated/json/msd_s.json")).unwrap();
+    assert_ne!(got, want, "the merged build ignored the shard's cells");
+    assert!(got.contains(&format!("{changed:?}")) && !want.contains(&format!("{changed:?}")), "the changed cell {changed:?} is not in the merged JSON");
+}
