@@ -8,6 +8,7 @@ pub use crate::fit::expr;
 pub mod fields;
 #[cfg(test)]
 mod fixtures;
+pub mod interp;
 pub mod rust;
 pub mod targets;
 pub mod texture;

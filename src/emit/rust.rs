@@ -128,17 +128,8 @@ pub fn table_eval_f32(values: &[f32], counts: &[usize], domain: &[(f32, f32)], x
         idx[d] = i as usize;
         frac[d] = (t - i as f32).clamp(0.0, 1.0);
     }
-    if counts.len() == 1 {
-        let i = idx[0];
-        values[i] * (1.0 - frac[0]) + values[i + 1] * frac[0]
-    } else {
-        let nx = counts[0];
-        let k = idx[1] * nx + idx[0];
-        let (f0, f1) = (frac[0], frac[1]);
-        let a = values[k] * (1.0 - f0) + values[k + 1] * f0;
-        let b = values[k + nx] * (1.0 - f0) + values[k + nx + 1] * f0;
-        a * (1.0 - f1) + b * f1
-    }
+    let at: Vec<super::interp::Address<f32>> = (0..counts.len()).map(|d| (idx[d], idx[d] + 1, frac[d])).collect();
+    super::interp::multilinear(values.as_chunks::<1>().0, counts, &at)[0]
 }
 
 #[cfg(test)]

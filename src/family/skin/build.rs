@@ -20,6 +20,7 @@
 use crate::pipeline::{BuildError, Built, Mode, Verification, committed_texels, compact_json, fmt_err, spec_rel_path};
 use super::emit::{Layout, SkinLutCode};
 use crate::emit::texture::{ktx2_rgba, png_srgb_preview};
+use crate::emit::interp::{multilinear, nodes};
 use crate::emit::{Artifact, GENERATOR, header_lines};
 use crate::integrate::{Estimate, Tolerance};
 use super::integrals::{
@@ -97,18 +98,10 @@ fn lut_n_dot_ls(lut: &SkinLut) -> Vec<f64> {
 
 /// Bilinear interpolation in f64 at continuous texel coordinates (x, y).
 fn bilinear(values: &[[f64; 3]], (w, h): (usize, usize), x: f64, y: f64) -> [f64; 3] {
-    let i = (x.floor() as usize).min(w - 2);
-    let j = if h > 1 { (y.floor() as usize).min(h - 2) } else { 0 };
-    let (fx, fy) = (x - i as f64, if h > 1 { y - j as f64 } else { 0.0 });
-    let at = |a: usize, b: usize| values[b * w + a];
-    std::array::from_fn(|c| {
-        let a = at(i, j)[c] * (1.0 - fx) + at(i + 1, j)[c] * fx;
-        if h == 1 || fy == 0.0 {
-            return a;
-        }
-        let b = at(i, j + 1)[c] * (1.0 - fx) + at(i + 1, j + 1)[c] * fx;
-        a * (1.0 - fy) + b * fy
-    })
+    if h == 1 {
+        return multilinear(values, &[w], &[nodes(x, w)]);
+    }
+    multilinear(values, &[w, h], &[nodes(x, w), nodes(y, h)])
 }
 
 /// Measured errors on the grid with every midpoint added (see the module docs), one

@@ -21,6 +21,7 @@
 use super::emit::{DfgLutCode, lookup_f32};
 use super::spec::{DfgFormat, DfgLut, RoughnessMapping};
 use crate::emit::texture::{TextureFormat, ktx2_texels, png_srgb_preview};
+use crate::emit::interp::{centred, multilinear};
 use crate::emit::{Artifact, GENERATOR, header_lines};
 use crate::family::ggx::integrals::{EnvEstimate, env};
 use crate::pipeline::{BuildError, Built, Mode, Verification, committed_texels, compact_json, fmt_err, spec_rel_path};
@@ -119,20 +120,7 @@ pub fn stored(lut: &DfgLut, values: &[[f64; 2]]) -> Vec<[f32; 2]> {
 /// Bilinear interpolation in f64 of `texels` at texture coordinates (u, t) (texel centres,
 /// clamp to edge, exact weights).
 fn bilinear(texels: &[[f64; 2]], (w, h): (usize, usize), u: f64, t: f64) -> [f64; 2] {
-    let axis = |p: f64, n: usize| {
-        let x = p * n as f64 - 0.5;
-        let x0 = x.floor();
-        let i0 = (x0.max(0.0) as usize).min(n - 1);
-        let i1 = ((x0 + 1.0).max(0.0) as usize).min(n - 1);
-        (i0, i1, x - x0)
-    };
-    let (i0, i1, fx) = axis(u, w);
-    let (j0, j1, fy) = axis(t, h);
-    std::array::from_fn(|c| {
-        let a = texels[j0 * w + i0][c] * (1.0 - fx) + texels[j0 * w + i1][c] * fx;
-        let b = texels[j1 * w + i0][c] * (1.0 - fx) + texels[j1 * w + i1][c] * fx;
-        a * (1.0 - fy) + b * fy
-    })
+    multilinear(texels, &[w, h], &[centred(u, w), centred(t, h)])
 }
 
 /// Max, sum of squares, worst point and per-channel max of (got − want) over points.

@@ -21,6 +21,7 @@
 use super::emit::{ConeLutCode, lookup_f32};
 use super::spec::ConeLut;
 use crate::emit::texture::{ktx2_volume, png_srgb_preview};
+use crate::emit::interp::{centred, multilinear};
 use crate::emit::{GENERATOR, header_lines};
 use crate::family::ggx::lut::build::{Accumulator, Measure, lut_built, Quadrature, alpha_of_t, digits3, f16_texture, integrate, mapping_doc, stored, tabulate as tabulate_2d};
 use crate::pipeline::{BuildError, Built, Mode, committed_texels, compact_json, fmt_err, spec_rel_path};
@@ -53,25 +54,11 @@ pub fn tabulate(lut: &ConeLut) -> (Vec<[f64; 2]>, Quadrature) {
 /// Trilinear interpolation in f64 of `texels` at (u, t) (texel centres, clamp to edge) and
 /// cone cosine c (slices at k/(d − 1)), exact weights.
 pub fn trilinear(texels: &[[f64; 2]], (w, h, d): (usize, usize, usize), u: f64, t: f64, c: f64) -> [f64; 2] {
-    let axis = |p: f64, n: usize| {
-        let x = p * n as f64 - 0.5;
-        let x0 = x.floor();
-        ((x0.max(0.0) as usize).min(n - 1), ((x0 + 1.0).max(0.0) as usize).min(n - 1), x - x0)
-    };
-    let (i0, i1, fx) = axis(u.clamp(0.0, 1.0), w);
-    let (j0, j1, fy) = axis(t.clamp(0.0, 1.0), h);
+    // The slices sit at k/(d − 1); at c = 1 the last slice alone (weight 0 on nothing past it).
     let z = c.clamp(0.0, 1.0) * (d - 1) as f64;
     let k0 = (z.floor() as usize).min(d - 1);
-    let (k1, fz) = ((k0 + 1).min(d - 1), z - z.floor());
-    let at = |i: usize, j: usize, k: usize| texels[(k * h + j) * w + i];
-    std::array::from_fn(|ch| {
-        let plane = |k: usize| {
-            let a = at(i0, j0, k)[ch] * (1.0 - fx) + at(i1, j0, k)[ch] * fx;
-            let b = at(i0, j1, k)[ch] * (1.0 - fx) + at(i1, j1, k)[ch] * fx;
-            a * (1.0 - fy) + b * fy
-        };
-        plane(k0) * (1.0 - fz) + plane(k1) * fz
-    })
+    let slices = ((k0 + 1).min(d - 1), z - z.floor());
+    multilinear(texels, &[w, h, d], &[centred(u.clamp(0.0, 1.0), w), centred(t.clamp(0.0, 1.0), h), (k0, slices.0, slices.1)])
 }
 
 /// What the verification measured (see the module docs).
