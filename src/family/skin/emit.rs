@@ -110,13 +110,8 @@ impl SkinLutCode<'_> {
         let f0 = c0 - i0 as f32;
         let i1 = (c1 as u32).min(ny as u32 - 2);
         let f1 = c1 - i1 as f32;
-        let k = (i1 * nx as u32 + i0) as usize;
-        let t = self.values;
-        std::array::from_fn(|ch| {
-            let a = t[k][ch] * (1.0 - f0) + t[k + 1][ch] * f0;
-            let b = t[k + nx][ch] * (1.0 - f0) + t[k + nx + 1][ch] * f0;
-            a * (1.0 - f1) + b * f1
-        })
+        let (i0, i1) = (i0 as usize, i1 as usize);
+        crate::emit::interp::multilinear(self.values, &[nx, ny], &[(i0, i0 + 1, f0), (i1, i1 + 1, f1)])
     }
 
     /// The emitted lookup `NAME(curvature, band)` (SH) in f32.
@@ -128,9 +123,9 @@ impl SkinLutCode<'_> {
         let [c0, _] = self.coords_f32(curvature, 0.0);
         let i0 = (c0 as u32).min(nx as u32 - 2);
         let f0 = c0 - i0 as f32;
-        let k = ((band.min(2) - 1) * nx as u32 + i0) as usize;
-        let t = self.values;
-        std::array::from_fn(|ch| t[k][ch] * (1.0 - f0) + t[k + 1][ch] * f0)
+        let row = (band.min(2) - 1) as usize * nx;
+        let i0 = i0 as usize;
+        crate::emit::interp::multilinear(&self.values[row..row + nx], &[nx], &[(i0, i0 + 1, f0)])
     }
 
     fn mapping_doc(&self) -> String {

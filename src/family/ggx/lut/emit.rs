@@ -65,13 +65,7 @@ pub fn axis_f32(p: f32, n: usize) -> (usize, usize, f32) {
 
 /// The emitted Rust lookup `F(n_dot_v, t)` in f32 over `texels` (stored channels, row-major).
 pub fn lookup_f32(texels: &[[f32; 2]], (w, h): (usize, usize), n_dot_v: f32, t: f32) -> [f32; 2] {
-    let (i0, i1, fx) = axis_f32(input_f32(n_dot_v), w);
-    let (j0, j1, fy) = axis_f32(input_f32(t), h);
-    std::array::from_fn(|c| {
-        let a = texels[j0 * w + i0][c] * (1.0 - fx) + texels[j0 * w + i1][c] * fx;
-        let b = texels[j1 * w + i0][c] * (1.0 - fx) + texels[j1 * w + i1][c] * fx;
-        a * (1.0 - fy) + b * fy
-    })
+    crate::emit::interp::multilinear(texels, &[w, h], &[axis_f32(input_f32(n_dot_v), w), axis_f32(input_f32(t), h)])
 }
 
 impl DfgLutCode<'_> {

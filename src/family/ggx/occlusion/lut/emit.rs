@@ -50,18 +50,8 @@ pub fn cone_axis_f32(c: f32, d: usize) -> (usize, usize, f32) {
 /// The emitted Rust lookup `F(n_dot_v, t, cos_cone)` in f32 over `texels` (stored channels,
 /// slice-major, then row-major).
 pub fn lookup_f32(texels: &[[f32; 2]], (w, h, d): (usize, usize, usize), n_dot_v: f32, t: f32, cos_cone: f32) -> [f32; 2] {
-    let (i0, i1, fx) = axis_f32(input_f32(n_dot_v), w);
-    let (j0, j1, fy) = axis_f32(input_f32(t), h);
-    let (k0, k1, fz) = cone_axis_f32(input_f32(cos_cone), d);
-    let at = |i: usize, j: usize, k: usize| texels[(k * h + j) * w + i];
-    std::array::from_fn(|c| {
-        let plane = |k: usize| {
-            let a = at(i0, j0, k)[c] * (1.0 - fx) + at(i1, j0, k)[c] * fx;
-            let b = at(i0, j1, k)[c] * (1.0 - fx) + at(i1, j1, k)[c] * fx;
-            a * (1.0 - fy) + b * fy
-        };
-        plane(k0) * (1.0 - fz) + plane(k1) * fz
-    })
+    let at = [axis_f32(input_f32(n_dot_v), w), axis_f32(input_f32(t), h), cone_axis_f32(input_f32(cos_cone), d)];
+    crate::emit::interp::multilinear(texels, &[w, h, d], &at)
 }
 
 impl ConeLutCode<'_> {
