@@ -188,6 +188,34 @@ mod tests {
         }
     }
 
+    /// The published forms' nodes rendered as Rust, compiled by rustc and run, compute the
+    /// f32 evaluator's bits (the same f32 operations; Rust never contracts to FMA).
+    #[test]
+    fn published_form_nodes_compile_and_compute_what_the_evaluator_computes() {
+        let e = crate::fit::expr::every_node();
+        let lit = |v: f32| format!("{}_f32", super::super::f32_literal(v));
+        let text = crate::fit::expr::render_in(crate::fit::expr::Syntax::Rust, &e, &|i| format!("x{i}"), &|_, j| format!("c{j}"), &lit);
+        let points = [(0.0f32, 0.0f32), (0.9, 0.05), (0.7, 0.6), (1.0, 1.0), (0.2, 0.31), (1.5, -0.2)];
+        let mut main = format!("fn f(x0: f32, x1: f32) -> f32 {{\n    {text}\n}}\nfn main() {{\n");
+        for (x0, x1) in points {
+            main.push_str(&format!("    println!(\"{{}}\", f(f32::from_bits({:#x}), f32::from_bits({:#x})).to_bits());\n", x0.to_bits(), x1.to_bits()));
+        }
+        main.push_str("}\n");
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path();
+        std::fs::write(dir.join("main.rs"), &main).unwrap();
+        let rustc = std::env::var("RUSTC").unwrap_or_else(|_| "rustc".into());
+        let out = std::process::Command::new(rustc).args(["--edition", "2021", "-A", "warnings", "-o"]).arg(dir.join("main")).arg(dir.join("main.rs")).output().unwrap();
+        assert!(out.status.success(), "rustc: {}\n{main}", String::from_utf8_lossy(&out.stderr));
+        let run = std::process::Command::new(dir.join("main")).output().unwrap();
+        let got: Vec<u32> = String::from_utf8(run.stdout).unwrap().lines().map(|l| l.parse().unwrap()).collect();
+        for ((x0, x1), g) in points.iter().zip(&got) {
+            let want = crate::fit::expr::eval_f32(&e, &[*x0, *x1], &[], &[]);
+            assert_eq!(*g, want.to_bits(), "({x0}, {x1}): compiled {} vs evaluator {want} from '{text}'", f32::from_bits(*g));
+        }
+        assert_eq!(got.len(), points.len());
+    }
+
     /// Linear and bilinear interpolation worked out by hand on values and positions exact in
     /// binary (so every product and sum below is exact in f32), clamped at the edges.
     #[test]

@@ -309,6 +309,25 @@ mod tests {
         }
     }
 
+    /// The published forms' nodes rendered as WGSL and folded by naga's constant evaluator
+    /// (x0, x1 constants) give the f32 evaluator's value: exactly for the arithmetic, min, max,
+    /// abs, sqrt and select; naga folds exp2, log2 and pow with Rust's f32 functions, the ones
+    /// `eval_f32` calls, so those agree exactly too.
+    #[test]
+    fn published_form_nodes_fold_in_naga_as_in_f32() {
+        let e = crate::fit::expr::every_node();
+        let text = crate::fit::expr::render_in(crate::fit::expr::Syntax::Wgsl, &e, &|i| format!("x{i}"), &|_, j| format!("c{j}"), &lit);
+        // Not at x1 < 0: WGSL's select evaluates both branches, and naga refuses to fold the
+        // sqrt of a negative constant (at run time it is an indeterminate value the select
+        // discards).
+        for (x0, x1) in [(0.0f32, 0.0f32), (0.9, 0.05), (0.7, 0.6), (1.0, 1.0), (0.2, 0.31), (1.5, 0.2)] {
+            let decls = format!("const x0: f32 = {};\nconst x1: f32 = {};\n", lit(x0), lit(x1));
+            let got = crate::emit::fixtures::naga_folded_f32(&decls, &text);
+            let want = crate::fit::expr::eval_f32(&e, &[x0, x1], &[], &[]);
+            assert_eq!(got.to_bits(), want.to_bits(), "({x0}, {x1}): naga {got} from '{text}', f32 {want}");
+        }
+    }
+
     /// A whole module: the header lines as comments, the import-path directive, then a
     /// source that naga validates (the directive stripped, as a composer does), whose table
     /// function passes its argument through the module's input clamp.

@@ -1,6 +1,13 @@
-//! A small expression tree for emitted functions: built once from a fitted model, rendered
-//! to WGSL and Rust, and evaluated in f32 here with the same operation order, so the error
-//! shadefit measures is the error of the code it emits (up to FMA contraction on a GPU).
+//! A small expression tree for emitted functions: built once from a fitted model (or written
+//! as a published form), rendered to WGSL and Rust, and evaluated in f32 here with the same
+//! operation order, so the error shadefit measures is the error of the code it emits (up to FMA
+//! contraction on a GPU), and in f64 for the form itself.
+//!
+//! Beyond the rational models' Lit/Var/Coef/Add/Mul/Div, the tree has what published forms
+//! are written with: Sub, Neg, Min, Max, Clamp, Select (c > 0 ? a : b), Sqrt, Exp2, Log2,
+//! Abs and Pow with a constant exponent. WGSL spells them as its built-ins (`select(b, a, c >
+//! 0.0)`; `clamp` as `min(max(x, lo), hi)`, the spec's definition, so that NaN handling is the
+//! f32 evaluator's); Rust as f32 methods.
 
 use crate::fit::model::{RationalModel, Term};
 use nalgebra::DVector;
@@ -15,6 +22,27 @@ pub enum Expr {
     Add(Box<Expr>, Box<Expr>),
     Mul(Box<Expr>, Box<Expr>),
     Div(Box<Expr>, Box<Expr>),
+    Sub(Box<Expr>, Box<Expr>),
+    Neg(Box<Expr>),
+    Min(Box<Expr>, Box<Expr>),
+    Max(Box<Expr>, Box<Expr>),
+    /// (x, lo, hi): min(max(x, lo), hi).
+    Clamp(Box<Expr>, Box<Expr>, Box<Expr>),
+    /// (c, a, b): a where c > 0, else b.
+    Select(Box<Expr>, Box<Expr>, Box<Expr>),
+    Sqrt(Box<Expr>),
+    Exp2(Box<Expr>),
+    Log2(Box<Expr>),
+    Abs(Box<Expr>),
+    /// x^p for a constant p.
+    Pow(Box<Expr>, f32),
+}
+
+/// The language an expression is rendered in (they differ in the built-ins only).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Syntax {
+    Wgsl,
+    Rust,
 }
 
 use Expr::*;
@@ -142,40 +170,130 @@ pub fn f32_arrays(model: &RationalModel, c: &DVector<f64>) -> (Vec<f32>, Vec<f32
 
 /// Evaluate in f32 with the emitted operation order.
 pub fn eval_f32(e: &Expr, vars: &[f32], num: &[f32], den: &[f32]) -> f32 {
+    let r = |x: &Expr| eval_f32(x, vars, num, den);
     match e {
         Lit(v) => *v,
         Var(i) => vars[*i],
         Coef(0, j) => num[*j],
         Coef(_, j) => den[*j],
-        Add(a, b) => eval_f32(a, vars, num, den) + eval_f32(b, vars, num, den),
-        Mul(a, b) => eval_f32(a, vars, num, den) * eval_f32(b, vars, num, den),
-        Div(a, b) => eval_f32(a, vars, num, den) / eval_f32(b, vars, num, den),
+        Add(a, b) => r(a) + r(b),
+        Mul(a, b) => r(a) * r(b),
+        Div(a, b) => r(a) / r(b),
+        Sub(a, b) => r(a) - r(b),
+        Neg(a) => -r(a),
+        Min(a, b) => r(a).min(r(b)),
+        Max(a, b) => r(a).max(r(b)),
+        Clamp(x, lo, hi) => r(x).max(r(lo)).min(r(hi)),
+        Select(c, a, b) => {
+            if r(c) > 0.0 { r(a) } else { r(b) }
+        }
+        Sqrt(a) => r(a).sqrt(),
+        Exp2(a) => r(a).exp2(),
+        Log2(a) => r(a).log2(),
+        Abs(a) => r(a).abs(),
+        Pow(a, p) => r(a).powf(*p),
+    }
+}
+
+/// Evaluate in f64 (the form itself, e.g. a published form against the integral; literals are
+/// the tree's f32 values).
+pub fn eval_f64(e: &Expr, vars: &[f64], num: &[f64], den: &[f64]) -> f64 {
+    let r = |x: &Expr| eval_f64(x, vars, num, den);
+    match e {
+        Lit(v) => *v as f64,
+        Var(i) => vars[*i],
+        Coef(0, j) => num[*j],
+        Coef(_, j) => den[*j],
+        Add(a, b) => r(a) + r(b),
+        Mul(a, b) => r(a) * r(b),
+        Div(a, b) => r(a) / r(b),
+        Sub(a, b) => r(a) - r(b),
+        Neg(a) => -r(a),
+        Min(a, b) => r(a).min(r(b)),
+        Max(a, b) => r(a).max(r(b)),
+        Clamp(x, lo, hi) => r(x).max(r(lo)).min(r(hi)),
+        Select(c, a, b) => {
+            if r(c) > 0.0 { r(a) } else { r(b) }
+        }
+        Sqrt(a) => r(a).sqrt(),
+        Exp2(a) => r(a).exp2(),
+        Log2(a) => r(a).log2(),
+        Abs(a) => r(a).abs(),
+        Pow(a, p) => r(a).powf(*p as f64),
     }
 }
 
 /// Render with language-specific names for variables, coefficients and literals. Parentheses
 /// follow the tree exactly (a right operand of the same operator is bracketed), so the emitted
-/// code evaluates in the order [`eval_f32`] does.
+/// code evaluates in the order [`eval_f32`] does. The arithmetic reads the same in WGSL and
+/// Rust; an expression with built-ins (min, sqrt, …) renders through [`render_in`].
 pub fn render(
     e: &Expr,
     var: &dyn Fn(usize) -> String,
     coef: &dyn Fn(u8, usize) -> String,
     lit: &dyn Fn(f32) -> String,
 ) -> String {
-    let r = |x: &Expr| render(x, var, coef, lit);
+    render_in(Syntax::Wgsl, e, var, coef, lit)
+}
+
+/// [`render`] in a language: WGSL's built-in calls or Rust's f32 methods for the built-ins.
+pub fn render_in(
+    syntax: Syntax,
+    e: &Expr,
+    var: &dyn Fn(usize) -> String,
+    coef: &dyn Fn(u8, usize) -> String,
+    lit: &dyn Fn(f32) -> String,
+) -> String {
+    let r = |x: &Expr| render_in(syntax, x, var, coef, lit);
     let wrap = |x: &Expr, when: bool| if when { format!("({})", r(x)) } else { r(x) };
+    let sum = |x: &Expr| matches!(x, Add(..) | Sub(..));
+    // A call: `f(a, …)` in WGSL, `a.f(…)` in Rust, whose receiver is bracketed unless it is a
+    // name or a call itself (a literal too: `-1.5_f32.abs()` would negate the call).
+    let call = |wgsl: &str, rust: &str, args: &[&Expr], extra: Option<String>| -> String {
+        let mut parts: Vec<String> = args.iter().map(|a| r(a)).collect();
+        parts.extend(extra);
+        match syntax {
+            Syntax::Wgsl => format!("{wgsl}({})", parts.join(", ")),
+            Syntax::Rust => {
+                let recv = if matches!(args[0], Var(..) | Coef(..)) || is_call(args[0]) { parts[0].clone() } else { format!("({})", parts[0]) };
+                format!("{recv}.{rust}({})", parts[1..].join(", "))
+            }
+        }
+    };
     match e {
         Lit(v) => lit(*v),
         Var(i) => var(*i),
         Coef(a, j) => coef(*a, *j),
-        Add(a, b) => format!("{} + {}", r(a), wrap(b, matches!(**b, Add(..)))),
+        Add(a, b) => format!("{} + {}", r(a), wrap(b, sum(b))),
+        Sub(a, b) => format!("{} - {}", r(a), wrap(b, sum(b))),
+        Neg(a) => format!("-({})", r(a)),
         Mul(a, b) => format!(
             "{} * {}",
-            wrap(a, matches!(**a, Add(..) | Div(..))),
-            wrap(b, matches!(**b, Add(..) | Mul(..) | Div(..)))
+            wrap(a, matches!(**a, Add(..) | Sub(..) | Div(..))),
+            wrap(b, matches!(**b, Add(..) | Sub(..) | Mul(..) | Div(..)))
         ),
         Div(a, b) => format!("({}) / ({})", r(a), r(b)),
+        Min(a, b) => call("min", "min", &[a, b], None),
+        Max(a, b) => call("max", "max", &[a, b], None),
+        Clamp(x, lo, hi) => {
+            let inner = Max(x.clone(), lo.clone());
+            call("min", "min", &[&inner, hi], None)
+        }
+        Select(c, a, b) => match syntax {
+            Syntax::Wgsl => format!("select({}, {}, {} > 0.0)", r(b), r(a), wrap(c, !matches!(**c, Var(..) | Coef(..) | Lit(..)) && !is_call(c))),
+            Syntax::Rust => format!("(if {} > 0.0 {{ {} }} else {{ {} }})", wrap(c, !matches!(**c, Var(..) | Coef(..) | Lit(..)) && !is_call(c)), r(a), r(b)),
+        },
+        Sqrt(a) => call("sqrt", "sqrt", &[a], None),
+        Exp2(a) => call("exp2", "exp2", &[a], None),
+        Log2(a) => call("log2", "log2", &[a], None),
+        Abs(a) => call("abs", "abs", &[a], None),
+        Pow(a, p) => call("pow", "powf", &[a], Some(lit(*p))),
     }
+}
+
+/// Whether a node renders as a call (needs no brackets as an operand or a receiver).
+fn is_call(e: &Expr) -> bool {
+    matches!(e, Min(..) | Max(..) | Clamp(..) | Select(..) | Sqrt(..) | Exp2(..) | Log2(..) | Abs(..) | Pow(..))
 }
 
 /// Sanitised f32 inputs extended with the model's derived features, as emitted code computes them.
@@ -191,9 +309,54 @@ pub fn sanitize(x: f32, lo: f32, hi: f32) -> f32 {
     if x.is_nan() { lo } else { x.clamp(lo, hi) }
 }
 
+/// A tree with every node of the published forms' vocabulary over two variables, for the
+/// renderers' tests: clamp(min(x0², 2^(−9.28 x1))·x0 − |x0 − 0.5|, 0, 1)
+/// + select(x1 − 0.3, sqrt(x1), log2(1 + x0)) + max(−x1, pow(x0 + 0.25, 1.5)).
+#[cfg(test)]
+pub(crate) fn every_node() -> Expr {
+    let b = Box::new;
+    let x0 = || b(Var(0));
+    let x1 = || b(Var(1));
+    let first = Clamp(
+        b(Sub(
+            b(Mul(b(Min(b(Mul(x0(), x0())), b(Exp2(b(Mul(b(Lit(-9.28)), x1())))))), x0())),
+            b(Abs(b(Sub(x0(), b(Lit(0.5)))))),
+        )),
+        b(Lit(0.0)),
+        b(Lit(1.0)),
+    );
+    let second = Select(b(Sub(x1(), b(Lit(0.3)))), b(Sqrt(x1())), b(Log2(b(Add(b(Lit(1.0)), x0())))));
+    let third = Max(b(Neg(x1())), b(Pow(b(Add(x0(), b(Lit(0.25)))), 1.5)));
+    Add(b(Add(b(first), b(second))), b(third))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The published forms' nodes evaluate as written out by hand (the formula of
+    /// [`every_node`] in f32 and in f64, both branches of the select, the clamp's both ends
+    /// and its inside): the same operations in the same order, so exactly in f32; in f64 the
+    /// literals are the f32 ones.
+    #[test]
+    fn every_node_evaluates_as_its_formula() {
+        let e = every_node();
+        let f32_formula = |x0: f32, x1: f32| {
+            let first = ((x0 * x0).min((-9.28f32 * x1).exp2()) * x0 - (x0 - 0.5).abs()).max(0.0).min(1.0);
+            let second = if x1 - 0.3 > 0.0 { x1.sqrt() } else { (1.0 + x0).log2() };
+            first + second + (-x1).max((x0 + 0.25).powf(1.5))
+        };
+        let f64_formula = |x0: f64, x1: f64| {
+            let first = ((x0 * x0).min((-9.28f32 as f64 * x1).exp2()) * x0 - (x0 - 0.5).abs()).max(0.0).min(1.0);
+            let second = if x1 - 0.3f32 as f64 > 0.0 { x1.sqrt() } else { (1.0 + x0).log2() };
+            first + second + (-x1).max((x0 + 0.25).powf(1.5))
+        };
+        for (x0, x1) in [(0.0f32, 0.0f32), (0.9, 0.05), (0.7, 0.6), (1.0, 1.0), (0.2, 0.31), (1.5, -0.2), (3.0, 0.1)] {
+            assert_eq!(eval_f32(&e, &[x0, x1], &[], &[]).to_bits(), f32_formula(x0, x1).to_bits(), "({x0}, {x1})");
+            let (a, b) = (x0 as f64, x1 as f64);
+            assert_eq!(eval_f64(&e, &[a, b], &[], &[]).to_bits(), f64_formula(a, b).to_bits(), "({x0}, {x1}) in f64");
+        }
+    }
 
     #[test]
     fn rendering_keeps_the_tree_order() {
