@@ -6,12 +6,14 @@
 //! - [`hemisphere`]: the operators generic over lobes on the one adaptive engine: split-sum
 //!   [scale, bias] (optionally in a visibility cone), directional albedo E(μ), E_avg;
 //! - [`trowbridge_reitz`]: the GGX lobe (height-correlated and separable Schlick–Smith
-//!   masking), D and Λ; [`lambert`]: Lambert's lobe;
+//!   masking), D and Λ; [`lambert`]: Lambert's lobe; [`charlie`]: the Charlie cloth lobe with
+//!   Ashikhmin's visibility;
 //! - [`fresnel`]: Schlick's and the dielectric Fresnel and their averages;
 //! - [`roughness`]: α from perceptual roughness and from WWII's Gloss.
 //!
 //! The layer depends on `integrate` only; families take their terms from here.
 
+pub mod charlie;
 pub mod fresnel;
 pub mod hemisphere;
 pub mod lambert;
