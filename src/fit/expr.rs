@@ -168,11 +168,59 @@ pub fn f32_arrays(model: &RationalModel, c: &DVector<f64>) -> (Vec<f32>, Vec<f32
     )
 }
 
-/// Evaluate in f32 with the emitted operation order.
-pub fn eval_f32(e: &Expr, vars: &[f32], num: &[f32], den: &[f32]) -> f32 {
-    let r = |x: &Expr| eval_f32(x, vars, num, den);
+/// The float types an expression evaluates in (f32: the emitted code; f64: the form itself).
+pub trait Float: Copy + PartialOrd + std::ops::Add<Output = Self> + std::ops::Sub<Output = Self> + std::ops::Mul<Output = Self> + std::ops::Div<Output = Self> + std::ops::Neg<Output = Self> {
+    const ZERO: Self;
+    /// A literal of the tree (an f32) in this type.
+    fn of_f32(v: f32) -> Self;
+    fn min(self, other: Self) -> Self;
+    fn max(self, other: Self) -> Self;
+    fn sqrt(self) -> Self;
+    fn exp2(self) -> Self;
+    fn log2(self) -> Self;
+    fn abs(self) -> Self;
+    fn powf(self, p: f32) -> Self;
+}
+
+macro_rules! float_impl {
+    ($t:ty) => {
+        impl Float for $t {
+            const ZERO: $t = 0.0;
+            fn of_f32(v: f32) -> $t {
+                v as $t
+            }
+            fn min(self, other: $t) -> $t {
+                <$t>::min(self, other)
+            }
+            fn max(self, other: $t) -> $t {
+                <$t>::max(self, other)
+            }
+            fn sqrt(self) -> $t {
+                <$t>::sqrt(self)
+            }
+            fn exp2(self) -> $t {
+                <$t>::exp2(self)
+            }
+            fn log2(self) -> $t {
+                <$t>::log2(self)
+            }
+            fn abs(self) -> $t {
+                <$t>::abs(self)
+            }
+            fn powf(self, p: f32) -> $t {
+                <$t>::powf(self, p as $t)
+            }
+        }
+    };
+}
+float_impl!(f32);
+float_impl!(f64);
+
+/// Evaluate in `T` with the emitted operation order (coefficients and variables in `T`).
+pub fn eval<T: Float>(e: &Expr, vars: &[T], num: &[T], den: &[T]) -> T {
+    let r = |x: &Expr| eval(x, vars, num, den);
     match e {
-        Lit(v) => *v,
+        Lit(v) => T::of_f32(*v),
         Var(i) => vars[*i],
         Coef(0, j) => num[*j],
         Coef(_, j) => den[*j],
@@ -185,7 +233,7 @@ pub fn eval_f32(e: &Expr, vars: &[f32], num: &[f32], den: &[f32]) -> f32 {
         Max(a, b) => r(a).max(r(b)),
         Clamp(x, lo, hi) => r(x).max(r(lo)).min(r(hi)),
         Select(c, a, b) => {
-            if r(c) > 0.0 { r(a) } else { r(b) }
+            if r(c) > T::ZERO { r(a) } else { r(b) }
         }
         Sqrt(a) => r(a).sqrt(),
         Exp2(a) => r(a).exp2(),
@@ -195,32 +243,15 @@ pub fn eval_f32(e: &Expr, vars: &[f32], num: &[f32], den: &[f32]) -> f32 {
     }
 }
 
+/// Evaluate in f32 with the emitted operation order.
+pub fn eval_f32(e: &Expr, vars: &[f32], num: &[f32], den: &[f32]) -> f32 {
+    eval(e, vars, num, den)
+}
+
 /// Evaluate in f64 (the form itself, e.g. a published form against the integral; literals are
 /// the tree's f32 values).
 pub fn eval_f64(e: &Expr, vars: &[f64], num: &[f64], den: &[f64]) -> f64 {
-    let r = |x: &Expr| eval_f64(x, vars, num, den);
-    match e {
-        Lit(v) => *v as f64,
-        Var(i) => vars[*i],
-        Coef(0, j) => num[*j],
-        Coef(_, j) => den[*j],
-        Add(a, b) => r(a) + r(b),
-        Mul(a, b) => r(a) * r(b),
-        Div(a, b) => r(a) / r(b),
-        Sub(a, b) => r(a) - r(b),
-        Neg(a) => -r(a),
-        Min(a, b) => r(a).min(r(b)),
-        Max(a, b) => r(a).max(r(b)),
-        Clamp(x, lo, hi) => r(x).max(r(lo)).min(r(hi)),
-        Select(c, a, b) => {
-            if r(c) > 0.0 { r(a) } else { r(b) }
-        }
-        Sqrt(a) => r(a).sqrt(),
-        Exp2(a) => r(a).exp2(),
-        Log2(a) => r(a).log2(),
-        Abs(a) => r(a).abs(),
-        Pow(a, p) => r(a).powf(*p as f64),
-    }
+    eval(e, vars, num, den)
 }
 
 /// Render with language-specific names for variables, coefficients and literals. Parentheses
