@@ -11,20 +11,7 @@
 //! - [`nodes`]: a continuous node coordinate x ∈ [0, n − 1] with the first and the last node at
 //!   the ends (a table over its domain; the last cell takes x = n − 1 with f = 1).
 
-use std::ops::{Add, Mul, Sub};
-
-/// The float types the interpolator runs in.
-pub trait Real: Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> {
-    const ONE: Self;
-}
-
-impl Real for f64 {
-    const ONE: f64 = 1.0;
-}
-
-impl Real for f32 {
-    const ONE: f32 = 1.0;
-}
+use crate::fit::expr::Float;
 
 /// An axis's address: the two texels blended and the weight of the second.
 pub type Address<T> = (usize, usize, T);
@@ -47,14 +34,14 @@ pub fn nodes(x: f64, n: usize) -> Address<f64> {
 
 /// The blend of `texels` (first axis fastest, `dims` texels per axis) at one address per axis,
 /// channel by channel.
-pub fn multilinear<T: Real, const C: usize>(texels: &[[T; C]], dims: &[usize], at: &[Address<T>]) -> [T; C] {
+pub fn multilinear<T: Float, const C: usize>(texels: &[[T; C]], dims: &[usize], at: &[Address<T>]) -> [T; C] {
     debug_assert_eq!(dims.len(), at.len());
     std::array::from_fn(|c| blend(texels, dims, at, c, at.len(), 0))
 }
 
 /// The blend over the first `axes` axes of channel `c` at offset `base` (the index of the
 /// texel where those axes are 0).
-fn blend<T: Real, const C: usize>(texels: &[[T; C]], dims: &[usize], at: &[Address<T>], c: usize, axes: usize, base: usize) -> T {
+fn blend<T: Float, const C: usize>(texels: &[[T; C]], dims: &[usize], at: &[Address<T>], c: usize, axes: usize, base: usize) -> T {
     if axes == 0 {
         return texels[base][c];
     }

@@ -118,18 +118,15 @@ pub fn render_module(header: &[String], f: &Function<'_>, doc: &str) -> String {
 
 /// f32 evaluation of a table lookup with the emitted operation order.
 pub fn table_eval_f32(values: &[f32], counts: &[usize], domain: &[(f32, f32)], x: &[f32]) -> f32 {
-    let mut idx = [0usize; 2];
-    let mut frac = [0f32; 2];
+    let mut at: [super::interp::Address<f32>; 2] = [(0, 0, 0.0); 2];
     for d in 0..counts.len() {
         let (lo, hi) = domain[d];
         let xd = super::expr::sanitize(x[d], lo, hi);
         let t = (xd - lo) * ((counts[d] as f32 - 1.0) / (hi - lo));
-        let i = (t as u32).min(counts[d] as u32 - 2);
-        idx[d] = i as usize;
-        frac[d] = (t - i as f32).clamp(0.0, 1.0);
+        let i = (t as u32).min(counts[d] as u32 - 2) as usize;
+        at[d] = (i, i + 1, (t - i as f32).clamp(0.0, 1.0));
     }
-    let at: Vec<super::interp::Address<f32>> = (0..counts.len()).map(|d| (idx[d], idx[d] + 1, frac[d])).collect();
-    super::interp::multilinear(values.as_chunks::<1>().0, counts, &at)[0]
+    super::interp::multilinear(values.as_chunks::<1>().0, counts, &at[..counts.len()])[0]
 }
 
 #[cfg(test)]

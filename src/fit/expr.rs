@@ -168,9 +168,11 @@ pub fn f32_arrays(model: &RationalModel, c: &DVector<f64>) -> (Vec<f32>, Vec<f32
     )
 }
 
-/// The float types an expression evaluates in (f32: the emitted code; f64: the form itself).
+/// The float types an expression (and a table lookup, `emit::interp`) evaluates in (f32: the
+/// emitted code; f64: the form itself).
 pub trait Float: Copy + PartialOrd + std::ops::Add<Output = Self> + std::ops::Sub<Output = Self> + std::ops::Mul<Output = Self> + std::ops::Div<Output = Self> + std::ops::Neg<Output = Self> {
     const ZERO: Self;
+    const ONE: Self;
     /// A literal of the tree (an f32) in this type.
     fn of_f32(v: f32) -> Self;
     fn min(self, other: Self) -> Self;
@@ -186,6 +188,7 @@ macro_rules! float_impl {
     ($t:ty) => {
         impl Float for $t {
             const ZERO: $t = 0.0;
+            const ONE: $t = 1.0;
             fn of_f32(v: f32) -> $t {
                 v as $t
             }

@@ -20,7 +20,7 @@ pub fn runtime_index_with_scenes(specs: &[Spec], scenes: &[SceneIndex]) -> Artif
          // Index of the emitted modules, one feature per family; included by lib.rs.\n\n"
     ));
     for spec in specs {
-        let fam = family(spec);
+        let fam = spec.feature;
         s.push_str(&format!(
             "#[cfg(feature = \"{fam}\")]\n#[path = \"{n}.rs\"]\npub mod {n};\n",
             n = spec.file.name
@@ -31,7 +31,7 @@ pub fn runtime_index_with_scenes(specs: &[Spec], scenes: &[SceneIndex]) -> Artif
     }
     s.push_str("\n/// WGSL libraries by module name (each starts with `#define_import_path shadefit::NAME`).\npub mod wgsl {\n");
     for spec in specs {
-        let fam = family(spec);
+        let fam = spec.feature;
         s.push_str(&format!(
             "    #[cfg(feature = \"{fam}\")]\n    pub const {}: &str = include_str!(\"../wgsl/{}.wgsl\");\n",
             spec.file.name.to_uppercase(),
@@ -46,7 +46,7 @@ pub fn runtime_index_with_scenes(specs: &[Spec], scenes: &[SceneIndex]) -> Artif
     }
     s.push_str("\n    /// The WGSL library of a module, if its feature is enabled.\n    pub fn module(name: &str) -> Option<&'static str> {\n        match name {\n");
     for spec in specs {
-        let fam = family(spec);
+        let fam = spec.feature;
         s.push_str(&format!(
             "            #[cfg(feature = \"{fam}\")]\n            \"{}\" => Some({}),\n",
             spec.file.name,
@@ -58,7 +58,7 @@ pub fn runtime_index_with_scenes(specs: &[Spec], scenes: &[SceneIndex]) -> Artif
     }
     s.push_str("            _ => None,\n        }\n    }\n\n    /// Names of the modules compiled in.\n    pub const NAMES: &[&str] = &[\n");
     for spec in specs {
-        s.push_str(&format!("        #[cfg(feature = \"{}\")]\n        \"{}\",\n", family(spec), spec.file.name));
+        s.push_str(&format!("        #[cfg(feature = \"{}\")]\n        \"{}\",\n", spec.feature, spec.file.name));
     }
     for (m, _) in scenes {
         s.push_str(&format!("        #[cfg(feature = \"scenes\")]\n        \"{m}\",\n"));
@@ -86,7 +86,7 @@ pub fn runtime_index_with_scenes(specs: &[Spec], scenes: &[SceneIndex]) -> Artif
         };
         s.push_str(&format!(
             "    #[cfg(feature = \"{fam}\")]\n    EmittedFunction {{ module: \"{m}\", name: \"{f}\", domain: &[{d}], cpu: {cpu}({m}::{f}) }},\n",
-            fam = family(spec),
+            fam = spec.feature,
             m = spec.file.name,
             f = spec.file.emit.function,
             d = domain.join(", ")
@@ -107,9 +107,4 @@ pub fn runtime_index_with_scenes(specs: &[Spec], scenes: &[SceneIndex]) -> Artif
     }
     s.push_str("];\n");
     Artifact { path: "src/emitted.rs".into(), contents: s.into() }
-}
-
-/// The runtime feature of a spec's module: its family's (`Family::feature`, through the catalog).
-pub fn family(spec: &Spec) -> &str {
-    spec.feature
 }

@@ -32,6 +32,11 @@ impl Charlie {
     pub fn d(&self, sh: f64) -> f64 {
         (2.0 + 1.0 / self.alpha) * sh.powf(1.0 / self.alpha) / (2.0 * PI)
     }
+
+    /// D(h) at cos θh = `ch`.
+    fn d_of_cos(&self, ch: f64) -> f64 {
+        self.d(((1.0 - ch) * (1.0 + ch)).max(0.0).sqrt())
+    }
 }
 
 impl Lobe for Charlie {
@@ -43,12 +48,11 @@ impl Lobe for Charlie {
     }
 
     fn eval(&self, mu_v: &f64, _vh: f64, ch: f64, mu_l: f64) -> f64 {
-        let sh = ((1.0 - ch) * (1.0 + ch)).max(0.0).sqrt();
-        self.d(sh) / (4.0 * (mu_l + mu_v - mu_l * mu_v))
+        self.d_of_cos(ch) / (4.0 * (mu_l + mu_v - mu_l * mu_v))
     }
 
     fn pdf(&self, ch: f64) -> f64 {
-        self.d(((1.0 - ch) * (1.0 + ch)).max(0.0).sqrt()) * ch
+        self.d_of_cos(ch) * ch
     }
 
     /// sin²θh = ξ^(2/k).

@@ -59,11 +59,7 @@ const SCHEME: ParamSpec = ParamSpec {
     default: None,
 };
 
-fn alpha_of_roughness(r: f64) -> f64 {
-    r * r
-}
-
-const ROUGHNESS_ALIAS: (ParamSpec, usize, fn(f64) -> f64) = (ROUGHNESS, 0, alpha_of_roughness);
+const ROUGHNESS_ALIAS: (ParamSpec, usize, fn(f64) -> f64) = (ROUGHNESS, 0, crate::shading::roughness::alpha_from_roughness);
 
 /// The GGX lobe of the quantities: α = p[0], height-correlated Smith G2.
 struct HeightCorrelated;
