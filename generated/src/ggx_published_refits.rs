@@ -15,63 +15,77 @@ fn input(v: f32, lo: f32, hi: f32) -> f32 {
 /// Karis's EnvBRDFApprox refitted to the height-correlated integral, roughness r (α = r²): (scale, bias) of the split sum: specular = F0·scale + bias.
 /// Karis 2014 EnvBRDFApprox: max abs 3.050e-1 (published 4.660e-1, 0.65x), rms 6.667e-2 (published 9.153e-2) over 8320 values; n·v at 64 texel centres × roughness r ∈ [0, 1] (65), against ggx-env (height-correlated Smith; α = r²).
 pub fn ggx_refit_karis(roughness: f32, n_dot_v: f32) -> [f32; 2] {
+    let roughness = input(roughness, 0e0_f32, 1e0_f32);
+    let n_dot_v = input(n_dot_v, 0e0_f32, 1e0_f32);
     let c0 = [-1.0033357e0_f32, -2.9198445e-2_f32, -5.191666e-1_f32, 2.144828e-2_f32];
     let c1 = [9.959458e-1_f32, 4.0822875e-2_f32, 1.1444206e0_f32, -3.8653046e-2_f32];
-    let (rough, nv) = (input(roughness, 0e0_f32, 1e0_f32), input(n_dot_v, 0e0_f32, 1e0_f32));
-    let r: [f32; 4] = std::array::from_fn(|i| rough * c0[i] + c1[i]);
-    let a004 = (r[0] * r[0]).min((-9.180113e0_f32 * nv).exp2()) * r[0] + r[1];
+    let r = [
+        roughness * c0[0] + c1[0],
+        roughness * c0[1] + c1[1],
+        roughness * c0[2] + c1[2],
+        roughness * c0[3] + c1[3],
+    ];
+    let a004 = (r[0] * r[0]).min((-9.180113e0_f32 * n_dot_v).exp2()) * r[0] + r[1];
     [-1.0227146e0_f32 * a004 + r[2], 1.0227146e0_f32 * a004 + r[3]]
 }
 
 /// Karis's EnvBRDFApprox refitted to UE4's separable Schlick–Smith G (k = α/2): (scale, bias) of the split sum: specular = F0·scale + bias.
 /// Karis 2014 EnvBRDFApprox: max abs 1.409e-1 (published 2.424e-1, 0.58x), rms 8.242e-2 (published 5.348e-2) over 8320 values; n·v at 64 texel centres × roughness r ∈ [0, 1] (65), against ggx-env-ue4 (separable Schlick–Smith, k = α/2; α = r²).
 pub fn ggx_refit_karis_separable(roughness: f32, n_dot_v: f32) -> [f32; 2] {
+    let roughness = input(roughness, 0e0_f32, 1e0_f32);
+    let n_dot_v = input(n_dot_v, 0e0_f32, 1e0_f32);
     let c0 = [-9.44185e-1_f32, -1.8488478e-3_f32, -6.2241024e-1_f32, 5.335537e-3_f32];
     let c1 = [1.0048656e0_f32, 3.5720747e-2_f32, 1.1064248e0_f32, -1.5154834e-1_f32];
-    let (rough, nv) = (input(roughness, 0e0_f32, 1e0_f32), input(n_dot_v, 0e0_f32, 1e0_f32));
-    let r: [f32; 4] = std::array::from_fn(|i| rough * c0[i] + c1[i]);
-    let a004 = (r[0] * r[0]).min((-8.14884e0_f32 * nv).exp2()) * r[0] + r[1];
+    let r = [
+        roughness * c0[0] + c1[0],
+        roughness * c0[1] + c1[1],
+        roughness * c0[2] + c1[2],
+        roughness * c0[3] + c1[3],
+    ];
+    let a004 = (r[0] * r[0]).min((-8.14884e0_f32 * n_dot_v).exp2()) * r[0] + r[1];
     [-1.0299811e0_f32 * a004 + r[2], 1.0299811e0_f32 * a004 + r[3]]
 }
 
 /// Lazarov's Black Ops II form refitted (gloss g: α = sqrt(2/(8192^g + 2))): (scale, bias) of the split sum: specular = F0·scale + bias.
 /// Lazarov 2013 (Black Ops II): max abs 2.493e-1 (published 3.491e-1, 0.71x), rms 9.416e-2 (published 8.725e-2) over 8320 values; n·v at 64 texel centres × gloss g ∈ [0, 1] (65), against ggx-env (height-correlated Smith; α = sqrt(2/(8192^g + 2))).
 pub fn ggx_refit_lazarov(gloss: f32, n_dot_v: f32) -> [f32; 2] {
-    let (g, nv) = (input(gloss, 0e0_f32, 1e0_f32), input(n_dot_v, 0e0_f32, 1e0_f32));
-    let t = [g * 1.121512e0_f32, g * 4.9903548e-1_f32, g * 1.8610064e-2_f32 + -1.4022746e-2_f32, g * 2.4458338e-1_f32 + 6.5181065e-1_f32];
-    let a0 = t[0] * t[1].min((-9.314638e0_f32 * nv).exp2()) + t[2];
+    let gloss = input(gloss, 0e0_f32, 1e0_f32);
+    let n_dot_v = input(n_dot_v, 0e0_f32, 1e0_f32);
+    let t = [
+        gloss * 1.121512e0_f32 + 0.0,
+        gloss * 4.9903548e-1_f32 + 0.0,
+        gloss * 1.8610064e-2_f32 + -1.4022746e-2_f32,
+        gloss * 2.4458338e-1_f32 + 6.5181065e-1_f32,
+    ];
+    let a0 = t[0] * t[1].min((-9.314638e0_f32 * n_dot_v).exp2()) + t[2];
     [t[3] - a0, a0]
 }
 
 /// MaterialX's rational pair refitted (n·v clamped to its fitted [1/128, 125/128]): (scale, bias) of the split sum: specular = F0·scale + bias.
 /// MaterialX mx_ggx_dir_albedo_analytic: max abs 4.746e-2 (published 1.145e-1, 0.41x), rms 7.153e-3 (published 6.042e-3) over 8320 values; n·v at 64 texel centres × alpha ∈ [0, 1] (65), against ggx-env (height-correlated Smith; α as given).
 pub fn ggx_refit_materialx(n_dot_v: f32, alpha: f32) -> [f32; 2] {
-    const R: [[f32; 4]; 9] = [
-        [6.037509e-2_f32, 9.345e-1_f32, 1e0_f32, 1e0_f32],
-        [3.9792202e-2_f32, -2.323e0_f32, 2.0661255e1_f32, 2.281e-1_f32],
-        [1.3056496e1_f32, 2.229e0_f32, 1.1702307e1_f32, 1.594e1_f32],
-        [1.8575928e1_f32, -3.748e0_f32, -4.732445e1_f32, -5.583e1_f32],
-        [1.6727402e2_f32, 1.424e0_f32, 1.2747188e2_f32, 1.308e1_f32],
-        [8.505381e-1_f32, -7.684e-1_f32, 2.3104203e0_f32, 4.126e1_f32],
-        [-2.9243024e2_f32, 1.436e0_f32, -8.713513e1_f32, 5.49e1_f32],
-        [-8.655233e0_f32, 2.913e-1_f32, 8.3331024e1_f32, 3.002e2_f32],
-        [1.1121431e2_f32, 6.286e-1_f32, -7.6406136e1_f32, -2.851e2_f32],
+    let n_dot_v = input(n_dot_v, 7.8125e-3_f32, 9.765625e-1_f32);
+    let alpha = input(alpha, 0e0_f32, 1e0_f32);
+    let x = n_dot_v;
+    let y = alpha;
+    let x2 = x * x;
+    let y2 = y * y;
+    let r = [
+        6.037509e-2_f32 + 3.9792202e-2_f32 * x + 1.3056496e1_f32 * y + 1.8575928e1_f32 * x * y + 1.6727402e2_f32 * x2 + 8.505381e-1_f32 * y2 + -2.9243024e2_f32 * x2 * y + -8.655233e0_f32 * x * y2 + 1.1121431e2_f32 * x2 * y2,
+        9.345e-1_f32 + -2.323e0_f32 * x + 2.229e0_f32 * y + -3.748e0_f32 * x * y + 1.424e0_f32 * x2 + -7.684e-1_f32 * y2 + 1.436e0_f32 * x2 * y + 2.913e-1_f32 * x * y2 + 6.286e-1_f32 * x2 * y2,
+        1e0_f32 + 2.0661255e1_f32 * x + 1.1702307e1_f32 * y + -4.732445e1_f32 * x * y + 1.2747188e2_f32 * x2 + 2.3104203e0_f32 * y2 + -8.713513e1_f32 * x2 * y + 8.3331024e1_f32 * x * y2 + -7.6406136e1_f32 * x2 * y2,
+        1e0_f32 + 2.281e-1_f32 * x + 1.594e1_f32 * y + -5.583e1_f32 * x * y + 1.308e1_f32 * x2 + 4.126e1_f32 * y2 + 5.49e1_f32 * x2 * y + 3.002e2_f32 * x * y2 + -2.851e2_f32 * x2 * y2,
     ];
-    let (x, y) = (input(n_dot_v, 7.8125e-3_f32, 9.765625e-1_f32), input(alpha, 0e0_f32, 1e0_f32));
-    let (x2, y2) = (x * x, y * y);
-    let m = [1.0, x, y, x * y, x2, y2, x2 * y, x * y2, x2 * y2];
-    let r: [f32; 4] = std::array::from_fn(|c| (0..9).fold(0.0, |s, k| s + R[k][c] * m[k]));
-    [(r[0] / r[2]).clamp(0.0, 1.0), (r[1] / r[3]).clamp(0.0, 1.0)]
+    [(r[0] / r[2]).max(0.0).min(1.0), (r[1] / r[3]).max(0.0).min(1.0)]
 }
 
 /// Kulla–Conty's dielectric Fresnel average F_avg(η) refitted (η clamped to [1/3, 3]).
 /// Kulla–Conty F_avg, η ≥ 1 branch: max abs 4.731e-3 (published 6.523e-3, 0.73x), rms 3.272e-3 (published 4.766e-3) over 513 values; 513 values of η in [1, 3], against the exact dielectric Fresnel average.
 /// Kulla–Conty F_avg, η < 1 branch: max abs 8.554e-4 (published 2.529e-3, 0.34x), rms 5.988e-4 (published 6.300e-4) over 513 values; 513 values of η in [1/3, 1), against the exact dielectric Fresnel average.
 pub fn ggx_refit_fresnel_avg_dielectric(eta: f32) -> f32 {
-    let e = input(eta, 3.3333334e-1_f32, 3e0_f32);
-    if e < 1.0 {
-        1.0220853e0_f32 + e * (-2.626728e-2_f32 + e * (-7.609418e-1_f32 + e * -2.3391718e-1_f32))
-    } else {
-        (e - 1.0) / (3.4117167e0_f32 + 1.3185056e0_f32 * e)
-    }
+    let eta = input(eta, 3.3333334e-1_f32, 3e0_f32);
+    let e = eta;
+    let below = 1.0220853e0_f32 + e * (-2.626728e-2_f32 + e * (-7.609418e-1_f32 + e * -2.3391718e-1_f32));
+    let above = (e - 1.0) / (3.4117167e0_f32 + 1.3185056e0_f32 * e);
+    if e < 1.0 { below } else { above }
 }

@@ -213,6 +213,31 @@ mod tests {
         assert_eq!(got.len(), points.len());
     }
 
+    /// A program's Rust (every vector node, one lane at a time), compiled by rustc and run,
+    /// computes the f32 evaluator's bits in each lane.
+    #[test]
+    fn program_vector_nodes_compile_and_compute_what_the_evaluator_computes() {
+        use crate::fit::expr::program::{EVERY_CONSTS, EVERY_POINTS, every_vector_node};
+        let p = every_vector_node();
+        let lit = |v: f32| format!("{}_f32", super::super::f32_literal(v));
+        let body = p.render(crate::fit::expr::Syntax::Rust, &|i| format!("x{i}"), &EVERY_CONSTS, &lit);
+        let mut main = format!("fn f(x0: f32, x1: f32) -> [f32; 2] {{\n{body}}}\nfn main() {{\n");
+        for (x0, x1) in EVERY_POINTS {
+            main.push_str(&format!("    for v in f(f32::from_bits({:#x}), f32::from_bits({:#x})) {{ println!(\"{{}}\", v.to_bits()); }}\n", x0.to_bits(), x1.to_bits()));
+        }
+        main.push_str("}\n");
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path();
+        std::fs::write(dir.join("main.rs"), &main).unwrap();
+        let rustc = std::env::var("RUSTC").unwrap_or_else(|_| "rustc".into());
+        let out = std::process::Command::new(rustc).args(["--edition", "2021", "-A", "warnings", "-o"]).arg(dir.join("main")).arg(dir.join("main.rs")).output().unwrap();
+        assert!(out.status.success(), "rustc: {}\n{main}", String::from_utf8_lossy(&out.stderr));
+        let run = std::process::Command::new(dir.join("main")).output().unwrap();
+        let got: Vec<u32> = String::from_utf8(run.stdout).unwrap().lines().map(|l| l.parse().unwrap()).collect();
+        let want: Vec<u32> = EVERY_POINTS.iter().flat_map(|&(x0, x1)| p.eval_f32(&[x0, x1], &EVERY_CONSTS)).map(f32::to_bits).collect();
+        assert_eq!(got, want, "{main}");
+    }
+
     /// Linear and bilinear interpolation worked out by hand on values and positions exact in
     /// binary (so every product and sum below is exact in f32), clamped at the edges.
     #[test]

@@ -328,6 +328,33 @@ mod tests {
         }
     }
 
+    /// A program's WGSL (every vector node), its bindings made module constants and folded by
+    /// naga's constant evaluator, gives the f32 evaluator's bits in each lane: the same
+    /// operations per lane (naga folds exp2 with Rust's f32 function, the one the evaluator calls).
+    #[test]
+    fn program_vector_nodes_fold_in_naga_as_in_f32() {
+        use crate::fit::expr::program::{EVERY_CONSTS, EVERY_POINTS, every_vector_node};
+        let p = every_vector_node();
+        let body = p.render(crate::fit::expr::Syntax::Wgsl, &|i| format!("x{i}"), &EVERY_CONSTS, &lit);
+        let mut lets = String::new();
+        let mut result = String::new();
+        for line in body.lines() {
+            if let Some(l) = line.trim().strip_prefix("let ") {
+                lets += &format!("const {l}\n");
+            } else if let Some(r) = line.trim().strip_prefix("return ") {
+                result = r.trim_end_matches(';').to_string();
+            }
+        }
+        for (x0, x1) in EVERY_POINTS {
+            let decls = format!("const x0: f32 = {};\nconst x1: f32 = {};\n{lets}", lit(x0), lit(x1));
+            let want = p.eval_f32(&[x0, x1], &EVERY_CONSTS);
+            for (k, lane) in ["x", "y"].iter().enumerate() {
+                let got = crate::emit::fixtures::naga_folded_f32(&decls, &format!("({result}).{lane}"));
+                assert_eq!(got.to_bits(), want[k].to_bits(), "({x0}, {x1}) lane {lane}: naga {got}, f32 {}", want[k]);
+            }
+        }
+    }
+
     /// A whole module: the header lines as comments, the import-path directive, then a
     /// source that naga validates (the directive stripped, as a composer does), whose table
     /// function passes its argument through the module's input clamp.

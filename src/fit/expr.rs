@@ -4,10 +4,14 @@
 //! contraction on a GPU), and in f64 for the form itself.
 //!
 //! Beyond the rational models' Lit/Var/Coef/Add/Mul/Div, the tree has what published forms
-//! are written with: Sub, Neg, Min, Max, Clamp, Select (c > 0 ? a : b), Sqrt, Exp2, Log2,
-//! Abs and Pow with a constant exponent. WGSL spells them as its built-ins (`select(b, a, c >
-//! 0.0)`; `clamp` as `min(max(x, lo), hi)`, the spec's definition, so that NaN handling is the
-//! f32 evaluator's); Rust as f32 methods.
+//! are written with: Sub, Neg, Min, Max, Clamp, Select (c > 0 ? a : b), Less (x < y ? a : b),
+//! Sqrt, Exp2, Log2, Abs and Pow with a constant exponent, and, inside a [`program::Program`]
+//! (a published form with let-bindings), WGSL's small vectors: Vector, Splat, Swizzle and Let.
+//! WGSL spells them as its built-ins (`select(b, a, c > 0.0)`, `clamp(x, lo, hi)`, `vec4<f32>(…)`,
+//! `.zw`); Rust as f32 methods (`x.max(lo).min(hi)`: NaN → lo, as the evaluator), its vectors
+//! as arrays, one expression per lane.
+
+pub mod program;
 
 use crate::fit::model::{RationalModel, Term};
 use nalgebra::DVector;
@@ -36,6 +40,38 @@ pub enum Expr {
     Abs(Box<Expr>),
     /// x^p for a constant p.
     Pow(Box<Expr>, f32),
+    /// (x, y, a, b): a where x < y, else b.
+    Less(Box<Expr>, Box<Expr>, Box<Expr>, Box<Expr>),
+    /// A vector of 2–4 scalar lanes (`vec4<f32>(a, b, c, d)`).
+    Vector(Vec<Expr>),
+    /// A scalar in every one of n lanes (`vec2<f32>(x)`).
+    Splat(u8, Box<Expr>),
+    /// Lanes of a vector, by index (`.zw` = [2, 3]; one index is a scalar).
+    Swizzle(Box<Expr>, Vec<u8>),
+    /// A program's earlier binding, by index.
+    Let(usize),
+}
+
+macro_rules! expr_op {
+    ($tr:ident, $m:ident) => {
+        impl std::ops::$tr for Expr {
+            type Output = Expr;
+            fn $m(self, other: Expr) -> Expr {
+                Expr::$tr(Box::new(self), Box::new(other))
+            }
+        }
+    };
+}
+expr_op!(Add, add);
+expr_op!(Sub, sub);
+expr_op!(Mul, mul);
+expr_op!(Div, div);
+
+impl std::ops::Neg for Expr {
+    type Output = Expr;
+    fn neg(self) -> Expr {
+        Expr::Neg(Box::new(self))
+    }
 }
 
 /// The language an expression is rendered in (they differ in the built-ins only).
@@ -219,14 +255,90 @@ macro_rules! float_impl {
 float_impl!(f32);
 float_impl!(f64);
 
+/// What a tree evaluates to: a scalar of a [`Float`] type, or a program's lanes
+/// ([`program::Lanes`]), with the operations per lane.
+pub trait Value<T: Float>: Copy + std::ops::Add<Output = Self> + std::ops::Sub<Output = Self> + std::ops::Mul<Output = Self> + std::ops::Div<Output = Self> + std::ops::Neg<Output = Self> {
+    /// A scalar (a literal, variable or coefficient).
+    fn of(x: T) -> Self;
+    fn min(self, other: Self) -> Self;
+    fn max(self, other: Self) -> Self;
+    fn sqrt(self) -> Self;
+    fn exp2(self) -> Self;
+    fn log2(self) -> Self;
+    fn abs(self) -> Self;
+    fn powf(self, p: f32) -> Self;
+    /// a where c > 0, else b.
+    fn select_positive(c: Self, a: Self, b: Self) -> Self;
+    /// a where x < y, else b.
+    fn select_less(x: Self, y: Self, a: Self, b: Self) -> Self;
+    /// The vector nodes (a scalar tree has none).
+    fn vector(lanes: &[Self]) -> Self;
+    fn splat(n: u8, x: Self) -> Self;
+    fn swizzle(self, lanes: &[u8]) -> Self;
+}
+
+macro_rules! scalar_value {
+    ($t:ty) => {
+        impl Value<$t> for $t {
+            fn of(x: $t) -> $t {
+                x
+            }
+            fn min(self, other: $t) -> $t {
+                Float::min(self, other)
+            }
+            fn max(self, other: $t) -> $t {
+                Float::max(self, other)
+            }
+            fn sqrt(self) -> $t {
+                Float::sqrt(self)
+            }
+            fn exp2(self) -> $t {
+                Float::exp2(self)
+            }
+            fn log2(self) -> $t {
+                Float::log2(self)
+            }
+            fn abs(self) -> $t {
+                Float::abs(self)
+            }
+            fn powf(self, p: f32) -> $t {
+                Float::powf(self, p)
+            }
+            fn select_positive(c: $t, a: $t, b: $t) -> $t {
+                if c > 0.0 { a } else { b }
+            }
+            fn select_less(x: $t, y: $t, a: $t, b: $t) -> $t {
+                if x < y { a } else { b }
+            }
+            fn vector(_: &[$t]) -> $t {
+                unreachable!("a vector node outside a program")
+            }
+            fn splat(_: u8, _: $t) -> $t {
+                unreachable!("a vector node outside a program")
+            }
+            fn swizzle(self, _: &[u8]) -> $t {
+                unreachable!("a vector node outside a program")
+            }
+        }
+    };
+}
+scalar_value!(f32);
+scalar_value!(f64);
+
 /// Evaluate in `T` with the emitted operation order (coefficients and variables in `T`).
-pub fn eval<T: Float>(e: &Expr, vars: &[T], num: &[T], den: &[T]) -> T {
-    let r = |x: &Expr| eval(x, vars, num, den);
+pub fn eval<T: Float + Value<T>>(e: &Expr, vars: &[T], num: &[T], den: &[T]) -> T {
+    eval_as(e, vars, num, den, &[])
+}
+
+/// Evaluate to `V` (a scalar, or a program's lanes with its bindings `lets`) with the emitted
+/// operation order.
+pub fn eval_as<T: Float, V: Value<T>>(e: &Expr, vars: &[V], num: &[T], den: &[T], lets: &[V]) -> V {
+    let r = |x: &Expr| eval_as(x, vars, num, den, lets);
     match e {
-        Lit(v) => T::of_f32(*v),
+        Lit(v) => V::of(T::of_f32(*v)),
         Var(i) => vars[*i],
-        Coef(0, j) => num[*j],
-        Coef(_, j) => den[*j],
+        Coef(0, j) => V::of(num[*j]),
+        Coef(_, j) => V::of(den[*j]),
         Add(a, b) => r(a) + r(b),
         Mul(a, b) => r(a) * r(b),
         Div(a, b) => r(a) / r(b),
@@ -235,14 +347,17 @@ pub fn eval<T: Float>(e: &Expr, vars: &[T], num: &[T], den: &[T]) -> T {
         Min(a, b) => r(a).min(r(b)),
         Max(a, b) => r(a).max(r(b)),
         Clamp(x, lo, hi) => r(x).max(r(lo)).min(r(hi)),
-        Select(c, a, b) => {
-            if r(c) > T::ZERO { r(a) } else { r(b) }
-        }
+        Select(c, a, b) => V::select_positive(r(c), r(a), r(b)),
         Sqrt(a) => r(a).sqrt(),
         Exp2(a) => r(a).exp2(),
         Log2(a) => r(a).log2(),
         Abs(a) => r(a).abs(),
         Pow(a, p) => r(a).powf(*p),
+        Less(x, y, a, b) => V::select_less(r(x), r(y), r(a), r(b)),
+        Vector(items) => V::vector(&items.iter().map(r).collect::<Vec<V>>()),
+        Splat(n, x) => V::splat(*n, r(x)),
+        Swizzle(x, lanes) => r(x).swizzle(lanes),
+        Let(j) => lets[*j],
     }
 }
 
@@ -278,7 +393,45 @@ pub fn render_in(
     coef: &dyn Fn(u8, usize) -> String,
     lit: &dyn Fn(f32) -> String,
 ) -> String {
-    let r = |x: &Expr| render_in(syntax, x, var, coef, lit);
+    struct Closures<'a> {
+        var: &'a dyn Fn(usize) -> String,
+        coef: &'a dyn Fn(u8, usize) -> String,
+        lit: &'a dyn Fn(f32) -> String,
+    }
+    impl Spell for Closures<'_> {
+        fn var(&self, i: usize) -> String {
+            (self.var)(i)
+        }
+        fn coef(&self, array: u8, j: usize) -> String {
+            (self.coef)(array, j)
+        }
+        fn lit(&self, v: f32) -> String {
+            (self.lit)(v)
+        }
+    }
+    render_with(syntax, e, &Closures { var, coef, lit })
+}
+
+/// How the leaves of a tree are spelled in emitted code.
+pub trait Spell {
+    fn var(&self, i: usize) -> String;
+    fn coef(&self, array: u8, j: usize) -> String;
+    fn lit(&self, v: f32) -> String;
+    /// −coef as one literal, where the coefficients are printed as their values.
+    fn negated_coef(&self, _array: u8, _j: usize) -> Option<String> {
+        None
+    }
+    /// A program's binding.
+    fn local(&self, j: usize) -> String {
+        format!("t{j}")
+    }
+}
+
+/// Render through a [`Spell`]. Vectors render as WGSL's; Rust has no vector type, so a
+/// program hands the Rust renderer one lane at a time ([`program::lane`]), where a lane of a
+/// binding is `name[k]`.
+pub fn render_with(syntax: Syntax, e: &Expr, spell: &dyn Spell) -> String {
+    let r = |x: &Expr| render_with(syntax, x, spell);
     let wrap = |x: &Expr, when: bool| if when { format!("({})", r(x)) } else { r(x) };
     let sum = |x: &Expr| matches!(x, Add(..) | Sub(..));
     // A call: `f(a, …)` in WGSL, `a.f(…)` in Rust, whose receiver is bracketed unless it is a
@@ -289,45 +442,86 @@ pub fn render_in(
         match syntax {
             Syntax::Wgsl => format!("{wgsl}({})", parts.join(", ")),
             Syntax::Rust => {
-                let recv = if matches!(args[0], Var(..) | Coef(..)) || is_call(args[0]) { parts[0].clone() } else { format!("({})", parts[0]) };
+                let recv = if is_atom(args[0]) || is_call(args[0]) { parts[0].clone() } else { format!("({})", parts[0]) };
                 format!("{recv}.{rust}({})", parts[1..].join(", "))
             }
         }
     };
+    // A quotient's operand is bracketed unless it is a program's name or a call (a rational
+    // model's P/Q keeps its brackets on both sides, as the emitted rationals always had).
+    let quotient = |x: &Expr| wrap(x, !matches!(x, Let(..) | Swizzle(..)) && !is_call(x));
+    let condition = |c: &Expr| wrap(c, !matches!(c, Var(..) | Coef(..) | Lit(..)) && !is_atom(c) && !is_call(c));
     match e {
-        Lit(v) => lit(*v),
-        Var(i) => var(*i),
-        Coef(a, j) => coef(*a, *j),
+        Lit(v) => spell.lit(*v),
+        Var(i) => spell.var(*i),
+        Coef(a, j) => spell.coef(*a, *j),
         Add(a, b) => format!("{} + {}", r(a), wrap(b, sum(b))),
         Sub(a, b) => format!("{} - {}", r(a), wrap(b, sum(b))),
-        Neg(a) => format!("-({})", r(a)),
+        Neg(a) => match **a {
+            Coef(arr, j) => spell.negated_coef(arr, j).unwrap_or_else(|| format!("-({})", r(a))),
+            _ => format!("-({})", r(a)),
+        },
         Mul(a, b) => format!(
             "{} * {}",
             wrap(a, matches!(**a, Add(..) | Sub(..) | Div(..))),
             wrap(b, matches!(**b, Add(..) | Sub(..) | Mul(..) | Div(..)))
         ),
-        Div(a, b) => format!("({}) / ({})", r(a), r(b)),
+        Div(a, b) => format!("{} / {}", quotient(a), quotient(b)),
         Min(a, b) => call("min", "min", &[a, b], None),
         Max(a, b) => call("max", "max", &[a, b], None),
-        Clamp(x, lo, hi) => {
-            let inner = Max(x.clone(), lo.clone());
-            call("min", "min", &[&inner, hi], None)
-        }
+        Clamp(x, lo, hi) => match syntax {
+            Syntax::Wgsl => call("clamp", "", &[x, lo, hi], None),
+            Syntax::Rust => {
+                let inner = Max(x.clone(), lo.clone());
+                call("min", "min", &[&inner, hi], None)
+            }
+        },
         Select(c, a, b) => match syntax {
-            Syntax::Wgsl => format!("select({}, {}, {} > 0.0)", r(b), r(a), wrap(c, !matches!(**c, Var(..) | Coef(..) | Lit(..)) && !is_call(c))),
-            Syntax::Rust => format!("(if {} > 0.0 {{ {} }} else {{ {} }})", wrap(c, !matches!(**c, Var(..) | Coef(..) | Lit(..)) && !is_call(c)), r(a), r(b)),
+            Syntax::Wgsl => format!("select({}, {}, {} > 0.0)", r(b), r(a), condition(c)),
+            Syntax::Rust => format!("(if {} > 0.0 {{ {} }} else {{ {} }})", condition(c), r(a), r(b)),
+        },
+        Less(x, y, a, b) => match syntax {
+            Syntax::Wgsl => format!("select({}, {}, {} < {})", r(b), r(a), condition(x), condition(y)),
+            Syntax::Rust => format!("(if {} < {} {{ {} }} else {{ {} }})", condition(x), condition(y), r(a), r(b)),
         },
         Sqrt(a) => call("sqrt", "sqrt", &[a], None),
         Exp2(a) => call("exp2", "exp2", &[a], None),
         Log2(a) => call("log2", "log2", &[a], None),
         Abs(a) => call("abs", "abs", &[a], None),
-        Pow(a, p) => call("pow", "powf", &[a], Some(lit(*p))),
+        Pow(a, p) => call("pow", "powf", &[a], Some(spell.lit(*p))),
+        Vector(items) => {
+            let parts: Vec<String> = items.iter().map(r).collect();
+            match syntax {
+                Syntax::Wgsl => format!("vec{}<f32>({})", items.len(), parts.join(", ")),
+                Syntax::Rust => format!("[{}]", parts.join(", ")),
+            }
+        }
+        Splat(n, x) => match syntax {
+            Syntax::Wgsl => format!("vec{n}<f32>({})", r(x)),
+            Syntax::Rust => format!("[{}; {n}]", r(x)),
+        },
+        Swizzle(x, lanes) => {
+            let base = wrap(x, !is_atom(x));
+            match syntax {
+                Syntax::Wgsl => format!("{base}.{}", lanes.iter().map(|&k| ['x', 'y', 'z', 'w'][k as usize]).collect::<String>()),
+                Syntax::Rust => {
+                    let idx: Vec<String> = lanes.iter().map(|k| format!("{base}[{k}]")).collect();
+                    if idx.len() == 1 { idx[0].clone() } else { format!("[{}]", idx.join(", ")) }
+                }
+            }
+        }
+        Let(j) => spell.local(*j),
     }
 }
 
 /// Whether a node renders as a call (needs no brackets as an operand or a receiver).
 fn is_call(e: &Expr) -> bool {
-    matches!(e, Min(..) | Max(..) | Clamp(..) | Select(..) | Sqrt(..) | Exp2(..) | Log2(..) | Abs(..) | Pow(..))
+    matches!(e, Min(..) | Max(..) | Clamp(..) | Select(..) | Less(..) | Sqrt(..) | Exp2(..) | Log2(..) | Abs(..) | Pow(..) | Vector(..) | Splat(..))
+}
+
+/// Whether a node renders as a name (a variable, coefficient, binding or lane of one).
+fn is_atom(e: &Expr) -> bool {
+    matches!(e, Var(..) | Coef(..) | Let(..)) || matches!(e, Swizzle(x, _) if is_atom(x))
 }
 
 /// Sanitised f32 inputs extended with the model's derived features, as emitted code computes them.

@@ -29,7 +29,9 @@ use crate::pipeline::{self, Reference};
 use crate::spec::Spec;
 use crate::plot::{Panel, PlotError};
 use crate::validate::{Item, measure};
-use forms::{KARIS, KULLA_CONTY, LAZAROV, MATERIALX, Karis, MaterialX};
+use crate::fit::expr::Syntax;
+use crate::fit::expr::program::{Program, build::{bind, swz}};
+use forms::{KARIS, KARIS_FORM, KULLA_CONTY, LAZAROV, MATERIALX, MATERIALX_FORM, Karis, MaterialX};
 use grid::{Grid, Target};
 use std::path::{Path, PathBuf};
 
@@ -445,44 +447,33 @@ pub static FORMS: &[FormSet] = &[
     FormSet { quantity: "ggx-env[bias]", order: 22, forms: bias_forms },
 ];
 
-/// What a WGSL form of the pair returns: E = A + B, or one channel.
-fn returned(channel: Option<usize>) -> &'static str {
-    match channel {
-        None => "ab.x + ab.y",
-        Some(0) => "ab.x",
-        Some(_) => "ab.y",
-    }
+/// A pair form as the bench's WGSL function `name(n_dot_v, other)` (inputs named `args` in
+/// the form's order, constants `consts`): the form's body, then E = A + B (`channel` None) or
+/// one channel.
+fn pair_wgsl(name: &str, form: &Program, consts: &[f64], args: [&str; 2], channel: Option<usize>) -> String {
+    let mut p = form.clone();
+    let ab = p.lets.len();
+    p.lets.push(("ab".into(), p.result.clone()));
+    p.result = match channel {
+        None => swz(bind(ab), "x") + swz(bind(ab), "y"),
+        Some(0) => swz(bind(ab), "x"),
+        Some(_) => swz(bind(ab), "y"),
+    };
+    let c32: Vec<f32> = consts.iter().map(|&v| v as f32).collect();
+    let other = args.iter().find(|a| **a != "n_dot_v").expect("a second input");
+    let body = p.render(Syntax::Wgsl, &|i| args[i].to_string(), &c32, &|v| format!("{v:e}"));
+    format!("fn {name}(n_dot_v: f32, {other}: f32) -> f32 {{\n{body}}}\n")
 }
 
-/// Karis's pair as a WGSL function of (n·v, perceptual roughness), as engines call it,
-/// returning E = A + B (`channel` None) or one channel.
+/// Karis's pair as a WGSL function of (n·v, perceptual roughness), as engines call it.
 fn karis_wgsl(k: &Karis, channel: Option<usize>) -> String {
-    format!(
-        "fn karis_albedo(n_dot_v: f32, roughness: f32) -> f32 {{\n\
-         \x20   let c0 = vec4<f32>({:e}, {:e}, {:e}, {:e});\n\
-         \x20   let c1 = vec4<f32>({:e}, {:e}, {:e}, {:e});\n\
-         \x20   let r = roughness * c0 + c1;\n\
-         \x20   let a004 = min(r.x * r.x, exp2({:e} * n_dot_v)) * r.x + r.y;\n\
-         \x20   let ab = vec2<f32>({:e}, {:e}) * a004 + r.zw;\n\
-         \x20   return {};\n}}\n",
-        k.c0[0] as f32, k.c0[1] as f32, k.c0[2] as f32, k.c0[3] as f32,
-        k.c1[0] as f32, k.c1[1] as f32, k.c1[2] as f32, k.c1[3] as f32,
-        k.k as f32, -k.s as f32, k.s as f32, returned(channel)
-    )
+    pair_wgsl("karis_albedo", &KARIS_FORM, &k.params(), ["roughness", "n_dot_v"], channel)
 }
 
 /// MaterialX's pair summed (E with F0 = F90 = 1, as `mx_ggx_energy_compensation` calls it,
 /// `channel` None) or one channel of it.
 fn materialx_wgsl(m: &MaterialX, channel: Option<usize>) -> String {
-    let v = |k: usize| format!("vec4<f32>({:e}, {:e}, {:e}, {:e})", m.r[k][0] as f32, m.r[k][1] as f32, m.r[k][2] as f32, m.r[k][3] as f32);
-    format!(
-        "fn materialx_albedo(n_dot_v: f32, alpha: f32) -> f32 {{\n\
-         \x20   let x = n_dot_v;\n    let y = alpha;\n    let x2 = x * x;\n    let y2 = y * y;\n\
-         \x20   let r = {} + {} * x + {} * y + {} * x * y + {} * x2 + {} * y2 + {} * x2 * y + {} * x * y2 + {} * x2 * y2;\n\
-         \x20   let ab = clamp(r.xy / r.zw, vec2<f32>(0.0), vec2<f32>(1.0));\n\
-         \x20   return {};\n}}\n",
-        v(0), v(1), v(2), v(3), v(4), v(5), v(6), v(7), v(8), returned(channel)
-    )
+    pair_wgsl("materialx_albedo", &MATERIALX_FORM, &m.params(), ["n_dot_v", "alpha"], channel)
 }
 
 /// A closed form of E(n·v, α) measured on the reference (points [α, n·v], the quantity's order;

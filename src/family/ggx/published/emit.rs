@@ -20,7 +20,9 @@
 //! from the constants and the committed JSON's errors. The input hash covers the spec text and
 //! the committed constants, so a new refit makes `build --check` fail until rebuilt.
 
-use super::forms::{KARIS, KULLA_CONTY, Karis, KullaConty, LAZAROV, Lazarov, MATERIALX, MaterialX};
+use super::forms::{KARIS, KARIS_FORM, KULLA_CONTY, KULLA_CONTY_FORM, Karis, KullaConty, LAZAROV, LAZAROV_FORM, Lazarov, MATERIALX, MATERIALX_FORM, MaterialX};
+use crate::fit::expr::Syntax;
+use crate::fit::expr::program::Program;
 use super::grid::{self, Target};
 use super::refit::{self, Refits};
 use crate::emit::{GENERATOR, f32_literal, header_lines};
@@ -93,17 +95,12 @@ fn f32s(p: &[f64]) -> Vec<f64> {
 /// The committed refits as the emitted code carries them.
 pub fn emitted() -> Refits {
     let r = &refit::COMMITTED;
-    let mut mx = r.materialx;
-    for row in &mut mx.r {
-        *row = row.map(|v| v as f32 as f64);
-    }
-    let kc = |k: &KullaConty| KullaConty { above: k.above.map(|v| v as f32 as f64), below: k.below.map(|v| v as f32 as f64) };
     Refits {
         karis_ue4: Karis::from_params(&f32s(&r.karis_ue4.params())),
         karis_hc: Karis::from_params(&f32s(&r.karis_hc.params())),
         lazarov: Lazarov::from_params(&f32s(&r.lazarov.params())),
-        materialx: mx,
-        kulla_conty: kc(&r.kulla_conty),
+        materialx: MaterialX::from_params(&f32s(&r.materialx.params())),
+        kulla_conty: KullaConty::from_params(&f32s(&r.kulla_conty.params())),
     }
 }
 
@@ -346,85 +343,32 @@ fn doc(lang: Lang, what: &str, rows: &[&Row]) -> String {
     s
 }
 
-fn karis_body(lang: Lang, m: &str, k: &Karis) -> String {
-    let l = |v| lang.lit(v);
-    let (r, nv) = (lang.clamp(m, "roughness", 0.0, 1.0), lang.clamp(m, "n_dot_v", 0.0, 1.0));
-    match lang {
-        Lang::Wgsl => format!(
-            "    let c0 = vec4<f32>({}, {}, {}, {});\n    let c1 = vec4<f32>({}, {}, {}, {});\n    \
-             let r = {r} * c0 + c1;\n    let a004 = min(r.x * r.x, exp2({} * {nv})) * r.x + r.y;\n    \
-             return vec2<f32>({}, {}) * a004 + r.zw;\n}}\n",
-            l(k.c0[0]), l(k.c0[1]), l(k.c0[2]), l(k.c0[3]), l(k.c1[0]), l(k.c1[1]), l(k.c1[2]), l(k.c1[3]), l(k.k), l(-k.s), l(k.s)
-        ),
-        Lang::Rust => format!(
-            "    let c0 = [{}, {}, {}, {}];\n    let c1 = [{}, {}, {}, {}];\n    \
-             let (rough, nv) = ({r}, {nv});\n    let r: [f32; 4] = std::array::from_fn(|i| rough * c0[i] + c1[i]);\n    \
-             let a004 = (r[0] * r[0]).min(({} * nv).exp2()) * r[0] + r[1];\n    \
-             [{} * a004 + r[2], {} * a004 + r[3]]\n}}\n",
-            l(k.c0[0]), l(k.c0[1]), l(k.c0[2]), l(k.c0[3]), l(k.c1[0]), l(k.c1[1]), l(k.c1[2]), l(k.c1[3]), l(k.k), l(-k.s), l(k.s)
-        ),
-    }
-}
-
-fn lazarov_body(lang: Lang, m: &str, z: &Lazarov) -> String {
-    let l = |v| lang.lit(v);
-    let (g, nv) = (lang.clamp(m, "gloss", 0.0, 1.0), lang.clamp(m, "n_dot_v", 0.0, 1.0));
-    match lang {
-        Lang::Wgsl => format!(
-            "    let t = {g} * vec4<f32>({}, {}, {}, {}) + vec4<f32>(0f, 0f, {}, {});\n    \
-             let a0 = t.x * min(t.y, exp2({} * {nv})) + t.z;\n    return vec2<f32>(t.w - a0, a0);\n}}\n",
-            l(z.slope[0]), l(z.slope[1]), l(z.slope[2]), l(z.slope[3]), l(z.offset[0]), l(z.offset[1]), l(z.k)
-        ),
-        Lang::Rust => format!(
-            "    let (g, nv) = ({g}, {nv});\n    let t = [g * {}, g * {}, g * {} + {}, g * {} + {}];\n    \
-             let a0 = t[0] * t[1].min(({} * nv).exp2()) + t[2];\n    [t[3] - a0, a0]\n}}\n",
-            l(z.slope[0]), l(z.slope[1]), l(z.slope[2]), l(z.offset[0]), l(z.slope[3]), l(z.offset[1]), l(z.k)
-        ),
-    }
-}
-
-fn materialx_body(lang: Lang, m: &str, x: &MaterialX) -> String {
-    let (nv, a) = (lang.clamp(m, "n_dot_v", MATERIALX_N_DOT_V.0, MATERIALX_N_DOT_V.1), lang.clamp(m, "alpha", 0.0, 1.0));
-    let monomials = ["", " * x", " * y", " * x * y", " * x2", " * y2", " * x2 * y", " * x * y2", " * x2 * y2"];
-    match lang {
-        Lang::Wgsl => {
-            let v = |k: usize| format!("vec4<f32>({})", x.r[k].iter().map(|&c| lang.lit(c)).collect::<Vec<_>>().join(", "));
-            let sum: Vec<String> = (0..9).map(|k| format!("{}{}", v(k), monomials[k])).collect();
-            format!(
-                "    let x = {nv};\n    let y = {a};\n    let x2 = x * x;\n    let y2 = y * y;\n    \
-                 let r = {};\n    return clamp(r.xy / r.zw, vec2<f32>(0f), vec2<f32>(1f));\n}}\n",
-                sum.join("\n        + ")
-            )
+impl Lang {
+    pub(crate) fn syntax(self) -> Syntax {
+        match self {
+            Lang::Wgsl => Syntax::Wgsl,
+            Lang::Rust => Syntax::Rust,
         }
+    }
+}
+
+/// A form's body with its constants: the inputs clamped to `domain` (WGSL: the clamp call at
+/// each use, Rust: the arguments rebound once, since Rust spells a vector lane by lane).
+fn form_body(lang: Lang, module: &str, form: &Program, consts: &[f64], args: &[&str], domain: &[(f64, f64)]) -> String {
+    let c32: Vec<f32> = consts.iter().map(|&v| v as f32).collect();
+    let lit = |v: f32| lang.lit(v as f64);
+    let mut s = String::new();
+    let input: Box<dyn Fn(usize) -> String> = match lang {
+        Lang::Wgsl => Box::new(|i: usize| lang.clamp(module, args[i], domain[i].0, domain[i].1)),
         Lang::Rust => {
-            let rows: Vec<String> = (0..9).map(|k| format!("        [{}],\n", x.r[k].iter().map(|&c| lang.lit(c)).collect::<Vec<_>>().join(", "))).collect();
-            format!(
-                "    const R: [[f32; 4]; 9] = [\n{}    ];\n    let (x, y) = ({nv}, {a});\n    let (x2, y2) = (x * x, y * y);\n    \
-                 let m = [1.0, x, y, x * y, x2, y2, x2 * y, x * y2, x2 * y2];\n    \
-                 let r: [f32; 4] = std::array::from_fn(|c| (0..9).fold(0.0, |s, k| s + R[k][c] * m[k]));\n    \
-                 [(r[0] / r[2]).clamp(0.0, 1.0), (r[1] / r[3]).clamp(0.0, 1.0)]\n}}\n",
-                rows.concat()
-            )
+            for (a, d) in args.iter().zip(domain) {
+                s += &format!("    let {a} = {};\n", lang.clamp(module, a, d.0, d.1));
+            }
+            Box::new(|i: usize| args[i].to_string())
         }
-    }
-}
-
-fn kc_body(lang: Lang, m: &str, k: &KullaConty) -> String {
-    let l = |v| lang.lit(v);
-    let eta = lang.clamp(m, "eta", ETA.0, ETA.1);
-    let (a, b) = (k.above, k.below);
-    match lang {
-        Lang::Wgsl => format!(
-            "    let e = {eta};\n    let below = {} + e * ({} + e * ({} + e * {}));\n    \
-             let above = (e - 1f) / ({} + {} * e);\n    return select(above, below, e < 1f);\n}}\n",
-            l(b[0]), l(b[1]), l(b[2]), l(b[3]), l(a[0]), l(a[1])
-        ),
-        Lang::Rust => format!(
-            "    let e = {eta};\n    if e < 1.0 {{\n        {} + e * ({} + e * ({} + e * {}))\n    }} else {{\n        \
-             (e - 1.0) / ({} + {} * e)\n    }}\n}}\n",
-            l(b[0]), l(b[1]), l(b[2]), l(b[3]), l(a[0]), l(a[1])
-        ),
-    }
+    };
+    s += &form.render(lang.syntax(), &input, &c32, &lit);
+    s + "}\n"
 }
 
 fn render(header: &[String], module: &str, prefix: &str, e: &Refits, rows: &[Row], lang: Lang) -> String {
@@ -437,18 +381,19 @@ fn render(header: &[String], module: &str, prefix: &str, e: &Refits, rows: &[Row
     );
     let f = |n: &str| format!("{prefix}_{n}");
     let pair = "(scale, bias) of the split sum: specular = F0·scale + bias.";
-    let items: [(String, String, &[&str], bool, String); 5] = [
-        (f("karis"), format!("Karis's EnvBRDFApprox refitted to the height-correlated integral, roughness r (α = r²): {pair}"), &["roughness", "n_dot_v"], true, karis_body(lang, module, &e.karis_hc)),
-        (f("karis_separable"), format!("Karis's EnvBRDFApprox refitted to UE4's separable Schlick–Smith G (k = α/2): {pair}"), &["roughness", "n_dot_v"], true, karis_body(lang, module, &e.karis_ue4)),
-        (f("lazarov"), format!("Lazarov's Black Ops II form refitted (gloss g: α = sqrt(2/(8192^g + 2))): {pair}"), &["gloss", "n_dot_v"], true, lazarov_body(lang, module, &e.lazarov)),
-        (f("materialx"), format!("MaterialX's rational pair refitted (n·v clamped to its fitted [1/128, 125/128]): {pair}"), &["n_dot_v", "alpha"], true, materialx_body(lang, module, &e.materialx)),
-        (f("fresnel_avg_dielectric"), "Kulla–Conty's dielectric Fresnel average F_avg(η) refitted (η clamped to [1/3, 3]).".to_string(), &["eta"], false, kc_body(lang, module, &e.kulla_conty)),
+    let unit = (0.0, 1.0);
+    let items: [(String, String, &[&str], &Program, Vec<f64>, Vec<(f64, f64)>); 5] = [
+        (f("karis"), format!("Karis's EnvBRDFApprox refitted to the height-correlated integral, roughness r (α = r²): {pair}"), &["roughness", "n_dot_v"], &KARIS_FORM, e.karis_hc.params(), vec![unit, unit]),
+        (f("karis_separable"), format!("Karis's EnvBRDFApprox refitted to UE4's separable Schlick–Smith G (k = α/2): {pair}"), &["roughness", "n_dot_v"], &KARIS_FORM, e.karis_ue4.params(), vec![unit, unit]),
+        (f("lazarov"), format!("Lazarov's Black Ops II form refitted (gloss g: α = sqrt(2/(8192^g + 2))): {pair}"), &["gloss", "n_dot_v"], &LAZAROV_FORM, e.lazarov.params(), vec![unit, unit]),
+        (f("materialx"), format!("MaterialX's rational pair refitted (n·v clamped to its fitted [1/128, 125/128]): {pair}"), &["n_dot_v", "alpha"], &MATERIALX_FORM, e.materialx.params(), vec![MATERIALX_N_DOT_V, unit]),
+        (f("fresnel_avg_dielectric"), "Kulla–Conty's dielectric Fresnel average F_avg(η) refitted (η clamped to [1/3, 3]).".to_string(), &["eta"], &KULLA_CONTY_FORM, e.kulla_conty.params(), vec![ETA]),
     ];
-    for (name, what, args, vec2, body) in items {
+    for (name, what, args, form, consts, domain) in items {
         s += "\n";
         s += &doc(lang, &what, &by(&name));
-        s += &lang.signature(&name, args, vec2);
-        s += &body;
+        s += &lang.signature(&name, args, form.width() == 2);
+        s += &form_body(lang, module, form, &consts, args, &domain);
     }
     s
 }
@@ -530,6 +475,28 @@ mod tests {
             let eta = 1.0 / 3.0 + (3.0 - 1.0 / 3.0) * i as f64 / 64.0;
             // A rational of degree 1 or a cubic on values ≤ 3: a few ulps of 1.
             assert!((g::ggx_refit_fresnel_avg_dielectric(eta as f32) as f64 - e.kulla_conty.eval(eta as f32 as f64)).abs() < 1e-6);
+        }
+    }
+
+    /// The emitted Rust of every refit computes its form's f32 evaluation (`Program::eval_f32`
+    /// of the clamped inputs with the emitted f32 constants) bit for bit, on the grid and at
+    /// the special values: the renderer keeps the form's operations and their order.
+    #[test]
+    fn emitted_rust_is_the_forms_f32_evaluation_bit_for_bit() {
+        let e = emitted();
+        let c32 = |p: Vec<f64>| p.iter().map(|&v| v as f32).collect::<Vec<f32>>();
+        let clamp = |v: f32, (lo, hi): (f64, f64)| crate::fit::expr::sanitize(v, lo as f32, hi as f32);
+        let unit = (0.0, 1.0);
+        let all = grid().into_iter().chain(SPECIAL.iter().flat_map(|&s| [(s, 0.5), (0.5, s), (s, s)]));
+        for (u, v) in all {
+            let bits = |p: [f32; 2]| p.map(f32::to_bits).to_vec();
+            let form = |f: &Program, c: Vec<f64>, d: [(f64, f64); 2]| f.eval_f32(&[clamp(u, d[0]), clamp(v, d[1])], &c32(c)).iter().map(|x| x.to_bits()).collect::<Vec<u32>>();
+            assert_eq!(bits(g::ggx_refit_karis(u, v)), form(&KARIS_FORM, e.karis_hc.params(), [unit, unit]), "karis ({u}, {v})");
+            assert_eq!(bits(g::ggx_refit_karis_separable(u, v)), form(&KARIS_FORM, e.karis_ue4.params(), [unit, unit]), "karis separable ({u}, {v})");
+            assert_eq!(bits(g::ggx_refit_lazarov(u, v)), form(&LAZAROV_FORM, e.lazarov.params(), [unit, unit]), "lazarov ({u}, {v})");
+            assert_eq!(bits(g::ggx_refit_materialx(u, v)), form(&MATERIALX_FORM, e.materialx.params(), [MATERIALX_N_DOT_V, unit]), "materialx ({u}, {v})");
+            let kc = KULLA_CONTY_FORM.eval_f32(&[clamp(u, ETA)], &c32(e.kulla_conty.params()));
+            assert_eq!(g::ggx_refit_fresnel_avg_dielectric(u).to_bits(), kc[0].to_bits(), "kulla-conty {u}");
         }
     }
 

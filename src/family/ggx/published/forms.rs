@@ -2,8 +2,20 @@
 //!
 //! All return the split-sum pair [scale, bias] = [A, B] of `super::super::integrals` (the
 //! environment BRDF of a Schlick F0 is F0·A + B), except the Fresnel average.
+//!
+//! Each form is written once, as a [`Program`] over its inputs and its constants (`params()`
+//! order): its f64 evaluation here, the refits (`super::refit`), the emitted refits
+//! (`super::emit`) and the bench's shader forms all derive from it.
 
+use crate::fit::expr::program::{Program, build::*};
 use std::array::from_fn;
+use std::sync::LazyLock;
+
+/// [A, B] of a pair form at `inputs`.
+fn pair(p: &Program, inputs: [f64; 2], consts: &[f64]) -> [f64; 2] {
+    let v = p.eval(&inputs, consts);
+    [v.v[0], v.v[1]]
+}
 
 /// Karis 2014, "Physically Based Shading on Mobile" (Unreal Engine blog), `EnvBRDFApprox`
 /// (as in UE's `BRDF.ush`; bevy's `F_AB` up to v0.18.1 is the same text):
@@ -26,12 +38,24 @@ pub struct Karis {
 
 pub const KARIS: Karis = Karis { c0: [-1.0, -0.0275, -0.572, 0.022], c1: [1.0, 0.0425, 1.04, -0.04], k: -9.28, s: 1.04 };
 
+/// Karis's form over (roughness, n·v) with constants c0, c1, k, s ([`Karis::params`]).
+pub static KARIS_FORM: LazyLock<Program> = LazyLock::new(|| {
+    let r = || bind(2);
+    Program {
+        lets: vec![
+            ("c0".into(), constants(0, 4)),
+            ("c1".into(), constants(4, 4)),
+            ("r".into(), var(0) * bind(0) + bind(1)),
+            ("a004".into(), min(swz(r(), "x") * swz(r(), "x"), exp2(k(8) * var(1))) * swz(r(), "x") + swz(r(), "y")),
+        ],
+        result: vector(vec![-k(9), k(9)]) * bind(3) + swz(r(), "zw"),
+    }
+});
+
 impl Karis {
     /// [A, B] at perceptual roughness `r` and n·v.
     pub fn eval(&self, r: f64, n_dot_v: f64) -> [f64; 2] {
-        let v: [f64; 4] = from_fn(|i| r * self.c0[i] + self.c1[i]);
-        let a004 = (v[0] * v[0]).min((self.k * n_dot_v).exp2()) * v[0] + v[1];
-        [-self.s * a004 + v[2], self.s * a004 + v[3]]
+        pair(&KARIS_FORM, [r, n_dot_v], &self.params())
     }
 
     pub fn params(&self) -> Vec<f64> {
@@ -73,12 +97,22 @@ pub const LAZAROV: Lazarov = Lazarov {
     k: -9.28,
 };
 
+/// Lazarov's form over (gloss, n·v) with constants slope, offset, k ([`Lazarov::params`]).
+pub static LAZAROV_FORM: LazyLock<Program> = LazyLock::new(|| {
+    let t = |lanes| swz(bind(0), lanes);
+    Program {
+        lets: vec![
+            ("t".into(), var(0) * constants(0, 4) + vector(vec![lit(0.0), lit(0.0), k(4), k(5)])),
+            ("a0".into(), t("x") * min(t("y"), exp2(k(6) * var(1))) + t("z")),
+        ],
+        result: vector(vec![t("w") - bind(1), bind(1)]),
+    }
+});
+
 impl Lazarov {
     /// [A, B] at gloss g and n·v.
     pub fn eval(&self, g: f64, n_dot_v: f64) -> [f64; 2] {
-        let t = [self.slope[0] * g, self.slope[1] * g, self.slope[2] * g + self.offset[0], self.slope[3] * g + self.offset[1]];
-        let a0 = t[0] * t[1].min((self.k * n_dot_v).exp2()) + t[2];
-        [t[3] - a0, a0]
+        pair(&LAZAROV_FORM, [g, n_dot_v], &self.params())
     }
 
     pub fn params(&self) -> Vec<f64> {
@@ -135,12 +169,39 @@ pub fn materialx_monomials(x: f64, y: f64) -> [f64; 9] {
     [1.0, x, y, x * y, x2, y2, x2 * y, x * y2, x2 * y2]
 }
 
+/// MaterialX's form over (n·v, α) with constants the rows of R ([`MaterialX::params`]):
+/// the monomials of [`materialx_monomials`], each row's vector times its monomial, summed in
+/// the source's order.
+pub static MATERIALX_FORM: LazyLock<Program> = LazyLock::new(|| {
+    let (x, y, x2, y2) = (|| bind(0), || bind(1), || bind(2), || bind(3));
+    let row = |i: usize| constants(4 * i, 4);
+    // vec4 · x · y as the source writes it: (row · x) · y.
+    let r = row(0) + row(1) * x() + row(2) * y() + row(3) * x() * y() + row(4) * x2() + row(5) * y2() + row(6) * x2() * y() + row(7) * x() * y2() + row(8) * x2() * y2();
+    Program {
+        lets: vec![
+            ("x".into(), var(0)),
+            ("y".into(), var(1)),
+            ("x2".into(), bind(0) * bind(0)),
+            ("y2".into(), bind(1) * bind(1)),
+            ("r".into(), r),
+        ],
+        result: clamp(swz(bind(4), "xy") / swz(bind(4), "zw"), splat(2, lit(0.0)), splat(2, lit(1.0))),
+    }
+});
+
 impl MaterialX {
     /// [A, B] at n·v and α.
     pub fn eval(&self, n_dot_v: f64, alpha: f64) -> [f64; 2] {
-        let m = materialx_monomials(n_dot_v, alpha);
-        let r: [f64; 4] = from_fn(|c| (0..9).map(|k| self.r[k][c] * m[k]).sum());
-        [(r[0] / r[2]).clamp(0.0, 1.0), (r[1] / r[3]).clamp(0.0, 1.0)]
+        pair(&MATERIALX_FORM, [n_dot_v, alpha], &self.params())
+    }
+
+    /// The rows of R, one after another.
+    pub fn params(&self) -> Vec<f64> {
+        self.r.iter().flatten().copied().collect()
+    }
+
+    pub fn from_params(p: &[f64]) -> MaterialX {
+        MaterialX { r: from_fn(|i| from_fn(|c| p[4 * i + c])) }
     }
 }
 
@@ -161,13 +222,30 @@ pub struct KullaConty {
 
 pub const KULLA_CONTY: KullaConty = KullaConty { above: [4.08567, 1.00071], below: [0.997118, 0.1014, -0.965241, -0.130607] };
 
+/// Kulla–Conty's two branches over η with constants above, below ([`KullaConty::params`]).
+pub static KULLA_CONTY_FORM: LazyLock<Program> = LazyLock::new(|| {
+    let e = || bind(0);
+    Program {
+        lets: vec![
+            ("e".into(), var(0)),
+            ("below".into(), k(2) + e() * (k(3) + e() * (k(4) + e() * k(5)))),
+            ("above".into(), (e() - lit(1.0)) / (k(0) + k(1) * e())),
+        ],
+        result: less(e(), lit(1.0), bind(1), bind(2)),
+    }
+});
+
 impl KullaConty {
     pub fn eval(&self, eta: f64) -> f64 {
-        if eta < 1.0 {
-            let b = self.below;
-            b[0] + eta * (b[1] + eta * (b[2] + eta * b[3]))
-        } else {
-            (eta - 1.0) / (self.above[0] + self.above[1] * eta)
-        }
+        KULLA_CONTY_FORM.eval(&[eta], &self.params()).v[0]
+    }
+
+    /// above, then below.
+    pub fn params(&self) -> Vec<f64> {
+        self.above.iter().chain(&self.below).copied().collect()
+    }
+
+    pub fn from_params(p: &[f64]) -> KullaConty {
+        KullaConty { above: [p[0], p[1]], below: [p[2], p[3], p[4], p[5]] }
     }
 }
