@@ -17,6 +17,8 @@ use crate::pipeline::module::{module_built, module_json};
 use crate::emit::header_lines;
 use crate::family::SpecKind;
 use crate::pipeline::{BuildError, Built, Mode, committed_json_with_hash, fmt_err, input_hash, spec_rel_path};
+use crate::fit::expr::Expr;
+use crate::fit::expr::program::{Program, build::*};
 use crate::spec::{KindDef, Spec, SpecError, SpecFile};
 use serde_json::json;
 use std::path::Path;
@@ -41,17 +43,26 @@ pub fn spec_file(path: &Path, text: &str) -> Result<Option<SpecFile>, SpecError>
     module_spec_file(path, text, KIND, axes)
 }
 
-/// One helper: name suffix, arguments, its doc, the WGSL and Rust expressions of the clamped
-/// arguments `x0, x1, …`, the same expression in f32 here (what the emitted code computes, for
-/// the recorded error), and the f64 formula it is measured against.
+/// One helper: name suffix, arguments, its doc, its shader form over the clamped arguments
+/// (bound to `x0, x1, …`; the WGSL, the Rust and the f32 evaluation of the recorded error all
+/// derive from it), and the f64 formula it is measured against.
 struct Helper {
     suffix: &'static str,
     args: &'static [&'static str],
     doc: &'static str,
-    wgsl: &'static str,
-    rust: &'static str,
-    f32: fn(&[f32]) -> f32,
+    result: fn() -> Expr,
     exact: fn(&[f64]) -> f64,
+}
+
+impl Helper {
+    fn form(&self) -> Program {
+        Program { lets: (0..self.args.len()).map(|i| (format!("x{i}"), var(i))).collect(), result: (self.result)() }
+    }
+}
+
+/// (1 − x)⁴ or x⁴ as the helpers write it: four factors multiplied left to right.
+fn fourth(x: impl Fn() -> Expr) -> Expr {
+    x() * x() * x() * x()
 }
 
 const HELPERS: [Helper; 4] = [
@@ -59,36 +70,28 @@ const HELPERS: [Helper; 4] = [
         suffix: "interreflected_visibility",
         args: &["visibility", "albedo"],
         doc: "Visibility after interreflections inside the cavity, A′ = A / (1 − ρ + ρA) (COD: WWII).",
-        wgsl: "x0 / max(1f - x1 + x1 * x0, 1e-30f)",
-        rust: "x0 / (1.0 - x1 + x1 * x0).max(1e-30)",
-        f32: |x| x[0] / (1.0 - x[1] + x[1] * x[0]).max(1e-30),
+        result: || bind(0) / max(lit(1.0) - bind(1) + bind(1) * bind(0), lit(1e-30)),
         exact: |p| if p[0] == 0.0 { 0.0 } else { super::interreflected(p[0], p[1]) },
     },
     Helper {
         suffix: "cone_of_visibility",
         args: &["visibility"],
         doc: "Cosine of the visibility cone's half-angle, cos θc = sqrt(1 − V) (the Nusselt analog).",
-        wgsl: "sqrt(1f - x0)",
-        rust: "(1.0 - x0).sqrt()",
-        f32: |x| (1.0 - x[0]).sqrt(),
+        result: || sqrt(lit(1.0) - bind(0)),
         exact: |p| super::cone_of_visibility(p[0]),
     },
     Helper {
         suffix: "adjusted_cone_printed",
         args: &["cos_cone", "gloss", "n_dot_v"],
         doc: "The talk's adjusted cone as printed: cos θ (1 − g²)(1 − (1 − (n·v)⁴)) = cos θ (1 − g²)(n·v)⁴.",
-        wgsl: "x0 * (1f - x1 * x1) * (1f - (1f - x2 * x2 * x2 * x2))",
-        rust: "x0 * (1.0 - x1 * x1) * (1.0 - (1.0 - x2 * x2 * x2 * x2))",
-        f32: |x| x[0] * (1.0 - x[1] * x[1]) * (1.0 - (1.0 - x[2] * x[2] * x[2] * x[2])),
+        result: || bind(0) * (lit(1.0) - bind(1) * bind(1)) * (lit(1.0) - (lit(1.0) - fourth(|| bind(2)))),
         exact: |p| super::cod_adjust_printed(p[0], p[1], p[2]),
     },
     Helper {
         suffix: "adjusted_cone_corrected",
         args: &["cos_cone", "gloss", "n_dot_v"],
         doc: "The adjusted cone in the reading that opens it at grazing views: cos θ (1 − g²)(1 − (1 − n·v)⁴).",
-        wgsl: "x0 * (1f - x1 * x1) * (1f - (1f - x2) * (1f - x2) * (1f - x2) * (1f - x2))",
-        rust: "x0 * (1.0 - x1 * x1) * (1.0 - (1.0 - x2) * (1.0 - x2) * (1.0 - x2) * (1.0 - x2))",
-        f32: |x| x[0] * (1.0 - x[1] * x[1]) * (1.0 - (1.0 - x[2]) * (1.0 - x[2]) * (1.0 - x[2]) * (1.0 - x[2])),
+        result: || bind(0) * (lit(1.0) - bind(1) * bind(1)) * (lit(1.0) - fourth(|| lit(1.0) - bind(2))),
         exact: |p| super::cod_adjust_corrected(p[0], p[1], p[2]),
     },
 ];
@@ -100,7 +103,7 @@ fn measure() -> (Vec<f64>, usize) {
     let errs = HELPERS
         .iter()
         .map(|h| {
-            let n = h.args.len();
+            let (n, form) = (h.args.len(), h.form());
             let total = axis.len().pow(n as u32);
             points += total;
             (0..total)
@@ -113,7 +116,7 @@ fn measure() -> (Vec<f64>, usize) {
                     // The grid is inside [0, 1], so the emitted clamps leave it as it is.
                     let p32: Vec<f32> = p.iter().map(|&v| v as f32).collect();
                     let q: Vec<f64> = p32.iter().map(|&v| v as f64).collect();
-                    ((h.f32)(&p32) as f64 - (h.exact)(&q)).abs()
+                    (form.eval_f32(&p32, &[])[0] as f64 - (h.exact)(&q)).abs()
                 })
                 .fold(0.0f64, f64::max)
         })
@@ -157,13 +160,8 @@ fn build(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> {
             let c = lang.comment();
             s += &format!("\n{c} {}\n{c} f32 code against the formula: max abs {}.\n", h.doc, fmt_err(*e));
             s += &lang.signature(&format!("{prefix}_{}", h.suffix), h.args, false);
-            for (i, a) in h.args.iter().enumerate() {
-                s += &format!("    let x{i} = {};\n", lang.clamp(&name, a, 0.0, 1.0));
-            }
-            s += &match lang {
-                Lang::Wgsl => format!("    return {};\n}}\n", h.wgsl),
-                Lang::Rust => format!("    {}\n}}\n", h.rust),
-            };
+            s += &h.form().render(lang.syntax(), &|i| lang.clamp(&name, h.args[i], 0.0, 1.0), &[], &|_| unreachable!("no constants"));
+            s += "}\n";
         }
         s
     };
