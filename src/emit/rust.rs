@@ -185,6 +185,18 @@ mod tests {
         }
     }
 
+    /// `main` compiled by rustc and run: the u32 it prints, one a line.
+    fn compiled_bits(main: &str) -> Vec<u32> {
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path();
+        std::fs::write(dir.join("main.rs"), main).unwrap();
+        let rustc = std::env::var("RUSTC").unwrap_or_else(|_| "rustc".into());
+        let out = std::process::Command::new(rustc).args(["--edition", "2021", "-A", "warnings", "-o"]).arg(dir.join("main")).arg(dir.join("main.rs")).output().unwrap();
+        assert!(out.status.success(), "rustc: {}\n{main}", String::from_utf8_lossy(&out.stderr));
+        let run = std::process::Command::new(dir.join("main")).output().unwrap();
+        String::from_utf8(run.stdout).unwrap().lines().map(|l| l.parse().unwrap()).collect()
+    }
+
     /// The published forms' nodes rendered as Rust, compiled by rustc and run, compute the
     /// f32 evaluator's bits (the same f32 operations; Rust never contracts to FMA).
     #[test]
@@ -198,14 +210,7 @@ mod tests {
             main.push_str(&format!("    println!(\"{{}}\", f(f32::from_bits({:#x}), f32::from_bits({:#x})).to_bits());\n", x0.to_bits(), x1.to_bits()));
         }
         main.push_str("}\n");
-        let tmp = tempfile::tempdir().unwrap();
-        let dir = tmp.path();
-        std::fs::write(dir.join("main.rs"), &main).unwrap();
-        let rustc = std::env::var("RUSTC").unwrap_or_else(|_| "rustc".into());
-        let out = std::process::Command::new(rustc).args(["--edition", "2021", "-A", "warnings", "-o"]).arg(dir.join("main")).arg(dir.join("main.rs")).output().unwrap();
-        assert!(out.status.success(), "rustc: {}\n{main}", String::from_utf8_lossy(&out.stderr));
-        let run = std::process::Command::new(dir.join("main")).output().unwrap();
-        let got: Vec<u32> = String::from_utf8(run.stdout).unwrap().lines().map(|l| l.parse().unwrap()).collect();
+        let got = compiled_bits(&main);
         for ((x0, x1), g) in points.iter().zip(&got) {
             let want = crate::fit::expr::eval_f32(&e, &[*x0, *x1], &[], &[]);
             assert_eq!(*g, want.to_bits(), "({x0}, {x1}): compiled {} vs evaluator {want} from '{text}'", f32::from_bits(*g));
@@ -226,14 +231,7 @@ mod tests {
             main.push_str(&format!("    for v in f(f32::from_bits({:#x}), f32::from_bits({:#x})) {{ println!(\"{{}}\", v.to_bits()); }}\n", x0.to_bits(), x1.to_bits()));
         }
         main.push_str("}\n");
-        let tmp = tempfile::tempdir().unwrap();
-        let dir = tmp.path();
-        std::fs::write(dir.join("main.rs"), &main).unwrap();
-        let rustc = std::env::var("RUSTC").unwrap_or_else(|_| "rustc".into());
-        let out = std::process::Command::new(rustc).args(["--edition", "2021", "-A", "warnings", "-o"]).arg(dir.join("main")).arg(dir.join("main.rs")).output().unwrap();
-        assert!(out.status.success(), "rustc: {}\n{main}", String::from_utf8_lossy(&out.stderr));
-        let run = std::process::Command::new(dir.join("main")).output().unwrap();
-        let got: Vec<u32> = String::from_utf8(run.stdout).unwrap().lines().map(|l| l.parse().unwrap()).collect();
+        let got = compiled_bits(&main);
         let want: Vec<u32> = EVERY_POINTS.iter().flat_map(|&(x0, x1)| p.eval_f32(&[x0, x1], &EVERY_CONSTS)).map(f32::to_bits).collect();
         assert_eq!(got, want, "{main}");
     }

@@ -277,56 +277,51 @@ pub trait Value<T: Float>: Copy + std::ops::Add<Output = Self> + std::ops::Sub<O
     fn swizzle(self, lanes: &[u8]) -> Self;
 }
 
-macro_rules! scalar_value {
-    ($t:ty) => {
-        impl Value<$t> for $t {
-            fn of(x: $t) -> $t {
-                x
-            }
-            fn min(self, other: $t) -> $t {
-                Float::min(self, other)
-            }
-            fn max(self, other: $t) -> $t {
-                Float::max(self, other)
-            }
-            fn sqrt(self) -> $t {
-                Float::sqrt(self)
-            }
-            fn exp2(self) -> $t {
-                Float::exp2(self)
-            }
-            fn log2(self) -> $t {
-                Float::log2(self)
-            }
-            fn abs(self) -> $t {
-                Float::abs(self)
-            }
-            fn powf(self, p: f32) -> $t {
-                Float::powf(self, p)
-            }
-            fn select_positive(c: $t, a: $t, b: $t) -> $t {
-                if c > 0.0 { a } else { b }
-            }
-            fn select_less(x: $t, y: $t, a: $t, b: $t) -> $t {
-                if x < y { a } else { b }
-            }
-            fn vector(_: &[$t]) -> $t {
-                unreachable!("a vector node outside a program")
-            }
-            fn splat(_: u8, _: $t) -> $t {
-                unreachable!("a vector node outside a program")
-            }
-            fn swizzle(self, _: &[u8]) -> $t {
-                unreachable!("a vector node outside a program")
-            }
-        }
-    };
+/// A scalar tree's value: the float itself.
+impl<T: Float> Value<T> for T {
+    fn of(x: T) -> T {
+        x
+    }
+    fn min(self, other: T) -> T {
+        Float::min(self, other)
+    }
+    fn max(self, other: T) -> T {
+        Float::max(self, other)
+    }
+    fn sqrt(self) -> T {
+        Float::sqrt(self)
+    }
+    fn exp2(self) -> T {
+        Float::exp2(self)
+    }
+    fn log2(self) -> T {
+        Float::log2(self)
+    }
+    fn abs(self) -> T {
+        Float::abs(self)
+    }
+    fn powf(self, p: f32) -> T {
+        Float::powf(self, p)
+    }
+    fn select_positive(c: T, a: T, b: T) -> T {
+        if c > T::ZERO { a } else { b }
+    }
+    fn select_less(x: T, y: T, a: T, b: T) -> T {
+        if x < y { a } else { b }
+    }
+    fn vector(_: &[T]) -> T {
+        unreachable!("a vector node outside a program")
+    }
+    fn splat(_: u8, _: T) -> T {
+        unreachable!("a vector node outside a program")
+    }
+    fn swizzle(self, _: &[u8]) -> T {
+        unreachable!("a vector node outside a program")
+    }
 }
-scalar_value!(f32);
-scalar_value!(f64);
 
 /// Evaluate in `T` with the emitted operation order (coefficients and variables in `T`).
-pub fn eval<T: Float + Value<T>>(e: &Expr, vars: &[T], num: &[T], den: &[T]) -> T {
+pub fn eval<T: Float>(e: &Expr, vars: &[T], num: &[T], den: &[T]) -> T {
     eval_as(e, vars, num, den, &[])
 }
 
