@@ -445,8 +445,20 @@ fn load_model(arg: &str, x_cols: &[String]) -> Result<RationalModel> {
     ms.build(path, &text, features, &|_| None).map_err(input_err)
 }
 
-pub fn validate(paths: &Paths, as_json: bool) -> Result<()> {
-    let validators: Vec<fn(&Path) -> Vec<crate::validate::Item>> = family::families().iter().map(|f| f.validate).collect();
+/// The families named by `--family` (all when none), in registry order; an unknown name is an
+/// input error listing the known ones.
+fn selected_families(names: &[String]) -> Result<Vec<&'static family::Family>> {
+    let all = family::families();
+    if let Some(bad) = names.iter().find(|n| !all.iter().any(|f| f.name == n.as_str())) {
+        let known: Vec<&str> = all.iter().map(|f| f.name).collect();
+        return Err(input_err(format!("--family: unknown family '{bad}' (known: {})", known.join(", "))));
+    }
+    Ok(all.iter().filter(|f| names.is_empty() || names.iter().any(|n| n == f.name)).copied().collect())
+}
+
+/// `shadefit validate [--family A,B] [--json]`: the families' published constants measured.
+pub fn validate(paths: &Paths, families: &[String], as_json: bool) -> Result<()> {
+    let validators: Vec<fn(&Path) -> Vec<crate::validate::Item>> = selected_families(families)?.iter().map(|f| f.validate).collect();
     let items = crate::validate::all(&paths.generated, &validators);
     if as_json {
         println!("{}", serde_json::to_string_pretty(&json!({ "items": items }))?);
@@ -541,12 +553,7 @@ pub fn bench(paths: &Paths, a: &BenchArgs) -> Result<()> {
         generated: &paths.generated,
         python: python.as_ref(),
     };
-    let all = crate::family::families();
-    if let Some(bad) = a.family.iter().find(|n| !all.iter().any(|f| f.name == n.as_str())) {
-        let known: Vec<&str> = all.iter().map(|f| f.name).collect();
-        return Err(input_err(format!("--family: unknown family '{bad}' (known: {})", known.join(", "))));
-    }
-    let families = all.iter().filter(|f| a.family.is_empty() || a.family.iter().any(|n| n == f.name)).map(|f| &f.bench).collect::<Vec<_>>();
+    let families = selected_families(&a.family)?.into_iter().map(|f| &f.bench).collect::<Vec<_>>();
     let report = bench::run(Mode::new(a.quick), sections, &inputs, &families)?;
     if a.json {
         println!("{}", serde_json::to_string_pretty(&report)?);

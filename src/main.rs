@@ -139,6 +139,10 @@ enum Command {
     Validate {
         #[arg(long)]
         json: bool,
+        /// Families whose published constants to measure, comma-separated (default: all; see
+        /// `shadefit families`).
+        #[arg(long, value_delimiter = ',')]
+        family: Vec<String>,
     },
     /// Run time against error: integrators, fit solvers, tables against numpy/scipy, shader forms.
     Bench {
@@ -194,7 +198,7 @@ fn main() -> ExitCode {
         }
         Command::Samples { name, json } => cli::samples(&paths, &name, json),
         Command::Plot { out } => cli::plot(&paths, &out),
-        Command::Validate { json } => cli::validate(&paths, json),
+        Command::Validate { json, family } => cli::validate(&paths, &family, json),
         Command::Bench { quick, json, only, family, python, no_python } => {
             cli::bench(&paths, &cli::BenchArgs { quick, json, only, family, python, no_python })
         }

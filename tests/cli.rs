@@ -468,3 +468,22 @@ fn a_model_the_spec_forces_into_a_pole_is_bad_input() {
     assert!(stderr(&o).contains("gloss_length"), "{}", stderr(&o));
     assert_nothing_written(d.path());
 }
+
+/// `validate --family` runs the named families' validators only, in registry order whatever
+/// the order named (fiber before sggx), and an unknown family exits 2 naming the known ones.
+#[test]
+fn validate_runs_the_named_families_only() {
+    let items = |fams: &str| -> Vec<String> {
+        let out = shadefit(&["validate", "--json", "--family", fams], None);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        v["items"].as_array().unwrap().iter().map(|i| i["name"].as_str().unwrap().to_string()).collect()
+    };
+    let (fiber, sggx) = (items("fiber"), items("sggx"));
+    assert!(!fiber.is_empty() && !sggx.is_empty());
+    assert_eq!(items("sggx,fiber"), [fiber, sggx].concat());
+    let out = shadefit(&["validate", "--family", "fibre"], None);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("unknown family 'fibre'") && err.contains("fiber"), "{err}");
+}
