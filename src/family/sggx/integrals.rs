@@ -183,22 +183,10 @@ pub fn extract(s: &M3) -> Extracted {
     }
 }
 
-/// A deterministic stream in [0, 1) (xorshift64*), for seeded random cases.
-#[derive(Debug, Clone)]
-pub struct Rng(pub u64);
-
-impl Rng {
-    pub fn next(&mut self) -> f64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        (self.0.wrapping_mul(0x2545F4914F6CDD1D) >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::integrate::rng::SplitMix64;
     use std::f64::consts::PI;
 
     #[test]
@@ -232,9 +220,9 @@ mod tests {
     fn filtering_keeps_spd_and_a_texel_filtered_with_itself_is_unchanged() {
         // Self-filter: S′ = S, so n′ is n to the power iteration's residual (1e-14 / (1 − λ₂/λ₁),
         // λ₂ ≤ 0.8² here: ≤ 3e-14) and the block to a few roundings of M_nᵀ S M_n: 1e-12.
-        let mut rng = Rng(11);
+        let mut rng = SplitMix64(11);
         for _ in 0..500 {
-            let (n, a) = texel(1.5 * rng.next(), 6.3 * rng.next(), 0.02 + 0.78 * rng.next(), 0.02 + 0.78 * rng.next(), 6.3 * rng.next());
+            let (n, a) = texel(1.5 * rng.next_f64(), 6.3 * rng.next_f64(), 0.02 + 0.78 * rng.next_f64(), 0.02 + 0.78 * rng.next_f64(), 6.3 * rng.next_f64());
             let s = sggx_from(n, a);
             let f = filter(&[(0.25, s), (0.75, s)]);
             assert!(is_spd(&f));
@@ -250,7 +238,7 @@ mod tests {
         for _ in 0..500 {
             let texels: Vec<(f64, M3)> = (0..4)
                 .map(|_| {
-                    let (n, a) = texel(1.2 * rng.next(), 6.3 * rng.next(), 0.02 + 0.9 * rng.next(), 0.02 + 0.9 * rng.next(), 6.3 * rng.next());
+                    let (n, a) = texel(1.2 * rng.next_f64(), 6.3 * rng.next_f64(), 0.02 + 0.9 * rng.next_f64(), 0.02 + 0.9 * rng.next_f64(), 6.3 * rng.next_f64());
                     (1.0, sggx_from(n, a))
                 })
                 .collect();
@@ -362,25 +350,5 @@ mod tests {
         assert!((e.n - V3::z()).norm() < 1e-12 && (e.power.lambda - 0.7725).abs() < 1e-12, "{:?}", e.power);
         let want = Aniso { sxx: 0.3175 / 0.7725, sxy: 0.0, syy: 0.09 / 0.7725 };
         assert!(e.aniso.max_diff(&want) < 1e-12, "{:?} vs {want:?}", e.aniso);
-    }
-
-    /// `Rng` is xorshift64* (Vigna 2016: x ^= x >> 12, x ^= x << 25, x ^= x >> 27, output the
-    /// top 53 bits of x·0x2545F4914F6CDD1D). From x = 1: 1 >> 12 = 0, then 1 ^ 2²⁵, and
-    /// (2²⁵ + 1) >> 27 = 0, so x₁ = 2²⁵ + 1; then x ^= x >> 12 adds 2¹³, x ^= x << 25 adds 2⁵⁰ +
-    /// 2³⁸ and cancels 2²⁵, x ^= x >> 27 adds 2²³ + 2¹¹: x₂ = 2⁵⁰ + 2³⁸ + 2²³ + 2¹³ + 2¹¹ + 1.
-    /// The next two states and the outputs are Python's integer arithmetic of the same steps.
-    #[test]
-    fn rng_is_xorshift64_star() {
-        let mut rng = Rng(1);
-        let outputs: Vec<f64> = (0..4).map(|_| rng.next()).collect();
-        let mut states = Vec::new();
-        let mut rng = Rng(1);
-        for _ in 0..4 {
-            rng.next();
-            states.push(rng.0);
-        }
-        assert_eq!(states, [(1u64 << 25) + 1, (1u64 << 50) + (1 << 38) + (1 << 23) + (1 << 13) + (1 << 11) + 1, 0xd004003202803, 0x200340a005480e81]);
-        let want = [2529537253518747u64, 6045066965290796, 6537840858852963, 2733948884444000].map(|k| k as f64 / (1u64 << 53) as f64);
-        assert_eq!(outputs, want);
     }
 }

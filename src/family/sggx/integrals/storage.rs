@@ -67,8 +67,9 @@ pub fn decode_course(t: [f64; 3], alpha_min: f64) -> Decoded {
 
 #[cfg(test)]
 mod tests {
-    use super::super::{ALPHA_MIN, Rng};
+    use super::super::ALPHA_MIN;
     use super::*;
+    use crate::integrate::rng::SplitMix64;
 
     #[test]
     fn encode_of_a_singular_block_has_middle_channel_one_half() {
@@ -85,13 +86,13 @@ mod tests {
         // Unquantised: decode ∘ encode is the identity to f64 rounding of a product of three
         // values ≤ 1 (1e-15). Quantised to b bits, each channel moves ≤ 2^-(b+1); Sxx = x² moves
         // ≤ 2x·δ + δ² ≤ 2^-b + 2^-2(b+1), and Sxy = x(2y−1)z by ≤ (1 + 2 + 1)δ(1 + δ)².
-        let mut rng = Rng(3);
+        let mut rng = SplitMix64(3);
         for bits in [8u32, 16] {
             let delta = 0.5 / ((1u64 << bits) - 1) as f64;
             let bound = 4.0 * delta * (1.0 + delta).powi(2);
             let mut worst: f64 = 0.0;
             for _ in 0..10_000 {
-                let a = Aniso::from_alphas(rng.next(), rng.next(), 6.3 * rng.next());
+                let a = Aniso::from_alphas(rng.next_f64(), rng.next_f64(), 6.3 * rng.next_f64());
                 assert!(decode_matrix(encode(a)).max_diff(&a) < 1e-15);
                 let e = decode_matrix(quantize(encode(a), bits)).max_diff(&a);
                 worst = worst.max(e);
@@ -105,13 +106,13 @@ mod tests {
     fn course_decoder_recovers_alphas_and_axis_and_guards_indefinite_matrices() {
         // Exact channels: α², the axis and the matrix come back to f64 rounding amplified by
         // 1/discr where the eigenvalues nearly coincide (here discr ≥ 1e-3: 1e-12).
-        let mut rng = Rng(5);
+        let mut rng = SplitMix64(5);
         for _ in 0..1000 {
-            let (at, ab) = (0.05 + 0.95 * rng.next(), 0.05 + 0.95 * rng.next());
+            let (at, ab) = (0.05 + 0.95 * rng.next_f64(), 0.05 + 0.95 * rng.next_f64());
             if (at * at - ab * ab).abs() < 1e-3 {
                 continue;
             }
-            let a = Aniso::from_alphas(at, ab, 6.3 * rng.next());
+            let a = Aniso::from_alphas(at, ab, 6.3 * rng.next_f64());
             let d = decode_course(encode(a), ALPHA_MIN);
             assert!(d.aniso().max_diff(&a) < 1e-12, "{:?} vs {a:?}", d.aniso());
             assert!((d.alpha_t_sqr - at.max(ab).powi(2)).abs() < 1e-12);
@@ -124,7 +125,7 @@ mod tests {
         // not indefinite ones: the mean of (1, 1, 1) (Sxy = +1, rank 1) and (0, 1, 0) is
         // (½, 1, ½), of rank 1, whose zero eigenvalue the decoder clamps to α_min².
         for _ in 0..10_000 {
-            let m = decode_matrix([rng.next(), rng.next(), rng.next()]);
+            let m = decode_matrix([rng.next_f64(), rng.next_f64(), rng.next_f64()]);
             assert!(m.sxx * m.syy - m.sxy * m.sxy >= -1e-16);
         }
         let mix = [0.5, 1.0, 0.5];
