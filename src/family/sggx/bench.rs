@@ -6,7 +6,8 @@
 //!
 //! No shader forms yet: the emitted functions are exact formulas (see `family::tests::NO_FORMS`).
 
-use super::integrals::{Aniso, Lobe, Rng, SphereRule, direction, sggx_from};
+use super::integrals::{Aniso, Lobe, SphereRule, direction, sggx_from};
+use crate::integrate::rng::SplitMix64;
 use super::projected_area_quadrature;
 use crate::bench::FamilyBench;
 use crate::bench::integrals::{IntegratorBench, IntegratorRow, Run, pick, row};
@@ -22,11 +23,11 @@ pub const BENCH: FamilyBench = FamilyBench {
 
 /// Seeded lobes (normals within 60° of z, α ∈ [0.05, 1]) and directions over the sphere.
 fn points(n: usize) -> Vec<(Lobe, super::integrals::V3)> {
-    let mut rng = Rng(40);
+    let mut rng = SplitMix64(40);
     (0..n)
         .map(|_| {
-            let s = sggx_from(direction(PI / 3.0 * rng.next(), 2.0 * PI * rng.next()), Aniso::from_alphas(0.05 + 0.95 * rng.next(), 0.05 + 0.95 * rng.next(), PI * rng.next()));
-            (Lobe::new(s).expect("α > 0 gives SPD lobes"), direction((2.0 * rng.next() - 1.0).acos(), 2.0 * PI * rng.next()))
+            let s = sggx_from(direction(PI / 3.0 * rng.next_f64(), 2.0 * PI * rng.next_f64()), Aniso::from_alphas(0.05 + 0.95 * rng.next_f64(), 0.05 + 0.95 * rng.next_f64(), PI * rng.next_f64()));
+            (Lobe::new(s).expect("α > 0 gives SPD lobes"), direction((2.0 * rng.next_f64() - 1.0).acos(), 2.0 * PI * rng.next_f64()))
         })
         .collect()
 }

@@ -336,10 +336,10 @@ mod tests {
         // The axis is not: sin ψ = √(1 − cos²ψ) cancels for nearly aligned lobes, where 1 − c²
         // carries an absolute f32 error ~2^-24, so sin ψ is off by up to √(2^-24) ≈ 2.4e-4 and
         // Sxy = cs(α_t² − α_b²) by as much (skipped where discr < 1e-2, the axis undefined).
-        let mut rng = super::super::integrals::Rng(23);
+        let mut rng = crate::integrate::rng::SplitMix64(23);
         let mut worst: f64 = 0.0;
         for _ in 0..20_000 {
-            let a = Aniso::from_alphas(rng.next(), rng.next(), 6.3 * rng.next());
+            let a = Aniso::from_alphas(rng.next_f64(), rng.next_f64(), 6.3 * rng.next_f64());
             let t = super::super::integrals::quantize(super::super::integrals::encode(a), 8);
             let m = super::super::integrals::decode_matrix(t);
             if (4.0 * m.sxy * m.sxy + (m.sxx - m.syy).powi(2)).sqrt() < 1e-2 {

@@ -12,9 +12,10 @@
 //! - Hardware filtering of the stored channels then decoding, against filtering S.
 
 use super::integrals::{
-    ALPHA_MIN, Aniso, Distance, Lean, Lobe, M3, Mixture, Ndf, Rng, SphereRule, V3, decode_course, direction, distance, encode,
+    ALPHA_MIN, Aniso, Distance, Lean, Lobe, M3, Mixture, Ndf, SphereRule, V3, decode_course, direction, distance, encode,
     estimate, extract, filter, quantize, sggx_from,
 };
+use crate::integrate::rng::SplitMix64;
 use crate::validate::Item;
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI};
 use std::path::Path;
@@ -47,15 +48,15 @@ pub fn course_cases() -> Vec<Case> {
 /// Seeded random footprints: 2–4 texels, normals within 60° of z, α ∈ [0.1, 0.8] (the sphere
 /// rule resolves lobes that wide), weights in [0.2, 1].
 pub fn random_cases(count: usize, seed: u64) -> Vec<Case> {
-    let mut rng = Rng(seed);
+    let mut rng = SplitMix64(seed);
     (0..count)
         .map(|i| {
-            let k = 2 + (rng.next() * 3.0) as usize;
+            let k = 2 + (rng.next_f64() * 3.0) as usize;
             let texels = (0..k)
                 .map(|_| {
-                    let n = direction(PI / 3.0 * rng.next(), 2.0 * PI * rng.next());
-                    let a = Aniso::from_alphas(0.1 + 0.7 * rng.next(), 0.1 + 0.7 * rng.next(), PI * rng.next());
-                    (0.2 + 0.8 * rng.next(), n, a)
+                    let n = direction(PI / 3.0 * rng.next_f64(), 2.0 * PI * rng.next_f64());
+                    let a = Aniso::from_alphas(0.1 + 0.7 * rng.next_f64(), 0.1 + 0.7 * rng.next_f64(), PI * rng.next_f64());
+                    (0.2 + 0.8 * rng.next_f64(), n, a)
                 })
                 .collect();
             Case { name: format!("random footprint {i}"), texels }
@@ -164,8 +165,8 @@ fn encoding_item(alpha_t: f64, alpha_b: f64, bits: u32) -> Item {
 /// `n` seeded pairs of flat-texel blocks: α_t and α_b uniform on [0.02, 1], the α_t axis at ψ
 /// uniform on [0, π).
 fn filter_pairs(n: usize) -> Vec<(Aniso, Aniso)> {
-    let mut rng = Rng(17);
-    let mut block = || Aniso::from_alphas(0.02 + 0.98 * rng.next(), 0.02 + 0.98 * rng.next(), PI * rng.next());
+    let mut rng = SplitMix64(17);
+    let mut block = || Aniso::from_alphas(0.02 + 0.98 * rng.next_f64(), 0.02 + 0.98 * rng.next_f64(), PI * rng.next_f64());
     (0..n).map(|_| (block(), block())).collect()
 }
 

@@ -22,6 +22,9 @@
 #![allow(clippy::excessive_precision)]
 
 use super::*;
+use super::atan::atan2_upper;
+use std::f64::consts::FRAC_PI_2;
+use super::ps::{Piece, Region};
 use crate::integrate::{GaussPair, Rule, quadpack_error};
 
 /// End map of [0, 1] onto itself with vanishing derivative at the flagged ends (removes
