@@ -3,7 +3,8 @@
 //! on and outside the domain, ±inf, NaN); what the build's f32 evaluators give there; and the
 //! value naga's constant evaluator folds a WGSL expression to.
 
-use super::rust::table_eval_f32;
+use super::interp::Placement;
+use super::rust::table_lookup_f32;
 use super::wgsl::{Body, Function};
 use crate::fit::expr::{self, Expr};
 use crate::fit::model::RationalModel;
@@ -47,8 +48,8 @@ impl Four {
         [
             fit("m_rat", &self.e_rat, &RAT_NUM[..], &RAT_DEN[..], Some((0.0f32, 1.5f32))),
             fit("m_poly", &self.e_poly, &POLY_NUM[..], &[][..], None),
-            Function { module: "m_t1", name: "m_t1", args: &self.a1, derived: &[], domain: &D1, body: Body::Table { values: &self.t1, counts: &[7] } },
-            Function { module: "m_t2", name: "m_t2", args: &self.a2, derived: &[], domain: &D2, body: Body::Table { values: &self.t2, counts: &[3, 4] } },
+            Function { module: "m_t1", name: "m_t1", args: &self.a1, derived: &[], domain: &D1, body: Body::Table { values: &self.t1, counts: &[7], channels: 1, placements: &[Placement::Nodes] } },
+            Function { module: "m_t2", name: "m_t2", args: &self.a2, derived: &[], domain: &D2, body: Body::Table { values: &self.t2, counts: &[3, 4], channels: 1, placements: &[Placement::Nodes; 2] } },
         ]
     }
 }
@@ -80,6 +81,6 @@ pub fn want(f: &Function<'_>, p: &[f32]) -> f32 {
             let v = expr::eval_f32(expr, &x, num, den);
             clamp.map_or(v, |(lo, hi)| v.clamp(lo, hi))
         }
-        Body::Table { values, counts } => table_eval_f32(values, counts, f.domain, p),
+        Body::Table { values, counts, channels, placements } => table_lookup_f32(values, *channels, counts, f.domain, placements, p)[0],
     }
 }

@@ -74,6 +74,15 @@ pub static QUANTITIES: &[QuantityDef] = &[
     },
 ];
 
+/// Table axes over WWII gloss g whose parameter is GGX α = sqrt(2/(1 + 2^(18g)))
+/// (`mapping = "gloss"` on a table axis, e.g. the rows of a split-sum table).
+pub static GLOSS_MAPPING: crate::spec::AxisMapping = crate::spec::AxisMapping {
+    name: "gloss",
+    doc: "gloss g, parameter alpha = sqrt(2/(1 + 2^(18 g)))",
+    to_parameter: crate::shading::roughness::alpha_from_gloss,
+    argument: [0.0, 1.0],
+};
+
 /// The gloss family's descriptor (registered in `crate::family::FAMILIES`).
 pub static FAMILY: Family = Family {
     name: "gloss",
@@ -87,4 +96,5 @@ pub static FAMILY: Family = Family {
     bench: bench::BENCH,
     scene_features: scene::FEATURES,
     commands: &[],
+    axis_mappings: &[&GLOSS_MAPPING],
 };
