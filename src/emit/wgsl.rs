@@ -35,15 +35,16 @@ pub(crate) fn blend_lines(axes: usize, read: &dyn Fn(usize, usize, usize) -> Str
     match axes {
         1 => format!("{}\n}}\n", ret(&row(0, 0))),
         2 => format!("    let a = {};\n    let b = {};\n{}\n}}\n", row(0, 0), row(1, 0), ret(&lerp("a", "b", "f1"))),
+        // Locals a0…a5: names no argument may take (spec::names).
         _ => format!(
-            "    let a = {};\n    let b = {};\n    let c = {};\n    let d = {};\n    let ab = {};\n    let cd = {};\n{}\n}}\n",
+            "    let a0 = {};\n    let a1 = {};\n    let a2 = {};\n    let a3 = {};\n    let a4 = {};\n    let a5 = {};\n{}\n}}\n",
             row(0, 0),
             row(1, 0),
             row(0, 1),
             row(1, 1),
-            lerp("a", "b", "f1"),
-            lerp("c", "d", "f1"),
-            ret(&lerp("ab", "cd", "f2"))
+            lerp("a0", "a1", "f1"),
+            lerp("a2", "a3", "f1"),
+            ret(&lerp("a4", "a5", "f2"))
         ),
     }
 }
@@ -493,6 +494,83 @@ mod tests {
                 let (h, g) = (program.function(f.name), program.function("as_table"));
                 for p in points(f) {
                     assert_eq!(program.eval(g, &p).0.to_bits(), program.eval(h, &p).0.to_bits(), "{}_load{p:?} ({format})", f.name);
+                }
+            }
+        }
+    }
+
+    /// The const form of a table read back from its texture form: every `textureLoad(lut,
+    /// vecN<u32>(i, j[, k]), 0)[.swizzle]` of `src` replaced by the const array's texel
+    /// ((k·n1 + j)·n0 + i), the function renamed `as_table` and its texture parameter dropped.
+    fn load_as_table(src: &str, f: &Function<'_>, counts: &[usize]) -> String {
+        let start = src.find(&format!("fn {}_load(", f.name)).unwrap();
+        let end = start + src[start..].find("\n}").unwrap() + 2;
+        let mut load = src[start..end].replace(&format!("fn {}_load(", f.name), "fn as_table(");
+        for tex in ["lut: texture_2d<f32>, ", "lut: texture_3d<f32>, "] {
+            load = load.replace(tex, "");
+        }
+        let table = format!("{}_TABLE", f.module.to_uppercase());
+        while let Some(at) = load.find("textureLoad(lut, vec") {
+            let open = at + load[at..].find('(').unwrap() + 1;
+            let open = open + load[open..].find('(').unwrap() + 1;
+            let close = open + load[open..].find("), 0)").unwrap();
+            let ijk: Vec<&str> = load[open..close].split(", ").collect();
+            let mut rest = close + "), 0)".len();
+            for sw in [".xyz", ".xy", ".x"] {
+                if load[rest..].starts_with(sw) {
+                    rest += sw.len();
+                    break;
+                }
+            }
+            let k = if counts.len() == 3 { ijk[2] } else { "0u" };
+            let read = format!("{table}[(({k}) * {}u + ({})) * {}u + ({})]", counts.get(1).copied().unwrap_or(1), ijk[1], counts[0], ijk[0]);
+            load = format!("{}{read}{}", &load[..at], &load[rest..]);
+        }
+        format!("{}{load}", &src[..start])
+    }
+
+    /// Tables of several channels, three axes and texel-centre placement ([`Grids`]): the
+    /// interpreted WGSL computes every channel as the build's f32 evaluator does, bit for bit,
+    /// at points inside, on and outside the domain, at ±inf and NaN; with their texture forms
+    /// (a 32-bit and a 16-bit format: `texture_3d` for three axes, the channels swizzled out of
+    /// the texel) every module validates in naga with the helper functions named, and `_load`
+    /// on the const array's texels gives the const function's bits.
+    #[test]
+    fn multichannel_and_three_axis_tables_compute_what_the_evaluator_computes() {
+        use crate::emit::fixtures::{grid_points, want_all, Grids};
+        let grids = Grids::new();
+        let header = ["spec: test".to_string()];
+        for f in &grids.functions() {
+            let program = bound::Program::new(&strip_directives(&render_module(&header, f)));
+            let h = program.function(f.name);
+            for p in grid_points(f) {
+                let got: Vec<u32> = program.eval_all(h, &p).iter().map(|(v, _)| v.to_bits()).collect();
+                let want: Vec<u32> = want_all(f, &p).iter().map(|v| v.to_bits()).collect();
+                assert_eq!(got, want, "{}{p:?}", f.name);
+            }
+            let Body::Table { counts, channels, .. } = f.body else { unreachable!() };
+            let rgba = if channels == 1 { "r" } else if channels == 2 { "rg" } else { "rgba" };
+            for (bits, filterable) in [("32float", false), ("16float", true)] {
+                let format = format!("{rgba}{bits}");
+                let tex = TableTexture { file: "data/t.ktx2", format: &format, filterable, keep_const: true };
+                let src = strip_directives(&render_table_module(&header, f, Some(&tex)));
+                let m = naga::front::wgsl::parse_str(&src).unwrap_or_else(|e| panic!("{}", e.emit_to_string(&src)));
+                naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all())
+                    .validate(&m)
+                    .unwrap_or_else(|e| panic!("{}", e.emit_to_string(&src)));
+                let mut names: Vec<String> = vec![format!("{}_input", f.module), f.name.to_string(), format!("{}_load", f.name)];
+                if filterable {
+                    names.extend([format!("{}_uv", f.module), format!("{}_sample", f.name)]);
+                }
+                let got: Vec<String> = m.functions.iter().filter_map(|(_, g)| g.name.clone()).collect();
+                assert_eq!(got, names, "{src}");
+                assert_eq!(src.contains("texture_3d<f32>"), counts.len() == 3, "{src}");
+                let program = bound::Program::new(&load_as_table(&src, f, counts));
+                let (h, g) = (program.function(f.name), program.function("as_table"));
+                for p in grid_points(f) {
+                    let a: Vec<u32> = program.eval_all(g, &p).iter().map(|(v, _)| v.to_bits()).collect();
+                    let b: Vec<u32> = program.eval_all(h, &p).iter().map(|(v, _)| v.to_bits()).collect();
+                    assert_eq!(a, b, "{}_load{p:?} ({format})", f.name);
                 }
             }
         }

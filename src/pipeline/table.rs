@@ -145,11 +145,13 @@ pub fn table_sample(spec: &Spec, points: &[Vec<f64>]) -> Vec<f64> {
         .collect()
 }
 
-/// The integral on a table's verification grid (`verify` points an axis, ends included, in the
-/// arguments), [`table_width`] values a point.
+/// The integral on a table's verification grid, [`table_width`] values a point: `verify` points
+/// an axis in the arguments, placed as the table's (ends included at nodes; at texel centres
+/// the centres of `verify` cells, which also lie where the lookup holds an edge texel, and
+/// never at the ends, where a mapped parameter may leave the quantity's domain).
 pub fn table_reference(spec: &Spec) -> Reference {
-    let counts: Vec<usize> = spec.file.axis.iter().map(|a| a.verify_count()).collect();
-    let points = grid(spec, &counts);
+    let layout = table_layout(spec);
+    let points = product(spec.file.axis.iter().zip(&layout.axes).map(|(a, (p, _))| p.points(a.range, a.verify_count())).collect());
     let values = table_sample(spec, &points);
     Reference { points, values }
 }

@@ -901,22 +901,33 @@ fn table_layout(path: &Path, text: &str, file: &SpecFile, quantity: &QuantityDef
                 at("mapping", format!("axis '{}': unknown mapping '{m}' (known: {})", a.name, known.join(", ")))
             })?,
         };
+        let placement = a.placement.unwrap_or_default();
         if a.mapping.is_some() || a.placement.is_some() {
             let [lo, hi] = a.range;
+            // The outermost points sampled: the ends, or at texel centres the first and the last
+            // centre of the finer of the table and verification grids (both at centres).
+            let (first, last) = match placement {
+                Placement::Nodes => (lo, hi),
+                Placement::Centres => {
+                    let half = (hi - lo) * 0.5 / a.count.max(a.verify_count()) as f64;
+                    (lo + half, hi - half)
+                }
+            };
             let [tlo, thi] = mapping.argument;
-            let (plo, phi) = ((mapping.to_parameter)(lo), (mapping.to_parameter)(hi));
+            let (plo, phi) = ((mapping.to_parameter)(first), (mapping.to_parameter)(last));
             let inside = |v: f64| v >= p.min && v <= p.max;
-            if !(lo.is_finite() && hi.is_finite() && lo < hi && lo >= tlo && hi <= thi && inside(plo) && inside(phi)) {
+            if !(lo.is_finite() && hi.is_finite() && lo < hi && first >= tlo && last <= thi && inside(plo) && inside(phi)) {
                 return Err(at(
                     "range",
                     format!(
-                        "axis '{}' range [{lo}, {hi}] must be finite, increasing, inside [{tlo}, {thi}] (mapping '{}': {}) and map inside [{}, {}] (it maps to [{plo}, {phi}])",
+                        "axis '{}' range [{lo}, {hi}] must be finite, increasing, sampled inside [{tlo}, {thi}] (mapping '{}': {}) \
+                         and map inside [{}, {}] (its outermost points {first}, {last} map to {plo}, {phi})",
                         a.name, mapping.name, mapping.doc, p.min, p.max
                     ),
                 ));
             }
         }
-        axes.push((a.placement.unwrap_or_default(), mapping));
+        axes.push((placement, mapping));
     }
     Ok(TableLayout { channels, axes })
 }
