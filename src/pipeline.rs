@@ -35,6 +35,8 @@ use std::path::Path;
 pub(crate) mod build_tests;
 #[cfg(test)]
 mod lobe_tests;
+#[cfg(test)]
+mod table_tests;
 pub mod committed;
 pub mod data;
 pub mod fields;
