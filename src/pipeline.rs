@@ -35,6 +35,8 @@ use std::path::Path;
 pub(crate) mod build_tests;
 #[cfg(test)]
 mod lobe_tests;
+#[cfg(test)]
+mod table_tests;
 pub mod committed;
 pub mod data;
 pub mod fields;
@@ -105,8 +107,12 @@ pub fn grid(spec: &Spec, counts: &[usize]) -> Vec<Vec<f64>> {
 
 /// Tensor grid over some axes with the given counts, first axis fastest.
 pub(crate) fn tensor(axes: &[crate::spec::AxisSpec], counts: &[usize]) -> Vec<Vec<f64>> {
-    let pts: Vec<Vec<f64>> = axes.iter().zip(counts).map(|(a, &n)| a.points(n)).collect();
-    let total: usize = counts.iter().product();
+    product(axes.iter().zip(counts).map(|(a, &n)| a.points(n)).collect())
+}
+
+/// Tensor product of per-axis point lists, first axis fastest.
+pub(crate) fn product(pts: Vec<Vec<f64>>) -> Vec<Vec<f64>> {
+    let total: usize = pts.iter().map(Vec::len).product();
     (0..total)
         .map(|mut k| {
             pts.iter()
@@ -404,7 +410,7 @@ mod tests {
     /// `tensor` is the full grid, first axis fastest, each axis at its own points.
     #[test]
     fn the_grid_runs_first_axis_fastest() {
-        let axis = |name: &str, range: [f64; 2]| spec::AxisSpec { name: name.into(), range, count: 2, verify: None };
+        let axis = |name: &str, range: [f64; 2]| spec::AxisSpec { name: name.into(), range, count: 2, verify: None, mapping: None, placement: None };
         let two = [axis("x", [0.0, 1.0]), axis("y", [-2.0, 2.0])];
         let want = vec![vec![0.0, -2.0], vec![0.5, -2.0], vec![1.0, -2.0], vec![0.0, 2.0], vec![0.5, 2.0], vec![1.0, 2.0]];
         assert_eq!(tensor(&two, &[3, 2]), want);

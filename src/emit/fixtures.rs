@@ -3,7 +3,8 @@
 //! on and outside the domain, ±inf, NaN); what the build's f32 evaluators give there; and the
 //! value naga's constant evaluator folds a WGSL expression to.
 
-use super::rust::table_eval_f32;
+use super::interp::Placement;
+use super::rust::table_lookup_f32;
 use super::wgsl::{Body, Function};
 use crate::fit::expr::{self, Expr};
 use crate::fit::model::RationalModel;
@@ -47,8 +48,8 @@ impl Four {
         [
             fit("m_rat", &self.e_rat, &RAT_NUM[..], &RAT_DEN[..], Some((0.0f32, 1.5f32))),
             fit("m_poly", &self.e_poly, &POLY_NUM[..], &[][..], None),
-            Function { module: "m_t1", name: "m_t1", args: &self.a1, derived: &[], domain: &D1, body: Body::Table { values: &self.t1, counts: &[7] } },
-            Function { module: "m_t2", name: "m_t2", args: &self.a2, derived: &[], domain: &D2, body: Body::Table { values: &self.t2, counts: &[3, 4] } },
+            Function { module: "m_t1", name: "m_t1", args: &self.a1, derived: &[], domain: &D1, body: Body::Table { values: &self.t1, counts: &[7], channels: 1, placements: &[Placement::Nodes] } },
+            Function { module: "m_t2", name: "m_t2", args: &self.a2, derived: &[], domain: &D2, body: Body::Table { values: &self.t2, counts: &[3, 4], channels: 1, placements: &[Placement::Nodes; 2] } },
         ]
     }
 }
@@ -80,6 +81,74 @@ pub fn want(f: &Function<'_>, p: &[f32]) -> f32 {
             let v = expr::eval_f32(expr, &x, num, den);
             clamp.map_or(v, |(lo, hi)| v.clamp(lo, hi))
         }
-        Body::Table { values, counts } => table_eval_f32(values, counts, f.domain, p),
+        Body::Table { values, counts, channels, placements } => table_lookup_f32(values, *channels, counts, f.domain, placements, p)[0],
+    }
+}
+
+/// Tables of the shapes beyond one value at the nodes of one or two axes: two channels at the
+/// texel centres of one axis, one value over three axes (nodes, centres, nodes), three channels
+/// at the centres of three axes, and four channels over two axes.
+pub struct Grids {
+    a1: Vec<String>,
+    a2: Vec<String>,
+    a3: Vec<String>,
+    c2: Vec<f32>,
+    s3: Vec<f32>,
+    c3: Vec<f32>,
+    c4: Vec<f32>,
+}
+
+const D3: [(f32, f32); 3] = [(0.0, 1.0), (-1.0, 3.0), (0.25, 2.0)];
+const CENTRES: [Placement; 3] = [Placement::Centres; 3];
+const MIXED: [Placement; 3] = [Placement::Nodes, Placement::Centres, Placement::Nodes];
+
+impl Grids {
+    pub fn new() -> Grids {
+        let v = |n: usize, k: f32| (0..n).map(|i| ((i as f32 + k) * 0.7).sin()).collect::<Vec<f32>>();
+        Grids {
+            a1: vec!["x".to_string()],
+            a2: vec!["x".to_string(), "y".to_string()],
+            a3: vec!["x".to_string(), "y".to_string(), "z".to_string()],
+            c2: v(5 * 2, 0.0),
+            s3: v(3 * 2 * 4, 0.3),
+            c3: v(2 * 3 * 2 * 3, 0.6),
+            c4: v(3 * 4 * 4, 0.9),
+        }
+    }
+
+    pub fn functions(&self) -> [Function<'_>; 4] {
+        let t = |name, args, domain, values, counts, channels, placements| Function {
+            module: name,
+            name,
+            args,
+            derived: &[],
+            domain,
+            body: Body::Table { values, counts, channels, placements },
+        };
+        [
+            t("m_c2", &self.a1, &D1[..], &self.c2[..], &[5][..], 2, &CENTRES[..1]),
+            t("m_s3", &self.a3, &D3[..], &self.s3[..], &[3, 2, 4][..], 1, &MIXED[..]),
+            t("m_c3", &self.a3, &D3[..], &self.c3[..], &[2, 3, 2][..], 3, &CENTRES[..]),
+            t("m_c4", &self.a2, &D2[..], &self.c4[..], &[3, 4][..], 4, &MIXED[..2]),
+        ]
+    }
+}
+
+/// Fewer values an argument for three arguments: inside, on and outside each domain, ±inf, NaN.
+const XS3: [f32; 8] = [-1.0, 0.25, 0.3, 1.37, 2.0, 5.0, f32::INFINITY, f32::NAN];
+
+/// The points a table of [`Grids`] is run at (all combinations; [`XS3`] for three arguments).
+pub fn grid_points(f: &Function<'_>) -> Vec<Vec<f32>> {
+    match f.args.len() {
+        3 => XS3.iter().flat_map(|&x| XS3.iter().flat_map(move |&y| XS3.iter().map(move |&z| vec![x, y, z]))).collect(),
+        _ => points(f),
+    }
+}
+
+/// Every channel of table `f` at `p` as the build's f32 evaluator computes it.
+pub fn want_all(f: &Function<'_>, p: &[f32]) -> Vec<f32> {
+    match &f.body {
+        Body::Table { values, counts, channels, placements } => table_lookup_f32(values, *channels, counts, f.domain, placements, p),
+        Body::Fit { .. } => vec![want(f, p)],
     }
 }

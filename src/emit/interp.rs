@@ -32,6 +32,38 @@ pub fn nodes(x: f64, n: usize) -> Address<f64> {
     (i, i + 1, x - i as f64)
 }
 
+/// Where the points of an emitted table's axis lie on its domain [lo, hi]: nodes (the first and
+/// the last point at the ends) or texel centres ((i + ½)/n of the domain).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Placement {
+    #[default]
+    Nodes,
+    Centres,
+}
+
+/// The f32 factor taking an argument's offset from `lo` to table steps (the emitted literal):
+/// (n − 1)/(hi − lo) for nodes, n/(hi − lo) for centres.
+pub fn step_scale(lo: f32, hi: f32, n: usize, placement: Placement) -> f32 {
+    match placement {
+        Placement::Nodes => (n as f32 - 1.0) / (hi - lo),
+        Placement::Centres => n as f32 / (hi - lo),
+    }
+}
+
+/// The emitted lookup's address of `x` ∈ [lo, hi] (already clamped) on an axis of `n` ≥ 2
+/// points, in f32 with the emitted operations: t = (x − lo)·scale (minus ½ at centres, so that
+/// t is in texel steps from the first centre), i = min(⌊max(t, 0)⌋, n − 2), f = clamp(t − i, 0,
+/// 1). Outside the first and last centre f is 0 or 1: the edge texel, as clamp-to-edge sampling.
+pub fn emitted_address(x: f32, lo: f32, hi: f32, n: usize, placement: Placement) -> Address<f32> {
+    let scale = step_scale(lo, hi, n, placement);
+    let t = match placement {
+        Placement::Nodes => (x - lo) * scale,
+        Placement::Centres => (x - lo) * scale - 0.5,
+    };
+    let i = (t.max(0.0) as u32).min(n as u32 - 2) as usize;
+    (i, i + 1, (t - i as f32).clamp(0.0, 1.0))
+}
+
 /// The blend of `texels` (first axis fastest, `dims` texels per axis) at one address per axis,
 /// channel by channel.
 pub fn multilinear<T: Float, const C: usize>(texels: &[[T; C]], dims: &[usize], at: &[Address<T>]) -> [T; C] {

@@ -3,6 +3,7 @@
 
 use super::expr::render;
 use super::f32_literal;
+use super::interp::{step_scale, Placement};
 use super::wgsl::{Body, Function};
 
 fn lit(v: f32) -> String {
@@ -19,6 +20,19 @@ fn array(name: &str, doc: &str, values: &[f32]) -> String {
         }
         s.push_str(&lit(*v));
         s.push(',');
+    }
+    s.push_str("\n];\n");
+    s
+}
+
+/// A const array of `[f32; channels]` points, three points a line.
+fn vec_array(name: &str, doc: &str, values: &[f32], channels: usize) -> String {
+    let n = values.len() / channels;
+    let mut s = format!("/// {doc}\npub const {name}: [[f32; {channels}]; {n}] = [");
+    for (i, v) in values.chunks(channels).enumerate() {
+        s.push_str(if i % 3 == 0 { "\n    " } else { " " });
+        let items: Vec<String> = v.iter().map(|&x| lit(x)).collect();
+        s.push_str(&format!("[{}],", items.join(", ")));
     }
     s.push_str("\n];\n");
     s
@@ -81,52 +95,79 @@ pub fn render_module(header: &[String], f: &Function<'_>, doc: &str) -> String {
                 params.join(", ")
             ));
         }
-        Body::Table { values, counts } => {
-            s.push_str(&array(&format!("{upper}_TABLE"), "Table values on a uniform grid (first axis fastest).", values));
+        Body::Table { values, counts, channels, placements } => {
+            let t = format!("{upper}_TABLE");
+            let c = *channels;
+            if c == 1 {
+                s.push_str(&array(&t, "Table values on a uniform grid (first axis fastest).", values));
+            } else {
+                s.push_str(&vec_array(&t, &format!("Table values on a uniform grid (first axis fastest), {c} channels a point."), values, c));
+            }
+            let ty = if c == 1 { "f32".to_string() } else { format!("[f32; {c}]") };
             s.push_str(&format!(
-                "\n/// CPU version of the WGSL function of the same name (linear interpolation).\npub fn {}({}) -> f32 {{\n{inputs}",
+                "\n/// CPU version of the WGSL function of the same name (linear interpolation).\npub fn {}({}) -> {ty} {{\n{inputs}",
                 f.name,
                 params.join(", ")
             ));
-            for (i, ((lo, hi), n)) in f.domain.iter().zip(counts.iter()).enumerate() {
-                s.push_str(&format!(
-                    "    let t{i} = (x{i} - {lo}) * {scale};\n    let i{i} = (t{i} as u32).min({last});\n    let f{i} = (t{i} - i{i} as f32).clamp(0.0, 1.0);\n",
-                    lo = lit(*lo),
-                    scale = lit((*n as f32 - 1.0) / (hi - lo)),
-                    last = n - 2
-                ));
+            for (i, (((lo, hi), n), p)) in f.domain.iter().zip(counts.iter()).zip(placements.iter()).enumerate() {
+                let (scale, lo, last) = (lit(step_scale(*lo, *hi, *n, *p)), lit(*lo), n - 2);
+                s.push_str(&match p {
+                    Placement::Nodes => format!("    let t{i} = (x{i} - {lo}) * {scale};\n    let i{i} = (t{i} as u32).min({last});\n"),
+                    Placement::Centres => format!("    let t{i} = (x{i} - {lo}) * {scale} - 0.5;\n    let i{i} = (t{i}.max(0.0) as u32).min({last});\n"),
+                });
+                s.push_str(&format!("    let f{i} = (t{i} - i{i} as f32).clamp(0.0, 1.0);\n"));
             }
-            let t = format!("{upper}_TABLE");
-            if counts.len() == 1 {
-                s.push_str(&format!(
-                    "    let i0 = i0 as usize;\n    {t}[i0] * (1.0 - f0) + {t}[i0 + 1] * f0\n}}\n"
-                ));
-            } else {
-                let nx = counts[0];
-                s.push_str(&format!(
-                    "    let k = (i1 * {nx} + i0) as usize;\n    \
-                     let a = {t}[k] * (1.0 - f0) + {t}[k + 1] * f0;\n    \
-                     let b = {t}[k + {nx}] * (1.0 - f0) + {t}[k + {nx1}] * f0;\n    \
-                     a * (1.0 - f1) + b * f1\n}}\n",
-                    nx1 = nx + 1
-                ));
+            let (nx, ny) = (counts[0], counts.get(1).copied().unwrap_or(1));
+            match counts.len() {
+                1 => s.push_str("    let i0 = i0 as usize;\n"),
+                2 => s.push_str(&format!("    let k = (i1 * {nx} + i0) as usize;\n")),
+                _ => s.push_str(&format!("    let k = ((i2 * {ny} + i1) * {nx} + i0) as usize;\n")),
             }
+            let read = |dx: usize, dy: usize, dz: usize| {
+                let o = dx + nx * (dy + ny * dz);
+                match (counts.len(), o) {
+                    (1, 0) => format!("{t}[i0]"),
+                    (1, _) => format!("{t}[i0 + 1]"),
+                    (_, 0) => format!("{t}[k]"),
+                    _ => format!("{t}[k + {o}]"),
+                }
+            };
+            // Several channels: the lerp channel by channel (`c`: a name no argument may take).
+            let lerp = |a: &str, b: &str, f: &str| {
+                if c == 1 { format!("{a} * (1.0 - {f}) + {b} * {f}") } else { format!("std::array::from_fn::<f32, {c}, _>(|c| {a}[c] * (1.0 - {f}) + {b}[c] * {f})") }
+            };
+            s.push_str(&super::wgsl::blend_lines(counts.len(), &read, &lerp, &|v| format!("    {v}")));
         }
     }
     s
 }
 
-/// f32 evaluation of a table lookup with the emitted operation order.
+/// f32 evaluation of a one-value table lookup at its nodes with the emitted operation order
+/// (see [`table_lookup_f32`]).
 pub fn table_eval_f32(values: &[f32], counts: &[usize], domain: &[(f32, f32)], x: &[f32]) -> f32 {
-    let mut at: [super::interp::Address<f32>; 2] = [(0, 0, 0.0); 2];
+    table_lookup_f32(values, 1, counts, domain, &[Placement::Nodes; 3][..counts.len()], x)[0]
+}
+
+/// f32 evaluation of a table lookup with the emitted operation order: each argument clamped to
+/// its domain (NaN to the lower end), its address as the emitted code computes it
+/// ([`super::interp::emitted_address`]), then [`super::interp::multilinear`] of the `channels`
+/// values a point.
+pub fn table_lookup_f32(values: &[f32], channels: usize, counts: &[usize], domain: &[(f32, f32)], placements: &[Placement], x: &[f32]) -> Vec<f32> {
+    let mut at: [super::interp::Address<f32>; 3] = [(0, 0, 0.0); 3];
     for d in 0..counts.len() {
         let (lo, hi) = domain[d];
         let xd = super::expr::sanitize(x[d], lo, hi);
-        let t = (xd - lo) * ((counts[d] as f32 - 1.0) / (hi - lo));
-        let i = (t as u32).min(counts[d] as u32 - 2) as usize;
-        at[d] = (i, i + 1, (t - i as f32).clamp(0.0, 1.0));
+        at[d] = super::interp::emitted_address(xd, lo, hi, counts[d], placements[d]);
     }
-    super::interp::multilinear(values.as_chunks::<1>().0, counts, &at[..counts.len()])[0]
+    let at = &at[..counts.len()];
+    use super::interp::multilinear;
+    match channels {
+        1 => multilinear(values.as_chunks::<1>().0, counts, at).to_vec(),
+        2 => multilinear(values.as_chunks::<2>().0, counts, at).to_vec(),
+        3 => multilinear(values.as_chunks::<3>().0, counts, at).to_vec(),
+        4 => multilinear(values.as_chunks::<4>().0, counts, at).to_vec(),
+        _ => panic!("a table point has 1 to 4 channels, not {channels}"),
+    }
 }
 
 #[cfg(test)]
@@ -195,6 +236,63 @@ mod tests {
         assert!(out.status.success(), "rustc: {}\n{main}", String::from_utf8_lossy(&out.stderr));
         let run = std::process::Command::new(dir.join("main")).output().unwrap();
         String::from_utf8(run.stdout).unwrap().lines().map(|l| l.parse().unwrap()).collect()
+    }
+
+    /// Tables of several channels, three axes and texel-centre placement (`Grids`), rendered,
+    /// compiled by rustc and run, compute every channel as [`table_lookup_f32`] does, bit for bit
+    /// (Rust never contracts to FMA), at points inside, on and outside the domain, ±inf and NaN.
+    #[test]
+    fn multichannel_and_three_axis_tables_compile_and_compute_what_the_evaluator_computes() {
+        use crate::emit::fixtures::{grid_points, want_all, Grids};
+        let grids = Grids::new();
+        let fs = grids.functions();
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path();
+        let mut main = String::from("fn main() {\n");
+        for f in &fs {
+            std::fs::write(dir.join(format!("{}.rs", f.module)), render_module(&["spec: test".to_string()], f, "A test module.")).unwrap();
+            main = format!("mod {m};\n{main}", m = f.module);
+            for p in grid_points(f) {
+                let a: Vec<String> = p.iter().map(|v| format!("f32::from_bits({:#x})", v.to_bits())).collect();
+                let Body::Table { channels, .. } = f.body else { unreachable!() };
+                let value = if channels == 1 { format!("[{}::{}({})]", f.module, f.name, a.join(", ")) } else { format!("{}::{}({})", f.module, f.name, a.join(", ")) };
+                main.push_str(&format!("    for v in {value} {{ println!(\"{{}}\", v.to_bits()); }}\n"));
+            }
+        }
+        main.push_str("}\n");
+        std::fs::write(dir.join("main.rs"), main).unwrap();
+        let rustc = std::env::var("RUSTC").unwrap_or_else(|_| "rustc".into());
+        let out = std::process::Command::new(rustc).args(["--edition", "2021", "-A", "warnings", "-o"]).arg(dir.join("main")).arg(dir.join("main.rs")).output().unwrap();
+        assert!(out.status.success(), "rustc: {}", String::from_utf8_lossy(&out.stderr));
+        let run = std::process::Command::new(dir.join("main")).output().unwrap();
+        let got: Vec<u32> = String::from_utf8(run.stdout).unwrap().lines().map(|l| l.parse().unwrap()).collect();
+        let expected: Vec<(String, u32)> = fs
+            .iter()
+            .flat_map(|f| grid_points(f).into_iter().flat_map(move |p| want_all(f, &p).into_iter().enumerate().map(move |(c, w)| (format!("{}{p:?}[{c}]", f.name), w.to_bits()))))
+            .collect();
+        assert_eq!(got.len(), expected.len());
+        for (g, (at, w)) in got.iter().zip(&expected) {
+            assert_eq!(*g, *w, "{at}: compiled {} vs evaluator {}", f32::from_bits(*g), f32::from_bits(*w));
+        }
+    }
+
+    /// At texel centres the lookup interpolates between centres and holds the edge texel
+    /// outside them (clamp to edge), worked out by hand on values exact in binary: 4 centres on
+    /// [0, 2] at 0.25, 0.75, 1.25, 1.75 with values 0, 1, 4, 9, two channels (v and −2v).
+    #[test]
+    fn centred_lookups_interpolate_between_centres_and_hold_the_edges() {
+        let v = [0.0f32, -0.0, 1.0, -2.0, 4.0, -8.0, 9.0, -18.0];
+        let at = |x: f32| table_lookup_f32(&v, 2, &[4], &[(0.0, 2.0)], &[Placement::Centres], &[x]);
+        assert_eq!(at(0.25), [0.0, 0.0]);
+        assert_eq!(at(0.5), [0.5, -1.0]); // halfway between the first two centres
+        assert_eq!(at(1.375), [5.25, -10.5]); // a quarter of the way from 4 to 9
+        assert_eq!(at(1.75), [9.0, -18.0]);
+        for x in [0.0, 0.1, -5.0] {
+            assert_eq!(at(x), [0.0, 0.0], "{x}: below the first centre");
+        }
+        for x in [1.9, 2.0, 7.0] {
+            assert_eq!(at(x), [9.0, -18.0], "{x}: above the last centre");
+        }
     }
 
     /// The published forms' nodes rendered as Rust, compiled by rustc and run, compute the

@@ -5,13 +5,48 @@
 
 use super::expr::{render, Expr};
 use super::f32_literal;
+use super::interp::{step_scale, Placement};
 
 /// What an emitted function computes.
 pub enum Body<'a> {
     Fit { expr: &'a Expr, num: &'a [f32], den: &'a [f32], clamp: Option<(f32, f32)> },
-    /// Linear interpolation in a table on a uniform grid of each axis (1 or 2 axes; for two,
-    /// `values[j * nx + i]` with i along the first axis).
-    Table { values: &'a [f32], counts: &'a [usize] },
+    /// Multilinear interpolation in a table on a uniform grid of each axis (1 to 3 axes, first
+    /// axis fastest: `values[((k * ny + j) * nx + i) * channels + c]`), `channels` values a
+    /// point (1: the function returns f32; 2 to 4: vecN<f32>), each axis's points at its nodes
+    /// or at texel centres (`placements`, one per axis).
+    Table { values: &'a [f32], counts: &'a [usize], channels: usize, placements: &'a [Placement] },
+}
+
+/// The WGSL type of a table point's `channels` values.
+fn value_type(channels: usize) -> String {
+    if channels == 1 { "f32".into() } else { format!("vec{channels}<f32>") }
+}
+
+/// The swizzle taking a texel's `channels` (an RGBA `textureLoad` result).
+fn swizzle(channels: usize) -> &'static str {
+    ["", ".x", ".xy", ".xyz", ""][channels]
+}
+
+/// The multilinear blend's lines over `axes` axes, `read(dx, dy, dz)` the texel at offsets
+/// (0 or 1) from (i0, i1, i2), in [`super::interp::multilinear`]'s order: along the first axis,
+/// then the second, then the third. `lerp(a, b, f)` is a · (1 − f) + b · f in the language.
+pub(crate) fn blend_lines(axes: usize, read: &dyn Fn(usize, usize, usize) -> String, lerp: &dyn Fn(&str, &str, &str) -> String, ret: &dyn Fn(&str) -> String) -> String {
+    let row = |dy: usize, dz: usize| lerp(&read(0, dy, dz), &read(1, dy, dz), "f0");
+    match axes {
+        1 => format!("{}\n}}\n", ret(&row(0, 0))),
+        2 => format!("    let a = {};\n    let b = {};\n{}\n}}\n", row(0, 0), row(1, 0), ret(&lerp("a", "b", "f1"))),
+        // Locals a0…a5: names no argument may take (spec::names).
+        _ => format!(
+            "    let a0 = {};\n    let a1 = {};\n    let a2 = {};\n    let a3 = {};\n    let a4 = {};\n    let a5 = {};\n{}\n}}\n",
+            row(0, 0),
+            row(1, 0),
+            row(0, 1),
+            row(1, 1),
+            lerp("a0", "a1", "f1"),
+            lerp("a2", "a3", "f1"),
+            ret(&lerp("a4", "a5", "f2"))
+        ),
+    }
 }
 
 pub struct Function<'a> {
@@ -26,6 +61,20 @@ pub struct Function<'a> {
 
 fn lit(v: f32) -> String {
     format!("{}f", f32_literal(v))
+}
+
+/// A const array of `vecN<f32>` points, `channels` values each, three points a line.
+fn vec_array(name: &str, values: &[f32], channels: usize) -> String {
+    let ty = value_type(channels);
+    let n = values.len() / channels;
+    let mut s = format!("const {name}: array<{ty}, {n}> = array<{ty}, {n}>(");
+    for (i, v) in values.chunks(channels).enumerate() {
+        s.push_str(if i % 3 == 0 { "\n    " } else { " " });
+        let items: Vec<String> = v.iter().map(|&x| lit(x)).collect();
+        s.push_str(&format!("{ty}({}),", items.join(", ")));
+    }
+    s.push_str("\n);\n");
+    s
 }
 
 fn array(name: &str, values: &[f32]) -> String {
@@ -111,93 +160,125 @@ fn input_lines(f: &Function<'_>) -> String {
 /// (hi − lo)·scale rounds above n − 1, and at the bottom on a GPU that rewrites (x − lo)·scale
 /// as fma(x, scale, −fl(lo·scale)) (an NVIDIA driver does; WGSL cannot forbid it), which made
 /// a table of non-negative values return −8e-9 at its first point.
-fn table_index_lines(f: &Function<'_>, counts: &[usize]) -> String {
+///
+/// At texel centres tK counts steps from the first centre, tK = (xK − lo)·n/(hi − lo) − ½, and
+/// iK = min(u32(max(tK, 0)), n − 2): below the first centre fK is 0, above the last 1, so the
+/// lookup holds the edge value there as a clamp-to-edge sampler does.
+fn table_index_lines(f: &Function<'_>, counts: &[usize], placements: &[Placement]) -> String {
     let mut s = String::new();
-    for (i, ((lo, hi), n)) in f.domain.iter().zip(counts.iter()).enumerate() {
-        s.push_str(&format!(
-            "    let t{i} = (x{i} - {lo}) * {scale};\n    let i{i} = min(u32(t{i}), {last}u);\n    let f{i} = clamp(t{i} - f32(i{i}), 0.0f, 1.0f);\n",
-            lo = lit(*lo),
-            scale = lit((*n as f32 - 1.0) / (hi - lo)),
-            last = n - 2
-        ));
+    for (i, (((lo, hi), n), p)) in f.domain.iter().zip(counts.iter()).zip(placements).enumerate() {
+        let scale = lit(step_scale(*lo, *hi, *n, *p));
+        let (lo, last) = (lit(*lo), n - 2);
+        s.push_str(&match p {
+            Placement::Nodes => format!("    let t{i} = (x{i} - {lo}) * {scale};\n    let i{i} = min(u32(t{i}), {last}u);\n"),
+            Placement::Centres => format!("    let t{i} = (x{i} - {lo}) * {scale} - 0.5f;\n    let i{i} = min(u32(max(t{i}, 0.0f)), {last}u);\n"),
+        });
+        s.push_str(&format!("    let f{i} = clamp(t{i} - f32(i{i}), 0.0f, 1.0f);\n"));
     }
     s
 }
 
-/// The functions reading a table from a texture (`texture_2d<f32>`, one channel; a table of
-/// axes n0 (× n1) is n0 × n1 texels, texel (i, j) the value at point i of the first axis and j
-/// of the second, 1 row for one axis):
+pub(crate) fn wgsl_lerp(a: &str, b: &str, f: &str) -> String {
+    format!("{a} * (1.0f - {f}) + {b} * {f}")
+}
+
+fn wgsl_return(v: &str) -> String {
+    format!("    return {v};")
+}
+
+/// The functions reading a table from a texture (`texture_2d<f32>`, or `texture_3d<f32>` for
+/// three axes; a table of axes n0 (× n1 (× n2)) is n0 × n1 (× n2) texels, texel (i, j, k) the
+/// value at point i of the first axis, j of the second and k of the third, 1 row for one axis;
+/// a point's channels the texel's first ones):
 /// - `FUNCTION_load(lut, args)`: the table function with each `TABLE[k]` a `textureLoad` of the
-///   same texel; same clamp, index, weights and order, so an r32float texture gives the same f32
-///   arithmetic as the `const` array (no sampler; binds as unfilterable float);
+///   same texel; same clamp, index, weights and order, so a 32-bit float texture gives the same
+///   f32 arithmetic as the `const` array (no sampler; binds as unfilterable float);
 /// - when `texture.filterable`: `MODULE_uv(args)`, texel-centre coordinates
 ///   u = (tK + 0.5) / nK with tK as the table function computes it (v = 0.5 for one axis), and
 ///   `FUNCTION_sample(lut, lut_sampler, args)` through a linear, clamp-to-edge sampler, which
-///   interpolates the same two (four) texels with the same weights up to the sampler's weight
-///   precision (Vulkan guarantees 4 sub-texel bits, GPUs have 8).
+///   interpolates the same two (four, eight) texels with the same weights up to the sampler's
+///   weight precision (Vulkan guarantees 4 sub-texel bits, GPUs have 8).
 pub fn table_texture_functions(f: &Function<'_>, counts: &[usize], texture: &TableTexture<'_>) -> String {
+    let (channels, placements) = match &f.body {
+        Body::Table { channels, placements, .. } => (*channels, *placements),
+        Body::Fit { .. } => panic!("{}: texture helpers are for tables", f.name),
+    };
     let params: Vec<String> = f.args.iter().map(|a| format!("{a}: f32")).collect();
     let inputs = input_lines(f);
-    let index = table_index_lines(f, counts);
-    let load = |x: &str, y: &str| format!("textureLoad(lut, vec2<u32>({x}, {y}), 0).x");
-    let (w, h) = (counts[0], counts.get(1).copied().unwrap_or(1));
-    let same = if texture.format == "r32float" {
-        format!("// with r32float texels the same f32 arithmetic on the same values as {}.\n", f.name)
+    let index = table_index_lines(f, counts, placements);
+    let axes = counts.len();
+    let tex = if axes == 3 { "texture_3d<f32>" } else { "texture_2d<f32>" };
+    let ty = value_type(channels);
+    let load = |dx: usize, dy: usize, dz: usize| {
+        let at = |d: usize, i: usize| if d == 0 { format!("i{i}") } else { format!("i{i} + 1u") };
+        let coords = match axes {
+            1 => format!("vec2<u32>({}, 0u)", at(dx, 0)),
+            2 => format!("vec2<u32>({}, {})", at(dx, 0), at(dy, 1)),
+            _ => format!("vec3<u32>({}, {}, {})", at(dx, 0), at(dy, 1), at(dz, 2)),
+        };
+        format!("textureLoad(lut, {coords}, 0){}", swizzle(channels))
+    };
+    let size = counts.iter().map(|n| n.to_string()).collect::<Vec<_>>();
+    let size = if axes == 1 { format!("{}x1", size[0]) } else { size.join("x") };
+    let same = if texture.format.ends_with("32float") {
+        format!("// with {} texels the same f32 arithmetic on the same values as {}.\n", texture.format, f.name)
     } else {
         format!("// the values rounded to {} as stored.\n", texture.format)
     };
     let mut s = format!(
-        "\n// The texture form of {name}: the table from `lut` ({file}, {fmt}, {w}x{h} texels,\n\
-         // texel (i, j) the value at point i of the first axis{second}) by textureLoad, with the\n\
+        "\n// The texture form of {name}: the table from `lut` ({file}, {fmt}, {size} texels,\n\
+         // texel {ijk} the value at point i of the first axis{second}) by textureLoad, with the\n\
          // clamp, indices, weights and order of {name}; no sampler (bind as unfilterable float);\n\
          {same}\
-         fn {name}_load(lut: texture_2d<f32>, {p}) -> f32 {{\n{inputs}{index}",
+         fn {name}_load(lut: {tex}, {p}) -> {ty} {{\n{inputs}{index}",
         name = f.name,
         file = texture.file,
         fmt = texture.format,
-        second = if counts.len() == 2 { ", j of the second" } else { "; one row" },
+        ijk = if axes == 3 { "(i, j, k)" } else { "(i, j)" },
+        second = match axes {
+            1 => "; one row",
+            2 => ", j of the second",
+            _ => ", j of the second, k of the third",
+        },
         p = params.join(", "),
     );
-    if counts.len() == 1 {
-        s.push_str(&format!("    return {} * (1.0f - f0) + {} * f0;\n}}\n", load("i0", "0u"), load("i0 + 1u", "0u")));
-    } else {
-        s.push_str(&format!(
-            "    let a = {} * (1.0f - f0) + {} * f0;\n    \
-             let b = {} * (1.0f - f0) + {} * f0;\n    \
-             return a * (1.0f - f1) + b * f1;\n}}\n",
-            load("i0", "i1"),
-            load("i0 + 1u", "i1"),
-            load("i0", "i1 + 1u"),
-            load("i0 + 1u", "i1 + 1u"),
-        ));
-    }
+    s.push_str(&blend_lines(axes, &load, &wgsl_lerp, &wgsl_return));
     if texture.filterable {
-        let t: Vec<String> = (0..counts.len()).map(|i| format!("(t{i} + 0.5f) / {}", lit(counts[i] as f32))).collect();
-        let v = t.get(1).cloned().unwrap_or_else(|| "0.5f".into());
+        let t: Vec<String> = (0..axes).map(|i| format!("(t{i} + 0.5f) / {}", lit(counts[i] as f32))).collect();
+        let uv = match axes {
+            1 => format!("vec2<f32>({}, 0.5f)", t[0]),
+            2 => format!("vec2<f32>({}, {})", t[0], t[1]),
+            _ => format!("vec3<f32>({}, {}, {})", t[0], t[1], t[2]),
+        };
+        let uv_ty = if axes == 3 { "vec3<f32>" } else { "vec2<f32>" };
         // The index lines without iK and fK: tK alone.
         let ts: String = index.lines().filter(|l| l.trim_start().starts_with("let t")).map(|l| format!("{l}\n")).collect();
         let call: Vec<&str> = f.args.iter().map(String::as_str).collect();
         s.push_str(&format!(
             "\n// Texture coordinates of {name}'s arguments at texel centres: u = (t0 + 0.5) / n0,\n\
              // t0 the argument in table steps as {name} computes it{vnote}.\n\
-             fn {m}_uv({p}) -> vec2<f32> {{\n{inputs}{ts}    return vec2<f32>({u}, {v});\n}}\n\
+             fn {m}_uv({p}) -> {uv_ty} {{\n{inputs}{ts}    return {uv};\n}}\n\
              \n// {name} from `lut` ({fmt}) through a linear, clamp-to-edge sampler at {m}_uv:\n\
              // the texels and weights of {name}, the weights to the sampler's sub-texel precision.\n\
              {f32note}\
-             fn {name}_sample(lut: texture_2d<f32>, lut_sampler: sampler, {p}) -> f32 {{\n    \
-             return textureSampleLevel(lut, lut_sampler, {m}_uv({c}), 0.0).x;\n}}\n",
+             fn {name}_sample(lut: {tex}, lut_sampler: sampler, {p}) -> {ty} {{\n    \
+             return textureSampleLevel(lut, lut_sampler, {m}_uv({c}), 0.0){sw};\n}}\n",
             name = f.name,
             m = f.module,
             fmt = texture.format,
-            f32note = if texture.format == "r32float" {
-                "// r32float: the device must have float32-filterable (the spec's float32_filterable = true).\n"
+            f32note = if texture.format.ends_with("32float") {
+                format!("// {}: the device must have float32-filterable (the spec's float32_filterable = true).\n", texture.format)
             } else {
-                ""
+                String::new()
             },
-            vnote = if counts.len() == 2 { ", v likewise" } else { "; v = 0.5, the one row" },
+            vnote = match axes {
+                1 => "; v = 0.5, the one row",
+                2 => ", v likewise",
+                _ => ", v and w likewise",
+            },
             p = params.join(", "),
-            u = t[0],
             c = call.join(", "),
+            sw = swizzle(channels),
         ));
     }
     s
@@ -231,23 +312,27 @@ fn body(f: &Function<'_>) -> String {
                 params.join(", ")
             ));
         }
-        Body::Table { values, counts } => {
-            s.push_str(&array(&format!("{upper}_TABLE"), values));
-            s.push_str(&format!("\nfn {}({}) -> f32 {{\n{inputs}", f.name, params.join(", ")));
-            s.push_str(&table_index_lines(f, counts));
+        Body::Table { values, counts, channels, placements } => {
             let t = format!("{upper}_TABLE");
-            if counts.len() == 1 {
-                s.push_str(&format!("    return {t}[i0] * (1.0f - f0) + {t}[i0 + 1u] * f0;\n}}\n"));
-            } else {
-                let nx = counts[0];
-                s.push_str(&format!(
-                    "    let k = i1 * {nx}u + i0;\n    \
-                     let a = {t}[k] * (1.0f - f0) + {t}[k + 1u] * f0;\n    \
-                     let b = {t}[k + {nx}u] * (1.0f - f0) + {t}[k + {nx1}u] * f0;\n    \
-                     return a * (1.0f - f1) + b * f1;\n}}\n",
-                    nx1 = nx + 1
-                ));
+            s.push_str(&if *channels == 1 { array(&t, values) } else { vec_array(&t, values, *channels) });
+            s.push_str(&format!("\nfn {}({}) -> {} {{\n{inputs}", f.name, params.join(", "), value_type(*channels)));
+            s.push_str(&table_index_lines(f, counts, placements));
+            let (nx, ny) = (counts[0], counts.get(1).copied().unwrap_or(1));
+            match counts.len() {
+                1 => {}
+                2 => s.push_str(&format!("    let k = i1 * {nx}u + i0;\n")),
+                _ => s.push_str(&format!("    let k = (i2 * {ny}u + i1) * {nx}u + i0;\n")),
             }
+            let read = |dx: usize, dy: usize, dz: usize| {
+                let o = dx + nx * (dy + ny * dz);
+                match (counts.len(), o) {
+                    (1, 0) => format!("{t}[i0]"),
+                    (1, _) => format!("{t}[i0 + 1u]"),
+                    (_, 0) => format!("{t}[k]"),
+                    _ => format!("{t}[k + {o}u]"),
+                }
+            };
+            s.push_str(&blend_lines(counts.len(), &read, &wgsl_lerp, &wgsl_return));
         }
     }
     s
@@ -367,7 +452,7 @@ mod tests {
             args: &args,
             derived: &[],
             domain: &[(0.25, 2.0)],
-            body: Body::Table { values: &[0.0, 1.0, 4.0, 9.0, 16.0], counts: &[5] },
+            body: Body::Table { values: &[0.0, 1.0, 4.0, 9.0, 16.0], counts: &[5], channels: 1, placements: &[Placement::Nodes] },
         };
         let header = vec!["spec: fits/m.toml".to_string(), "measured error: max abs 0".to_string()];
         let src = render_module(&header, &f);
@@ -436,6 +521,83 @@ mod tests {
                 let (h, g) = (program.function(f.name), program.function("as_table"));
                 for p in points(f) {
                     assert_eq!(program.eval(g, &p).0.to_bits(), program.eval(h, &p).0.to_bits(), "{}_load{p:?} ({format})", f.name);
+                }
+            }
+        }
+    }
+
+    /// The const form of a table read back from its texture form: every `textureLoad(lut,
+    /// vecN<u32>(i, j[, k]), 0)[.swizzle]` of `src` replaced by the const array's texel
+    /// ((k·n1 + j)·n0 + i), the function renamed `as_table` and its texture parameter dropped.
+    fn load_as_table(src: &str, f: &Function<'_>, counts: &[usize]) -> String {
+        let start = src.find(&format!("fn {}_load(", f.name)).unwrap();
+        let end = start + src[start..].find("\n}").unwrap() + 2;
+        let mut load = src[start..end].replace(&format!("fn {}_load(", f.name), "fn as_table(");
+        for tex in ["lut: texture_2d<f32>, ", "lut: texture_3d<f32>, "] {
+            load = load.replace(tex, "");
+        }
+        let table = format!("{}_TABLE", f.module.to_uppercase());
+        while let Some(at) = load.find("textureLoad(lut, vec") {
+            let open = at + load[at..].find('(').unwrap() + 1;
+            let open = open + load[open..].find('(').unwrap() + 1;
+            let close = open + load[open..].find("), 0)").unwrap();
+            let ijk: Vec<&str> = load[open..close].split(", ").collect();
+            let mut rest = close + "), 0)".len();
+            for sw in [".xyz", ".xy", ".x"] {
+                if load[rest..].starts_with(sw) {
+                    rest += sw.len();
+                    break;
+                }
+            }
+            let k = if counts.len() == 3 { ijk[2] } else { "0u" };
+            let read = format!("{table}[(({k}) * {}u + ({})) * {}u + ({})]", counts.get(1).copied().unwrap_or(1), ijk[1], counts[0], ijk[0]);
+            load = format!("{}{read}{}", &load[..at], &load[rest..]);
+        }
+        format!("{}{load}", &src[..start])
+    }
+
+    /// Tables of several channels, three axes and texel-centre placement ([`Grids`]): the
+    /// interpreted WGSL computes every channel as the build's f32 evaluator does, bit for bit,
+    /// at points inside, on and outside the domain, at ±inf and NaN; with their texture forms
+    /// (a 32-bit and a 16-bit format: `texture_3d` for three axes, the channels swizzled out of
+    /// the texel) every module validates in naga with the helper functions named, and `_load`
+    /// on the const array's texels gives the const function's bits.
+    #[test]
+    fn multichannel_and_three_axis_tables_compute_what_the_evaluator_computes() {
+        use crate::emit::fixtures::{grid_points, want_all, Grids};
+        let grids = Grids::new();
+        let header = ["spec: test".to_string()];
+        for f in &grids.functions() {
+            let program = bound::Program::new(&strip_directives(&render_module(&header, f)));
+            let h = program.function(f.name);
+            for p in grid_points(f) {
+                let got: Vec<u32> = program.eval_all(h, &p).iter().map(|(v, _)| v.to_bits()).collect();
+                let want: Vec<u32> = want_all(f, &p).iter().map(|v| v.to_bits()).collect();
+                assert_eq!(got, want, "{}{p:?}", f.name);
+            }
+            let Body::Table { counts, channels, .. } = f.body else { unreachable!() };
+            let rgba = if channels == 1 { "r" } else if channels == 2 { "rg" } else { "rgba" };
+            for (bits, filterable) in [("32float", false), ("16float", true)] {
+                let format = format!("{rgba}{bits}");
+                let tex = TableTexture { file: "data/t.ktx2", format: &format, filterable, keep_const: true };
+                let src = strip_directives(&render_table_module(&header, f, Some(&tex)));
+                let m = naga::front::wgsl::parse_str(&src).unwrap_or_else(|e| panic!("{}", e.emit_to_string(&src)));
+                naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all())
+                    .validate(&m)
+                    .unwrap_or_else(|e| panic!("{}", e.emit_to_string(&src)));
+                let mut names: Vec<String> = vec![format!("{}_input", f.module), f.name.to_string(), format!("{}_load", f.name)];
+                if filterable {
+                    names.extend([format!("{}_uv", f.module), format!("{}_sample", f.name)]);
+                }
+                let got: Vec<String> = m.functions.iter().filter_map(|(_, g)| g.name.clone()).collect();
+                assert_eq!(got, names, "{src}");
+                assert_eq!(src.contains("texture_3d<f32>"), counts.len() == 3, "{src}");
+                let program = bound::Program::new(&load_as_table(&src, f, counts));
+                let (h, g) = (program.function(f.name), program.function("as_table"));
+                for p in grid_points(f) {
+                    let a: Vec<u32> = program.eval_all(g, &p).iter().map(|(v, _)| v.to_bits()).collect();
+                    let b: Vec<u32> = program.eval_all(h, &p).iter().map(|(v, _)| v.to_bits()).collect();
+                    assert_eq!(a, b, "{}_load{p:?} ({format})", f.name);
                 }
             }
         }

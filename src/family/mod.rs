@@ -120,6 +120,8 @@ pub struct Family {
     pub scene_features: &'static [Feature],
     /// CLI subcommands of the family's own (e.g. texture tools).
     pub commands: &'static [FamilyCommand],
+    /// Table axis mappings of the family's own (`mapping = "NAME"` on a table axis).
+    pub axis_mappings: &'static [&'static crate::spec::AxisMapping],
 }
 
 /// Every family, in the order `eval --help`, `validate` and `plot` list them.
@@ -137,6 +139,7 @@ pub fn catalog() -> &'static Catalog {
         quantities: FAMILIES.iter().flat_map(|f| f.quantities.iter()).collect(),
         kinds: FAMILIES.iter().flat_map(|f| f.spec_kinds.iter().map(|k| &k.spec)).collect(),
         features: FAMILIES.iter().flat_map(|f| f.quantities.iter().map(|q| (q.name, f.feature))).collect(),
+        mappings: FAMILIES.iter().flat_map(|f| f.axis_mappings.iter().copied()).collect(),
     })
 }
 

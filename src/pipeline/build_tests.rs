@@ -21,7 +21,7 @@ pub(crate) static EXP: QuantityDef = QuantityDef {
 };
 
 pub(crate) fn spec(text: &str) -> Spec {
-    spec_in(text, &Catalog { quantities: vec![&EXP], kinds: vec![], features: vec![] })
+    spec_in(text, &Catalog { quantities: vec![&EXP], kinds: vec![], features: vec![], mappings: vec![] })
 }
 
 /// A spec from its text, at `fits/NAME.toml` (NAME: the first quoted string, `name = "…"`).
@@ -375,7 +375,7 @@ evaluator = "quad"
 /// minimum on [0, 1], and rebuilds from its committed JSON byte for byte.
 #[test]
 fn a_fields_spec_recovers_exact_fields_and_reads_back() {
-    let s = spec_in(FIELDS, &Catalog { quantities: vec![&FIELDS_Q], kinds: vec![], features: vec![] });
+    let s = spec_in(FIELDS, &Catalog { quantities: vec![&FIELDS_Q], kinds: vec![], features: vec![], mappings: vec![] });
     let tmp = tempfile::tempdir().unwrap();
     let root = tmp.path();
     let b = build_spec(&s, Mode::Fit, root, &|_| None).unwrap();
@@ -425,7 +425,7 @@ fn a_fields_spec_recovers_exact_fields_and_reads_back() {
 fn a_fields_builds_rounding_report_is_its_errors_on_the_fitting_samples() {
     let text = FIELDS.replace("count = 9\nverify = 11", "count = 9\nverify = 17");
     assert_ne!(text, FIELDS);
-    let s = spec_in(&text, &Catalog { quantities: vec![&FIELDS_Q], kinds: vec![], features: vec![] });
+    let s = spec_in(&text, &Catalog { quantities: vec![&FIELDS_Q], kinds: vec![], features: vec![], mappings: vec![] });
     let tmp = tempfile::tempdir().unwrap();
     let b = build_spec(&s, Mode::Fit, tmp.path(), &|_| None).unwrap();
     let j = json_of(&b);
@@ -467,7 +467,7 @@ fn a_fields_builds_rounding_report_is_its_errors_on_the_fitting_samples() {
 fn a_fields_modules_f64_coefficients_split_at_the_numerator() {
     let text = FIELDS.replace("numerator = [\"1\", \"o\"]", "numerator = [\"1\"]");
     assert_ne!(text, FIELDS);
-    let s = spec_in(&text, &Catalog { quantities: vec![&FIELDS_Q], kinds: vec![], features: vec![] });
+    let s = spec_in(&text, &Catalog { quantities: vec![&FIELDS_Q], kinds: vec![], features: vec![], mappings: vec![] });
     let b = build_spec(&s, Mode::Fit, tempfile::tempdir().unwrap().path(), &|_| None).unwrap();
     let j = json_of(&b);
     let module = String::from_utf8(file(&b, "src/quad_fields.rs").to_vec()).unwrap();
@@ -516,7 +516,7 @@ static SCALED_Q: QuantityDef = QuantityDef { name: "scaled-fields", basis: Some(
 #[test]
 fn a_fields_build_reports_its_stage1_conditions() {
     let text = FIELDS.replace("quadratic-fields", "scaled-fields");
-    let b = build_spec(&spec_in(&text, &Catalog { quantities: vec![&SCALED_Q], kinds: vec![], features: vec![] }), Mode::Fit, tempfile::tempdir().unwrap().path(), &|_| None)
+    let b = build_spec(&spec_in(&text, &Catalog { quantities: vec![&SCALED_Q], kinds: vec![], features: vec![], mappings: vec![] }), Mode::Fit, tempfile::tempdir().unwrap().path(), &|_| None)
         .unwrap();
     let fit = &json_of(&b)["fit"];
     let mut conds: Vec<f64> = (0..17)
@@ -552,7 +552,7 @@ fn a_fields_build_reports_its_stage1_conditions() {
 /// not read as fields.
 #[test]
 fn committed_fields_evaluate_the_exact_fields() {
-    let catalog = Catalog { quantities: vec![&EXP, &FIELDS_Q], kinds: vec![], features: vec![] };
+    let catalog = Catalog { quantities: vec![&EXP, &FIELDS_Q], kinds: vec![], features: vec![], mappings: vec![] };
     let tmp = tempfile::tempdir().unwrap();
     let generated = tmp.path().join("generated");
     std::fs::create_dir_all(tmp.path().join("fits")).unwrap();
@@ -607,7 +607,7 @@ fn a_texture_table_states_its_storage_error_and_samples_where_it_filters() {
 /// the domain of each argument, a spec's and a scene's alike.
 #[test]
 fn the_runtime_index_calls_each_function_with_its_arity() {
-    let catalog = Catalog { quantities: vec![&EXP, &FIELDS_Q], kinds: vec![], features: vec![] };
+    let catalog = Catalog { quantities: vec![&EXP, &FIELDS_Q], kinds: vec![], features: vec![], mappings: vec![] };
     let two = "name = \"quad_table\"\nkind = \"table\"\nquantity = \"quadratic-fields\"\ndescription = \"a 2-D table\"\n\n\
                [[axis]]\nname = \"o\"\nrange = [0.0, 1.0]\ncount = 5\n\n[[axis]]\nname = \"u\"\nrange = [-1.0, 1.0]\ncount = 5\n\n\
                [emit]\nfunction = \"quad_lut\"\n";
@@ -646,7 +646,7 @@ static RIPPLED_Q: QuantityDef = QuantityDef {
 /// within the cap.
 #[test]
 fn the_specs_objective_and_rms_cap_reach_the_fitters() {
-    let catalog = Catalog { quantities: vec![&RIPPLED_Q, &EXP], kinds: vec![], features: vec![] };
+    let catalog = Catalog { quantities: vec![&RIPPLED_Q, &EXP], kinds: vec![], features: vec![], mappings: vec![] };
     let tmp = tempfile::tempdir().unwrap();
     let build = |text: &str| build_spec(&spec_in(text, &catalog), Mode::Fit, tmp.path(), &|_| None).unwrap();
     for (text, kind) in [(FIELDS.replace("quadratic-fields", "rippled-fields"), "fields"), (FIT.to_string(), "fit")] {
@@ -688,7 +688,7 @@ fn the_specs_objective_and_rms_cap_reach_the_fitters() {
 /// nor a fields spec (it returns an array); every module is indexed all the same.
 #[test]
 fn the_runtime_index_lists_only_scalar_functions() {
-    let catalog = Catalog { quantities: vec![&EXP, &FIELDS_Q], kinds: vec![], features: vec![] };
+    let catalog = Catalog { quantities: vec![&EXP, &FIELDS_Q], kinds: vec![], features: vec![], mappings: vec![] };
     let texture_only = TABLE.replace("exp_table", "exp_texture").replace("[emit]", "[emit]\nform = \"texture\"");
     let specs = [spec_in(FIT, &catalog), spec_in(TABLE, &catalog), spec_in(&texture_only, &catalog), spec_in(FIELDS, &catalog)];
     let text = String::from_utf8(runtime_index(&specs).contents).unwrap();
@@ -720,7 +720,7 @@ static EXP_PAIR: QuantityDef = QuantityDef {
 /// coefficients and values); a scalar quantity's JSON names none.
 #[test]
 fn a_channel_spec_records_and_builds_its_channel() {
-    let catalog = Catalog { quantities: vec![&EXP, &EXP_PAIR], kinds: vec![], features: vec![] };
+    let catalog = Catalog { quantities: vec![&EXP, &EXP_PAIR], kinds: vec![], features: vec![], mappings: vec![] };
     let tmp = tempfile::tempdir().unwrap();
     let fast = |text: &str| text.replace("quantity = \"exp-decay\"", "quantity = \"exp-pair\"\nchannel = \"fast\"");
     let fit = build_spec(&spec_in(&fast(FIT), &catalog), Mode::Fit, tmp.path(), &|_| None).unwrap();

@@ -99,7 +99,7 @@ fn spec_of(req: &DataFit, model: RationalModel, data: &Data) -> Result<Spec, Bui
         let mut distinct: Vec<f64> = data.x.iter().map(|p| p[j]).collect();
         distinct.sort_by(f64::total_cmp);
         distinct.dedup();
-        axis.push(AxisSpec { name: col.clone(), range: [lo, hi], count: distinct.len(), verify: Some(data.len()) });
+        axis.push(AxisSpec { name: col.clone(), range: [lo, hi], count: distinct.len(), verify: Some(data.len()), mapping: None, placement: None });
     }
     let origin = req.command();
     let mut text = format!("{origin}\n");
@@ -115,6 +115,7 @@ fn spec_of(req: &DataFit, model: RationalModel, data: &Data) -> Result<Spec, Bui
         kind: Kind::Fit,
         quantity: format!("data: column {} of {}", req.y, req.csv.file_name().and_then(|s| s.to_str()).unwrap_or("?")),
         channel: None,
+        channels: None,
         description: format!("Fit of column {} of {} over {}", req.y, req.csv.display(), req.x.join(", ")),
         tolerance: 1e-12,
         max_error: None,
@@ -132,7 +133,7 @@ fn spec_of(req: &DataFit, model: RationalModel, data: &Data) -> Result<Spec, Bui
             float32_filterable: false,
         },
     };
-    Ok(Spec { path: req.csv.to_path_buf(), text, file, quantity: &DATA, model: Some(model), channel: None, origin: Some(origin), feature: "core", merged: None })
+    Ok(Spec { path: req.csv.to_path_buf(), text, file, quantity: &DATA, model: Some(model), channel: None, origin: Some(origin), feature: "core", merged: None, table: None })
 }
 
 /// Fit `data` (read from `req.csv`) with `model` and render the files of a fit spec: the fit

@@ -65,11 +65,11 @@ pub fn runtime_index_with_scenes(specs: &[Spec], scenes: &[SceneIndex]) -> Artif
     }
     s.push_str("    ];\n}\n");
     s.push_str("\n/// Every emitted function with its domain and CPU version (for GPU verification).\npub const FUNCTIONS: &[EmittedFunction] = &[\n");
-    // Family spec kinds (e.g. RGB LUT lookups) and coefficient fields (see emit::fields) return
-    // arrays: not scalar functions of this list; a table emitted as a texture only
+    // Family spec kinds (e.g. RGB LUT lookups), coefficient fields (see emit::fields) and tables
+    // of several channels return arrays: not scalar functions of this list; a table emitted as a texture only
     // (`form = "texture"`) has no WGSL function of that name (its `_load` takes a texture).
     let listed = |s: &&Spec| {
-        !matches!(s.file.kind, Kind::Custom(_) | Kind::Fields) && s.file.emit.form.is_none_or(|f| f.has_const())
+        !matches!(s.file.kind, Kind::Custom(_) | Kind::Fields) && s.file.emit.form.is_none_or(|f| f.has_const()) && table_width(s) == 1
     };
     for spec in specs.iter().filter(listed) {
         let arity = spec.file.axis.len();

@@ -95,7 +95,7 @@ fn table(name: &str, quantity: &str, channel: &str, axes: &[(&str, f64, f64, usi
         text.push_str(&format!("\n[[axis]]\nname = \"{a}\"\nrange = [{lo:?}, {hi:?}]\ncount = {n}\nverify = {}\n", 2 * n - 1));
     }
     text.push_str(&format!("\n[emit]\nfunction = \"{name}\"\n"));
-    let catalog = Catalog { quantities: vec![&ALBEDO, &AVG, &SPLIT], kinds: vec![], features: vec![] };
+    let catalog = Catalog { quantities: vec![&ALBEDO, &AVG, &SPLIT], kinds: vec![], features: vec![], mappings: vec![] };
     let spec = Spec::parse(Path::new(&format!("fits/{name}.toml")), text, &catalog).unwrap();
     build_spec(&spec, Mode::Fit, tempfile::tempdir().unwrap().path(), &|_| None).unwrap()
 }

@@ -38,8 +38,10 @@
 
 pub mod data;
 pub mod names;
+pub mod table;
 
 pub use names::is_identifier;
+pub use table::{AxisMapping, Placement, TableLayout, TableTextureFormat};
 
 use crate::fit::model::{Derived, ModelError, ModelParts, Pin, RationalModel, Term};
 use crate::fit::Objective;
@@ -326,6 +328,8 @@ pub struct Catalog {
     pub kinds: Vec<&'static KindDef>,
     /// (quantity, the runtime crate's feature of the family that serves it).
     pub features: Vec<(&'static str, &'static str)>,
+    /// Table axis mappings of the families' own, beside [`table::GENERIC_MAPPINGS`].
+    pub mappings: Vec<&'static AxisMapping>,
 }
 
 impl Catalog {
@@ -337,6 +341,11 @@ impl Catalog {
 
     pub fn kind(&self, name: &str) -> Option<&'static KindDef> {
         self.kinds.iter().copied().find(|k| k.name == name)
+    }
+
+    /// The table axis mapping named `name`: a generic one or a family's.
+    pub fn mapping(&self, name: &str) -> Option<&'static AxisMapping> {
+        table::GENERIC_MAPPINGS.iter().chain(&self.mappings).copied().find(|m| m.name == name)
     }
 
     /// The runtime feature of the family serving quantity `name` ("core" when none is named).
@@ -472,6 +481,12 @@ pub struct AxisSpec {
     pub count: usize,
     /// Verification grid size along this axis (default: 4·count + 1).
     pub verify: Option<usize>,
+    /// kind = "table": the axis's argument-to-parameter mapping (default `linear`).
+    #[serde(default)]
+    pub mapping: Option<String>,
+    /// kind = "table": where its points lie (default `nodes`).
+    #[serde(default)]
+    pub placement: Option<Placement>,
 }
 
 impl AxisSpec {
@@ -551,27 +566,6 @@ impl TableForm {
     }
 }
 
-/// Texel format of a table texture (WebGPU names): one channel, 16- or 32-bit float.
-#[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq, Default)]
-#[serde(rename_all = "lowercase")]
-pub enum TableTextureFormat {
-    /// IEEE half floats: filterable in core WebGPU; 11 significant bits.
-    R16float,
-    /// f32: the table values exactly; unfilterable in core WebGPU (`float32-filterable`).
-    #[default]
-    R32float,
-}
-
-impl TableTextureFormat {
-    pub fn name(self) -> &'static str {
-        match self {
-            TableTextureFormat::R16float => "r16float",
-            TableTextureFormat::R32float => "r32float",
-        }
-    }
-}
-
-
 #[derive(Debug, Clone, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct SpecFile {
@@ -580,6 +574,8 @@ pub struct SpecFile {
     pub quantity: String,
     /// Vector quantities: the channel a fit or table takes (see `shadefit eval --help`).
     pub channel: Option<String>,
+    /// kind = "table", vector quantities: several channels, in the order the table holds them.
+    pub channels: Option<Vec<String>>,
     #[serde(default)]
     pub description: String,
     /// Integrator absolute tolerance for every sample.
@@ -617,6 +613,8 @@ pub struct Spec {
     /// The cells of a sharded kind merged from shard files (`shadefit merge`): its builder takes
     /// them in `Mode::Fit` instead of computing them. None when read from fits/.
     pub merged: Option<std::sync::Arc<Vec<u8>>>,
+    /// kind = "table": its channels, placements and mappings (None for the other kinds).
+    pub table: Option<TableLayout>,
 }
 
 /// How a spec evaluates its quantity at a point of its axes: the channel it takes, and the
@@ -632,18 +630,30 @@ impl Sampler {
     /// The integral at `point` (the spec's axes, in order) to the spec's tolerance.
     pub fn eval(&self, point: &[f64]) -> Estimate {
         let q = self.quantity;
-        let full: Vec<f64>;
-        let p = if point.len() < q.params.len() {
-            // Spec::parse admits only left-out parameters that have a default.
-            full = point.iter().copied().chain(q.params[point.len()..].iter().map(|p| p.default.unwrap_or(f64::NAN))).collect();
-            &full[..]
-        } else {
-            point
-        };
+        let p = self.complete(point);
         match (self.channel, q.eval_channels) {
-            (Some(c), Some(all)) => all(p, self.tolerance)[c],
-            _ => (q.eval)(p, self.tolerance),
+            (Some(c), Some(all)) => all(&p, self.tolerance)[c],
+            _ => (q.eval)(&p, self.tolerance),
         }
+    }
+
+    /// The channels `picks` of a vector quantity at `point` (one evaluation of every channel);
+    /// with no picks, [`Sampler::eval`].
+    pub fn eval_channels(&self, point: &[f64], picks: &[usize]) -> Vec<Estimate> {
+        match (picks, self.quantity.eval_channels) {
+            ([_, ..], Some(all)) => {
+                let every = all(&self.complete(point), self.tolerance);
+                picks.iter().map(|&c| every[c]).collect()
+            }
+            _ => vec![self.eval(point)],
+        }
+    }
+
+    /// `point` with the defaults of the trailing parameters it leaves out (Spec::parse admits
+    /// only left-out parameters that have a default).
+    fn complete(&self, point: &[f64]) -> Vec<f64> {
+        let q = self.quantity;
+        point.iter().copied().chain(q.params.get(point.len()..).unwrap_or(&[]).iter().map(|p| p.default.unwrap_or(f64::NAN))).collect()
     }
 }
 
@@ -724,11 +734,15 @@ impl Spec {
         if file.emit.texture_format.is_some() && !form.has_texture() {
             return Err(at("texture_format", "needs form = \"texture\" or \"both\"".into()));
         }
-        if file.emit.float32_filterable && (!form.has_texture() || file.emit.texture_format.unwrap_or_default() != TableTextureFormat::R32float) {
-            return Err(at("float32_filterable", "applies to a texture form with texture_format = \"r32float\" only (r16float is filterable in core WebGPU)".into()));
+        let width = file.channels.as_ref().map_or(1, Vec::len);
+        let format = file.emit.texture_format.unwrap_or(TableTextureFormat::default_for(width));
+        if file.emit.float32_filterable && (!form.has_texture() || !format.is_32bit()) {
+            let f32name = TableTextureFormat::default_for(width).name();
+            let f16name = f32name.replace("32", "16");
+            return Err(at("float32_filterable", format!("applies to a texture form with texture_format = \"{f32name}\" only ({f16name} is filterable in core WebGPU)")));
         }
-        if form.has_texture() && file.axis.len() > 2 {
-            return Err(at("form", format!("a table texture is 2-D: {} axes", file.axis.len())));
+        if form.has_texture() && !format.holds(width) {
+            return Err(at("texture_format", format!("{} holds {} channels a texel, the table {width}", format.name(), format.texel_channels())));
         }
         if let Some(b) = file.max_error
             && !(b > 0.0 && b.is_finite())
@@ -739,9 +753,15 @@ impl Spec {
             return Err(at("tolerance", format!("{} must be in (0, 1)", file.tolerance)));
         }
         let custom_kind = matches!(file.kind, Kind::Custom(_));
+        if file.channels.is_some() && file.kind != Kind::Table {
+            return Err(at("channels", format!("applies to kind = \"table\" only, not \"{}\"", file.kind.name())));
+        }
+        if file.channels.is_some() && file.channel.is_some() {
+            return Err(at("channels", "give either channel (one) or channels (several), not both".into()));
+        }
         let channel = match (&file.channel, quantity.channels) {
             (None, []) => None,
-            (None, _) if custom_kind => None,
+            (None, _) if custom_kind || file.channels.is_some() => None,
             (None, names) => {
                 return Err(at(
                     "quantity",
@@ -776,7 +796,13 @@ impl Spec {
         let own_axes = matches!(file.kind, Kind::Custom(_));
         for (a, p) in file.axis.iter().zip(quantity.params).filter(|_| !own_axes) {
             let [lo, hi] = a.range;
-            if !(lo.is_finite() && hi.is_finite() && lo < hi && lo >= p.min && hi <= p.max) {
+            if a.mapping.is_some() || a.placement.is_some() {
+                if file.kind != Kind::Table {
+                    let field = if a.mapping.is_some() { "mapping" } else { "placement" };
+                    return Err(at(field, format!("applies to kind = \"table\" only, not \"{}\"", file.kind.name())));
+                }
+                // A table's mapped range is checked with its mapping (table_layout).
+            } else if !(lo.is_finite() && hi.is_finite() && lo < hi && lo >= p.min && hi <= p.max) {
                 return Err(at(
                     "range",
                     format!("axis '{}' range [{lo}, {hi}] must be finite, increasing and inside [{}, {}]", a.name, p.min, p.max),
@@ -834,11 +860,76 @@ impl Spec {
         if file.kind != Kind::Fields && (file.fields.is_some() || file.emit.evaluator.is_some()) {
             return Err(at("fields", "[fields] and emit.evaluator belong to kind = \"fields\"".into()));
         }
-        if file.kind == Kind::Table && file.axis.len() > 2 {
-            return Err(at("axis", "tables have one or two axes".into()));
+        if file.kind == Kind::Table && file.axis.len() > 3 {
+            return Err(at("axis", "tables have one, two or three axes".into()));
         }
-        Ok(Spec { path: path.to_path_buf(), text, file, quantity, model, channel, origin: None, feature: catalog.feature(quantity.name), merged: None })
+        let table = match file.kind {
+            Kind::Table => Some(table_layout(path, &text, &file, quantity, catalog)?),
+            _ => None,
+        };
+        Ok(Spec { path: path.to_path_buf(), text, file, quantity, model, channel, origin: None, feature: catalog.feature(quantity.name), merged: None, table })
     }
+}
+
+/// The layout of a kind = "table" spec: its channels (named ones of a vector quantity, each
+/// once), and each axis's placement and mapping, whose range of arguments must lie where the
+/// mapping is defined and map inside the parameter's domain.
+fn table_layout(path: &Path, text: &str, file: &SpecFile, quantity: &QuantityDef, catalog: &Catalog) -> Result<TableLayout, SpecError> {
+    let at = |field: &str, msg: String| SpecError::new(path, line_of(text, field), field, msg);
+    let mut channels = Vec::new();
+    if let Some(names) = &file.channels {
+        if quantity.channels.is_empty() || quantity.eval_channels.is_none() {
+            return Err(at("channels", format!("'{}' is a scalar quantity; remove channels", quantity.name)));
+        }
+        if !(1..=4).contains(&names.len()) {
+            return Err(at("channels", format!("a table holds 1 to 4 channels, not {}", names.len())));
+        }
+        for (i, c) in names.iter().enumerate() {
+            match quantity.channels.iter().position(|n| n == c) {
+                Some(_) if names[..i].contains(c) => return Err(at("channels", format!("'{c}' is given twice"))),
+                Some(k) => channels.push(k),
+                None => return Err(at("channels", format!("'{c}' is not a channel of '{}' (channels: {})", quantity.name, quantity.channels.join(", ")))),
+            }
+        }
+    }
+    let mut axes = Vec::new();
+    for (a, p) in file.axis.iter().zip(quantity.params) {
+        let mapping = match &a.mapping {
+            None => &table::LINEAR,
+            Some(m) => catalog.mapping(m).ok_or_else(|| {
+                let known: Vec<&str> = table::GENERIC_MAPPINGS.iter().chain(&catalog.mappings).map(|m| m.name).collect();
+                at("mapping", format!("axis '{}': unknown mapping '{m}' (known: {})", a.name, known.join(", ")))
+            })?,
+        };
+        let placement = a.placement.unwrap_or_default();
+        if a.mapping.is_some() || a.placement.is_some() {
+            let [lo, hi] = a.range;
+            // The outermost points sampled: the ends, or at texel centres the first and the last
+            // centre of the finer of the table and verification grids (both at centres).
+            let (first, last) = match placement {
+                Placement::Nodes => (lo, hi),
+                Placement::Centres => {
+                    let half = (hi - lo) * 0.5 / a.count.max(a.verify_count()) as f64;
+                    (lo + half, hi - half)
+                }
+            };
+            let [tlo, thi] = mapping.argument;
+            let (plo, phi) = ((mapping.to_parameter)(first), (mapping.to_parameter)(last));
+            let inside = |v: f64| v >= p.min && v <= p.max;
+            if !(lo.is_finite() && hi.is_finite() && lo < hi && first >= tlo && last <= thi && inside(plo) && inside(phi)) {
+                return Err(at(
+                    "range",
+                    format!(
+                        "axis '{}' range [{lo}, {hi}] must be finite, increasing, sampled inside [{tlo}, {thi}] (mapping '{}': {}) \
+                         and map inside [{}, {}] (its outermost points {first}, {last} map to {plo}, {phi})",
+                        a.name, mapping.name, mapping.doc, p.min, p.max
+                    ),
+                ));
+            }
+        }
+        axes.push((placement, mapping));
+    }
+    Ok(TableLayout { channels, axes })
 }
 
 /// The model shared by the coefficient fields of a kind = "fields" spec (features: the outer

@@ -109,7 +109,7 @@ mod tests {
     /// refit that is not committed adds nothing.
     #[test]
     fn a_validation_item_measures_the_committed_refit() {
-        let catalog = Catalog { quantities: vec![&EXP], kinds: vec![], features: vec![] };
+        let catalog = Catalog { quantities: vec![&EXP], kinds: vec![], features: vec![], mappings: vec![] };
         let tmp = tempfile::tempdir().unwrap();
         let generated = tmp.path().join("generated");
         std::fs::create_dir_all(tmp.path().join("fits")).unwrap();

@@ -526,6 +526,12 @@ impl Program {
                 B::NotEqual => V::B(x != y),
                 other => panic!("unsupported bool operator {other:?}"),
             },
+            // Vectors (a table's channels): component by component, a scalar operand with each.
+            (V::Arr(x), V::Arr(y)) if x.len() == y.len() => {
+                V::Arr(Rc::new(x.iter().zip(y.iter()).map(|(a, b)| self.binary(op, a.clone(), b.clone())).collect()))
+            }
+            (V::Arr(x), s @ V::F { .. }) => V::Arr(Rc::new(x.iter().map(|a| self.binary(op, a.clone(), s.clone())).collect())),
+            (s @ V::F { .. }, V::Arr(y)) => V::Arr(Rc::new(y.iter().map(|b| self.binary(op, s.clone(), b.clone())).collect())),
             (a, b) => panic!("unsupported operands {a:?} {op:?} {b:?}"),
         }
     }

@@ -569,7 +569,7 @@ fn ps_table_row(refit: &Spec, committed: &[DVector<f64>], evaluator: &OpCounts, 
     let mut calls = Vec::new();
     for (k, values) in tables.iter().enumerate() {
         let module = format!("{name}_c{k}");
-        let f = Function { module: &module, name: &module, args: &args, derived: &[], domain: &domain, body: Body::Table { values, counts: &[n, n] } };
+        let f = Function { module: &module, name: &module, args: &args, derived: &[], domain: &domain, body: Body::Table { values, counts: &[n, n], channels: 1, placements: &[crate::emit::interp::Placement::Nodes; 2] } };
         src.push_str(&wgsl::render_module(&[], &f));
         calls.push(format!("{module}({})", args.join(", ")));
     }

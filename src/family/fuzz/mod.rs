@@ -138,4 +138,5 @@ pub static FAMILY: Family = Family {
     bench: bench::BENCH,
     scene_features: scene::FEATURES,
     commands: &[],
+    axis_mappings: &[],
 };

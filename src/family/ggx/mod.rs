@@ -213,4 +213,5 @@ pub static FAMILY: Family = Family {
     bench: bench::BENCH,
     scene_features: &[],
     commands: &[],
+    axis_mappings: &[],
 };

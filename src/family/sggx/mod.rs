@@ -147,4 +147,5 @@ pub static FAMILY: Family = Family {
     bench: bench::BENCH,
     scene_features: &[],
     commands: &[mip::COMMAND],
+    axis_mappings: &[],
 };
