@@ -116,6 +116,7 @@ fn spec_of(req: &DataFit, model: RationalModel, data: &Data) -> Result<Spec, Bui
         quantity: format!("data: column {} of {}", req.y, req.csv.file_name().and_then(|s| s.to_str()).unwrap_or("?")),
         channel: None,
         channels: None,
+        order: None,
         description: format!("Fit of column {} of {} over {}", req.y, req.csv.display(), req.x.join(", ")),
         tolerance: 1e-12,
         max_error: None,

@@ -73,12 +73,10 @@ pub fn runtime_index_with_scenes(specs: &[Spec], scenes: &[SceneIndex]) -> Artif
     };
     for spec in specs.iter().filter(listed) {
         let arity = spec.file.axis.len();
-        let domain: Vec<String> = spec
-            .file
-            .axis
-            .iter()
-            .map(|a| format!("[{}, {}]", emit::f32_literal(a.range[0] as f32), emit::f32_literal(a.range[1] as f32)))
-            .collect();
+        // A table's arguments are in its storage order.
+        let ranges: Vec<[f64; 2]> = if spec.file.kind == Kind::Table { table_domain(spec) } else { spec.file.axis.iter().map(|a| a.range).collect() };
+        let domain: Vec<String> =
+            ranges.iter().map(|r| format!("[{}, {}]", emit::f32_literal(r[0] as f32), emit::f32_literal(r[1] as f32))).collect();
         let cpu = match arity {
             1 => "Cpu::One",
             2 => "Cpu::Two",

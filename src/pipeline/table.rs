@@ -18,7 +18,19 @@ pub fn table_layout(spec: &Spec) -> TableLayout {
     spec.table.clone().unwrap_or_else(|| TableLayout {
         channels: Vec::new(),
         axes: spec.file.axis.iter().map(|_| (Placement::Nodes, &spec::table::LINEAR)).collect(),
+        order: (0..spec.file.axis.len()).collect(),
     })
+}
+
+/// A table's axes in storage order (first fastest): each `[[axis]]` with its placement and
+/// mapping.
+pub fn table_axes<'a>(spec: &'a Spec, layout: &TableLayout) -> Vec<(&'a spec::AxisSpec, Placement, &'static spec::AxisMapping)> {
+    layout.order.iter().map(|&k| (&spec.file.axis[k], layout.axes[k].0, layout.axes[k].1)).collect()
+}
+
+/// The argument ranges of a table's emitted function, in storage order.
+pub fn table_domain(spec: &Spec) -> Vec<[f64; 2]> {
+    table_axes(spec, &table_layout(spec)).iter().map(|(a, _, _)| a.range).collect()
 }
 
 /// Values a point of a table spec (its channels, or 1).
@@ -26,12 +38,12 @@ pub fn table_width(spec: &Spec) -> usize {
     table_layout(spec).width()
 }
 
-/// The emitted code's addressing of each axis.
+/// The emitted code's addressing of each axis, in storage order.
 fn addressing(layout: &TableLayout) -> Vec<Addressing> {
     layout
-        .axes
+        .order
         .iter()
-        .map(|(p, _)| match p {
+        .map(|&k| match layout.axes[k].0 {
             Placement::Nodes => Addressing::Nodes,
             Placement::Centres => Addressing::Centres,
         })
@@ -128,18 +140,22 @@ pub fn committed_values(spec: &Spec, root: &Path) -> Result<Vec<f64>, BuildError
 /// axis fastest).
 pub fn table_points(spec: &Spec) -> Vec<Vec<f64>> {
     let layout = table_layout(spec);
-    product(spec.file.axis.iter().zip(&layout.axes).map(|(a, (p, _))| p.points(a.range, a.count)).collect())
+    product(table_axes(spec, &layout).iter().map(|(a, p, _)| p.points(a.range, a.count)).collect())
 }
 
-/// The table's values at `points` (its arguments), flat: each point mapped to the quantity's
-/// parameters, its channels evaluated once; in parallel, in order.
+/// The table's values at `points` (its arguments, in storage order), flat: each point mapped to
+/// the quantity's parameters (in their order), its channels evaluated once; in parallel, in
+/// order.
 pub fn table_sample(spec: &Spec, points: &[Vec<f64>]) -> Vec<f64> {
     let layout = table_layout(spec);
     let sampler = spec.sampler();
     points
         .par_iter()
         .flat_map_iter(|t| {
-            let p: Vec<f64> = t.iter().zip(&layout.axes).map(|(&x, (_, m))| (m.to_parameter)(x)).collect();
+            let mut p = vec![0.0; t.len()];
+            for (&x, &k) in t.iter().zip(&layout.order) {
+                p[k] = (layout.axes[k].1.to_parameter)(x);
+            }
             sampler.eval_channels(&p, &layout.channels).into_iter().map(|e| e.value)
         })
         .collect()
@@ -151,7 +167,7 @@ pub fn table_sample(spec: &Spec, points: &[Vec<f64>]) -> Vec<f64> {
 /// never at the ends, where a mapped parameter may leave the quantity's domain).
 pub fn table_reference(spec: &Spec) -> Reference {
     let layout = table_layout(spec);
-    let points = product(spec.file.axis.iter().zip(&layout.axes).map(|(a, (p, _))| p.points(a.range, a.verify_count())).collect());
+    let points = product(table_axes(spec, &layout).iter().map(|(a, p, _)| p.points(a.range, a.verify_count())).collect());
     let values = table_sample(spec, &points);
     Reference { points, values }
 }
@@ -176,11 +192,12 @@ pub fn table_from_values(spec: &Spec, values: Vec<f64>, reference: &Reference) -
     let layout = table_layout(spec);
     let width = layout.width();
     let placements = addressing(&layout);
-    let counts: Vec<usize> = spec.file.axis.iter().map(|a| a.count).collect();
+    let axes = table_axes(spec, &layout);
+    let counts: Vec<usize> = axes.iter().map(|(a, _, _)| a.count).collect();
     let points = table_points(spec);
     assert_eq!(values.len(), points.len() * width, "{name}: {width} values a table point");
     let v32: Vec<f32> = values.iter().map(|&v| v as f32).collect();
-    let d32 = domain_f32(spec);
+    let d32: Vec<(f32, f32)> = axes.iter().map(|(a, _, _)| (a.range[0] as f32, a.range[1] as f32)).collect();
     let (vx, truth) = (&reference.points, &reference.values);
     let approx32: Vec<f32> = vx
         .iter()
@@ -214,7 +231,8 @@ pub fn table_from_values(spec: &Spec, values: Vec<f64>, reference: &Reference) -
         err_line.push_str(&format!("; {} texture storage <= {}", tex_format.name(), fmt_err(storage as f64)));
     }
     let header = header_lines(&spec_rel_path(spec), &hash, &err_line);
-    let a = args(spec);
+    // `[emit] args` name the arguments in storage order; by default the axes' names.
+    let a = spec.file.emit.args.clone().unwrap_or_else(|| axes.iter().map(|(x, _, _)| x.name.clone()).collect());
     let func = wgsl::Function {
         module: &name,
         name: &spec.file.emit.function,
@@ -232,19 +250,16 @@ pub fn table_from_values(spec: &Spec, values: Vec<f64>, reference: &Reference) -
         counts.iter().map(|c| c.to_string()).collect::<Vec<_>>().join("×"),
         label
     );
-    let axes: Vec<AxisJson> = spec
-        .file
-        .axis
+    let axes: Vec<AxisJson> = axes
         .iter()
-        .zip(&layout.axes)
-        .map(|(a, (p, m))| {
+        .map(|&(a, p, m)| {
             let mapped = m.name != spec::table::LINEAR.name;
             AxisJson {
                 name: &a.name,
                 range: a.range,
                 count: a.count,
                 verify: a.verify_count(),
-                placement: (*p != Placement::Nodes).then(|| p.name()),
+                placement: (p != Placement::Nodes).then(|| p.name()),
                 mapping: mapped.then_some(m.name),
                 parameter_range: mapped.then(|| a.range.map(m.to_parameter)),
             }

@@ -305,3 +305,36 @@ fn bad_table_keys_are_refused_naming_the_field() {
     bad(fit.to_string(), "mapping", "applies to kind = \"table\" only");
     bad(fit.replace("kind = \"fit\"", "kind = \"fit\"\nchannels = [\"u\"]").replace("mapping = \"perceptual\"\n", ""), "channels", "applies to kind = \"table\" only");
 }
+
+/// `order` stores the axes in another order than the quantity's parameters (first fastest,
+/// the function's arguments in that order): y before x, point (j, i) at y_j, x_i; each axis
+/// once, or the spec is refused.
+#[test]
+fn order_stores_the_axes_in_the_order_given() {
+    let text = TRILINEAR.replace("channels = [\"v\", \"u\"]", "channels = [\"u\"]\norder = [\"y\", \"x\"]");
+    let text = format!("{}[emit]{}", &text[..text.find("\n[[axis]]\nname = \"z\"").unwrap()], text.split("[emit]").nth(1).unwrap()).replace("rg32float", "r32float");
+    let b = built(&text);
+    let j = json_of(&b);
+    let values: Vec<f64> = j["values"].as_array().unwrap().iter().map(|p| p.as_f64().unwrap()).collect();
+    let (xs, ys) = ([0.0, 0.5, 1.0, 1.5, 2.0], [-0.75, -0.25, 0.25, 0.75]);
+    assert_eq!(values.len(), 20);
+    for (n, v) in values.iter().enumerate() {
+        // z is left at its default, 0; the closed form at dyadic points is exact.
+        assert_eq!(*v, tri(&[xs[n / 4], ys[n % 4], 0.0])[0], "point {n}");
+    }
+    assert_eq!((j["axes"][0]["name"].as_str(), j["axes"][1]["name"].as_str()), (Some("y"), Some("x")));
+    assert!(text_of(&b).contains("fn tri_lut(y: f32, x: f32) -> f32"));
+    let (vk, w, h, _, _, _) = read_ktx2(file(&b, "data/tri_lut.ktx2"));
+    assert_eq!((vk, w, h), (100, 4, 5));
+    let index = String::from_utf8(runtime_index(&[parse(&text).unwrap()]).contents).unwrap();
+    assert!(index.contains("name: \"tri_lut\", domain: &[[-1e0, 1e0], [0e0, 2e0]]"), "{index}");
+    for bad in ["[\"y\", \"y\"]", "[\"y\"]", "[\"y\", \"x\", \"z\"]"] {
+        let e = parse(&text.replace("[\"y\", \"x\"]", bad)).unwrap_err();
+        assert_eq!(e.field, "order", "{e}");
+        assert!(e.msg.contains("needs each axis once: [x, y]"), "{e}");
+    }
+}
+
+fn text_of(b: &Built) -> &str {
+    text(b, &format!("wgsl/{}.wgsl", b.name))
+}

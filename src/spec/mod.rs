@@ -576,6 +576,9 @@ pub struct SpecFile {
     pub channel: Option<String>,
     /// kind = "table", vector quantities: several channels, in the order the table holds them.
     pub channels: Option<Vec<String>>,
+    /// kind = "table": the axes' names in the table's storage order (first fastest), which is
+    /// also the emitted function's argument order (default: the `[[axis]]` order).
+    pub order: Option<Vec<String>>,
     #[serde(default)]
     pub description: String,
     /// Integrator absolute tolerance for every sample.
@@ -753,6 +756,9 @@ impl Spec {
             return Err(at("tolerance", format!("{} must be in (0, 1)", file.tolerance)));
         }
         let custom_kind = matches!(file.kind, Kind::Custom(_));
+        if file.order.is_some() && file.kind != Kind::Table {
+            return Err(at("order", format!("applies to kind = \"table\" only, not \"{}\"", file.kind.name())));
+        }
         if file.channels.is_some() && file.kind != Kind::Table {
             return Err(at("channels", format!("applies to kind = \"table\" only, not \"{}\"", file.kind.name())));
         }
@@ -929,7 +935,20 @@ fn table_layout(path: &Path, text: &str, file: &SpecFile, quantity: &QuantityDef
         }
         axes.push((placement, mapping));
     }
-    Ok(TableLayout { channels, axes })
+    let names: Vec<&str> = file.axis.iter().map(|a| a.name.as_str()).collect();
+    let order = match &file.order {
+        None => (0..names.len()).collect(),
+        Some(o) => {
+            let idx: Vec<Option<usize>> = o.iter().map(|n| names.iter().position(|a| a == n)).collect();
+            let mut sorted: Vec<usize> = idx.iter().flatten().copied().collect();
+            sorted.sort_unstable();
+            if idx.iter().any(Option::is_none) || sorted != (0..names.len()).collect::<Vec<_>>() {
+                return Err(at("order", format!("needs each axis once: [{}], found [{}]", names.join(", "), o.join(", "))));
+            }
+            idx.into_iter().flatten().collect()
+        }
+    };
+    Ok(TableLayout { channels, axes, order })
 }
 
 /// The model shared by the coefficient fields of a kind = "fields" spec (features: the outer

@@ -7,6 +7,8 @@
 //! quantity = "some-vector-quantity"
 //! channels = ["scale", "bias"]     # optional: several channels of a vector quantity, in order
 //!                                  # (the emitted function returns vec2<f32> / [f32; 2])
+//! order = ["n_dot_v", "alpha"]     # optional: the axes in storage order (first fastest: the
+//!                                  # texture's x, y, z) and argument order; default [[axis]]'s
 //!
 //! [[axis]]
 //! name = "alpha"                   # the quantity's parameter
@@ -166,8 +168,12 @@ pub struct TableLayout {
     /// Indices of the channels of a vector quantity the table holds, in order (`channels`);
     /// empty for one value a point (a scalar quantity, or the one `channel`).
     pub channels: Vec<usize>,
-    /// Per axis: where its points lie and how its argument maps to the parameter.
+    /// Per axis (in the `[[axis]]` order): where its points lie and how its argument maps to
+    /// the parameter.
     pub axes: Vec<(Placement, &'static AxisMapping)>,
+    /// The table's axes in storage order (first fastest; the emitted function's arguments and
+    /// the texture's x, y, z), as indices of `[[axis]]`: `order = [...]`, else 0, 1, 2.
+    pub order: Vec<usize>,
 }
 
 impl TableLayout {

@@ -429,41 +429,44 @@ pub(crate) mod tests {
         format!("name = \"ggx_t\"\nkind = \"ggx-dfg-lut\"\nquantity = \"ggx-env\"\nresolution = [{w}, {h}]\n\n[emit]\nfunction = \"ggx_t\"\n")
     }
 
-    /// The generic table kind computes this LUT's texels: `kind = "table"` with the channels
-    /// [scale, bias] of `ggx-env`, α's axis at texel centres over perceptual roughness
-    /// (`mapping = "perceptual"`) and n·v's at texel centres, holds each texel of a
-    /// `ggx-dfg-lut` of the same resolution and tolerance bit for bit (the same integrals at the
-    /// same points). Its first axis is α's (the quantity's parameter order), so its point (j, i)
-    /// is the LUT's texel (i, j); its module (RG16F, so with the sampler helpers) validates.
+    /// The generic table kind computes this LUT's texture: `kind = "table"` with the channels
+    /// [scale, bias] of `ggx-env`, n·v's axis and α's at texel centres, α's over perceptual
+    /// roughness (`mapping = "perceptual"`), stored n·v fastest (`order = ["n_dot_v", "alpha"]`,
+    /// this LUT's layout), holds each texel of a `ggx-dfg-lut` of the same resolution and
+    /// tolerance bit for bit (the same integrals at the same points), and its RG16F KTX2 holds
+    /// the same level bytes; its module (with the sampler helpers: RG16F filters) validates.
     #[test]
-    fn a_generic_table_at_texel_centres_holds_the_dfg_texels() {
+    fn a_generic_table_at_texel_centres_is_the_dfg_texture() {
         let (w, h) = (6, 5);
-        let text = spec_text([w, h]).replace("resolution", "tolerance = 1e-7\nresolution");
+        let text = spec_text([w, h]).replace("resolution", "tolerance = 1e-7\ntexture_format = \"rg16float\"\nresolution");
+        let dfg_spec = crate::spec::Spec::parse(std::path::Path::new("fits/ggx_t.toml"), text.clone(), crate::family::catalog()).unwrap();
         let lut = DfgLut::parse(std::path::Path::new("fits/ggx_t.toml"), &text).unwrap();
         let (texels, _) = tabulate(&lut);
         let table = format!(
-            "name = \"ggx_table_t\"\nkind = \"table\"\nquantity = \"ggx-env\"\nchannels = [\"scale\", \"bias\"]\ntolerance = 1e-7\n\n\
+            "name = \"ggx_table_t\"\nkind = \"table\"\nquantity = \"ggx-env\"\nchannels = [\"scale\", \"bias\"]\norder = [\"n_dot_v\", \"alpha\"]\ntolerance = 1e-7\n\n\
              [[axis]]\nname = \"alpha\"\nmapping = \"perceptual\"\nplacement = \"centres\"\nrange = [0.0, 1.0]\ncount = {h}\nverify = {h}\n\n\
              [[axis]]\nname = \"n_dot_v\"\nplacement = \"centres\"\nrange = [0.0, 1.0]\ncount = {w}\nverify = {w}\n\n\
-             [emit]\nfunction = \"ggx_table_t\"\nargs = [\"roughness\", \"n_dot_v\"]\nform = \"both\"\ntexture_format = \"rg16float\"\n"
+             [emit]\nfunction = \"ggx_table_t\"\nargs = [\"n_dot_v\", \"roughness\"]\nform = \"both\"\ntexture_format = \"rg16float\"\n"
         );
         let spec = crate::spec::Spec::parse(std::path::Path::new("fits/ggx_table_t.toml"), table, crate::family::catalog()).unwrap();
         let values = crate::pipeline::table_sample(&spec, &crate::pipeline::table_points(&spec));
-        assert_eq!(values.len(), 2 * w * h);
-        for j in 0..h {
-            for i in 0..w {
-                let k = j + h * i;
-                assert_eq!([values[2 * k], values[2 * k + 1]], texels[j * w + i], "texel ({i}, {j})");
-            }
-        }
+        let pairs: Vec<[f64; 2]> = values.chunks(2).map(|p| [p[0], p[1]]).collect();
+        assert_eq!(pairs, texels);
+        let level = |ktx2: &[u8]| {
+            let at = |k: usize| u64::from_le_bytes(ktx2[k..k + 8].try_into().unwrap()) as usize;
+            ktx2[at(80)..at(80) + at(88)].to_vec()
+        };
+        let ktx2_of = |b: &Built, name: &str| b.artifacts.iter().find(|a| a.path.ends_with(format!("data/{name}.ktx2"))).unwrap().contents.clone();
         let b = crate::pipeline::build_spec(&spec, Mode::Fit, std::path::Path::new(""), &|_| None).unwrap();
+        let dfg = build(&dfg_spec, Mode::Fit, std::path::Path::new("")).unwrap();
+        assert_eq!(level(&ktx2_of(&b, "ggx_table_t")), level(&ktx2_of(&dfg, "ggx_t")));
         let wgsl = b.artifacts.iter().find(|a| a.path.ends_with("wgsl/ggx_table_t.wgsl")).unwrap();
         let src = crate::emit::wgsl::strip_directives(std::str::from_utf8(&wgsl.contents).unwrap());
         let m = naga::front::wgsl::parse_str(&src).unwrap_or_else(|e| panic!("{}", e.emit_to_string(&src)));
         naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all())
             .validate(&m)
             .unwrap_or_else(|e| panic!("{}", e.emit_to_string(&src)));
-        assert!(src.contains("fn ggx_table_t_sample(lut: texture_2d<f32>, lut_sampler: sampler, roughness: f32, n_dot_v: f32) -> vec2<f32>"), "{src}");
+        assert!(src.contains("fn ggx_table_t_sample(lut: texture_2d<f32>, lut_sampler: sampler, n_dot_v: f32, roughness: f32) -> vec2<f32>"), "{src}");
     }
 
     /// The module doc names the function, the quantity, the G it integrates and the light cone.
