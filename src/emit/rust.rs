@@ -201,11 +201,10 @@ mod tests {
         use crate::emit::fixtures::{points, want, Four};
         let four = Four::new();
         let fs = four.functions();
-        let tmp = tempfile::tempdir().unwrap();
-        let dir = tmp.path();
+        let mut modules = Vec::new();
         let mut main = String::from("fn main() {\n");
         for f in &fs {
-            std::fs::write(dir.join(format!("{}.rs", f.module)), render_module(&["spec: test".to_string()], f, "A test module.")).unwrap();
+            modules.push((f.module.to_string(), render_module(&["spec: test".to_string()], f, "A test module.")));
             main = format!("mod {m};\n{main}", m = f.module);
             for p in points(f) {
                 let a: Vec<String> = p.iter().map(|v| format!("f32::from_bits({:#x})", v.to_bits())).collect();
@@ -213,12 +212,7 @@ mod tests {
             }
         }
         main.push_str("}\n");
-        std::fs::write(dir.join("main.rs"), main).unwrap();
-        let rustc = std::env::var("RUSTC").unwrap_or_else(|_| "rustc".into());
-        let out = std::process::Command::new(rustc).args(["--edition", "2021", "-A", "warnings", "-o"]).arg(dir.join("main")).arg(dir.join("main.rs")).output().unwrap();
-        assert!(out.status.success(), "rustc: {}", String::from_utf8_lossy(&out.stderr));
-        let run = std::process::Command::new(dir.join("main")).output().unwrap();
-        let got: Vec<u32> = String::from_utf8(run.stdout).unwrap().lines().map(|l| l.parse().unwrap()).collect();
+        let got = compiled_bits_with(&main, &modules);
         let expected: Vec<(String, u32)> = fs.iter().flat_map(|f| points(f).into_iter().map(move |p| (format!("{}{p:?}", f.name), want(f, &p).to_bits()))).collect();
         assert_eq!(got.len(), expected.len());
         for (g, (at, w)) in got.iter().zip(&expected) {
@@ -228,8 +222,16 @@ mod tests {
 
     /// `main` compiled by rustc and run: the u32 it prints, one a line.
     fn compiled_bits(main: &str) -> Vec<u32> {
+        compiled_bits_with(main, &[])
+    }
+
+    /// [`compiled_bits`] with the modules `(name, text)` beside `main.rs` (`mod name;` in it).
+    fn compiled_bits_with(main: &str, modules: &[(String, String)]) -> Vec<u32> {
         let tmp = tempfile::tempdir().unwrap();
         let dir = tmp.path();
+        for (name, text) in modules {
+            std::fs::write(dir.join(format!("{name}.rs")), text).unwrap();
+        }
         std::fs::write(dir.join("main.rs"), main).unwrap();
         let rustc = std::env::var("RUSTC").unwrap_or_else(|_| "rustc".into());
         let out = std::process::Command::new(rustc).args(["--edition", "2021", "-A", "warnings", "-o"]).arg(dir.join("main")).arg(dir.join("main.rs")).output().unwrap();
@@ -246,11 +248,10 @@ mod tests {
         use crate::emit::fixtures::{grid_points, want_all, Grids};
         let grids = Grids::new();
         let fs = grids.functions();
-        let tmp = tempfile::tempdir().unwrap();
-        let dir = tmp.path();
+        let mut modules = Vec::new();
         let mut main = String::from("fn main() {\n");
         for f in &fs {
-            std::fs::write(dir.join(format!("{}.rs", f.module)), render_module(&["spec: test".to_string()], f, "A test module.")).unwrap();
+            modules.push((f.module.to_string(), render_module(&["spec: test".to_string()], f, "A test module.")));
             main = format!("mod {m};\n{main}", m = f.module);
             for p in grid_points(f) {
                 let a: Vec<String> = p.iter().map(|v| format!("f32::from_bits({:#x})", v.to_bits())).collect();
@@ -260,12 +261,7 @@ mod tests {
             }
         }
         main.push_str("}\n");
-        std::fs::write(dir.join("main.rs"), main).unwrap();
-        let rustc = std::env::var("RUSTC").unwrap_or_else(|_| "rustc".into());
-        let out = std::process::Command::new(rustc).args(["--edition", "2021", "-A", "warnings", "-o"]).arg(dir.join("main")).arg(dir.join("main.rs")).output().unwrap();
-        assert!(out.status.success(), "rustc: {}", String::from_utf8_lossy(&out.stderr));
-        let run = std::process::Command::new(dir.join("main")).output().unwrap();
-        let got: Vec<u32> = String::from_utf8(run.stdout).unwrap().lines().map(|l| l.parse().unwrap()).collect();
+        let got = compiled_bits_with(&main, &modules);
         let expected: Vec<(String, u32)> = fs
             .iter()
             .flat_map(|f| grid_points(f).into_iter().flat_map(move |p| want_all(f, &p).into_iter().enumerate().map(move |(c, w)| (format!("{}{p:?}[{c}]", f.name), w.to_bits()))))
