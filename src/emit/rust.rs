@@ -123,15 +123,7 @@ pub fn render_module(header: &[String], f: &Function<'_>, doc: &str) -> String {
                 2 => s.push_str(&format!("    let k = (i1 * {nx} + i0) as usize;\n")),
                 _ => s.push_str(&format!("    let k = ((i2 * {ny} + i1) * {nx} + i0) as usize;\n")),
             }
-            let read = |dx: usize, dy: usize, dz: usize| {
-                let o = dx + nx * (dy + ny * dz);
-                match (counts.len(), o) {
-                    (1, 0) => format!("{t}[i0]"),
-                    (1, _) => format!("{t}[i0 + 1]"),
-                    (_, 0) => format!("{t}[k]"),
-                    _ => format!("{t}[k + {o}]"),
-                }
-            };
+            let read = super::wgsl::flat_read(counts, &t, "");
             // Several channels: the lerp channel by channel (`c`: a name no argument may take).
             let lerp = |a: &str, b: &str, f: &str| {
                 if c == 1 { format!("{a} * (1.0 - {f}) + {b} * {f}") } else { format!("std::array::from_fn::<f32, {c}, _>(|c| {a}[c] * (1.0 - {f}) + {b}[c] * {f})") }

@@ -27,6 +27,22 @@ fn swizzle(channels: usize) -> &'static str {
     ["", ".x", ".xy", ".xyz", ""][channels]
 }
 
+/// The texel of a const table `t` at offsets (dx, dy, dz) from the cell's first node, first
+/// axis fastest: `t[i0 + 1]` in one axis, `t[k + offset]` from the flat index `k` in more;
+/// `int` is the language's suffix of an index literal (`u` in WGSL).
+pub(crate) fn flat_read<'a>(counts: &'a [usize], t: &'a str, int: &'a str) -> impl Fn(usize, usize, usize) -> String + 'a {
+    let (nx, ny) = (counts[0], counts.get(1).copied().unwrap_or(1));
+    move |dx, dy, dz| {
+        let o = dx + nx * (dy + ny * dz);
+        match (counts.len(), o) {
+            (1, 0) => format!("{t}[i0]"),
+            (1, _) => format!("{t}[i0 + 1{int}]"),
+            (_, 0) => format!("{t}[k]"),
+            _ => format!("{t}[k + {o}{int}]"),
+        }
+    }
+}
+
 /// The multilinear blend's lines over `axes` axes, `read(dx, dy, dz)` the texel at offsets
 /// (0 or 1) from (i0, i1, i2), in [`super::interp::multilinear`]'s order: along the first axis,
 /// then the second, then the third. `lerp(a, b, f)` is a · (1 − f) + b · f in the language.
@@ -323,15 +339,7 @@ fn body(f: &Function<'_>) -> String {
                 2 => s.push_str(&format!("    let k = i1 * {nx}u + i0;\n")),
                 _ => s.push_str(&format!("    let k = (i2 * {ny}u + i1) * {nx}u + i0;\n")),
             }
-            let read = |dx: usize, dy: usize, dz: usize| {
-                let o = dx + nx * (dy + ny * dz);
-                match (counts.len(), o) {
-                    (1, 0) => format!("{t}[i0]"),
-                    (1, _) => format!("{t}[i0 + 1u]"),
-                    (_, 0) => format!("{t}[k]"),
-                    _ => format!("{t}[k + {o}u]"),
-                }
-            };
+            let read = flat_read(counts, &t, "u");
             s.push_str(&blend_lines(counts.len(), &read, &wgsl_lerp, &wgsl_return));
         }
     }

@@ -357,18 +357,15 @@ impl Lang {
 fn form_body(lang: Lang, module: &str, form: &Program, consts: &[f64], args: &[&str], domain: &[(f64, f64)]) -> String {
     let c32: Vec<f32> = consts.iter().map(|&v| v as f32).collect();
     let lit = |v: f32| lang.lit(v as f64);
-    let mut s = String::new();
-    let input: Box<dyn Fn(usize) -> String> = match lang {
-        Lang::Wgsl => Box::new(|i: usize| lang.clamp(module, args[i], domain[i].0, domain[i].1)),
-        Lang::Rust => {
-            for (a, d) in args.iter().zip(domain) {
-                s += &format!("    let {a} = {};\n", lang.clamp(module, a, d.0, d.1));
-            }
-            Box::new(|i: usize| args[i].to_string())
-        }
+    let input = |i: usize| match lang {
+        Lang::Wgsl => lang.clamp(module, args[i], domain[i].0, domain[i].1),
+        Lang::Rust => args[i].to_string(),
     };
-    s += &form.render(lang.syntax(), &input, &c32, &lit);
-    s + "}\n"
+    let rebound: String = match lang {
+        Lang::Wgsl => String::new(),
+        Lang::Rust => args.iter().zip(domain).map(|(a, d)| format!("    let {a} = {};\n", lang.clamp(module, a, d.0, d.1))).collect(),
+    };
+    rebound + &form.render(lang.syntax(), &input, &c32, &lit) + "}\n"
 }
 
 fn render(header: &[String], module: &str, prefix: &str, e: &Refits, rows: &[Row], lang: Lang) -> String {
