@@ -40,6 +40,7 @@ mod table_tests;
 pub mod committed;
 pub mod data;
 pub mod fields;
+pub mod grid;
 pub mod module;
 mod error;
 mod fitted;
@@ -50,6 +51,7 @@ mod table;
 
 pub use error::*;
 pub use fitted::*;
+pub use grid::{Grid, GridAxis};
 pub use index::*;
 pub use json::*;
 pub use staleness::*;

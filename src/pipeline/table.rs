@@ -136,11 +136,26 @@ pub fn committed_values(spec: &Spec, root: &Path) -> Result<Vec<f64>, BuildError
     Ok(vals)
 }
 
+/// The grid of a table spec: its axes in storage order, each over its range at its placement,
+/// mapped to its parameter.
+pub fn table_grid(spec: &Spec) -> Grid {
+    let layout = table_layout(spec);
+    Grid {
+        axes: layout
+            .order
+            .iter()
+            .map(|&k| {
+                let a = &spec.file.axis[k];
+                GridAxis { range: a.range, count: a.count, placement: layout.axes[k].0, mapping: layout.axes[k].1, param: k }
+            })
+            .collect(),
+    }
+}
+
 /// The grid points of a table spec in its arguments (`count` per axis at its placement, first
 /// axis fastest).
 pub fn table_points(spec: &Spec) -> Vec<Vec<f64>> {
-    let layout = table_layout(spec);
-    product(table_axes(spec, &layout).iter().map(|(a, p, _)| p.points(a.range, a.count)).collect())
+    table_grid(spec).points()
 }
 
 /// The table's values at `points` (its arguments, in storage order), flat: each point mapped to
@@ -148,17 +163,7 @@ pub fn table_points(spec: &Spec) -> Vec<Vec<f64>> {
 /// order.
 pub fn table_sample(spec: &Spec, points: &[Vec<f64>]) -> Vec<f64> {
     let layout = table_layout(spec);
-    let sampler = spec.sampler();
-    points
-        .par_iter()
-        .flat_map_iter(|t| {
-            let mut p = vec![0.0; t.len()];
-            for (&x, &k) in t.iter().zip(&layout.order) {
-                p[k] = (layout.axes[k].1.to_parameter)(x);
-            }
-            sampler.eval_channels(&p, &layout.channels).into_iter().map(|e| e.value)
-        })
-        .collect()
+    table_grid(spec).sample(&spec.sampler(), &layout.channels, points).into_iter().flatten().map(|e| e.value).collect()
 }
 
 /// The integral on a table's verification grid, [`table_width`] values a point: `verify` points
@@ -166,8 +171,9 @@ pub fn table_sample(spec: &Spec, points: &[Vec<f64>]) -> Vec<f64> {
 /// the centres of `verify` cells, which also lie where the lookup holds an edge texel, and
 /// never at the ends, where a mapped parameter may leave the quantity's domain).
 pub fn table_reference(spec: &Spec) -> Reference {
-    let layout = table_layout(spec);
-    let points = product(table_axes(spec, &layout).iter().map(|(a, p, _)| p.points(a.range, a.verify_count())).collect());
+    let grid = table_grid(spec);
+    let verify: Vec<usize> = table_layout(spec).order.iter().map(|&k| spec.file.axis[k].verify_count()).collect();
+    let points = Grid::product(grid.axes.iter().zip(verify).map(|(a, n)| a.placement.points(a.range, n)).collect());
     let values = table_sample(spec, &points);
     Reference { points, values }
 }
@@ -181,7 +187,7 @@ pub(super) fn build_table(spec: &Spec, mode: Mode, root: &Path) -> Result<Built,
 }
 
 /// The texel format's precision (what a channel holds).
-fn precision(format: TableTextureFormat) -> emit::texture::TextureFormat {
+pub fn stored_precision(format: TableTextureFormat) -> emit::texture::TextureFormat {
     if format.is_32bit() { emit::texture::TextureFormat::Rgba32float } else { emit::texture::TextureFormat::Rgba16float }
 }
 
@@ -218,7 +224,7 @@ pub fn table_from_values(spec: &Spec, values: Vec<f64>, reference: &Reference) -
     let hash = input_hash(spec);
     let form = spec.file.emit.form.unwrap_or_default();
     let tex_format = spec.file.emit.texture_format.unwrap_or(TableTextureFormat::default_for(width));
-    let stored = precision(tex_format);
+    let stored = stored_precision(tex_format);
     let per_point = if width == 1 { String::new() } else { format!(" x {width} channels") };
     let mut err_line = format!(
         "linear interpolation of the f32 table: max abs {}, rms {} over {} points{per_point}",

@@ -19,14 +19,13 @@
 //! committed JSON and re-renders every file without integrating.
 
 use super::emit::{DfgLutCode, lookup_f32};
-use super::spec::{DfgFormat, DfgLut, RoughnessMapping};
+use super::spec::{DfgLut, RoughnessMapping};
 use crate::emit::texture::{TextureFormat, ktx2_texels, png_srgb_preview};
 use crate::emit::interp::{centred, multilinear};
 use crate::emit::{Artifact, GENERATOR, header_lines};
-use crate::family::ggx::integrals::{EnvEstimate, env};
-use crate::pipeline::{BuildError, Built, Mode, Verification, committed_texels, compact_json, fmt_err, spec_rel_path};
-use crate::spec::Spec;
-use rayon::prelude::*;
+use crate::family::ggx::integrals::EnvEstimate;
+use crate::pipeline::{BuildError, Built, Grid, Mode, Verification, committed_texels, compact_json, fmt_err, spec_rel_path};
+use crate::spec::{Spec, TableTextureFormat};
 use serde::{Deserialize, Serialize};
 use serde_json::{Value, json};
 use std::path::Path;
@@ -38,24 +37,28 @@ pub const VERIFY_DENSITY: usize = 4;
 /// (≳ 1e-5 at the worst points).
 pub const VERIFY_TOLERANCE: f64 = 1e-6;
 
-/// The integrals at row coordinates `ts` × n·v values `us` (row-major, n·v fastest), rows in
-/// parallel, collected in order.
+/// The integrals at the points `per_axis` of the LUT's grid (n·v values, row coordinates, and
+/// for ggx-env cone cosines; first fastest), through the table kind's grid sampler, in order.
+pub fn sample(lut: &DfgLut, mut per_axis: Vec<Vec<f64>>, tol: f64) -> Vec<EnvEstimate> {
+    let grid = lut.grid();
+    if grid.axes.len() > per_axis.len() {
+        per_axis.push(vec![lut.cos_cone]);
+    }
+    let points = Grid::product(per_axis);
+    grid.sample(&lut.sampler(tol), &[0, 1], &points)
+        .into_iter()
+        .map(|e| EnvEstimate { scale: e[0].value, bias: e[1].value, error: e[0].error, evals: e[0].evals })
+        .collect()
+}
+
+/// The integrals at row coordinates `ts` × n·v values `us` (row-major, n·v fastest).
 pub fn integrate(lut: &DfgLut, us: &[f64], ts: &[f64], tol: f64) -> Vec<EnvEstimate> {
-    ts.par_iter()
-        .map(|&t| {
-            let alpha = lut.mapping.alpha(t);
-            let sh = lut.shadowing_at(alpha);
-            us.iter().map(|&u| env(alpha, u, lut.cos_cone, sh, tol)).collect::<Vec<_>>()
-        })
-        .collect::<Vec<_>>()
-        .concat()
+    sample(lut, vec![us.to_vec(), ts.to_vec()], tol)
 }
 
 /// The texels (scale, bias) with their quadrature work.
 pub fn tabulate(lut: &DfgLut) -> (Vec<[f64; 2]>, Quadrature) {
-    let us: Vec<f64> = (0..lut.width).map(|i| lut.n_dot_v(i)).collect();
-    let ts: Vec<f64> = (0..lut.height).map(|j| lut.row_coordinate(j)).collect();
-    let est = integrate(lut, &us, &ts, lut.tolerance);
+    let est = sample(lut, lut.grid().axes.iter().take(2).map(|a| a.arguments()).collect(), lut.tolerance);
     let evals: u64 = est.iter().map(|e| e.evals).sum();
     let q = Quadrature {
         tolerance: lut.tolerance,
@@ -105,10 +108,9 @@ pub struct Measured {
     pub error_map: Vec<f64>,
 }
 
-pub fn f16_texture(format: DfgFormat) -> TextureFormat {
-    match format {
-        DfgFormat::Rg16float | DfgFormat::Rgba16float => TextureFormat::Rgba16float,
-    }
+/// The precision the texture stores (the table kind's: f16 for both DFG formats).
+pub fn f16_texture(format: TableTextureFormat) -> TextureFormat {
+    crate::pipeline::stored_precision(format)
 }
 
 /// The stored channels in f32, as the texture holds them (f64 → f32 → f16).
@@ -178,8 +180,8 @@ pub fn digits3(x: f64) -> f64 {
 pub fn verify(lut: &DfgLut, values: &[[f64; 2]]) -> Result<Measured, BuildError> {
     let (w, h) = (lut.width, lut.height);
     let d = VERIFY_DENSITY;
-    let us: Vec<f64> = (0..d * w).map(|k| (k as f64 + 0.5) / (d * w) as f64).collect();
-    let ts: Vec<f64> = (0..d * h).map(|k| (k as f64 + 0.5) / (d * h) as f64).collect();
+    let grid = lut.grid();
+    let (us, ts) = (grid.axes[0].cell_centres(d * w), grid.axes[1].cell_centres(d * h));
     let truth = integrate(lut, &us, &ts, VERIFY_TOLERANCE);
     let encoded: Vec<[f64; 2]> = values.iter().map(|v| lut.layout.encode(*v)).collect();
     let stored32 = stored(lut, values);
@@ -303,7 +305,7 @@ pub fn build(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> 
     );
     let header = header_lines(&spec_rel_path(spec), &hash, &err_line);
     let provenance = header.join("\n");
-    let channels = lut.format.channels();
+    let channels = lut.format.texel_channels();
     let flat: Vec<f32> = stored32
         .iter()
         .flat_map(|v| if channels == 2 { vec![v[0], v[1]] } else { vec![v[0], v[1], 0.0, 1.0] })
@@ -399,6 +401,7 @@ pub fn lut_built(
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
+    use crate::family::ggx::integrals::env;
 
     /// Filament's layout of a texel (scale, bias): [bias, scale + bias].
     pub(crate) fn filament([s, b]: [f64; 2]) -> [f64; 2] {

@@ -10,7 +10,8 @@
 //! texels decoded from them (`F_texel`, f16 → f32), and the same lookups on the CPU: bilinear
 //! with exact f32 weights in the order of [`lookup_f32`].
 
-use super::spec::{DfgFormat, Layout};
+use super::spec::Layout;
+use crate::spec::TableTextureFormat;
 
 /// One DFG LUT module to emit.
 pub struct DfgLutCode<'a> {
@@ -19,7 +20,7 @@ pub struct DfgLutCode<'a> {
     pub width: usize,
     pub height: usize,
     pub layout: Layout,
-    pub format: DfgFormat,
+    pub format: TableTextureFormat,
     /// The row argument: "roughness" or "alpha".
     pub row: &'a str,
     /// Byte offset of the level data in the KTX2 file.
@@ -135,7 +136,7 @@ impl DfgLutCode<'_> {
              pub const {up}_KTX2: &[u8] = include_bytes!(\"../data/{m}.ktx2\");\n"
         ));
         s.push_str(&format!("/// Byte offset of the texels in [`{up}_KTX2`].\nconst LEVEL_OFFSET: usize = {};\n", self.level_offset));
-        s.push_str(&format!("/// f16 channels per texel in the file.\nconst STRIDE: usize = {};\n\n", self.format.channels()));
+        s.push_str(&format!("/// f16 channels per texel in the file.\nconst STRIDE: usize = {};\n\n", self.format.texel_channels()));
         s.push_str(
             "/// An IEEE binary16 value as f32 (exact).\nfn f16_to_f32(h: u16) -> f32 {\n    \
              let sign = if h & 0x8000 != 0 { -1.0 } else { 1.0 };\n    \

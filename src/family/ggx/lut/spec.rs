@@ -32,7 +32,11 @@
 //! (count = columns) and, for ggx-env, cos_cone as an axis of one point.
 
 use crate::family::ggx::integrals::Shadowing;
-use crate::spec::{CustomSpec, SpecError, SpecFile, check_resolution, check_tolerance, is_kind, line_of, parse_toml};
+use crate::pipeline::{Grid, GridAxis};
+use crate::shading::roughness::alpha_from_gloss;
+use crate::spec::table::{self, AxisMapping, Placement, TableTextureFormat};
+use crate::quantity::QuantityDef;
+use crate::spec::{CustomSpec, Sampler, SpecError, SpecFile, check_resolution, check_tolerance, is_kind, line_of, parse_toml};
 use serde::Deserialize;
 use serde_json::json;
 use std::path::Path;
@@ -82,15 +86,24 @@ impl RoughnessMapping {
         }
     }
 
-    /// α at row coordinate t ∈ [0, 1].
-    pub fn alpha(self, t: f64) -> f64 {
+    /// The rows' axis mapping (the table kind's: α = r², α itself, or [`GLOSS_ROWS`]).
+    pub fn axis_mapping(self) -> &'static AxisMapping {
         match self {
-            RoughnessMapping::Perceptual => t * t,
-            RoughnessMapping::Alpha => t,
-            RoughnessMapping::Gloss => crate::shading::roughness::alpha_from_gloss(t),
+            RoughnessMapping::Perceptual => &table::PERCEPTUAL,
+            RoughnessMapping::Alpha => &table::LINEAR,
+            RoughnessMapping::Gloss => &GLOSS_ROWS,
         }
     }
+
+    /// α at row coordinate t ∈ [0, 1].
+    pub fn alpha(self, t: f64) -> f64 {
+        (self.axis_mapping().to_parameter)(t)
+    }
 }
+
+/// Rows at COD: WWII gloss g: α = sqrt(2/(1 + 2^(18 g))) (`shading::roughness`).
+pub static GLOSS_ROWS: AxisMapping =
+    AxisMapping { name: "gloss", doc: "gloss g, alpha = sqrt(2/(1 + 2^(18 g)))", to_parameter: alpha_from_gloss, argument: [0.0, 1.0] };
 
 #[derive(Debug, Clone, Copy, Default, Deserialize, PartialEq, Eq)]
 #[serde(rename_all = "lowercase")]
@@ -151,32 +164,17 @@ impl Layout {
     }
 }
 
-/// Texel format of the KTX2 file.
-#[derive(Debug, Clone, Copy, Default, Deserialize, PartialEq, Eq)]
-#[serde(rename_all = "lowercase")]
-pub enum DfgFormat {
-    /// R16G16_SFLOAT: the two channels.
-    #[default]
-    Rg16float,
-    /// R16G16B16A16_SFLOAT: the two channels, B = 0, A = 1 (where RG16F is not wanted).
-    Rgba16float,
-}
+/// The texel formats a DFG LUT may take (the table kind's, two f16 channels: RG16F, or RGBA16F
+/// with B = 0, A = 1 where RG16F is not wanted).
+pub const FORMATS: [TableTextureFormat; 2] = [TableTextureFormat::Rg16float, TableTextureFormat::Rgba16float];
 
-impl DfgFormat {
-    pub fn name(self) -> &'static str {
-        match self {
-            DfgFormat::Rg16float => "rg16float",
-            DfgFormat::Rgba16float => "rgba16float",
-        }
+/// `texture_format` checked against [`FORMATS`] (default RG16F).
+pub fn check_format(f: Option<TableTextureFormat>, at: impl Fn(&str, String) -> SpecError) -> Result<TableTextureFormat, SpecError> {
+    let f = f.unwrap_or(TableTextureFormat::Rg16float);
+    if !FORMATS.contains(&f) {
+        return Err(at("texture_format", format!("'{}': a DFG LUT stores two f16 channels: \"rg16float\" or \"rgba16float\"", f.name())));
     }
-
-    /// Channels per texel in the file.
-    pub fn channels(self) -> usize {
-        match self {
-            DfgFormat::Rg16float => 2,
-            DfgFormat::Rgba16float => 4,
-        }
-    }
+    Ok(f)
 }
 
 #[derive(Debug, Clone, Deserialize)]
@@ -208,8 +206,7 @@ struct DfgLutFile {
     #[serde(default)]
     layout: Layout,
     cos_cone: Option<f64>,
-    #[serde(default)]
-    texture_format: DfgFormat,
+    texture_format: Option<TableTextureFormat>,
     emit: DfgEmit,
 }
 
@@ -228,7 +225,7 @@ pub struct DfgLut {
     pub cos_cone: f64,
     /// UE4's separable Schlick–Smith G (quantity ggx-env-ue4) instead of the height-correlated G2.
     pub ue4: bool,
-    pub format: DfgFormat,
+    pub format: TableTextureFormat,
     /// Absolute quadrature tolerance per texel (each of scale and bias).
     pub tolerance: f64,
 }
@@ -267,7 +264,7 @@ impl DfgLut {
             layout: f.layout,
             cos_cone,
             ue4,
-            format: f.texture_format,
+            format: check_format(f.texture_format, at)?,
             tolerance,
         })
     }
@@ -296,6 +293,23 @@ impl DfgLut {
     pub fn alpha_range(&self) -> [f64; 2] {
         let (a, b) = (self.alpha(0), self.alpha(self.height - 1));
         [a.min(b), a.max(b)]
+    }
+
+    /// The table's axes as the table kind's grid: n·v columns and roughness rows at the texel
+    /// centres of [0, 1] (the rows mapped to α), and for ggx-env the cone cosine as one point.
+    pub fn grid(&self) -> Grid {
+        let centres = |count, mapping, param| GridAxis { range: [0.0, 1.0], count, placement: Placement::Centres, mapping, param };
+        let mut axes = vec![centres(self.width, &table::LINEAR, 1), centres(self.height, self.mapping.axis_mapping(), 0)];
+        if !self.ue4 {
+            axes.push(GridAxis { range: [self.cos_cone; 2], count: 1, placement: Placement::Nodes, mapping: &table::LINEAR, param: 2 });
+        }
+        Grid { axes }
+    }
+
+    /// The quantity tabulated ([scale, bias]), integrated to `tolerance`.
+    pub fn sampler(&self, tolerance: f64) -> Sampler {
+        let quantity: &'static QuantityDef = crate::family::ggx::QUANTITIES.iter().find(|q| q.name == self.quantity).expect("a checked DFG quantity");
+        Sampler { quantity, channel: None, tolerance }
     }
 
     /// The shadowing at α (UE4's separable G takes k = α/2).
@@ -351,7 +365,7 @@ mod tests {
     fn defaults_and_texel_centres() {
         let l = parse(SPEC).unwrap();
         assert_eq!((l.width, l.height, l.tolerance, l.cos_cone), (8, 4, DEFAULT_TOLERANCE, 0.0));
-        assert_eq!((l.mapping, l.layout, l.format), (RoughnessMapping::Perceptual, Layout::ScaleBias, DfgFormat::Rg16float));
+        assert_eq!((l.mapping, l.layout, l.format), (RoughnessMapping::Perceptual, Layout::ScaleBias, TableTextureFormat::Rg16float));
         // Centres: n·v = (i + 0.5)/8, r = (j + 0.5)/4, α = r².
         assert_eq!((l.n_dot_v(0), l.n_dot_v(7)), (0.0625, 0.9375));
         assert_eq!((l.alpha(0), l.alpha(3)), (0.015625, 0.765625));
@@ -382,7 +396,8 @@ mod tests {
         bad(("[8, 4]", "[8, 4]\nlayout = \"ue\""), 5, "layout", "unknown variant");
         bad(("[8, 4]", "[8, 4]\nroughness_mapping = \"sqrt\""), 5, "roughness_mapping", "unknown variant");
         bad(("[8, 4]", "[8, 4]\nn_dot_v_mapping = \"sqrt\""), 5, "n_dot_v_mapping", "unknown variant");
-        bad(("[8, 4]", "[8, 4]\ntexture_format = \"rgba32float\""), 5, "texture_format", "unknown variant");
+        bad(("[8, 4]", "[8, 4]\ntexture_format = \"rgba32float\""), 5, "texture_format", "\"rg16float\" or \"rgba16float\"");
+        bad(("[8, 4]", "[8, 4]\ntexture_format = \"rgb\""), 5, "texture_format", "unknown variant");
         bad(("quantity = \"ggx-env\"", "quantity = \"ggx-albedo\""), 3, "quantity", "'ggx-env' or 'ggx-env-ue4'");
         bad(("quantity = \"ggx-env\"", "quantity = \"ggx-env-ue4\"\ncos_cone = 0.5"), 4, "cos_cone", "ggx-env only");
         bad(("name = \"ggx_x\"", "name = \"ggx_y\""), 1, "name", "must match the file name");

@@ -23,7 +23,8 @@ use super::spec::ConeLut;
 use crate::emit::texture::{ktx2_volume, png_srgb_preview};
 use crate::emit::interp::{centred, multilinear};
 use crate::emit::{GENERATOR, header_lines};
-use crate::family::ggx::lut::build::{Accumulator, Measure, lut_built, Quadrature, alpha_of_t, digits3, f16_texture, integrate, mapping_doc, stored, tabulate as tabulate_2d};
+use crate::family::ggx::lut::build::{Accumulator, Measure, lut_built, Quadrature, alpha_of_t, digits3, f16_texture, mapping_doc, sample, stored};
+use crate::pipeline::GridAxis;
 use crate::pipeline::{BuildError, Built, Mode, committed_texels, compact_json, fmt_err, spec_rel_path};
 use crate::spec::Spec;
 use serde::{Deserialize, Serialize};
@@ -39,16 +40,18 @@ pub const VERIFY_TOLERANCE: f64 = 1e-6;
 /// The texels (scale, bias), slice after slice (each row-major, n·v fastest), with the
 /// quadrature work of all slices.
 pub fn tabulate(lut: &ConeLut) -> (Vec<[f64; 2]>, Quadrature) {
-    let mut values = Vec::with_capacity(lut.base.width * lut.base.height * lut.depth);
-    let (mut max_err, mut evals) = (0.0f64, 0.0);
-    for k in 0..lut.depth {
-        let (v, q) = tabulate_2d(&lut.slice(k));
-        values.extend(v);
-        max_err = max_err.max(q.max_error_estimate);
-        evals += q.evals_per_texel;
-    }
-    let q = Quadrature { tolerance: lut.base.tolerance, max_error_estimate: max_err, evals_per_texel: (evals / lut.depth as f64).round() };
-    (values, q)
+    let b = &lut.base;
+    let est = sample(b, vec![axis(lut, 0).arguments(), axis(lut, 1).arguments(), axis(lut, 2).arguments()], b.tolerance);
+    // The work per texel of each slice, rounded, then their mean (the 2-D table's figure per slice).
+    let evals: f64 = est.chunks(b.width * b.height).map(|s| (s.iter().map(|e| e.evals).sum::<u64>() as f64 / s.len() as f64).round()).sum();
+    let max_err = est.iter().map(|e| e.error).fold(0.0f64, f64::max);
+    let q = Quadrature { tolerance: b.tolerance, max_error_estimate: max_err, evals_per_texel: (evals / lut.depth as f64).round() };
+    (est.iter().map(|e| [e.scale, e.bias]).collect(), q)
+}
+
+/// Axis `k` of the table's grid (n·v, rows, cone slices).
+fn axis(lut: &ConeLut, k: usize) -> GridAxis {
+    lut.grid().axes.swap_remove(k)
 }
 
 /// Trilinear interpolation in f64 of `texels` at (u, t) (texel centres, clamp to edge) and
@@ -88,9 +91,9 @@ pub fn verify(lut: &ConeLut, values: &[[f64; 2]]) -> Result<Measured, BuildError
     let b = &lut.base;
     let (w, h, d) = (b.width, b.height, lut.depth);
     let n = VERIFY_DENSITY;
-    let us: Vec<f64> = (0..n * w).map(|k| (k as f64 + 0.5) / (n * w) as f64).collect();
-    let ts: Vec<f64> = (0..n * h).map(|k| (k as f64 + 0.5) / (n * h) as f64).collect();
-    let cs: Vec<f64> = (0..n * (d - 1)).map(|k| (k as f64 + 0.5) / (n * (d - 1)) as f64).collect();
+    let grid = lut.grid();
+    let (us, ts, cs) = (grid.axes[0].cell_centres(n * w), grid.axes[1].cell_centres(n * h), grid.axes[2].cell_centres(n * (d - 1)));
+    let all = sample(b, vec![us.clone(), ts.clone(), cs.clone()], VERIFY_TOLERANCE);
     let stored32 = stored(b, values);
     let stored64: Vec<[f64; 2]> = stored32.iter().map(|v| v.map(f64::from)).collect();
     let encoded: Vec<[f64; 2]> = values.iter().map(|v| b.layout.encode(*v)).collect();
@@ -99,7 +102,7 @@ pub fn verify(lut: &ConeLut, values: &[[f64; 2]]) -> Result<Measured, BuildError
     let inside = |p: f64, n: usize| p >= 0.5 / n as f64 && p <= 1.0 - 0.5 / n as f64;
     let mut map = vec![0.0f64; w * h * (d - 1)];
     for (m, &c) in cs.iter().enumerate() {
-        let truth = integrate(&lut.table(c), &us, &ts, VERIFY_TOLERANCE);
+        let truth = &all[m * us.len() * ts.len()..(m + 1) * us.len() * ts.len()];
         for (l, &t) in ts.iter().enumerate() {
             for (k, &u) in us.iter().enumerate() {
                 let e = &truth[l * us.len() + k];
@@ -186,7 +189,7 @@ pub fn build(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> 
     );
     let header = header_lines(&spec_rel_path(spec), &hash, &err_line);
     let provenance = header.join("\n");
-    let channels = b.format.channels();
+    let channels = b.format.texel_channels();
     let flat: Vec<f32> = stored32.iter().flat_map(|v| if channels == 2 { vec![v[0], v[1]] } else { vec![v[0], v[1], 0.0, 1.0] }).collect();
     let ktx2 = ktx2_volume(w as u32, h as u32, d as u32, channels, &flat, f16_texture(b.format), &[("shadefit", &provenance)]);
     let level_offset = u64::from_le_bytes(ktx2[80..88].try_into().expect("eight bytes")) as usize;
@@ -250,6 +253,7 @@ pub fn build(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> 
 mod tests {
     use super::*;
     use crate::family::ggx::lut::build::tests::{coord, filament, filament_texels};
+    use crate::family::ggx::lut::build::tabulate as tabulate_2d;
 
     /// The verification samples the cone cosine between the slices, at the centres of
     /// VERIFY_DENSITY (2) intervals in each: 0.25 and 0.75 on a 2 × 2 × 2 LUT. With slice 1's

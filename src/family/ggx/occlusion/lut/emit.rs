@@ -21,7 +21,8 @@
 //! with exact f32 weights in the order of [`lookup_f32`].
 
 use crate::family::ggx::lut::emit::{axis_f32, input_f32, wgsl_preamble};
-use crate::family::ggx::lut::spec::{DfgFormat, Layout};
+use crate::family::ggx::lut::spec::Layout;
+use crate::spec::TableTextureFormat;
 
 /// One cone LUT module to emit.
 pub struct ConeLutCode<'a> {
@@ -31,7 +32,7 @@ pub struct ConeLutCode<'a> {
     pub height: usize,
     pub depth: usize,
     pub layout: Layout,
-    pub format: DfgFormat,
+    pub format: TableTextureFormat,
     /// The row argument: "gloss", "roughness" or "alpha".
     pub row: &'a str,
     /// Byte offset of the level data in the KTX2 file.
@@ -127,7 +128,7 @@ impl ConeLutCode<'_> {
              /// `shadefit build`.\npub const {up}_KTX2: &[u8] = include_bytes!(\"../data/{m}.ktx2\");\n"
         ));
         s.push_str(&format!("/// Byte offset of the texels in [`{up}_KTX2`].\nconst LEVEL_OFFSET: usize = {};\n", self.level_offset));
-        s.push_str(&format!("/// f16 channels per texel in the file.\nconst STRIDE: usize = {};\n\n", self.format.channels()));
+        s.push_str(&format!("/// f16 channels per texel in the file.\nconst STRIDE: usize = {};\n\n", self.format.texel_channels()));
         s.push_str(
             "/// An IEEE binary16 value as f32 (exact).\nfn f16_to_f32(h: u16) -> f32 {\n    \
              let sign = if h & 0x8000 != 0 { -1.0 } else { 1.0 };\n    \

@@ -24,7 +24,9 @@
 //! axis puts its first and last texel centres on cos θc = 0 and 1: a sampler reads it at
 //! w = (cos θc (slices − 1) + 0.5)/slices.
 
-use crate::family::ggx::lut::spec::{DfgFormat, DfgLut, Layout, MAX_RESOLUTION, RoughnessMapping, TOLERANCE_RANGE};
+use crate::family::ggx::lut::spec::{DfgLut, check_format, Layout, MAX_RESOLUTION, RoughnessMapping, TOLERANCE_RANGE};
+use crate::pipeline::{Grid, GridAxis};
+use crate::spec::Placement;
 use crate::spec::{CustomSpec, SpecError, SpecFile, check_resolution, check_tolerance, is_kind, line_of, parse_toml};
 use serde::Deserialize;
 use serde_json::json;
@@ -71,8 +73,7 @@ struct ConeLutFile {
     cone_mapping: ConeMapping,
     #[serde(default)]
     layout: Layout,
-    #[serde(default)]
-    texture_format: DfgFormat,
+    texture_format: Option<crate::spec::TableTextureFormat>,
     emit: ConeEmit,
 }
 
@@ -111,7 +112,7 @@ impl ConeLut {
             layout: f.layout,
             cos_cone: 0.0,
             ue4: false,
-            format: f.texture_format,
+            format: check_format(f.texture_format, at)?,
             tolerance,
         };
         Ok(ConeLut { base, depth: f.resolution[2] })
@@ -130,6 +131,14 @@ impl ConeLut {
     /// The 2-D table of cone cosine `c` (slice k is `table(cos_cone(k))`).
     pub fn table(&self, c: f64) -> DfgLut {
         DfgLut { cos_cone: c, ..self.base.clone() }
+    }
+
+    /// The table's grid: the 2-D table's n·v columns and rows, and the cone slices at nodes
+    /// k/(slices − 1) of [0, 1].
+    pub fn grid(&self) -> Grid {
+        let mut g = self.base.grid();
+        g.axes[2] = GridAxis { range: [0.0, 1.0], count: self.depth, placement: Placement::Nodes, mapping: &crate::spec::table::LINEAR, param: 2 };
+        g
     }
 
     /// The 2-D table of slice k.
@@ -172,7 +181,7 @@ pub(super) mod tests {
     fn defaults_slices_and_axes() {
         let l = ConeLut::parse(Path::new("fits/ggx_c.toml"), SPEC).unwrap();
         assert_eq!((l.base.width, l.base.height, l.depth, l.base.tolerance), (8, 4, 3, DEFAULT_TOLERANCE));
-        assert_eq!((l.base.mapping, l.base.layout, l.base.format), (RoughnessMapping::Gloss, Layout::ScaleBias, DfgFormat::Rg16float));
+        assert_eq!((l.base.mapping, l.base.layout, l.base.format), (RoughnessMapping::Gloss, Layout::ScaleBias, crate::spec::TableTextureFormat::Rg16float));
         assert_eq!([l.cos_cone(0), l.cos_cone(1), l.cos_cone(2)], [0.0, 0.5, 1.0]);
         // Gloss rows: g = (j + 0.5)/4, α = sqrt(2/(1 + 2^(18 g))); g = 1/8 gives sqrt(2/(1 + 2^2.25)).
         assert_eq!(l.base.alpha(0), (2.0 / (1.0 + 2f64.powf(2.25))).sqrt());
