@@ -233,6 +233,7 @@ fn build_verified(spec: &Spec, mode: Mode, root: &Path, texture: bool) -> Result
     let (w, h) = layout.size();
     let kappas = lut.curvatures();
     let nls = lut_n_dot_ls(&lut);
+    let precision = crate::pipeline::stored_precision(lut.format);
 
     let (values, fresh) = match mode {
         Mode::Fit => {
@@ -249,7 +250,7 @@ fn build_verified(spec: &Spec, mode: Mode, root: &Path, texture: bool) -> Result
     let (values, verification, quadrature, texture) = match fresh {
         Some(q) => {
             let values32: Vec<[f32; 3]> = values.iter().map(|v| v.map(|x| x as f32)).collect();
-            let stored: Vec<[f32; 3]> = values32.iter().map(|v| v.map(|x| lut.format.stored(x))).collect();
+            let stored: Vec<[f32; 3]> = values32.iter().map(|v| v.map(|x| precision.stored(x))).collect();
             let (emitted, sampled) = (code(&lut, &name, layout, &values32), code(&lut, &name, layout, &stored));
             let codes: &[&SkinLutCode] = if texture { &[&emitted, &sampled] } else { &[&emitted] };
             let mut ver = verify(spec, &lut, &values, codes)?.into_iter();
@@ -268,7 +269,7 @@ fn build_verified(spec: &Spec, mode: Mode, root: &Path, texture: bool) -> Result
     let code = code(&lut, &name, layout, &values32);
     let storage = values
         .iter()
-        .flat_map(|v| v.iter().map(|&x| (lut.format.stored(x as f32) as f64 - x).abs()))
+        .flat_map(|v| v.iter().map(|&x| (precision.stored(x as f32) as f64 - x).abs()))
         .fold(0.0, f64::max);
     let (lo, hi) = values.iter().flat_map(|v| v.iter()).fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| (a.min(x), b.max(x)));
 
@@ -287,7 +288,7 @@ fn build_verified(spec: &Spec, mode: Mode, root: &Path, texture: bool) -> Result
     let rust = code.render_rust(&header, &doc);
     let texels: Vec<[f32; 4]> = values32.iter().map(|v| [v[0], v[1], v[2], 1.0]).collect();
     let provenance = header.join("\n");
-    let ktx2 = ktx2_rgba(w as u32, h as u32, &texels, lut.format, &[("shadefit", &provenance)]);
+    let ktx2 = ktx2_rgba(w as u32, h as u32, &texels, precision, &[("shadefit", &provenance)]);
     let (sx, sy) = preview_scale(layout);
     let png = png_srgb_preview(w, h, &values, sx, sy, &[("Software", GENERATOR.to_string()), ("Comment", provenance.clone())]);
 

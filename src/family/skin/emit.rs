@@ -17,7 +17,7 @@
 
 use crate::fit::expr::sanitize;
 use crate::emit::f32_literal;
-use crate::emit::texture::TextureFormat;
+use crate::spec::TableTextureFormat as TextureFormat;
 use super::integrals::CurvatureMapping;
 
 /// Texel layout of a skin LUT.

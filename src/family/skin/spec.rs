@@ -39,7 +39,7 @@
 
 use super::profile::{LoadedProfile, ProfileSection};
 use crate::spec::{CustomSpec, SpecError, SpecFile, check_resolution, check_tolerance, is_kind, line_of, parse_toml};
-use crate::emit::texture::TextureFormat;
+use crate::spec::TableTextureFormat as TextureFormat;
 use super::integrals::{CurvatureMapping, Kernel, mapped_curvature};
 use serde::Deserialize;
 use serde_json::json;
@@ -99,8 +99,7 @@ struct SkinLutFile {
     #[allow(dead_code)] // one variant: parsing it is the check
     n_dot_l_mapping: NDotLMapping,
     kernel: Option<KernelName>,
-    #[serde(default)]
-    texture_format: TextureFormat,
+    texture_format: Option<TextureFormat>,
     #[serde(default)]
     float32_filterable: bool,
     profile: Option<ProfileSection>,
@@ -155,7 +154,11 @@ impl SkinLut {
         if !(k.is_finite() && k > 0.0 && k <= MAX_CURVATURE) {
             return Err(at("curvature_max", format!("{k}/mm must be finite and in (0, {MAX_CURVATURE}]")));
         }
-        match (f.texture_format, f.float32_filterable) {
+        let format = f.texture_format.unwrap_or(TextureFormat::Rgba16float);
+        if !matches!(format, TextureFormat::Rgba16float | TextureFormat::Rgba32float) {
+            return Err(at("texture_format", format!("'{}': a skin LUT stores RGB with alpha 1: \"rgba16float\" or \"rgba32float\"", format.name())));
+        }
+        match (format, f.float32_filterable) {
             (TextureFormat::Rgba32float, false) => {
                 return Err(at(
                     "texture_format",
@@ -213,7 +216,7 @@ impl SkinLut {
             curvature_count: *f.resolution.last().expect("checked length"),
             curvature_max: k,
             curvature_mapping: f.curvature_mapping,
-            format: f.texture_format,
+            format,
             tolerance,
             profile,
         })
@@ -314,6 +317,8 @@ mod tests {
         // A 32-bit float texture behind a linear sampler only with the feature requested.
         let f32_tex = "curvature_max = 2.0\ntexture_format = \"rgba32float\"";
         bad(("curvature_max = 2.0", f32_tex), 6, "texture_format", "set float32_filterable = true");
+        let two = "curvature_max = 2.0\ntexture_format = \"rg16float\"";
+        bad(("curvature_max = 2.0", two), 6, "texture_format", "\"rgba16float\" or \"rgba32float\"");
         bad(("curvature_max = 2.0", "curvature_max = 2.0\nfloat32_filterable = true"), 6, "float32_filterable", "rgba32float");
         let ok = parse(&PUNCTUAL.replace("curvature_max = 2.0", &format!("{f32_tex}\nfloat32_filterable = true"))).unwrap();
         assert_eq!(ok.format, TextureFormat::Rgba32float);
