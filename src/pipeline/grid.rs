@@ -28,6 +28,11 @@ impl GridAxis {
         self.placement.points(self.range, self.count)
     }
 
+    /// Argument `i` of the axis's `count`.
+    pub fn argument(&self, i: usize) -> f64 {
+        self.placement.point(self.range, self.count, i)
+    }
+
     /// The centres of `cells` equal cells of the range: points off the table's own points
     /// (for a denser verification) that never reach the ends.
     pub fn cell_centres(&self, cells: usize) -> Vec<f64> {

@@ -54,15 +54,17 @@ impl Placement {
     }
 
     /// The `n` points on `[lo, hi]` (the last node is `hi` exactly).
-    pub fn points(self, [lo, hi]: [f64; 2], n: usize) -> Vec<f64> {
+    pub fn points(self, range: [f64; 2], n: usize) -> Vec<f64> {
+        (0..n).map(|i| self.point(range, n, i)).collect()
+    }
+
+    /// Point `i` of the `n` on `[lo, hi]`.
+    pub fn point(self, [lo, hi]: [f64; 2], n: usize, i: usize) -> f64 {
         match self {
-            Placement::Nodes => {
-                if n == 1 {
-                    return vec![lo];
-                }
-                (0..n).map(|i| if i + 1 == n { hi } else { lo + (hi - lo) * i as f64 / (n - 1) as f64 }).collect()
-            }
-            Placement::Centres => (0..n).map(|i| lo + (hi - lo) * (i as f64 + 0.5) / n as f64).collect(),
+            Placement::Nodes if n == 1 => lo,
+            Placement::Nodes if i + 1 == n => hi,
+            Placement::Nodes => lo + (hi - lo) * i as f64 / (n - 1) as f64,
+            Placement::Centres => lo + (hi - lo) * (i as f64 + 0.5) / n as f64,
         }
     }
 }

@@ -46,7 +46,16 @@ use crate::spec::{CustomSpec, KindDef, Spec, SpecError, SpecFile, is_kind, line_
 use rayon::prelude::*;
 use serde::Deserialize;
 use serde_json::json;
+use crate::pipeline::{Grid, GridAxis};
+use crate::spec::table::{self, AxisMapping, Placement};
 use std::f64::consts::{FRAC_PI_2, PI};
+
+fn quarter_turn(t: f64) -> f64 {
+    t * FRAC_PI_2
+}
+
+/// A texel coordinate t ∈ [0, 1] to the angle t·π/2 (θh and θd of the slices).
+static QUARTER_TURN: AxisMapping = AxisMapping { name: "quarter-turn", doc: "t, parameter t*pi/2", to_parameter: quarter_turn, argument: [0.0, 1.0] };
 use std::path::Path;
 
 /// The `kind` value.
@@ -208,20 +217,44 @@ impl Table {
         Table::parse(&spec.path, &spec.text)
     }
 
+    /// The slices' grid, as the table kind's: θh columns and θd rows at the texel centres of
+    /// [0, 1] mapped to [0, π/2], gloss layers at the nodes of [0, 1] (parameters 1, 2, 0 of
+    /// ms-diffuse).
+    pub fn slices_grid(&self) -> Grid {
+        let angle = |count, param| GridAxis { range: [0.0, 1.0], count, placement: Placement::Centres, mapping: &QUARTER_TURN, param };
+        Grid { axes: vec![angle(self.width, 1), angle(self.height, 2), self.layers_axis()] }
+    }
+
+    /// The albedo table's grid: n·v at the texel centres of [0, 1], the gloss layers.
+    pub fn albedo_grid(&self) -> Grid {
+        let n_dot_v = GridAxis { range: [0.0, 1.0], count: self.albedo_width, placement: Placement::Centres, mapping: &table::LINEAR, param: 1 };
+        Grid { axes: vec![n_dot_v, self.layers_axis()] }
+    }
+
+    fn layers_axis(&self) -> GridAxis {
+        GridAxis { range: [0.0, 1.0], count: self.layers, placement: Placement::Nodes, mapping: &table::LINEAR, param: 0 }
+    }
+
+    /// Parameter of point `i` on axis `k` of `grid`.
+    fn at(grid: Grid, k: usize, i: usize) -> f64 {
+        let a = &grid.axes[k];
+        a.parameter(a.argument(i))
+    }
+
     pub fn theta_h(&self, i: usize) -> f64 {
-        (i as f64 + 0.5) / self.width as f64 * FRAC_PI_2
+        Table::at(self.slices_grid(), 0, i)
     }
 
     pub fn theta_d(&self, j: usize) -> f64 {
-        (j as f64 + 0.5) / self.height as f64 * FRAC_PI_2
+        Table::at(self.slices_grid(), 1, j)
     }
 
     pub fn gloss(&self, k: usize) -> f64 {
-        if self.layers == 1 { 0.0 } else { k as f64 / (self.layers - 1) as f64 }
+        Table::at(self.slices_grid(), 2, k)
     }
 
     pub fn n_dot_v(&self, a: usize) -> f64 {
-        (a as f64 + 0.5) / self.albedo_width as f64
+        Table::at(self.albedo_grid(), 0, a)
     }
 
     pub fn slice_cells(&self) -> u64 {
