@@ -24,7 +24,7 @@ use crate::emit::interp::{multilinear, nodes};
 use crate::emit::{Artifact, GENERATOR, header_lines};
 use crate::integrate::{Estimate, Tolerance};
 use super::integrals::{
-    self as skin, DEFAULT_TOLERANCE, Kernel, lut_n_dot_l, punctual_grid_estimates, sh_bands_estimates,
+    self as skin, DEFAULT_TOLERANCE, Kernel, punctual_grid_estimates, sh_bands_estimates,
 };
 use crate::spec::Spec;
 use super::spec::{SkinLut, SkinLutKind};
@@ -91,7 +91,7 @@ fn integrate(
 
 fn lut_n_dot_ls(lut: &SkinLut) -> Vec<f64> {
     match lut.kind {
-        SkinLutKind::Punctual { n_dot_l, .. } => (0..n_dot_l).map(|i| lut_n_dot_l(i, n_dot_l)).collect(),
+        SkinLutKind::Punctual { n_dot_l, .. } => SkinLut::n_dot_l_axis(n_dot_l).arguments(),
         SkinLutKind::Sh => Vec::new(),
     }
 }
@@ -115,15 +115,14 @@ fn verify(
     let n = lut.curvature_count;
     let m = 2 * n - 1;
     // Mapped coordinate t = k/(m − 1) of the fine grid: even k are the texels.
-    let kappas: Vec<f64> =
-        (0..m).map(|k| skin::mapped_curvature(k as f64 / (m - 1) as f64, lut.curvature_max, lut.curvature_mapping)).collect();
+    let kappas = lut.curvatures_at(m);
     let mut points: Vec<Vec<f64>> = Vec::new();
     let mut approx64: Vec<[f64; 3]> = Vec::new();
     let mut approx32: Vec<Vec<[f32; 3]>> = vec![Vec::new(); codes.len()];
     let truth: Vec<[f64; 3]> = match lut.kind {
         SkinLutKind::Punctual { n_dot_l, .. } => {
             let mu = 2 * n_dot_l - 1;
-            let nls: Vec<f64> = (0..mu).map(|i| lut_n_dot_l(i, mu)).collect();
+            let nls = SkinLut::n_dot_l_axis(mu).arguments();
             for (b, &kappa) in kappas.iter().enumerate() {
                 for (a, &nl) in nls.iter().enumerate() {
                     points.push(vec![kappa, nl]);

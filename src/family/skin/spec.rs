@@ -39,8 +39,10 @@
 
 use super::profile::{LoadedProfile, ProfileSection};
 use crate::spec::{CustomSpec, SpecError, SpecFile, check_resolution, check_tolerance, is_kind, line_of, parse_toml};
+use crate::pipeline::GridAxis;
 use crate::spec::TableTextureFormat as TextureFormat;
-use super::integrals::{CurvatureMapping, Kernel, mapped_curvature};
+use crate::spec::table::{self, Placement};
+use super::integrals::{CurvatureMapping, Kernel};
 use serde::Deserialize;
 use serde_json::json;
 use std::path::Path;
@@ -229,8 +231,29 @@ impl SkinLut {
 
     /// κ (1/mm) of the curvature samples, in order (ends included, mapped).
     pub fn curvatures(&self) -> Vec<f64> {
-        let n = self.curvature_count;
-        (0..n).map(|j| mapped_curvature(j as f64 / (n - 1) as f64, self.curvature_max, self.curvature_mapping)).collect()
+        self.curvatures_at(self.curvature_count)
+    }
+
+    /// κ at `n` nodes of the mapped coordinate (the table's `curvature_count`, or the
+    /// verification's 2n − 1).
+    pub fn curvatures_at(&self, n: usize) -> Vec<f64> {
+        let axis = GridAxis { count: n, ..self.curvature_axis() };
+        axis.arguments().into_iter().map(|t| self.curvature_max * axis.parameter(t)).collect()
+    }
+
+    /// The curvature axis of the table kind's grid: nodes of the mapped coordinate t ∈ [0, 1],
+    /// whose parameter is κ/κ_max (t, or t² for `sqrt` rows).
+    pub fn curvature_axis(&self) -> GridAxis {
+        let mapping = match self.curvature_mapping {
+            CurvatureMapping::Linear => &table::LINEAR,
+            CurvatureMapping::Sqrt => &table::SQUARE,
+        };
+        GridAxis { range: [0.0, 1.0], count: self.curvature_count, placement: Placement::Nodes, mapping, param: 0 }
+    }
+
+    /// The n·l axis of a punctual LUT's grid: `n` nodes on [−1, 1].
+    pub fn n_dot_l_axis(n: usize) -> GridAxis {
+        GridAxis { range: [-1.0, 1.0], count: n, placement: Placement::Nodes, mapping: &table::LINEAR, param: 1 }
     }
 
     /// The common spec this LUT enters the pipeline as: axes in the quantity's parameter order
