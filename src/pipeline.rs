@@ -51,7 +51,7 @@ mod table;
 
 pub use error::*;
 pub use fitted::*;
-pub use grid::{Grid, GridAxis};
+pub use grid::{Grid, GridAxis, Quadrature};
 pub use index::*;
 pub use json::*;
 pub use staleness::*;

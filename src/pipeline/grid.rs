@@ -8,6 +8,18 @@
 use crate::integrate::Estimate;
 use crate::spec::{AxisMapping, Placement, Sampler};
 use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+/// The quadrature work of a tabulated grid, as its JSON states it.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Quadrature {
+    /// The absolute tolerance asked of each texel.
+    pub tolerance: f64,
+    /// The largest error estimate over texels and channels.
+    pub max_error_estimate: f64,
+    /// Integrand evaluations a texel, rounded.
+    pub evals_per_texel: f64,
+}
 
 /// One axis of a table's grid.
 #[derive(Debug, Clone)]

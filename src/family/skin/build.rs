@@ -17,7 +17,7 @@
 //! `Mode::Committed` (build --check) takes the texel values and the measured errors from the
 //! committed JSON and re-renders every file without integrating.
 
-use crate::pipeline::{BuildError, Built, Mode, Verification, committed_texels, compact_json, fmt_err, spec_rel_path};
+use crate::pipeline::{BuildError, Built, Mode, Quadrature, Verification, committed_texels, compact_json, fmt_err, spec_rel_path};
 use super::emit::{Layout, SkinLutCode};
 use crate::emit::texture::{ktx2_rgba, png_srgb_preview};
 use crate::emit::interp::{multilinear, nodes};
@@ -31,13 +31,6 @@ use super::spec::{SkinLut, SkinLutKind};
 use serde_json::{Value, json};
 use sha2::{Digest, Sha256};
 use std::path::Path;
-
-/// Quadrature work and the largest error estimate over the texels.
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct Quadrature {
-    max_error_estimate: f64,
-    evals_per_texel: f64,
-}
 
 /// Input hash of a skin LUT: the generator, the spec text and, for a CSV profile, its bytes.
 pub fn input_hash(spec: &Spec, lut: &SkinLut) -> String {
@@ -205,9 +198,7 @@ fn committed_parts(v: &Value, name: &str, texels: usize) -> Result<(Vec<[f64; 3]
         rms_error_f32: num(ver, "rms_error_f32")?,
         max_abs_error_in_parameter: None,
     };
-    let q = &v["quadrature"];
-    let quadrature =
-        Quadrature { max_error_estimate: num(q, "max_error_estimate")?, evals_per_texel: num(q, "evals_per_texel")? };
+    let quadrature: Quadrature = serde_json::from_value(v["quadrature"].clone()).map_err(|e| bad(&format!("quadrature: {e}")))?;
     Ok((values, verification, quadrature))
 }
 
@@ -239,6 +230,7 @@ fn build_verified(spec: &Spec, mode: Mode, root: &Path, texture: bool) -> Result
             let est = integrate(spec, &lut, &nls, &kappas)?;
             let evals: u64 = est.iter().map(|e| e[0].evals).sum();
             let q = Quadrature {
+                tolerance: lut.tolerance,
                 max_error_estimate: est.iter().flat_map(|e| e.iter().map(|x| x.error)).fold(0.0, f64::max),
                 evals_per_texel: (evals as f64 / est.len() as f64).round(),
             };
@@ -331,11 +323,7 @@ fn build_verified(spec: &Spec, mode: Mode, root: &Path, texture: bool) -> Result
         "layout": "row-major, x fastest: values[y * width + x]",
         "channels": ["red", "green", "blue"],
         "range": [lo, hi],
-        "quadrature": {
-            "tolerance": lut.tolerance,
-            "max_error_estimate": quadrature.max_error_estimate,
-            "evals_per_texel": quadrature.evals_per_texel,
-        },
+        "quadrature": quadrature,
         "verification": verification,
         "values": values,
     });

@@ -68,13 +68,8 @@ pub fn tabulate(lut: &DfgLut) -> (Vec<[f64; 2]>, Quadrature) {
     (est.iter().map(|e| [e.scale, e.bias]).collect(), q)
 }
 
-/// Quadrature of the texels.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct Quadrature {
-    pub tolerance: f64,
-    pub max_error_estimate: f64,
-    pub evals_per_texel: f64,
-}
+/// Quadrature of the texels (the table kind's).
+pub use crate::pipeline::Quadrature;
 
 /// One error measure on the verification grid.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
