@@ -41,7 +41,7 @@ pub mod names;
 pub mod table;
 
 pub use names::is_identifier;
-pub use table::{AxisMapping, Placement, TableLayout, TableTextureFormat};
+pub use table::{AxisMapping, Placement, Preset, TableLayout, TableTextureFormat, preset_spec_file};
 
 use crate::fit::model::{Derived, ModelError, ModelParts, Pin, RationalModel, Term};
 use crate::fit::Objective;

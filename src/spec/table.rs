@@ -29,7 +29,36 @@
 //! `sqrt-one-minus` (1 − t², t = √(1 − cos θ) to cos θ); families add their own through the
 //! [`super::Catalog`].
 
+use super::{Spec, SpecError, SpecFile, is_kind};
 use serde::Deserialize;
+use std::path::Path;
+
+/// A family's table kind, a preset of the table kind: its spec file read by its own schema
+/// (errors name the file, the line and the field) and the common spec it enters the pipeline
+/// as. Its `KindDef::spec_file` is [`preset_spec_file`]; its build reads it back with
+/// [`Preset::from_spec`].
+pub trait Preset: Sized {
+    /// The spec files' `kind`.
+    const KIND: &'static str;
+    /// Parse and check a spec file of this kind.
+    fn parse(path: &Path, text: &str) -> Result<Self, SpecError>;
+    /// The common spec (the quantity's parameters as axes, the function, the tolerance).
+    fn common(&self, path: &Path, text: &str) -> Result<SpecFile, SpecError>;
+    /// The preset of a loaded spec (parsed again from its text: the spec layer checked it).
+    fn from_spec(spec: &Spec) -> Result<Self, SpecError> {
+        Self::parse(&spec.path, &spec.text)
+    }
+}
+
+/// For `Spec::parse` (a `KindDef::spec_file`): the common spec of a spec of preset `P`
+/// (checked), or `None` when the text is not one (its `kind` differs, or it is not TOML: the
+/// common parser reports that).
+pub fn preset_spec_file<P: Preset>(path: &Path, text: &str) -> Result<Option<SpecFile>, SpecError> {
+    if !is_kind(text, P::KIND) {
+        return Ok(None);
+    }
+    P::parse(path, text)?.common(path, text).map(Some)
+}
 
 /// Where the points of a table axis of `count` points lie on its range [lo, hi].
 #[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq, Default)]

@@ -16,7 +16,7 @@ use std::path::{Path, PathBuf};
 pub const DFG_LUT: SpecKind = SpecKind {
     spec: KindDef {
         name: spec::KIND,
-        spec_file: spec::spec_file,
+        spec_file: crate::spec::preset_spec_file::<spec::DfgLut>,
         samples_note: "{name} is a DFG LUT: its samples are its texels, \"values\" ([scale, bias]) in generated/json/{name}.json",
         input_hash: crate::pipeline::input_hash,
     },
@@ -43,6 +43,7 @@ pub fn figures(out: &Path, generated: &Path) -> Result<Vec<PathBuf>, PlotError> 
 
 #[cfg(test)]
 mod tests {
+    use crate::spec::Preset;
     use super::build::{build, tabulate};
     use super::spec::DfgLut;
     use crate::family::ggx::integrals::{Inner, env_with};

@@ -42,7 +42,7 @@ use crate::emit::texture::{TextureFormat, ktx2_texels, png_srgb_preview};
 use crate::emit::{Artifact, GENERATOR, f32_literal, header_lines};
 use crate::family::SpecKind;
 use crate::pipeline::{BuildError, Built, Mode, Verification, compact_json, fmt_err, spec_rel_path};
-use crate::spec::{CustomSpec, KindDef, Spec, SpecError, SpecFile, is_kind, line_of, parse_toml};
+use crate::spec::{CustomSpec, KindDef, Preset, Spec, SpecError, SpecFile, line_of, parse_toml};
 use rayon::prelude::*;
 use serde::Deserialize;
 use serde_json::json;
@@ -69,7 +69,7 @@ pub const PATHS_RANGE: [u64; 2] = [256, 1 << 24];
 pub const TABLE: SpecKind = SpecKind {
     spec: KindDef {
         name: KIND,
-        spec_file,
+        spec_file: crate::spec::preset_spec_file::<Table>,
         samples_note: "{name} is a simulated table: its cells are in generated/json/{name}.json (\"slices\", \"albedo\")",
         input_hash: crate::pipeline::input_hash,
     },
@@ -155,67 +155,6 @@ pub struct Table {
 }
 
 impl Table {
-    pub fn parse(path: &Path, text: &str) -> Result<Table, SpecError> {
-        let f: TableFile = parse_toml(path, text)?;
-        let at = |field: &str, msg: String| SpecError::new(path, line_of(text, field), field, msg);
-        if f.quantity != "ms-diffuse" {
-            return Err(at("quantity", format!("'{}': kind = \"{KIND}\" tabulates 'ms-diffuse'", f.quantity)));
-        }
-        if f.resolution.len() != 3 {
-            return Err(at("resolution", format!("needs resolution = [theta_h columns, theta_d rows, gloss layers], found {} numbers", f.resolution.len())));
-        }
-        let (w, h, g) = (f.resolution[0], f.resolution[1], f.resolution[2]);
-        if !(2..=MAX_SIDE).contains(&w) || !(2..=MAX_SIDE).contains(&h) || !(1..=MAX_LAYERS).contains(&g) {
-            return Err(at("resolution", format!("[{w}, {h}, {g}]: sides must be in [2, {MAX_SIDE}], layers in [1, {MAX_LAYERS}]")));
-        }
-        let phi_d = f.phi_d.unwrap_or(FRAC_PI_2);
-        if !(0.0..=PI).contains(&phi_d) {
-            return Err(at("phi_d", format!("{phi_d} must be in [0, π]")));
-        }
-        let f0 = f.f0.unwrap_or(TALK_F0);
-        if !(0.0..=1.0).contains(&f0) {
-            return Err(at("f0", format!("{f0} must be in [0, 1]")));
-        }
-        let paths_ok = |p: u64| (PATHS_RANGE[0]..=PATHS_RANGE[1]).contains(&p);
-        if !paths_ok(f.paths) {
-            return Err(at("paths", format!("{} must be in [{}, {}]", f.paths, PATHS_RANGE[0], PATHS_RANGE[1])));
-        }
-        let albedo_paths = f.albedo_paths.unwrap_or(f.paths);
-        if !paths_ok(albedo_paths) {
-            return Err(at("albedo_paths", format!("{albedo_paths} must be in [{}, {}]", PATHS_RANGE[0], PATHS_RANGE[1])));
-        }
-        if let Some(p) = f.merl_paths
-            && !(2..=PATHS_RANGE[1]).contains(&p)
-        {
-            return Err(at("merl_paths", format!("{p} must be in [2, {}] (two paths give a standard error)", PATHS_RANGE[1])));
-        }
-        let albedo_width = f.albedo_resolution.unwrap_or(32);
-        if !(2..=MAX_SIDE).contains(&albedo_width) {
-            return Err(at("albedo_resolution", format!("{albedo_width} must be in [2, {MAX_SIDE}]")));
-        }
-        Ok(Table {
-            name: f.name,
-            description: f.description,
-            function: f.emit.function,
-            width: w,
-            height: h,
-            layers: g,
-            phi_d,
-            f0,
-            specular: match f.specular {
-                SpecularName::Gone => Specular::Gone,
-                SpecularName::Walks => Specular::Walks,
-            },
-            paths: f.paths,
-            albedo_width,
-            albedo_paths,
-            merl_paths: f.merl_paths,
-        })
-    }
-
-    pub fn from_spec(spec: &Spec) -> Result<Table, SpecError> {
-        Table::parse(&spec.path, &spec.text)
-    }
 
     /// The slices' grid, as the table kind's: θh columns and θd rows at the texel centres of
     /// [0, 1] mapped to [0, π/2], gloss layers at the nodes of [0, 1] (parameters 1, 2, 0 of
@@ -314,8 +253,71 @@ impl Table {
         range.into_par_iter().map(|c| self.cell(c)).collect()
     }
 
+}
+
+impl Preset for Table {
+    const KIND: &'static str = KIND;
+
+    fn parse(path: &Path, text: &str) -> Result<Table, SpecError> {
+        let f: TableFile = parse_toml(path, text)?;
+        let at = |field: &str, msg: String| SpecError::new(path, line_of(text, field), field, msg);
+        if f.quantity != "ms-diffuse" {
+            return Err(at("quantity", format!("'{}': kind = \"{KIND}\" tabulates 'ms-diffuse'", f.quantity)));
+        }
+        if f.resolution.len() != 3 {
+            return Err(at("resolution", format!("needs resolution = [theta_h columns, theta_d rows, gloss layers], found {} numbers", f.resolution.len())));
+        }
+        let (w, h, g) = (f.resolution[0], f.resolution[1], f.resolution[2]);
+        if !(2..=MAX_SIDE).contains(&w) || !(2..=MAX_SIDE).contains(&h) || !(1..=MAX_LAYERS).contains(&g) {
+            return Err(at("resolution", format!("[{w}, {h}, {g}]: sides must be in [2, {MAX_SIDE}], layers in [1, {MAX_LAYERS}]")));
+        }
+        let phi_d = f.phi_d.unwrap_or(FRAC_PI_2);
+        if !(0.0..=PI).contains(&phi_d) {
+            return Err(at("phi_d", format!("{phi_d} must be in [0, π]")));
+        }
+        let f0 = f.f0.unwrap_or(TALK_F0);
+        if !(0.0..=1.0).contains(&f0) {
+            return Err(at("f0", format!("{f0} must be in [0, 1]")));
+        }
+        let paths_ok = |p: u64| (PATHS_RANGE[0]..=PATHS_RANGE[1]).contains(&p);
+        if !paths_ok(f.paths) {
+            return Err(at("paths", format!("{} must be in [{}, {}]", f.paths, PATHS_RANGE[0], PATHS_RANGE[1])));
+        }
+        let albedo_paths = f.albedo_paths.unwrap_or(f.paths);
+        if !paths_ok(albedo_paths) {
+            return Err(at("albedo_paths", format!("{albedo_paths} must be in [{}, {}]", PATHS_RANGE[0], PATHS_RANGE[1])));
+        }
+        if let Some(p) = f.merl_paths
+            && !(2..=PATHS_RANGE[1]).contains(&p)
+        {
+            return Err(at("merl_paths", format!("{p} must be in [2, {}] (two paths give a standard error)", PATHS_RANGE[1])));
+        }
+        let albedo_width = f.albedo_resolution.unwrap_or(32);
+        if !(2..=MAX_SIDE).contains(&albedo_width) {
+            return Err(at("albedo_resolution", format!("{albedo_width} must be in [2, {MAX_SIDE}]")));
+        }
+        Ok(Table {
+            name: f.name,
+            description: f.description,
+            function: f.emit.function,
+            width: w,
+            height: h,
+            layers: g,
+            phi_d,
+            f0,
+            specular: match f.specular {
+                SpecularName::Gone => Specular::Gone,
+                SpecularName::Walks => Specular::Walks,
+            },
+            paths: f.paths,
+            albedo_width,
+            albedo_paths,
+            merl_paths: f.merl_paths,
+        })
+    }
+
     /// The common spec: every parameter of ms-diffuse as an axis.
-    fn spec_file(&self, path: &Path, text: &str) -> Result<SpecFile, SpecError> {
+    fn common(&self, path: &Path, text: &str) -> Result<SpecFile, SpecError> {
         let one = |name: &str, x: f64| json!({"name": name, "range": [x, x], "count": 1, "verify": 1});
         let walks = if self.specular == Specular::Walks { 1.0 } else { 0.0 };
         let axes = vec![
@@ -355,15 +357,6 @@ impl Cell {
     pub fn of(e: crate::integrate::Estimate) -> Cell {
         Cell { value: e.value, se: e.error }
     }
-}
-
-/// For `Spec::parse`: the common spec of a table spec, or None when the text is another kind.
-pub fn spec_file(path: &Path, text: &str) -> Result<Option<SpecFile>, SpecError> {
-    if !is_kind(text, KIND) {
-        return Ok(None);
-    }
-    let t = Table::parse(path, text)?;
-    t.spec_file(path, text).map(Some)
 }
 
 /// Statistics of a set of cells: the largest standard error, the rms one and the number of

@@ -17,6 +17,7 @@
 //! `Mode::Committed` (build --check) takes the texel values and the measured errors from the
 //! committed JSON and re-renders every file without integrating.
 
+use crate::spec::Preset;
 use crate::pipeline::{BuildError, Built, Mode, Quadrature, Verification, committed_texels, compact_json, fmt_err, spec_rel_path};
 use super::emit::{Layout, SkinLutCode};
 use crate::emit::texture::{ktx2_rgba, png_srgb_preview};

@@ -11,6 +11,7 @@ pub mod profile;
 pub mod scene;
 pub mod spec;
 
+use crate::spec::Preset;
 use super::Family;
 use super::{EvalOptions, OptionEval, SpecKind};
 use crate::spec::KindDef;
@@ -78,7 +79,7 @@ pub static QUANTITIES: &[QuantityDef] = &[
 static SKIN_LUT: SpecKind = SpecKind {
     spec: KindDef {
         name: spec::KIND,
-        spec_file: spec::spec_file,
+        spec_file: crate::spec::preset_spec_file::<spec::SkinLut>,
         samples_note: "{name} is a skin LUT: its samples are its texels, \"values\" in generated/json/{name}.json (RGB, with the axes)",
         input_hash: |s| match spec::SkinLut::from_spec(s) {
             Ok(lut) => build::input_hash(s, &lut),

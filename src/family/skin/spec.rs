@@ -38,7 +38,7 @@
 //! listing, staleness and the runtime index treat it like any other spec.
 
 use super::profile::{LoadedProfile, ProfileSection};
-use crate::spec::{CustomSpec, SpecError, SpecFile, check_resolution, check_tolerance, is_kind, line_of, parse_toml};
+use crate::spec::{CustomSpec, SpecError, SpecFile, check_resolution, check_tolerance, line_of, parse_toml, Preset};
 use crate::pipeline::GridAxis;
 use crate::spec::TableTextureFormat as TextureFormat;
 use crate::spec::table::{self, Placement};
@@ -136,8 +136,41 @@ pub struct SkinLut {
 }
 
 impl SkinLut {
+
+    /// κ (1/mm) of the curvature samples, in order (ends included, mapped).
+    pub fn curvatures(&self) -> Vec<f64> {
+        self.curvatures_at(self.curvature_count)
+    }
+
+    /// κ at `n` nodes of the mapped coordinate (the table's `curvature_count`, or the
+    /// verification's 2n − 1).
+    pub fn curvatures_at(&self, n: usize) -> Vec<f64> {
+        let axis = GridAxis { count: n, ..self.curvature_axis() };
+        axis.arguments().into_iter().map(|t| self.curvature_max * axis.parameter(t)).collect()
+    }
+
+    /// The curvature axis of the table kind's grid: nodes of the mapped coordinate t ∈ [0, 1],
+    /// whose parameter is κ/κ_max (t, or t² for `sqrt` rows).
+    pub fn curvature_axis(&self) -> GridAxis {
+        let mapping = match self.curvature_mapping {
+            CurvatureMapping::Linear => &table::LINEAR,
+            CurvatureMapping::Sqrt => &table::SQUARE,
+        };
+        GridAxis { range: [0.0, 1.0], count: self.curvature_count, placement: Placement::Nodes, mapping, param: 0 }
+    }
+
+    /// The n·l axis of a punctual LUT's grid: `n` nodes on [−1, 1].
+    pub fn n_dot_l_axis(n: usize) -> GridAxis {
+        GridAxis { range: [-1.0, 1.0], count: n, placement: Placement::Nodes, mapping: &table::LINEAR, param: 1 }
+    }
+
+}
+
+impl Preset for SkinLut {
+    const KIND: &'static str = KIND;
+
     /// Parse and check a skin LUT spec (its `kind` must be "skin-lut").
-    pub fn parse(path: &Path, text: &str) -> Result<SkinLut, SpecError> {
+    fn parse(path: &Path, text: &str) -> Result<SkinLut, SpecError> {
         let f: SkinLutFile = parse_toml(path, text)?;
         let at = |field: &str, msg: String| SpecError::new(path, line_of(text, field), field, msg);
         let punctual = match f.quantity.as_str() {
@@ -224,42 +257,10 @@ impl SkinLut {
         })
     }
 
-    /// The LUT of a loaded spec (parsed again from its text: the spec layer checked it).
-    pub fn from_spec(spec: &crate::spec::Spec) -> Result<SkinLut, SpecError> {
-        SkinLut::parse(&spec.path, &spec.text)
-    }
-
-    /// κ (1/mm) of the curvature samples, in order (ends included, mapped).
-    pub fn curvatures(&self) -> Vec<f64> {
-        self.curvatures_at(self.curvature_count)
-    }
-
-    /// κ at `n` nodes of the mapped coordinate (the table's `curvature_count`, or the
-    /// verification's 2n − 1).
-    pub fn curvatures_at(&self, n: usize) -> Vec<f64> {
-        let axis = GridAxis { count: n, ..self.curvature_axis() };
-        axis.arguments().into_iter().map(|t| self.curvature_max * axis.parameter(t)).collect()
-    }
-
-    /// The curvature axis of the table kind's grid: nodes of the mapped coordinate t ∈ [0, 1],
-    /// whose parameter is κ/κ_max (t, or t² for `sqrt` rows).
-    pub fn curvature_axis(&self) -> GridAxis {
-        let mapping = match self.curvature_mapping {
-            CurvatureMapping::Linear => &table::LINEAR,
-            CurvatureMapping::Sqrt => &table::SQUARE,
-        };
-        GridAxis { range: [0.0, 1.0], count: self.curvature_count, placement: Placement::Nodes, mapping, param: 0 }
-    }
-
-    /// The n·l axis of a punctual LUT's grid: `n` nodes on [−1, 1].
-    pub fn n_dot_l_axis(n: usize) -> GridAxis {
-        GridAxis { range: [-1.0, 1.0], count: n, placement: Placement::Nodes, mapping: &table::LINEAR, param: 1 }
-    }
-
     /// The common spec this LUT enters the pipeline as: axes in the quantity's parameter order
     /// (curvature, then n_dot_l or band), counts as tabulated, verification on the grid that
     /// adds every midpoint (2n − 1).
-    fn spec_file(&self, path: &Path, text: &str) -> Result<SpecFile, SpecError> {
+    fn common(&self, path: &Path, text: &str) -> Result<SpecFile, SpecError> {
         let n = self.curvature_count;
         let mut axes = vec![json!({"name": "curvature", "range": [0.0, self.curvature_max], "count": n, "verify": 2 * n - 1})];
         axes.push(match self.kind {
@@ -279,16 +280,6 @@ impl SkinLut {
         }
         .spec_file(path, text)
     }
-}
-
-/// For `Spec::parse`: the common spec of a skin LUT spec (checked), or `None` when the text is
-/// not one (its `kind` is not "skin-lut", or it is not TOML: the common parser reports that).
-pub fn spec_file(path: &Path, text: &str) -> Result<Option<SpecFile>, SpecError> {
-    if !is_kind(text, KIND) {
-        return Ok(None);
-    }
-    let lut = SkinLut::parse(path, text)?;
-    lut.spec_file(path, text).map(Some)
 }
 
 #[cfg(test)]

@@ -18,6 +18,7 @@
 //! `Mode::Committed` (build --check) takes the texels and the measured errors from the
 //! committed JSON and re-renders every file without integrating.
 
+use crate::spec::Preset;
 use super::emit::{DfgLutCode, lookup_f32};
 use super::spec::{DfgLut, RoughnessMapping};
 use crate::emit::texture::{TextureFormat, ktx2_texels, png_srgb_preview};

@@ -36,7 +36,7 @@ use crate::pipeline::{Grid, GridAxis};
 use crate::shading::roughness::alpha_from_gloss;
 use crate::spec::table::{self, AxisMapping, Placement, TableTextureFormat};
 use crate::quantity::QuantityDef;
-use crate::spec::{CustomSpec, Sampler, SpecError, SpecFile, check_resolution, check_tolerance, is_kind, line_of, parse_toml};
+use crate::spec::{CustomSpec, Sampler, SpecError, SpecFile, check_resolution, check_tolerance, line_of, parse_toml, Preset};
 use serde::Deserialize;
 use serde_json::json;
 use std::path::Path;
@@ -231,48 +231,6 @@ pub struct DfgLut {
 }
 
 impl DfgLut {
-    /// Parse and check a DFG LUT spec (its `kind` must be "ggx-dfg-lut").
-    pub fn parse(path: &Path, text: &str) -> Result<DfgLut, SpecError> {
-        let f: DfgLutFile = parse_toml(path, text)?;
-        let at = |field: &str, msg: String| SpecError::new(path, line_of(text, field), field, msg);
-        let ue4 = match f.quantity.as_str() {
-            "ggx-env" => false,
-            "ggx-env-ue4" => true,
-            other => return Err(at("quantity", format!("'{other}': DFG LUTs tabulate 'ggx-env' or 'ggx-env-ue4'"))),
-        };
-        if f.resolution.len() != 2 {
-            return Err(at("resolution", format!("needs resolution = [n·v columns, roughness rows], found {} numbers", f.resolution.len())));
-        }
-        check_resolution(&f.resolution, MAX_RESOLUTION).map_err(|m| at("resolution", m))?;
-        let cos_cone = f.cos_cone.unwrap_or(0.0);
-        if ue4 && f.cos_cone.is_some() {
-            return Err(at("cos_cone", "ggx-env-ue4 integrates the hemisphere; 'cos_cone' applies to ggx-env only".into()));
-        }
-        if !(0.0..=MAX_COS_CONE).contains(&cos_cone) {
-            return Err(at("cos_cone", format!("{cos_cone} must be in [0, {MAX_COS_CONE}] (0: the hemisphere)")));
-        }
-        let tolerance = f.tolerance.unwrap_or(DEFAULT_TOLERANCE);
-        check_tolerance(tolerance, TOLERANCE_RANGE, "above, quadrature error would rival f16 rounding; below, the rules cannot converge in f64").map_err(|m| at("tolerance", m))?;
-        Ok(DfgLut {
-            name: f.name,
-            quantity: f.quantity,
-            description: f.description,
-            function: f.emit.function,
-            width: f.resolution[0],
-            height: f.resolution[1],
-            mapping: f.roughness_mapping,
-            layout: f.layout,
-            cos_cone,
-            ue4,
-            format: check_format(f.texture_format, at)?,
-            tolerance,
-        })
-    }
-
-    /// The LUT of a loaded spec (parsed again from its text: the spec layer checked it).
-    pub fn from_spec(spec: &crate::spec::Spec) -> Result<DfgLut, SpecError> {
-        DfgLut::parse(&spec.path, &spec.text)
-    }
 
     /// n·v of column i (texel centre).
     pub fn n_dot_v(&self, i: usize) -> f64 {
@@ -317,8 +275,51 @@ impl DfgLut {
         if self.ue4 { Shadowing::Separable { k: 0.5 * alpha } } else { Shadowing::HeightCorrelated }
     }
 
+}
+
+impl Preset for DfgLut {
+    const KIND: &'static str = KIND;
+
+    /// Parse and check a DFG LUT spec (its `kind` must be "ggx-dfg-lut").
+    fn parse(path: &Path, text: &str) -> Result<DfgLut, SpecError> {
+        let f: DfgLutFile = parse_toml(path, text)?;
+        let at = |field: &str, msg: String| SpecError::new(path, line_of(text, field), field, msg);
+        let ue4 = match f.quantity.as_str() {
+            "ggx-env" => false,
+            "ggx-env-ue4" => true,
+            other => return Err(at("quantity", format!("'{other}': DFG LUTs tabulate 'ggx-env' or 'ggx-env-ue4'"))),
+        };
+        if f.resolution.len() != 2 {
+            return Err(at("resolution", format!("needs resolution = [n·v columns, roughness rows], found {} numbers", f.resolution.len())));
+        }
+        check_resolution(&f.resolution, MAX_RESOLUTION).map_err(|m| at("resolution", m))?;
+        let cos_cone = f.cos_cone.unwrap_or(0.0);
+        if ue4 && f.cos_cone.is_some() {
+            return Err(at("cos_cone", "ggx-env-ue4 integrates the hemisphere; 'cos_cone' applies to ggx-env only".into()));
+        }
+        if !(0.0..=MAX_COS_CONE).contains(&cos_cone) {
+            return Err(at("cos_cone", format!("{cos_cone} must be in [0, {MAX_COS_CONE}] (0: the hemisphere)")));
+        }
+        let tolerance = f.tolerance.unwrap_or(DEFAULT_TOLERANCE);
+        check_tolerance(tolerance, TOLERANCE_RANGE, "above, quadrature error would rival f16 rounding; below, the rules cannot converge in f64").map_err(|m| at("tolerance", m))?;
+        Ok(DfgLut {
+            name: f.name,
+            quantity: f.quantity,
+            description: f.description,
+            function: f.emit.function,
+            width: f.resolution[0],
+            height: f.resolution[1],
+            mapping: f.roughness_mapping,
+            layout: f.layout,
+            cos_cone,
+            ue4,
+            format: check_format(f.texture_format, at)?,
+            tolerance,
+        })
+    }
+
     /// The common spec: axes alpha (rows), n_dot_v (columns), and for ggx-env cos_cone fixed.
-    fn spec_file(&self, path: &Path, text: &str) -> Result<SpecFile, SpecError> {
+    fn common(&self, path: &Path, text: &str) -> Result<SpecFile, SpecError> {
         let (w, h) = (self.width, self.height);
         let mut axes = vec![
             json!({"name": "alpha", "range": self.alpha_range(), "count": h, "verify": 4 * h}),
@@ -338,16 +339,6 @@ impl DfgLut {
         }
         .spec_file(path, text)
     }
-}
-
-/// For `Spec::parse`: the common spec of a DFG LUT spec (checked), or `None` when the text is
-/// not one (its `kind` is not "ggx-dfg-lut", or it is not TOML: the common parser reports that).
-pub fn spec_file(path: &Path, text: &str) -> Result<Option<SpecFile>, SpecError> {
-    if !is_kind(text, KIND) {
-        return Ok(None);
-    }
-    let lut = DfgLut::parse(path, text)?;
-    lut.spec_file(path, text).map(Some)
 }
 
 #[cfg(test)]

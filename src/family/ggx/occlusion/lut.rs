@@ -15,7 +15,7 @@ use crate::spec::KindDef;
 pub const CONE_LUT: SpecKind = SpecKind {
     spec: KindDef {
         name: spec::KIND,
-        spec_file: spec::spec_file,
+        spec_file: crate::spec::preset_spec_file::<spec::ConeLut>,
         samples_note: "{name} is a cone LUT: its samples are its texels, \"values\" ([scale, bias]) in generated/json/{name}.json",
         input_hash: crate::pipeline::input_hash,
     },
@@ -25,6 +25,7 @@ pub const CONE_LUT: SpecKind = SpecKind {
 
 #[cfg(test)]
 mod tests {
+    use crate::spec::Preset;
     use super::build::{build, tabulate, trilinear};
     use super::spec::ConeLut;
     use crate::family::ggx::integrals::{Inner, Shadowing, env_with};

@@ -18,6 +18,7 @@
 //! `Mode::Committed` (build --check) takes the texels and the measured errors from the
 //! committed JSON and re-renders every file without integrating.
 
+use crate::spec::Preset;
 use super::emit::{ConeLutCode, lookup_f32};
 use super::spec::ConeLut;
 use crate::emit::texture::{ktx2_volume, png_srgb_preview};

@@ -27,7 +27,7 @@
 use crate::family::ggx::lut::spec::{DfgLut, check_format, Layout, MAX_RESOLUTION, RoughnessMapping, TOLERANCE_RANGE};
 use crate::pipeline::{Grid, GridAxis};
 use crate::spec::Placement;
-use crate::spec::{CustomSpec, SpecError, SpecFile, check_resolution, check_tolerance, is_kind, line_of, parse_toml};
+use crate::spec::{CustomSpec, SpecError, SpecFile, check_resolution, check_tolerance, line_of, parse_toml, Preset};
 use serde::Deserialize;
 use serde_json::json;
 use std::path::Path;
@@ -87,8 +87,37 @@ pub struct ConeLut {
 }
 
 impl ConeLut {
+
+    /// cos θc of slice k: k/(slices − 1).
+    pub fn cos_cone(&self, k: usize) -> f64 {
+        k as f64 / (self.depth - 1) as f64
+    }
+
+    /// The 2-D table of cone cosine `c` (slice k is `table(cos_cone(k))`).
+    pub fn table(&self, c: f64) -> DfgLut {
+        DfgLut { cos_cone: c, ..self.base.clone() }
+    }
+
+    /// The table's grid: the 2-D table's n·v columns and rows, and the cone slices at nodes
+    /// k/(slices − 1) of [0, 1].
+    pub fn grid(&self) -> Grid {
+        let mut g = self.base.grid();
+        g.axes[2] = GridAxis { range: [0.0, 1.0], count: self.depth, placement: Placement::Nodes, mapping: &crate::spec::table::LINEAR, param: 2 };
+        g
+    }
+
+    /// The 2-D table of slice k.
+    pub fn slice(&self, k: usize) -> DfgLut {
+        self.table(self.cos_cone(k))
+    }
+
+}
+
+impl Preset for ConeLut {
+    const KIND: &'static str = KIND;
+
     /// Parse and check a cone LUT spec (its `kind` must be "ggx-cone-lut").
-    pub fn parse(path: &Path, text: &str) -> Result<ConeLut, SpecError> {
+    fn parse(path: &Path, text: &str) -> Result<ConeLut, SpecError> {
         let f: ConeLutFile = parse_toml(path, text)?;
         let at = |field: &str, msg: String| SpecError::new(path, line_of(text, field), field, msg);
         if f.quantity != "ggx-env" {
@@ -118,36 +147,8 @@ impl ConeLut {
         Ok(ConeLut { base, depth: f.resolution[2] })
     }
 
-    /// The LUT of a loaded spec (parsed again from its text: the spec layer checked it).
-    pub fn from_spec(spec: &crate::spec::Spec) -> Result<ConeLut, SpecError> {
-        ConeLut::parse(&spec.path, &spec.text)
-    }
-
-    /// cos θc of slice k: k/(slices − 1).
-    pub fn cos_cone(&self, k: usize) -> f64 {
-        k as f64 / (self.depth - 1) as f64
-    }
-
-    /// The 2-D table of cone cosine `c` (slice k is `table(cos_cone(k))`).
-    pub fn table(&self, c: f64) -> DfgLut {
-        DfgLut { cos_cone: c, ..self.base.clone() }
-    }
-
-    /// The table's grid: the 2-D table's n·v columns and rows, and the cone slices at nodes
-    /// k/(slices − 1) of [0, 1].
-    pub fn grid(&self) -> Grid {
-        let mut g = self.base.grid();
-        g.axes[2] = GridAxis { range: [0.0, 1.0], count: self.depth, placement: Placement::Nodes, mapping: &crate::spec::table::LINEAR, param: 2 };
-        g
-    }
-
-    /// The 2-D table of slice k.
-    pub fn slice(&self, k: usize) -> DfgLut {
-        self.table(self.cos_cone(k))
-    }
-
     /// The common spec: axes alpha (rows), n_dot_v (columns), cos_cone (slices).
-    fn spec_file(&self, path: &Path, text: &str) -> Result<SpecFile, SpecError> {
+    fn common(&self, path: &Path, text: &str) -> Result<SpecFile, SpecError> {
         let b = &self.base;
         let (w, h, d) = (b.width, b.height, self.depth);
         let axes = vec![
@@ -158,15 +159,6 @@ impl ConeLut {
         CustomSpec { kind: KIND, name: &b.name, quantity: &b.quantity, description: &b.description, tolerance: b.tolerance, axes, function: &b.function }
             .spec_file(path, text)
     }
-}
-
-/// For `Spec::parse`: the common spec of a cone LUT spec (checked), or `None` when the text is
-/// not one.
-pub fn spec_file(path: &Path, text: &str) -> Result<Option<SpecFile>, SpecError> {
-    if !is_kind(text, KIND) {
-        return Ok(None);
-    }
-    ConeLut::parse(path, text)?.spec_file(path, text).map(Some)
 }
 
 #[cfg(test)]
