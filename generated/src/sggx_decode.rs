@@ -35,10 +35,10 @@ pub fn sggx_decode(tex: [f32; 3]) -> SggxAniso {
     let sxy = x * (y + y - 1.0) * z;
     let syy = z * z;
     let discr = (4.0 * (sxy * sxy) + (sxx - syy) * (sxx - syy)).sqrt();
-    let discr_rcp = 1.0 / discr.max(1e-6);
-    let alpha_t_sqr = (0.5 * (sxx + syy + discr)).clamp(0.0, 1.0).max(1e-6_f32);
-    let alpha_b_sqr = (0.5 * (sxx + syy - discr)).clamp(0.0, 1.0).max(1e-6_f32);
-    let c_sqr = (0.5 * ((sxx - syy) * discr_rcp + 1.0)).clamp(0.0, 1.0);
+    let discr_rcp = 1.0 / discr.max(1e-6_f32);
+    let alpha_t_sqr = (0.5 * (sxx + syy + discr)).max(0.0).min(1.0).max(1e-6_f32);
+    let alpha_b_sqr = (0.5 * (sxx + syy - discr)).max(0.0).min(1.0).max(1e-6_f32);
+    let c_sqr = (0.5 * ((sxx - syy) * discr_rcp + 1.0)).max(0.0).min(1.0);
     let sign = if sxy < 0.0 { -1.0 } else { 1.0 };
     SggxAniso { alpha_t_sqr, alpha_b_sqr, alpha_tb: (alpha_t_sqr * alpha_b_sqr).sqrt(), cos_psi: c_sqr.sqrt(), sin_psi: sign * (1.0 - c_sqr).sqrt() }
 }
@@ -57,12 +57,12 @@ pub fn sggx_bitangent(a: &SggxAniso, t: [f32; 3], b: [f32; 3]) -> [f32; 3] {
 /// anisotropic frame; dots clamped to [−1, 1], α's to [α_min², 1], the squared denominator ≥ 1e-30.
 /// f32 code against Burley's form in f64: max relative 5.193e-7.
 pub fn sggx_d(a: &SggxAniso, t_dot_h: f32, b_dot_h: f32, n_dot_h: f32) -> f32 {
-    let at2 = input(a.alpha_t_sqr, 1e-6_f32, 1.0);
-    let ab2 = input(a.alpha_b_sqr, 1e-6_f32, 1.0);
-    let atb = input(a.alpha_tb, 1e-6_f32, 1.0);
+    let at2 = input(a.alpha_t_sqr, 1e-6, 1.0);
+    let ab2 = input(a.alpha_b_sqr, 1e-6, 1.0);
+    let atb = input(a.alpha_tb, 1e-6, 1.0);
     let th = input(t_dot_h, -1.0, 1.0);
     let bh = input(b_dot_h, -1.0, 1.0);
     let nh = input(n_dot_h, -1.0, 1.0);
     let den = th * th * ab2 + bh * bh * at2 + nh * nh * (atb * atb);
-    atb * atb * atb / (std::f32::consts::PI * (den * den).max(1e-30))
+    atb * atb * atb / (3.1415927e0_f32 * (den * den).max(1e-30))
 }

@@ -1,7 +1,8 @@
 //! Functions of every body shape, for the emitters' tests: a fit with a denominator and a
 //! clamp, one without either, a one- and a two-axis table; the points they are run at (inside,
-//! on and outside the domain, ±inf, NaN); what the build's f32 evaluators give there; and the
-//! value naga's constant evaluator folds a WGSL expression to.
+//! on and outside the domain, ±inf, NaN); what the build's f32 evaluators give there; the
+//! value naga's constant evaluator folds a WGSL expression to; and what a `main` compiled by
+//! rustc prints.
 
 use super::interp::Placement;
 use super::rust::table_lookup_f32;
@@ -151,4 +152,20 @@ pub fn want_all(f: &Function<'_>, p: &[f32]) -> Vec<f32> {
         Body::Table { values, counts, channels, placements } => table_lookup_f32(values, *channels, counts, f.domain, placements, p),
         Body::Fit { .. } => vec![want(f, p)],
     }
+}
+
+/// `main` compiled by rustc with the modules `(name, text)` beside `main.rs` (`mod name;` in
+/// it), and run: the u32 it prints, one a line.
+pub fn compiled_bits_with(main: &str, modules: &[(String, String)]) -> Vec<u32> {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    for (name, text) in modules {
+        std::fs::write(dir.join(format!("{name}.rs")), text).unwrap();
+    }
+    std::fs::write(dir.join("main.rs"), main).unwrap();
+    let rustc = std::env::var("RUSTC").unwrap_or_else(|_| "rustc".into());
+    let out = std::process::Command::new(rustc).args(["--edition", "2021", "-A", "warnings", "-o"]).arg(dir.join("main")).arg(dir.join("main.rs")).output().unwrap();
+    assert!(out.status.success(), "rustc: {}\n{main}", String::from_utf8_lossy(&out.stderr));
+    let run = std::process::Command::new(dir.join("main")).output().unwrap();
+    String::from_utf8(run.stdout).unwrap().lines().map(|l| l.parse().unwrap()).collect()
 }

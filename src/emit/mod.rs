@@ -7,7 +7,7 @@
 pub use crate::fit::expr;
 pub mod fields;
 #[cfg(test)]
-mod fixtures;
+pub(crate) mod fixtures;
 pub mod interp;
 pub mod rust;
 pub mod targets;

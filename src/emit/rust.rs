@@ -165,6 +165,7 @@ pub fn table_lookup_f32(values: &[f32], channels: usize, counts: &[usize], domai
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::emit::fixtures::compiled_bits_with;
 
     /// An emitted array: six values a line (so a 4096-entry table stays readable and its diffs
     /// local), each a literal that reads back to the same f32 bits, in order.
@@ -215,21 +216,6 @@ mod tests {
     /// `main` compiled by rustc and run: the u32 it prints, one a line.
     fn compiled_bits(main: &str) -> Vec<u32> {
         compiled_bits_with(main, &[])
-    }
-
-    /// [`compiled_bits`] with the modules `(name, text)` beside `main.rs` (`mod name;` in it).
-    fn compiled_bits_with(main: &str, modules: &[(String, String)]) -> Vec<u32> {
-        let tmp = tempfile::tempdir().unwrap();
-        let dir = tmp.path();
-        for (name, text) in modules {
-            std::fs::write(dir.join(format!("{name}.rs")), text).unwrap();
-        }
-        std::fs::write(dir.join("main.rs"), main).unwrap();
-        let rustc = std::env::var("RUSTC").unwrap_or_else(|_| "rustc".into());
-        let out = std::process::Command::new(rustc).args(["--edition", "2021", "-A", "warnings", "-o"]).arg(dir.join("main")).arg(dir.join("main.rs")).output().unwrap();
-        assert!(out.status.success(), "rustc: {}\n{main}", String::from_utf8_lossy(&out.stderr));
-        let run = std::process::Command::new(dir.join("main")).output().unwrap();
-        String::from_utf8(run.stdout).unwrap().lines().map(|l| l.parse().unwrap()).collect()
     }
 
     /// Tables of several channels, three axes and texel-centre placement (`Grids`), rendered,

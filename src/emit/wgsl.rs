@@ -375,11 +375,11 @@ pub fn strip_directives(src: &str) -> String {
 }
 
 /// The f32 interpreter of naga's IR that the runtime's GPU test takes as reference (CPU
-/// semantics: the operations the source spells out, in f32), for the tests below.
+/// semantics: the operations the source spells out, in f32), for the emitters' and the families' tests.
 #[cfg(test)]
 #[allow(dead_code)]
 #[path = "../../generated/tests/support/bound.rs"]
-mod interpreter;
+pub(crate) mod interpreter;
 
 #[cfg(test)]
 mod tests {

@@ -420,6 +420,12 @@ pub trait Spell {
     fn local(&self, j: usize) -> String {
         format!("t{j}")
     }
+    /// Whether a quotient's operands are bracketed only where precedence needs it (a sum on
+    /// the left; a sum, product or quotient on the right), as a program is written. A rational
+    /// model's P/Q keeps its brackets on both sides, as the emitted rationals always had.
+    fn tight_quotients(&self) -> bool {
+        false
+    }
 }
 
 /// Render through a [`Spell`]. Vectors render as WGSL's; Rust has no vector type, so a
@@ -442,9 +448,12 @@ pub fn render_with(syntax: Syntax, e: &Expr, spell: &dyn Spell) -> String {
             }
         }
     };
-    // A quotient's operand is bracketed unless it is a program's name or a call (a rational
-    // model's P/Q keeps its brackets on both sides, as the emitted rationals always had).
-    let quotient = |x: &Expr| wrap(x, !matches!(x, Let(..) | Swizzle(..)) && !is_call(x));
+    // A quotient's operand is bracketed unless it is a program's name or a call, or, where
+    // the spelling asks for tight quotients, where precedence needs it ([`Spell::tight_quotients`]).
+    let quotient = |x: &Expr, right: bool| {
+        let needed = if spell.tight_quotients() { sum(x) || (right && matches!(x, Mul(..) | Div(..))) } else { !matches!(x, Let(..) | Swizzle(..)) && !is_call(x) };
+        wrap(x, needed)
+    };
     let condition = |c: &Expr| wrap(c, !matches!(c, Var(..) | Coef(..) | Lit(..)) && !is_atom(c) && !is_call(c));
     match e {
         Lit(v) => spell.lit(*v),
@@ -461,7 +470,7 @@ pub fn render_with(syntax: Syntax, e: &Expr, spell: &dyn Spell) -> String {
             wrap(a, matches!(**a, Add(..) | Sub(..) | Div(..))),
             wrap(b, matches!(**b, Add(..) | Sub(..) | Mul(..) | Div(..)))
         ),
-        Div(a, b) => format!("{} / {}", quotient(a), quotient(b)),
+        Div(a, b) => format!("{} / {}", quotient(a, false), quotient(b, true)),
         Min(a, b) => call("min", "min", &[a, b], None),
         Max(a, b) => call("max", "max", &[a, b], None),
         Clamp(x, lo, hi) => match syntax {

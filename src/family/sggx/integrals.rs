@@ -43,9 +43,9 @@ use nalgebra::{Matrix2, Matrix3, Vector3};
 mod ndf;
 mod sphere;
 mod storage;
-pub use ndf::{Lean, Lobe, d_burley, d_rearranged, is_spd};
+pub use ndf::{D_CONSTS, D_FORM, Lean, Lobe, d_burley, d_rearranged, is_spd};
 pub use sphere::{Distance, Mixture, Ndf, SphereRule, distance, estimate};
-pub use storage::{Decoded, decode_course, decode_matrix, encode, quantize};
+pub use storage::{DECODE_FORM, Decoded, decode_consts, decode_course, decode_matrix, encode, quantize};
 
 
 pub type M3 = Matrix3<f64>;

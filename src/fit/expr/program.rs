@@ -8,7 +8,8 @@
 //! bindings as `Let(k)` (earlier ones only). WGSL renders it as written (`let r = x * c0 + c1;`
 //! with `vec4<f32>` values); Rust, which has no vector type, one lane at a time
 //! (`let r = [x * c0[0] + c1[0], …];`), so both compute the same f32 operations in the same
-//! order as [`Program::eval_f32`].
+//! order as [`Program::eval_f32`]. A [`Record`] is a program with several named results, which
+//! the emitted code returns as one struct.
 
 use super::{Expr, Float, Spell, Syntax, Value, render_with};
 
@@ -110,12 +111,7 @@ pub struct Program {
 impl Program {
     /// The result's lanes at `inputs` with constants `consts`, in `T` with the emitted order.
     pub fn eval<T: Float>(&self, inputs: &[T], consts: &[T]) -> Lanes<T> {
-        let vars: Vec<Lanes<T>> = inputs.iter().map(|&x| Lanes::of(x)).collect();
-        let mut lets: Vec<Lanes<T>> = Vec::with_capacity(self.lets.len());
-        for (_, e) in &self.lets {
-            let v = super::eval_as(e, &vars, consts, &[], &lets);
-            lets.push(v);
-        }
+        let (vars, lets) = bindings(&self.lets, inputs, consts);
         super::eval_as(&self.result, &vars, consts, &[], &lets)
     }
 
@@ -131,20 +127,9 @@ impl Program {
         l.v[..l.len as usize].to_vec()
     }
 
-    /// Lanes of each binding and of the result.
-    fn widths(&self) -> (Vec<usize>, usize) {
-        let mut w = Vec::new();
-        for (_, e) in &self.lets {
-            let n = width(e, &w);
-            w.push(n);
-        }
-        let n = width(&self.result, &w);
-        (w, n)
-    }
-
     /// Lanes of the result.
     pub fn width(&self) -> usize {
-        self.widths().1
+        width(&self.result, &let_widths(&self.lets))
     }
 
     /// The function body (4-space indent, no closing brace): each binding on its line, then
@@ -152,46 +137,126 @@ impl Program {
     /// or the clamp call of the argument); constants print as `constant(consts[j])`, a negated
     /// constant as the literal of its negation.
     pub fn render(&self, syntax: Syntax, input: &dyn Fn(usize) -> String, consts: &[f32], constant: &dyn Fn(f32) -> String) -> String {
-        let (widths, n) = self.widths();
-        let spell = Bound { syntax, input, consts, constant, names: self.lets.iter().map(|(k, _)| k.as_str()).collect() };
-        let text = |e: &Expr, lanes: usize| -> String {
-            match syntax {
-                Syntax::Wgsl => {
-                    let one = render_with(syntax, e, &spell);
-                    // A long sum of three terms or more continues on the next lines, one term each.
-                    let terms = sum_terms(e);
-                    if one.len() <= LINE || terms.len() < 3 {
-                        return one;
-                    }
-                    // As `Add` renders: a right operand that is a sum in brackets.
-                    let parts: Vec<String> = terms
-                        .iter()
-                        .enumerate()
-                        .map(|(i, t)| {
-                            let text = render_with(syntax, t, &spell);
-                            if i > 0 && matches!(t, Expr::Add(..) | Expr::Sub(..)) { format!("({text})") } else { text }
-                        })
-                        .collect();
-                    parts.join("\n        + ")
-                }
-                Syntax::Rust if lanes == 1 => tail(render_with(syntax, e, &spell), e),
-                Syntax::Rust => {
-                    let parts: Vec<String> = (0..lanes).map(|k| tail(render_with(syntax, &lane(e, k, &widths), &spell), e)).collect();
-                    let one = format!("[{}]", parts.join(", "));
-                    if one.len() <= LINE { one } else { format!("[\n{}    ]", parts.iter().map(|p| format!("        {p},\n")).collect::<String>()) }
-                }
-            }
-        };
-        let mut s = String::new();
-        for ((name, e), &w) in self.lets.iter().zip(&widths) {
-            s += &format!("    let {name} = {};\n", text(e, w));
-        }
+        let (mut s, results) = render_parts(&self.lets, &[&self.result], syntax, input, consts, constant);
         match syntax {
-            Syntax::Wgsl => s += &format!("    return {};\n", text(&self.result, n)),
-            Syntax::Rust => s += &format!("    {}\n", text(&self.result, n)),
+            Syntax::Wgsl => s += &format!("    return {};\n", results[0]),
+            Syntax::Rust => s += &format!("    {}\n", results[0]),
         }
         s
     }
+}
+
+/// A form with several named results, returned as one struct of the emitted language: its
+/// fields over bindings they share. WGSL returns the struct's constructor (`return
+/// Name(a, …);`), Rust its literal (`Name { a, b: …, … }`, a field named as its binding
+/// written once); the evaluators return every field's lanes, field after field.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Record {
+    /// (name, value); a value refers to earlier bindings only.
+    pub lets: Vec<(String, Expr)>,
+    /// The struct's name in the emitted code.
+    pub name: String,
+    /// (field, value), in the struct's order.
+    pub fields: Vec<(String, Expr)>,
+}
+
+impl Record {
+    /// Each field's lanes at `inputs` with constants `consts`, in `T` with the emitted order.
+    pub fn eval<T: Float>(&self, inputs: &[T], consts: &[T]) -> Vec<Lanes<T>> {
+        let (vars, lets) = bindings(&self.lets, inputs, consts);
+        self.fields.iter().map(|(_, e)| super::eval_as(e, &vars, consts, &[], &lets)).collect()
+    }
+
+    /// The fields' lanes in f64, field after field.
+    pub fn eval_f64(&self, inputs: &[f64], consts: &[f64]) -> Vec<f64> {
+        self.eval(inputs, consts).iter().flat_map(|l| l.v[..l.len as usize].to_vec()).collect()
+    }
+
+    /// The fields' lanes in f32 (what the emitted code computes, FMA contraction aside).
+    pub fn eval_f32(&self, inputs: &[f32], consts: &[f32]) -> Vec<f32> {
+        self.eval(inputs, consts).iter().flat_map(|l| l.v[..l.len as usize].to_vec()).collect()
+    }
+
+    /// Lanes of each field.
+    pub fn widths(&self) -> Vec<usize> {
+        let lets = let_widths(&self.lets);
+        self.fields.iter().map(|(_, e)| width(e, &lets)).collect()
+    }
+
+    /// The function body as [`Program::render`] writes it, returning the struct.
+    pub fn render(&self, syntax: Syntax, input: &dyn Fn(usize) -> String, consts: &[f32], constant: &dyn Fn(f32) -> String) -> String {
+        let values: Vec<&Expr> = self.fields.iter().map(|(_, e)| e).collect();
+        let (mut s, results) = render_parts(&self.lets, &values, syntax, input, consts, constant);
+        match syntax {
+            Syntax::Wgsl => s += &format!("    return {}({});\n", self.name, results.join(", ")),
+            Syntax::Rust => {
+                let fields: Vec<String> = self.fields.iter().zip(&results).map(|((f, _), v)| if f == v { f.clone() } else { format!("{f}: {v}") }).collect();
+                s += &format!("    {} {{ {} }}\n", self.name, fields.join(", "));
+            }
+        }
+        s
+    }
+}
+
+/// The lanes of the inputs (scalars) and of each binding, evaluated in order.
+fn bindings<T: Float>(lets: &[(String, Expr)], inputs: &[T], consts: &[T]) -> (Vec<Lanes<T>>, Vec<Lanes<T>>) {
+    let vars: Vec<Lanes<T>> = inputs.iter().map(|&x| Lanes::of(x)).collect();
+    let mut values: Vec<Lanes<T>> = Vec::with_capacity(lets.len());
+    for (_, e) in lets {
+        let v = super::eval_as(e, &vars, consts, &[], &values);
+        values.push(v);
+    }
+    (vars, values)
+}
+
+/// Lanes of each binding.
+fn let_widths(lets: &[(String, Expr)]) -> Vec<usize> {
+    let mut w = Vec::new();
+    for (_, e) in lets {
+        let n = width(e, &w);
+        w.push(n);
+    }
+    w
+}
+
+/// Each binding on its line (`    let name = …;\n`), and the text of each result expression.
+fn render_parts(lets: &[(String, Expr)], results: &[&Expr], syntax: Syntax, input: &dyn Fn(usize) -> String, consts: &[f32], constant: &dyn Fn(f32) -> String) -> (String, Vec<String>) {
+    let widths = let_widths(lets);
+    let spell = Bound { syntax, input, consts, constant, names: lets.iter().map(|(k, _)| k.as_str()).collect() };
+    let text = |e: &Expr| -> String {
+        let lanes = width(e, &widths);
+        match syntax {
+            Syntax::Wgsl => {
+                let one = render_with(syntax, e, &spell);
+                // A long sum of three terms or more continues on the next lines, one term each.
+                let terms = sum_terms(e);
+                if one.len() <= LINE || terms.len() < 3 {
+                    return one;
+                }
+                // As `Add` renders: a right operand that is a sum in brackets.
+                let parts: Vec<String> = terms
+                    .iter()
+                    .enumerate()
+                    .map(|(i, t)| {
+                        let text = render_with(syntax, t, &spell);
+                        if i > 0 && matches!(t, Expr::Add(..) | Expr::Sub(..)) { format!("({text})") } else { text }
+                    })
+                    .collect();
+                parts.join("\n        + ")
+            }
+            Syntax::Rust if lanes == 1 => tail(render_with(syntax, e, &spell), e),
+            Syntax::Rust => {
+                let parts: Vec<String> = (0..lanes).map(|k| tail(render_with(syntax, &lane(e, k, &widths), &spell), e)).collect();
+                let one = format!("[{}]", parts.join(", "));
+                if one.len() <= LINE { one } else { format!("[\n{}    ]", parts.iter().map(|p| format!("        {p},\n")).collect::<String>()) }
+            }
+        }
+    };
+    let mut s = String::new();
+    for (name, e) in lets {
+        s += &format!("    let {name} = {};\n", text(e));
+    }
+    (s, results.iter().map(|e| text(e)).collect())
 }
 
 /// The longest expression kept on one line.
@@ -292,6 +357,9 @@ impl Spell for Bound<'_> {
     }
     fn local(&self, j: usize) -> String {
         self.names[j].to_string()
+    }
+    fn tight_quotients(&self) -> bool {
+        true
     }
 }
 
@@ -440,6 +508,38 @@ mod tests {
              \x20       s.max(0.0).min(2.0) + (if w[0] < 0.5 { w[2] } else { w[1] }),\n\
              \x20       (w[2] - s).max(0.0).min(2.0) + (if w[1] < 0.5 { w[3] } else { w[0] }),\n\
              \x20   ]\n"
+        );
+    }
+
+    /// A record over shared bindings: its fields evaluate as the formula written out by hand
+    /// (bit for bit in f32, field after field), and render as a struct constructor (WGSL) and
+    /// literal (Rust, a field named as its binding written once), written out by hand; its
+    /// quotients bracket only what precedence needs (a product on the left stays bare, one
+    /// on the right is bracketed).
+    #[test]
+    fn a_record_evaluates_and_renders_as_written() {
+        use build::*;
+        let r = Record {
+            lets: vec![("q".into(), var(0) + k(0)), ("r".into(), lit(1.0) / max(bind(0), lit(1e-30)))],
+            name: "Pair".into(),
+            fields: vec![("q".into(), bind(0)), ("s".into(), bind(0) * bind(1) / (var(1) * k(1))), ("v".into(), vector(vec![bind(1), -var(0)]))],
+        };
+        assert_eq!(r.widths(), [1, 1, 2]);
+        let c = [0.5f32, 3.0];
+        for (x0, x1) in EVERY_POINTS {
+            let q = x0 + c[0];
+            let rr = 1.0 / q.max(1e-30);
+            let want = [q, q * rr / (x1 * c[1]), rr, -x0];
+            assert_eq!(r.eval_f32(&[x0, x1], &c).iter().map(|v| v.to_bits()).collect::<Vec<_>>(), want.map(f32::to_bits), "({x0}, {x1})");
+        }
+        let lit = |v: f32| format!("{v}");
+        assert_eq!(
+            r.render(Syntax::Wgsl, &|i| format!("x{i}"), &c, &lit),
+            "    let q = x0 + 0.5;\n    let r = 1f / max(q, 1e-30f);\n    return Pair(q, q * r / (x1 * 3), vec2<f32>(r, -(x0)));\n"
+        );
+        assert_eq!(
+            r.render(Syntax::Rust, &|i| format!("x{i}"), &c, &lit),
+            "    let q = x0 + 0.5;\n    let r = 1.0 / q.max(1e-30);\n    Pair { q, s: q * r / (x1 * 3), v: [r, -(x0)] }\n"
         );
     }
 

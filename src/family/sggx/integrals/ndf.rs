@@ -2,14 +2,34 @@
 //! (S, S⁻¹, √|S|) and LEAN mapping adapted to GGX (conventions in the module doc of `super`).
 
 use super::{Aniso, M3, V3};
+use crate::fit::expr::Expr;
+use crate::fit::expr::program::{Program, build::*};
+use std::sync::LazyLock;
 use nalgebra::{Matrix2, Vector2};
 use std::f64::consts::PI;
 
-/// The anisotropic GGX NDF in the course's rearranged form, from h's components in the
-/// (t, b, n) frame.
+/// The anisotropic GGX NDF in the course's rearranged form written once, over (α_t², α_b²,
+/// α_t α_b, t·h, b·h, n·h) (inputs 0–5, h's components in the (t, b, n) frame) with the
+/// constants [`D_CONSTS`] = [π]:
+/// ```text
+/// den = (t·h)² α_b² + (b·h)² α_t² + (n·h)² (α_t α_b)²,   D = (α_t α_b)³ / (π max(den², 1e-30))
+/// ```
+/// Its f64 evaluation is [`d_rearranged`]; the emitted D (`super::super::emit`) is its WGSL,
+/// Rust and f32 evaluation.
+pub static D_FORM: LazyLock<Program> = LazyLock::new(|| {
+    let (at2, ab2, atb, th, bh, nh, den) = (|| bind(0), || bind(1), || bind(2), || bind(3), || bind(4), || bind(5), || bind(6));
+    let mut lets: Vec<(String, Expr)> = ["at2", "ab2", "atb", "th", "bh", "nh"].iter().enumerate().map(|(i, n)| (n.to_string(), var(i))).collect();
+    lets.push(("den".into(), th() * th() * ab2() + bh() * bh() * at2() + nh() * nh() * (atb() * atb())));
+    Program { lets, result: atb() * atb() * atb() / (k(0) * max(den() * den(), lit(1e-30))) }
+});
+
+/// The constants of [`D_FORM`].
+pub const D_CONSTS: [f64; 1] = [PI];
+
+/// The anisotropic GGX NDF in the course's rearranged form ([`D_FORM`] in f64), from h's
+/// components in the (t, b, n) frame.
 pub fn d_rearranged(th: f64, bh: f64, nh: f64, alpha_t_sqr: f64, alpha_b_sqr: f64, alpha_tb: f64) -> f64 {
-    let den = th * th * alpha_b_sqr + bh * bh * alpha_t_sqr + nh * nh * alpha_tb * alpha_tb;
-    alpha_tb.powi(3) / (PI * den * den)
+    D_FORM.eval_f64(&[alpha_t_sqr, alpha_b_sqr, alpha_tb, th, bh, nh], &D_CONSTS)[0]
 }
 
 /// Burley's (2012) form 1 / (π α_t α_b ((t·h/α_t)² + (b·h/α_b)² + (n·h)²)²): the reference of

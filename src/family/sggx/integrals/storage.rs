@@ -1,7 +1,11 @@
 //! Storage: the 8/16-bit encoding [√Sxx, ½ Sxy/√(Sxx Syy) + ½, √Syy] of a block, and the
-//! course's `DecodeSggx` in f64 (conventions in the module doc of `super`).
+//! course's `DecodeSggx`, written once as a program and evaluated in f64 here (conventions in
+//! the module doc of `super`).
 
 use super::Aniso;
+use crate::fit::expr::Expr;
+use crate::fit::expr::program::{Record, build::*};
+use std::sync::LazyLock;
 
 /// [√Sxx, ½ Sxy/√(Sxx Syy) + ½, √Syy] (the middle channel ½ where Sxx Syy = 0).
 pub fn encode(a: Aniso) -> [f64; 3] {
@@ -41,28 +45,63 @@ impl Decoded {
     }
 }
 
-/// `DecodeSggx` in f64, line for line (`Sign` read as ±1, see the body): eigenvalues of the 2×2 matrix clamped to [α_min², 1]
+/// The floor of discr under its reciprocal in `DecodeSggx` (a constant of [`DECODE_FORM`]).
+pub const DISCR_MIN: f64 = 1e-6;
+
+/// The constants of [`DECODE_FORM`]: the eigenvalues' floor α_min² and [`DISCR_MIN`].
+pub fn decode_consts(alpha_min: f64) -> [f64; 2] {
+    [alpha_min * alpha_min, DISCR_MIN]
+}
+
+/// The course's `DecodeSggx` written once, over the channels (x, y, z) (inputs 0–2) with the
+/// constants of [`decode_consts`]: eigenvalues of the 2×2 matrix clamped to [α_min², 1]
 /// (guarding the indefinite matrices that filtering the encoded channels produces), the
-/// rotation from the half-angle identity cos²ψ = ½((Sxx − Syy)/discr + 1).
+/// rotation from the half-angle identity cos²ψ = ½((Sxx − Syy)/discr + 1):
+/// ```text
+/// Sxx = x²,  Sxy = x (y + y − 1) z,  Syy = z²,  discr = √(4 Sxy² + (Sxx − Syy)²)
+/// α_t², α_b² = max(clamp(½ (Sxx + Syy ± discr), 0, 1), α_min²)
+/// c² = clamp(½ ((Sxx − Syy)/max(discr, 1e-6) + 1), 0, 1),  sign = Sxy < 0 ? −1 : 1
+/// → (α_t², α_b², √(α_t² α_b²), √c², sign √(1 − c²))
+/// ```
+/// The listing's `Sign` must not return 0: at Sxy = 0 with Sxx < Syy (an axis-aligned lobe
+/// rougher along b_n, or the texture unit's halfway mix of ±ρ) cos ψ = 0, and HLSL's sign(0) = 0
+/// would make the sine 0 too, collapsing the frame; Sign(x) = x < 0 ? −1 : 1 here. 2y − 1 is
+/// written y + y − 1 (the same value, exactly): no product for a GPU to fuse. Its f64
+/// evaluation is [`decode_course`]; the emitted decoder (`super::super::emit`) is its WGSL,
+/// Rust and f32 evaluation.
+pub static DECODE_FORM: LazyLock<Record> = LazyLock::new(|| {
+    let (x, y, z) = (|| bind(0), || bind(1), || bind(2));
+    let (sxx, sxy, syy, discr, discr_rcp) = (|| bind(3), || bind(4), || bind(5), || bind(6), || bind(7));
+    let (alpha_t_sqr, alpha_b_sqr, c_sqr, sign) = (|| bind(8), || bind(9), || bind(10), || bind(11));
+    let unit = |e: Expr| clamp(e, lit(0.0), lit(1.0));
+    let lets = vec![
+        ("x".into(), var(0)),
+        ("y".into(), var(1)),
+        ("z".into(), var(2)),
+        ("sxx".into(), x() * x()),
+        ("sxy".into(), x() * (y() + y() - lit(1.0)) * z()),
+        ("syy".into(), z() * z()),
+        ("discr".into(), sqrt(lit(4.0) * (sxy() * sxy()) + (sxx() - syy()) * (sxx() - syy()))),
+        ("discr_rcp".into(), lit(1.0) / max(discr(), k(1))),
+        ("alpha_t_sqr".into(), max(unit(lit(0.5) * (sxx() + syy() + discr())), k(0))),
+        ("alpha_b_sqr".into(), max(unit(lit(0.5) * (sxx() + syy() - discr())), k(0))),
+        ("c_sqr".into(), unit(lit(0.5) * ((sxx() - syy()) * discr_rcp() + lit(1.0)))),
+        ("sign".into(), less(sxy(), lit(0.0), lit(-1.0), lit(1.0))),
+    ];
+    let fields = vec![
+        ("alpha_t_sqr".into(), alpha_t_sqr()),
+        ("alpha_b_sqr".into(), alpha_b_sqr()),
+        ("alpha_tb".into(), sqrt(alpha_t_sqr() * alpha_b_sqr())),
+        ("cos_psi".into(), sqrt(c_sqr())),
+        ("sin_psi".into(), sign() * sqrt(lit(1.0) - c_sqr())),
+    ];
+    Record { lets, name: "SggxAniso".into(), fields }
+});
+
+/// `DecodeSggx` in f64: [`DECODE_FORM`] at the channels `t`, with no clamp of the channels.
 pub fn decode_course(t: [f64; 3], alpha_min: f64) -> Decoded {
-    let a = decode_matrix(t);
-    let discr = (4.0 * a.sxy * a.sxy + (a.sxx - a.syy).powi(2)).sqrt();
-    let discr_rcp = 1.0 / discr.max(1e-6);
-    let floor = alpha_min * alpha_min;
-    let alpha_t_sqr = (0.5 * (a.sxx + a.syy + discr)).clamp(0.0, 1.0).max(floor);
-    let alpha_b_sqr = (0.5 * (a.sxx + a.syy - discr)).clamp(0.0, 1.0).max(floor);
-    let c_sqr = (0.5 * ((a.sxx - a.syy) * discr_rcp + 1.0)).clamp(0.0, 1.0);
-    // The listing's `Sign` must not return 0: at Sxy = 0 with Sxx < Syy (an axis-aligned lobe
-    // rougher along b_n, or the texture unit's halfway mix of ±ρ) cos ψ = 0, and HLSL's sign(0) = 0
-    // would make the sine 0 too, collapsing the frame. Sign(x) = x < 0 ? −1 : 1 here.
-    let sign = if a.sxy < 0.0 { -1.0 } else { 1.0 };
-    Decoded {
-        alpha_t_sqr,
-        alpha_b_sqr,
-        alpha_tb: (alpha_t_sqr * alpha_b_sqr).sqrt(),
-        cos: c_sqr.sqrt(),
-        sin: sign * (1.0 - c_sqr).sqrt(),
-    }
+    let v = DECODE_FORM.eval_f64(&t, &decode_consts(alpha_min));
+    Decoded { alpha_t_sqr: v[0], alpha_b_sqr: v[1], alpha_tb: v[2], cos: v[3], sin: v[4] }
 }
 
 #[cfg(test)]
