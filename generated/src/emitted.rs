@@ -53,6 +53,9 @@ pub mod ggx_env_scale_rational;
 #[path = "ggx_occlusion.rs"]
 pub mod ggx_occlusion;
 #[cfg(feature = "ggx")]
+#[path = "ggx_occlusion_refits.rs"]
+pub mod ggx_occlusion_refits;
+#[cfg(feature = "ggx")]
 #[path = "ggx_published_refits.rs"]
 pub mod ggx_published_refits;
 #[cfg(feature = "gloss")]
@@ -138,6 +141,8 @@ pub mod wgsl {
     #[cfg(feature = "ggx")]
     pub const GGX_OCCLUSION: &str = include_str!("../wgsl/ggx_occlusion.wgsl");
     #[cfg(feature = "ggx")]
+    pub const GGX_OCCLUSION_REFITS: &str = include_str!("../wgsl/ggx_occlusion_refits.wgsl");
+    #[cfg(feature = "ggx")]
     pub const GGX_PUBLISHED_REFITS: &str = include_str!("../wgsl/ggx_published_refits.wgsl");
     #[cfg(feature = "gloss")]
     pub const GLOSS_COMBINE: &str = include_str!("../wgsl/gloss_combine.wgsl");
@@ -207,6 +212,8 @@ pub mod wgsl {
             "ggx_env_scale_rational" => Some(GGX_ENV_SCALE_RATIONAL),
             #[cfg(feature = "ggx")]
             "ggx_occlusion" => Some(GGX_OCCLUSION),
+            #[cfg(feature = "ggx")]
+            "ggx_occlusion_refits" => Some(GGX_OCCLUSION_REFITS),
             #[cfg(feature = "ggx")]
             "ggx_published_refits" => Some(GGX_PUBLISHED_REFITS),
             #[cfg(feature = "gloss")]
@@ -279,6 +286,8 @@ pub mod wgsl {
         "ggx_env_scale_rational",
         #[cfg(feature = "ggx")]
         "ggx_occlusion",
+        #[cfg(feature = "ggx")]
+        "ggx_occlusion_refits",
         #[cfg(feature = "ggx")]
         "ggx_published_refits",
         #[cfg(feature = "gloss")]

@@ -17,7 +17,8 @@ pub mod sggx;
 pub mod skin;
 
 use crate::bench::FamilyBench;
-use crate::pipeline::{BuildError, Built, Mode};
+use crate::fit::published::PublishedForm;
+use crate::pipeline::{self, BuildError, Built, Mode};
 use crate::plot::PlotError;
 use crate::quantity::QuantityDef;
 use crate::scene::Feature;
@@ -122,6 +123,8 @@ pub struct Family {
     pub commands: &'static [FamilyCommand],
     /// Table axis mappings of the family's own (`mapping = "NAME"` on a table axis).
     pub axis_mappings: &'static [&'static crate::spec::AxisMapping],
+    /// Published forms offered for refitting (`kind = "refit"` specs name them).
+    pub forms: &'static [PublishedForm],
 }
 
 /// Every family, in the order `eval --help`, `validate` and `plot` list them.
@@ -137,7 +140,7 @@ pub fn catalog() -> &'static Catalog {
     static CATALOG: OnceLock<Catalog> = OnceLock::new();
     CATALOG.get_or_init(|| Catalog {
         quantities: FAMILIES.iter().flat_map(|f| f.quantities.iter()).collect(),
-        kinds: FAMILIES.iter().flat_map(|f| f.spec_kinds.iter().map(|k| &k.spec)).collect(),
+        kinds: FAMILIES.iter().flat_map(|f| f.spec_kinds.iter().map(|k| &k.spec)).chain([&REFIT.spec]).collect(),
         features: FAMILIES.iter().flat_map(|f| f.quantities.iter().map(|q| (q.name, f.feature))).collect(),
         mappings: FAMILIES.iter().flat_map(|f| f.axis_mappings.iter().copied()).collect(),
     })
@@ -145,7 +148,32 @@ pub fn catalog() -> &'static Catalog {
 
 /// The family spec kind named `name`.
 pub fn spec_kind(name: &str) -> Option<&'static SpecKind> {
-    FAMILIES.iter().flat_map(|f| f.spec_kinds.iter()).find(|k| k.spec.name == name)
+    FAMILIES.iter().flat_map(|f| f.spec_kinds.iter()).chain([&REFIT]).find(|k| k.spec.name == name)
+}
+
+/// Every family's published forms, in registry order.
+pub fn published_forms() -> &'static [&'static PublishedForm] {
+    static FORMS: OnceLock<Vec<&'static PublishedForm>> = OnceLock::new();
+    FORMS.get_or_init(|| FAMILIES.iter().flat_map(|f| f.forms.iter()).collect())
+}
+
+/// The generic kind `refit` (`pipeline::refit`) over the registry's forms.
+pub static REFIT: SpecKind = SpecKind {
+    spec: KindDef {
+        name: pipeline::refit::KIND,
+        spec_file: |path, text| pipeline::refit::spec_file(path, text, published_forms(), catalog()),
+        samples_note: "{name} emits the committed refits of published forms: it has no samples of its own (see `shadefit validate`)",
+        input_hash: |spec| pipeline::refit::input_hash(spec, published_forms()),
+    },
+    build: |spec, mode, root| pipeline::refit::build(spec, mode, root, published_forms()),
+    shard: None,
+};
+
+/// The committed constants of `form` in the refit spec `spec` (generated/json/SPEC.json under
+/// `generated`, checked against fits/SPEC.toml): how a family's audit, figures and benchmarks
+/// read a refit.
+pub fn committed_refit(generated: &Path, spec: &str, form: &str) -> Result<Vec<f64>, BuildError> {
+    pipeline::refit::committed_constants(generated, spec, form, catalog(), published_forms())
 }
 
 /// The family that serves quantity `name`.
@@ -233,7 +261,10 @@ pub(crate) mod tests {
             }
             for k in f.spec_kinds {
                 assert!(seen.insert(format!("kind {}", k.spec.name)), "spec kind {} twice", k.spec.name);
-                assert!(!["fit", "table", "fields"].contains(&k.spec.name), "{} shadows a generic kind", k.spec.name);
+                assert!(!["fit", "table", "fields", "refit"].contains(&k.spec.name), "{} shadows a generic kind", k.spec.name);
+            }
+            for p in f.forms {
+                assert!(seen.insert(format!("form {}", p.name)), "published form {} twice", p.name);
             }
             for x in f.scene_features {
                 assert!(seen.insert(format!("feature {}", x.name)), "scene feature {} twice", x.name);

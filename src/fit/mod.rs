@@ -10,6 +10,7 @@ pub mod minimax;
 pub mod model;
 pub mod positivity;
 pub mod problem;
+pub mod published;
 pub mod report;
 pub mod simplex;
 pub mod solve;

@@ -69,4 +69,5 @@ pub static FAMILY: Family = Family {
     scene_features: &[],
     commands: &[],
     axis_mappings: &[],
+    forms: &[],
 };

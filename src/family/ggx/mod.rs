@@ -201,12 +201,20 @@ fn figures(out: &Path, generated: &Path) -> Result<Vec<PathBuf>, PlotError> {
 }
 
 /// The GGX split-sum family's descriptor (registered in `crate::family::FAMILIES`).
+/// The family's published forms offered for refitting: the split sum's and the Fresnel
+/// average's, then specular occlusion's.
+static GGX_FORMS: [crate::fit::published::PublishedForm; 8] = {
+    let [a, b, c, d, e] = published::refit::FORMS_DEF;
+    let [f, g, h] = occlusion::refit::FORMS_DEF;
+    [a, b, c, d, e, f, g, h]
+};
+
 pub static FAMILY: Family = Family {
     name: "ggx",
     feature: "ggx",
     doc: "GGX split-sum: DFG scale/bias (with a visibility cone), E(mu), E_avg, Fresnel averages, energy compensation",
     quantities: QUANTITIES,
-    spec_kinds: &[lut::DFG_LUT, published::emit::REFITS, occlusion::emit::OCCLUSION, occlusion::lut::CONE_LUT],
+    spec_kinds: &[lut::DFG_LUT, occlusion::emit::OCCLUSION, occlusion::lut::CONE_LUT],
     eval_options: None,
     validate: items,
     figures,
@@ -214,4 +222,5 @@ pub static FAMILY: Family = Family {
     scene_features: &[],
     commands: &[],
     axis_mappings: &[],
+    forms: &GGX_FORMS,
 };

@@ -40,6 +40,7 @@
 pub mod emit;
 pub mod lut;
 pub mod plot;
+pub mod refit;
 mod committed;
 mod validation;
 
@@ -96,12 +97,6 @@ pub const LAGARDE: [f64; 2] = [-16.0, -1.0];
 /// Jimenez et al. 2016's specular cone: cos α_s = 2^(k r²), k = −3.321928 (−log₂ 10).
 #[allow(clippy::approx_constant, reason = "the published constant, as printed (−log₂ 10 rounded to 7 digits)")]
 pub const JIMENEZ: f64 = -3.321928;
-/// Lagarde's form refitted (least rms, F0 = 4 %: see [`refits`]) against the cone model on the
-/// validation grid: what [`refits`] returns, printed and checked by the test
-/// `occlusion_refits_minimise_their_errors`.
-pub const LAGARDE_REFIT: [f64; 2] = [-6.366258901155545, 0.8167122185617204];
-/// Jimenez's k refitted minimax (F0 = 4 %) the same way.
-pub const JIMENEZ_REFIT: f64 = -0.6940408744589384;
 
 /// Lagarde & de Rousiers 2014: SO at n·v, visibility V and GGX α (Filament's argument).
 pub fn lagarde(n_dot_v: f64, v: f64, alpha: f64) -> f64 {

@@ -33,6 +33,7 @@ use crate::fit::expr::Syntax;
 use crate::fit::expr::program::{Program, build::{bind, swz}};
 use forms::{KARIS, KARIS_FORM, KULLA_CONTY, LAZAROV, MATERIALX, MATERIALX_FORM, Karis, MaterialX};
 use grid::{Grid, Target};
+use refit::Refits;
 use std::path::{Path, PathBuf};
 
 /// MaterialX's constants of PR #826 (commit 53ee6847c, 2022-01-31: "fitted to a Monte Carlo
@@ -90,12 +91,19 @@ fn domain(g: &Grid) -> String {
 }
 
 /// An item of a pair form with its refit beside it (per-channel extras, the refit's finding).
-fn pair_item(name: &str, source: &str, g: &Grid, published: impl Fn(f64, f64) -> [f64; 2], refit: impl Fn(f64, f64) -> [f64; 2], how: &str) -> Item {
+fn pair_item(name: &str, source: &str, g: &Grid, published: impl Fn(f64, f64) -> [f64; 2], refit: Result<impl Fn(f64, f64) -> [f64; 2], &str>, how: &str) -> Item {
     let p = pair(g, published);
     let mut item = Item::measured(name, source, &domain(g), &p.points, &p.truth, &p.approx);
     item.extra.push(("scale_max_abs_error".into(), channel_max(&p, 0)));
     item.extra.push(("bias_max_abs_error".into(), channel_max(&p, 1)));
     item.findings.push(format!("Measured against {} at tolerance {:.0e}; worst point is [n·v, {}, channel (0 scale, 1 bias)].", g.target.integral(), grid::TOL, g.target.axis_name()));
+    let refit = match refit {
+        Ok(f) => f,
+        Err(why) => {
+            item.findings.push(format!("shadefit's refit ({how}) is not committed here: {why}."));
+            return item;
+        }
+    };
     let r = pair(g, refit);
     let (m, rms, worst) = measure(&r.points, &r.truth, &r.approx);
     item.extra.push(("refit_max_abs_error".into(), m));
@@ -119,8 +127,7 @@ fn albedo_spread(g: &Grid) -> f64 {
         .fold(0.0f64, f64::max)
 }
 
-fn karis_items() -> Vec<Item> {
-    let refits = &refit::COMMITTED;
+fn karis_items(refits: Result<&Refits, &str>) -> Vec<Item> {
     let ue4 = grid::standard(Target::RoughnessUe4);
     let hc = grid::standard(Target::Roughness);
     let mut out = Vec::new();
@@ -130,7 +137,7 @@ fn karis_items() -> Vec<Item> {
         "Karis 2014, 'Physically Based Shading on Mobile' (UE blog; UE BRDF.ush)",
         ue4,
         |m, r| KARIS.eval(r, m),
-        |m, r| refits.karis_ue4.eval(r, m),
+        refits.map(|f| move |m, r| f.karis_ue4.eval(r, m)),
         "same form, all 10 constants, Nelder–Mead minimax against ggx-env-ue4",
     );
     // A + B = r.z + r.w: the a004 terms cancel.
@@ -163,7 +170,7 @@ fn karis_items() -> Vec<Item> {
         "bevy crates/bevy_pbr/src/render/pbr_lighting.wgsl (v0.15.0–v0.18.1; v0.19 clamp: PR #22833)",
         hc,
         |m, r| KARIS.eval(r, m),
-        |m, r| refits.karis_hc.eval(r, m),
+        refits.map(|f| move |m, r| f.karis_hc.eval(r, m)),
         "Karis's form, Nelder–Mead minimax against ggx-env",
     );
     let p_clamp = pair(hc, |m, r| forms::bevy_clamped(r, m));
@@ -212,14 +219,14 @@ fn karis_items() -> Vec<Item> {
     out
 }
 
-fn lazarov_item() -> Item {
+fn lazarov_item(refits: Result<&Refits, &str>) -> Item {
     let g = grid::standard(Target::Gloss);
     let mut item = pair_item(
         "ggx-env: Lazarov 2013 (Black Ops II) environment BRDF",
         "Lazarov 2013, 'Getting More Physical in Call of Duty: Black Ops II' (as in OpenXRay pbr_brdf_blinn.h EnvBlops2)",
         g,
         |m, gl| LAZAROV.eval(gl, m),
-        |m, gl| refit::COMMITTED.lazarov.eval(gl, m),
+        refits.map(|f| move |m, gl| f.lazarov.eval(gl, m)),
         "same form, 7 constants, Nelder–Mead minimax against ggx-env at α = sqrt(2/(8192^g + 2))",
     );
     item.findings.push(format!(
@@ -238,14 +245,14 @@ fn lazarov_item() -> Item {
     item
 }
 
-fn materialx_item() -> Item {
+fn materialx_item(refits: Result<&Refits, &str>) -> Item {
     let g = grid::standard(Target::Alpha);
     let mut item = pair_item(
         "ggx-env: MaterialX mx_ggx_dir_albedo_analytic",
         "MaterialX libraries/pbrlib/genglsl/lib/mx_microfacet_specular.glsl (v1.39.5)",
         g,
         |m, a| MATERIALX.eval(m, a),
-        |m, a| emit::materialx_refit(&refit::COMMITTED.materialx, m, a),
+        refits.map(|f| move |m, a| refit::materialx_refit(&f.materialx, m, a)),
         "same biquadratic/biquadratic pair with clamp; scale refitted minimax, bias kept as published (below); n·v clamped to the fitted [1/128, 125/128] as the emitted code does",
     );
     item.findings.push(
@@ -274,9 +281,8 @@ fn materialx_item() -> Item {
     item
 }
 
-fn kulla_conty_items() -> Vec<Item> {
+fn kulla_conty_items(refits: Result<&Refits, &str>) -> Vec<Item> {
     let mut out = Vec::new();
-    let r = refit::COMMITTED.kulla_conty;
     for above in [true, false] {
         let (eta, f) = grid::fresnel(above);
         let pts: Vec<Vec<f64>> = eta.iter().map(|&e| vec![e]).collect();
@@ -287,20 +293,28 @@ fn kulla_conty_items() -> Vec<Item> {
             ("fresnel-avg-dielectric: Kulla–Conty fit, η < 1 branch", "η ∈ [1/3, 1), 513 points")
         };
         let mut item = Item::measured(name, "Kulla & Conty 2017, 'Revisiting Physically Based Shading at Imageworks' (as in Cycles bsdf_util.h)", dom, &pts, f, &approx);
-        let refit: Vec<f64> = eta.iter().map(|&e| r.eval(e)).collect();
-        let (m, rms, _) = measure(&pts, f, &refit);
-        item.extra.push(("refit_max_abs_error".into(), m));
-        item.extra.push(("refit_rms_error".into(), rms));
+        let refit = refits.map(|r| {
+            let refit: Vec<f64> = eta.iter().map(|&e| r.kulla_conty.eval(e)).collect();
+            let (m, rms, _) = measure(&pts, f, &refit);
+            (m, rms)
+        });
+        if let Ok((m, rms)) = refit {
+            item.extra.push(("refit_max_abs_error".into(), m));
+            item.extra.push(("refit_rms_error".into(), rms));
+        }
         item.findings.push("Against the exact unpolarised dielectric Fresnel average 2∫F(μ, η)μ dμ (numerical, tolerance 1e-12; total internal reflection counts as F = 1).".into());
         if !above {
             let jump = KULLA_CONTY.eval(1.0 - 1e-12) - KULLA_CONTY.eval(1.0);
             item.findings.push(format!("The branches disagree at η = 1 by {jump:.2e} (the cubic gives {:.5} where F_avg = 0).", KULLA_CONTY.eval(1.0 - 1e-12)));
         }
-        item.findings.push(format!(
-            "shadefit's refit (same form, Nelder–Mead minimax): max {m:.3e} ({:.2}× the published), rms {rms:.3e} ({:.2}×).",
-            m / item.max_abs_error,
-            rms / item.rms_error
-        ));
+        item.findings.push(match refit {
+            Ok((m, rms)) => format!(
+                "shadefit's refit (same form, Nelder–Mead minimax): max {m:.3e} ({:.2}× the published), rms {rms:.3e} ({:.2}×).",
+                m / item.max_abs_error,
+                rms / item.rms_error
+            ),
+            Err(why) => format!("shadefit's refit (same form, Nelder–Mead minimax) is not committed here: {why}."),
+        });
         out.push(item);
     }
     out
@@ -420,11 +434,13 @@ fn filament_item() -> Item {
 }
 
 /// Published forms measured against the integrals (the committed refits beside them).
-pub fn items(_generated: &Path) -> Vec<Item> {
-    let mut out = karis_items();
-    out.push(lazarov_item());
-    out.push(materialx_item());
-    out.extend(kulla_conty_items());
+pub fn items(generated: &Path) -> Vec<Item> {
+    let committed = Refits::committed(generated).map_err(|e| format!("{e} (fits/{}.toml)", refit::SPEC));
+    let refits = committed.as_ref().map_err(String::as_str);
+    let mut out = karis_items(refits);
+    out.push(lazarov_item(refits));
+    out.push(materialx_item(refits));
+    out.extend(kulla_conty_items(refits));
     out.push(filament_item());
     out
 }
@@ -493,7 +509,7 @@ fn albedo_forms(ctx: &Ctx) -> Result<Vec<FormRow>, BenchError> {
     let n = ctx.pick(129, 33);
     let reference = integral.reference(pipeline::grid(&spec, &[n, n]));
     let m = ctx.pick(spec.file.axis[0].count, 17);
-    let refits = &refit::COMMITTED;
+    let refits = &Refits::committed(ctx.generated).map_err(BenchError::build(refit::SPEC))?;
     let cheaper = ctx.variant(&spec, "ggx_albedo_rational_bilinear", |t| {
         set(t, "model.numerator", strings(&["1", "n_dot_v", "alpha", "n_dot_v*alpha"]));
         set(t, "model.denominator", strings(&["n_dot_v", "alpha", "n_dot_v*alpha"]));
@@ -506,7 +522,7 @@ fn albedo_forms(ctx: &Ctx) -> Result<Vec<FormRow>, BenchError> {
         closed_row(name, &reference, PUBLISHED, &karis_wgsl(&KARIS, None), "karis_albedo", |x, a| { let [p, q] = KARIS.eval(a.sqrt(), x); p + q }, "Karis 2014 EnvBRDFApprox A + B = 1 − 0.55 r (input r = sqrt(α))")?,
         closed_row(name, &reference, "Karis refit", &karis_wgsl(&refits.karis_hc, None), "karis_albedo", |x, a| { let [p, q] = refits.karis_hc.eval(a.sqrt(), x); p + q }, "same form refitted to ggx-env (pair minimax)")?,
         closed_row(name, &reference, "MaterialX", &materialx_wgsl(&MATERIALX, None), "materialx_albedo", |x, a| { let [p, q] = MATERIALX.eval(x, a); p + q }, "mx_ggx_dir_albedo_analytic, A + B")?,
-        closed_row(name, &reference, "MaterialX refit", &materialx_wgsl(&refits.materialx, None), "materialx_albedo", |x, a| { let [p, q] = emit::materialx_refit(&refits.materialx, x, a); p + q }, "same pair refitted (scale minimax, bias as published; n·v clamped to its fitted [1/128, 125/128])")?,
+        closed_row(name, &reference, "MaterialX refit", &materialx_wgsl(&refits.materialx, None), "materialx_albedo", |x, a| { let [p, q] = refit::materialx_refit(&refits.materialx, x, a); p + q }, "same pair refitted (scale minimax, bias as published; n·v clamped to its fitted [1/128, 125/128])")?,
         refit_row(&spec, ctx.generated, &reference, "fits/ggx_albedo_rational.toml, committed")?,
         fit_row(&cheaper, integral.fit(&cheaper, &[m, m])?, &reference, "rational bilinear", &fit_note)?,
         table_row(&small, table_values(&mut integral, &small), &reference, "table 16²", "")?,
@@ -531,7 +547,7 @@ fn env_forms(ctx: &Ctx, channel: usize) -> Result<Vec<FormRow>, BenchError> {
     let n = ctx.pick(129, 33);
     let reference = integral.reference(pipeline::grid(&spec, &[n, n]));
     let m = ctx.pick(spec.file.axis[0].count, 17);
-    let refits = &refit::COMMITTED;
+    let refits = &Refits::committed(ctx.generated).map_err(BenchError::build(refit::SPEC))?;
     let cubic = ctx.variant(&spec, &format!("ggx_env_{which}_rational_cubic"), |t| {
         set(t, "model.numerator", strings(&["1", "n_dot_v", "alpha", "n_dot_v*alpha", "n_dot_v^2", "alpha^2", "n_dot_v^3", "n_dot_v^2*alpha"]));
         set(t, "model.denominator", strings(&["n_dot_v", "alpha", "n_dot_v*alpha", "n_dot_v^2", "alpha^2", "n_dot_v^3", "n_dot_v^2*alpha"]));
@@ -544,7 +560,7 @@ fn env_forms(ctx: &Ctx, channel: usize) -> Result<Vec<FormRow>, BenchError> {
         closed_row(&spec, &reference, PUBLISHED, &karis_wgsl(&KARIS, c), "karis_albedo", |x, a| KARIS.eval(a.sqrt(), x)[channel], "Karis 2014 EnvBRDFApprox (fitted to UE4's separable G; input r = sqrt(α))")?,
         closed_row(&spec, &reference, "Karis refit", &karis_wgsl(&refits.karis_hc, c), "karis_albedo", |x, a| refits.karis_hc.eval(a.sqrt(), x)[channel], "same form refitted to ggx-env (pair minimax)")?,
         closed_row(&spec, &reference, "MaterialX", &materialx_wgsl(&MATERIALX, c), "materialx_albedo", |x, a| MATERIALX.eval(x, a)[channel], "mx_ggx_dir_albedo_analytic")?,
-        closed_row(&spec, &reference, "MaterialX refit", &materialx_wgsl(&refits.materialx, c), "materialx_albedo", |x, a| emit::materialx_refit(&refits.materialx, x, a)[channel], "same pair refitted (scale minimax, bias as published; n·v clamped to its fitted [1/128, 125/128])")?,
+        closed_row(&spec, &reference, "MaterialX refit", &materialx_wgsl(&refits.materialx, c), "materialx_albedo", |x, a| refit::materialx_refit(&refits.materialx, x, a)[channel], "same pair refitted (scale minimax, bias as published; n·v clamped to its fitted [1/128, 125/128])")?,
         refit_row(&spec, ctx.generated, &reference, &format!("fits/ggx_env_{which}_rational.toml, committed"))?,
         fit_row(&cubic, integral.fit(&cubic, &[m, m])?, &reference, "rational cubic in n·v", &fit_note)?,
         table_row(&small, table_values(&mut integral, &small), &reference, "table 16²", "")?,
@@ -557,15 +573,16 @@ fn env_forms(ctx: &Ctx, channel: usize) -> Result<Vec<FormRow>, BenchError> {
 
 /// Error maps (form − integral) over (n·v, y) of each published pair form and its refit: four
 /// panels (published scale, bias; refit scale, bias) on one colour scale.
-pub fn figures(out: &Path, _generated: &Path) -> Result<Vec<PathBuf>, PlotError> {
-    let refits = &refit::COMMITTED;
+pub fn figures(out: &Path, generated: &Path) -> Result<Vec<PathBuf>, PlotError> {
+    let refits = &Refits::committed(generated)
+        .map_err(|e| PlotError::Draw { path: generated.join("json").join(format!("{}.json", refit::SPEC)), message: e.to_string() })?;
     let mut files = Vec::new();
     type Form<'a> = Box<dyn Fn(f64, f64) -> [f64; 2] + 'a>;
     let cases: Vec<(&str, &str, Target, Form, Form)> = vec![
         ("ggx_karis_errors", "Karis 2014 EnvBRDFApprox against ggx-env-ue4", Target::RoughnessUe4, Box::new(|m, r| KARIS.eval(r, m)), Box::new(|m, r| refits.karis_ue4.eval(r, m))),
         ("ggx_bevy_errors", "bevy F_AB (Karis) against ggx-env (height-correlated)", Target::Roughness, Box::new(|m, r| KARIS.eval(r, m)), Box::new(|m, r| refits.karis_hc.eval(r, m))),
         ("ggx_lazarov_errors", "Lazarov 2013 against ggx-env, α = sqrt(2/(8192^g + 2))", Target::Gloss, Box::new(|m, g| LAZAROV.eval(g, m)), Box::new(|m, g| refits.lazarov.eval(g, m))),
-        ("ggx_materialx_errors", "MaterialX mx_ggx_dir_albedo_analytic against ggx-env", Target::Alpha, Box::new(|m, a| MATERIALX.eval(m, a)), Box::new(|m, a| emit::materialx_refit(&refits.materialx, m, a))),
+        ("ggx_materialx_errors", "MaterialX mx_ggx_dir_albedo_analytic against ggx-env", Target::Alpha, Box::new(|m, a| MATERIALX.eval(m, a)), Box::new(|m, a| refit::materialx_refit(&refits.materialx, m, a))),
     ];
     for (stem, title, target, published, refit) in cases {
         let g = grid::standard(target);
@@ -763,7 +780,7 @@ mod tests {
     /// 0.55 r)| over the grid is rounding: three operations on values ≤ 1.1, ≤ 1e-15.
     #[test]
     fn the_karis_identity_finding_prints_a_rounding_sized_residual() {
-        let item = karis_items().into_iter().find(|i| i.name.starts_with("ggx-env-ue4: Karis")).expect("the Karis item");
+        let item = karis_items(Ok(&refit::repository())).into_iter().find(|i| i.name.starts_with("ggx-env-ue4: Karis")).expect("the Karis item");
         let text = item.findings.iter().find(|f| f.starts_with("A + B = r.z + r.w")).expect("the identity finding");
         let residual = number_after(text, "(1 − 0.55 r)| ≤ ");
         assert!((0.0..=1e-15).contains(&residual), "{text}");
@@ -858,7 +875,7 @@ mod tests {
 
     /// The bevy item of `karis_items` and its finding that starts with `prefix`.
     fn bevy_finding(prefix: &str) -> (Item, String) {
-        let item = karis_items().into_iter().find(|i| i.name.starts_with("ggx-env: bevy")).expect("bevy item");
+        let item = karis_items(Ok(&refit::repository())).into_iter().find(|i| i.name.starts_with("ggx-env: bevy")).expect("bevy item");
         let text = item.findings.iter().find(|f| f.starts_with(prefix)).expect("finding").clone();
         (item, text)
     }
@@ -983,7 +1000,7 @@ mod tests {
     /// refit's constants are all distinct, so a swap or a lost sign shows.
     #[test]
     fn karis_wgsl_prints_the_forms_constants_in_the_listings_order() {
-        let k = refit::COMMITTED.karis_hc;
+        let k = refit::repository().karis_hc;
         let listing: Vec<f32> = k.c0.iter().chain(&k.c1).chain(&[k.k, -k.s, k.s]).map(|&v| v as f32).collect();
         for (channel, ret) in [(None, "ab.x + ab.y"), (Some(0), "ab.x"), (Some(1), "ab.y")] {
             let src = karis_wgsl(&k, channel);
@@ -999,7 +1016,7 @@ mod tests {
     /// y, xy, x², y², x²y, xy², x²y²) as f32, and returns A + B, A or B as asked.
     #[test]
     fn materialx_wgsl_prints_the_rows_in_the_sources_order() {
-        let m = refit::COMMITTED.materialx;
+        let m = refit::repository().materialx;
         let rows: Vec<f32> = m.r.as_flattened().iter().map(|&v| v as f32).collect();
         for (channel, ret) in [(None, "ab.x + ab.y"), (Some(0), "ab.x"), (Some(1), "ab.y")] {
             let src = materialx_wgsl(&m, channel);
@@ -1053,13 +1070,13 @@ mod tests {
     fn items_restate_the_forms_errors_on_the_grids() {
         let items = items(Path::new("generated"));
         let item = |prefix: &str| items.iter().find(|i| i.name.starts_with(prefix)).unwrap_or_else(|| panic!("no item {prefix}"));
-        let r = &refit::COMMITTED;
+        let r = &refit::repository();
         type Form<'a> = Box<dyn Fn(f64, f64) -> [f64; 2] + 'a>;
         let cases: [(&str, Target, Form, Form); 4] = [
             ("ggx-env-ue4: Karis", Target::RoughnessUe4, Box::new(|m, y| KARIS.eval(y, m)), Box::new(|m, y| r.karis_ue4.eval(y, m))),
             ("ggx-env: bevy", Target::Roughness, Box::new(|m, y| KARIS.eval(y, m)), Box::new(|m, y| r.karis_hc.eval(y, m))),
             ("ggx-env: Lazarov", Target::Gloss, Box::new(|m, y| LAZAROV.eval(y, m)), Box::new(|m, y| r.lazarov.eval(y, m))),
-            ("ggx-env: MaterialX", Target::Alpha, Box::new(|m, y| MATERIALX.eval(m, y)), Box::new(|m, y| emit::materialx_refit(&r.materialx, m, y))),
+            ("ggx-env: MaterialX", Target::Alpha, Box::new(|m, y| MATERIALX.eval(m, y)), Box::new(|m, y| refit::materialx_refit(&r.materialx, m, y))),
         ];
         for (prefix, target, published, refit) in &cases {
             let it = item(prefix);

@@ -97,6 +97,7 @@ pub static FAMILY: Family = Family {
     scene_features: scene::FEATURES,
     commands: &[],
     axis_mappings: &[&GLOSS_MAPPING],
+    forms: &[],
 };
 
 #[cfg(test)]

@@ -127,4 +127,5 @@ pub static FAMILY: Family = Family {
     scene_features: &[],
     commands: &[],
     axis_mappings: &[],
+    forms: &[],
 };

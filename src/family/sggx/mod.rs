@@ -148,4 +148,5 @@ pub static FAMILY: Family = Family {
     scene_features: &[],
     commands: &[mip::COMMAND],
     axis_mappings: &[],
+    forms: &[],
 };

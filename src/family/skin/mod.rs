@@ -144,4 +144,5 @@ pub static FAMILY: Family = Family {
     scene_features: scene::FEATURES,
     commands: &[],
     axis_mappings: &[],
+    forms: &[],
 };

@@ -12,7 +12,8 @@
 //! recorded is the f32 code's (the Rust module, same operations as the WGSL) against the f64
 //! formulas on a grid of every argument; `Mode::Committed` reads it from the committed JSON.
 
-use super::super::published::emit::{Lang, module_spec_file};
+use super::super::published::emit::module_spec_file;
+use crate::emit::lang::Lang;
 use crate::pipeline::module::{module_built, module_json};
 use crate::emit::header_lines;
 use crate::family::SpecKind;

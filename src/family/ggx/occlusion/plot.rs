@@ -4,7 +4,7 @@
 //! refitted constants, and each committed COD: WWII 3-D table read trilinearly. SO is for a
 //! dielectric's F0 = 4 % as in `shadefit validate`; the integrals are computed here (1e-8).
 
-use super::{F0, JIMENEZ_REFIT, LAGARDE_REFIT, exact_so, jimenez, jimenez_with, lagarde, lagarde_with, lut_readers};
+use super::{F0, exact_so, jimenez, jimenez_with, lagarde, lagarde_with, lut_readers};
 use crate::plot::{Panel, PlotError, grid_of_heatmaps};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
@@ -17,6 +17,8 @@ const N: usize = 32;
 /// The figures into `out`, the 3-D tables read from `generated`.
 pub fn figures(out: &Path, generated: &Path) -> Result<Vec<PathBuf>, PlotError> {
     let readers = lut_readers(generated);
+    let refits = super::refit::Refits::committed(generated)
+        .map_err(|e| PlotError::Draw { path: generated.join("json").join(format!("{}.json", super::refit::SPEC)), message: e.to_string() })?;
     let xs: Vec<f64> = (0..N).map(|i| (i as f64 + 0.5) / N as f64).collect();
     let ys: Vec<f64> = (1..=N).map(|k| k as f64 / N as f64).collect();
     let mut files = Vec::new();
@@ -27,9 +29,9 @@ pub fn figures(out: &Path, generated: &Path) -> Result<Vec<PathBuf>, PlotError> 
         let err = |f: &dyn Fn(f64, f64) -> f64| -> Vec<f64> { pts.iter().zip(&exact).map(|(&(mu, v), e)| f(mu, v) - e).collect() };
         let mut maps: Vec<(String, Vec<f64>)> = vec![
             ("Lagarde 2014".into(), err(&|mu, v| lagarde(mu, v, alpha))),
-            ("Lagarde, refitted".into(), err(&|mu, v| lagarde_with(LAGARDE_REFIT, mu, v, alpha))),
+            ("Lagarde, refitted".into(), err(&|mu, v| lagarde_with(refits.lagarde, mu, v, alpha))),
             ("Jimenez 2016".into(), err(&|mu, v| jimenez(mu, v, r))),
-            ("Jimenez, refitted".into(), err(&|mu, v| jimenez_with(JIMENEZ_REFIT, mu, v, r))),
+            ("Jimenez, refitted".into(), err(&|mu, v| jimenez_with(refits.jimenez, mu, v, r))),
         ];
         for reader in &readers {
             maps.push((format!("{} (trilinear)", reader.name()), err(&|mu, v| reader.so(mu, alpha, v, F0))));

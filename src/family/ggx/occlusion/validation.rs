@@ -4,7 +4,7 @@
 //! tables audited as a shader reads them (module doc of `super`).
 
 use super::{
-    F0, JIMENEZ, JIMENEZ_MULTIBOUNCE, JIMENEZ_REFIT, LAGARDE, LAGARDE_REFIT, TOL, cod_adjust_corrected, cod_adjust_printed,
+    F0, JIMENEZ, JIMENEZ_MULTIBOUNCE, LAGARDE, TOL, cod_adjust_corrected, cod_adjust_printed,
     cone_of_visibility, interreflected, jimenez, jimenez_multibounce, jimenez_with, lagarde, lagarde_with, lut_readers,
     so_ratio, split_sums,
 };
@@ -61,11 +61,26 @@ fn rms_error(pts: &[[f64; 3]], refs: &[[f64; 4]], so: impl Fn(f64, f64, f64) -> 
 /// constants are fitted for the least rms instead.
 pub fn refits() -> ([f64; 2], f64) {
     use crate::fit::simplex::nelder_mead;
-    let pts = grid();
-    let refs = reference(&pts);
-    let (l, _) = nelder_mead(|p| rms_error(&pts, &refs, |r, mu, v| lagarde_with([p[0], p[1]], mu, v, r * r)), &LAGARDE);
-    let (j, _) = nelder_mead(|p| max_error(&pts, &refs, |r, mu, v| jimenez_with(p[0], mu, v, r)), &[JIMENEZ]);
+    let (pts, refs) = validation_grid();
+    let (l, _) = nelder_mead(|p| rms_error(pts, refs, |r, mu, v| lagarde_with([p[0], p[1]], mu, v, r * r)), &LAGARDE);
+    let (j, _) = nelder_mead(|p| max_error(pts, refs, |r, mu, v| jimenez_with(p[0], mu, v, r)), &[JIMENEZ]);
     ([l[0], l[1]], j[0])
+}
+
+/// The validation grid and the references there, computed once (20480 points, two split sums each).
+fn validation_grid() -> &'static (Vec<[f64; 3]>, Vec<[f64; 4]>) {
+    static GRID: std::sync::OnceLock<(Vec<[f64; 3]>, Vec<[f64; 4]>)> = std::sync::OnceLock::new();
+    GRID.get_or_init(|| {
+        let pts = grid();
+        let refs = reference(&pts);
+        (pts, refs)
+    })
+}
+
+/// The point count and the max and rms |so − SO| (F0 = 4 %) of `so(r, n·v, V)` on the validation grid.
+pub(super) fn so_errors(so: impl Fn(f64, f64, f64) -> f64 + Sync) -> (usize, crate::fit::published::Errors) {
+    let (pts, refs) = validation_grid();
+    (pts.len(), crate::fit::published::Errors { max_abs_error: max_error(pts, refs, &so), rms_error: rms_error(pts, refs, &so) })
 }
 
 const DOMAIN: &str = "perceptual roughness r ∈ [0.05, 1] (20) × n·v at 32 texel centres × visibility V ∈ [1/32, 1] (32): 20480 points";
@@ -152,9 +167,8 @@ pub fn typo_item() -> Item {
 /// against the cone model, the committed 3-D tables in `generated` read as a shader would, and
 /// Jimenez's multi-bounce fit against the interreflection model.
 pub fn items(generated: &Path) -> Vec<Item> {
-    let pts = grid();
-    let refs = reference(&pts);
-    items_on(generated, &pts, &refs)
+    let (pts, refs) = validation_grid();
+    items_on(generated, pts, refs)
 }
 
 /// [`items`] at the points `pts` ([r, n·v, V]) against `refs` (at each point [SO at F0 = 4 %,
@@ -192,50 +206,90 @@ fn items_on(generated: &Path, pts: &[[f64; 3]], refs: &[[f64; 4]]) -> Vec<Item> 
          {unoccluded:.3}: the specular cone of a rough lobe at a grazing view reaches below the horizon, and the hemisphere \
          cuts it although the BRDF's own shadowing already accounts for that part."
     ));
-    let (lagarde_refit_item, _) = approximation_item(
-        "specular occlusion: Lagarde & de Rousiers 2014, refitted to the cone model",
-        "this crate: Lagarde's shape with (a, b) fitted for the least rms (F0 = 4 %; its minimax is degenerate) on this grid (occlusion::refits)",
-        pts,
-        refs,
-        |r, mu, v| lagarde_with(LAGARDE_REFIT, mu, v, r * r),
-        &format!(
-            "Convention: Lagarde's, SO = saturate((n·v + V)^(2^(a α + b)) − 1 + V), α = r², with (a, b) = ({:e}, {:e}) in place \
-             of (−16, −1); rms error {:.3e} against the published constants' {:.3e} (max {:.3e} against {:.3e}: the max sits \
-             where no (a, b) reaches, glossy lobes outside a nearly open cone).",
-            LAGARDE_REFIT[0],
-            LAGARDE_REFIT[1],
-            rms_error(pts, refs, |r, mu, v| lagarde_with(LAGARDE_REFIT, mu, v, r * r)),
-            lagarde_item.rms_error,
-            max_error(pts, refs, |r, mu, v| lagarde_with(LAGARDE_REFIT, mu, v, r * r)),
-            lagarde_item.max_abs_error
-        ),
-    );
-    let (jimenez_refit_item, _) = approximation_item(
-        "specular occlusion: Jimenez et al. 2016 cone–cone, refitted to the cone model",
-        "this crate: Jimenez's shape with the specular cone's k fitted minimax (F0 = 4 %) on this grid (occlusion::refits)",
-        pts,
-        refs,
-        |r, mu, v| jimenez_with(JIMENEZ_REFIT, mu, v, r),
-        &format!(
-            "Convention: Jimenez's, with cos α_s = 2^(k r²), k = {JIMENEZ_REFIT:e} in place of −3.321928; max error {:.3e} against \
-             the published constant's {:.3e}.",
-            max_error(pts, refs, |r, mu, v| jimenez_with(JIMENEZ_REFIT, mu, v, r)), jimenez_item.max_abs_error
-        ),
-    );
-    let mut out = vec![typo_item(), lagarde_item, lagarde_refit_item, jimenez_item, jimenez_refit_item];
+    let refits = super::refit::Refits::committed(generated);
+    let mut out = vec![typo_item(), lagarde_item];
+    let (lagarde_item, jimenez_item) = match &refits {
+        Ok(r) => {
+            let l = r.lagarde;
+            let (lagarde_refit_item, _) = approximation_item(
+                "specular occlusion: Lagarde & de Rousiers 2014, refitted to the cone model",
+                "this crate: Lagarde's shape with (a, b) fitted for the least rms (F0 = 4 %; its minimax is degenerate) on this grid (fits/ggx_occlusion_refits.toml)",
+                pts,
+                refs,
+                |r, mu, v| lagarde_with(l, mu, v, r * r),
+                &format!(
+                    "Convention: Lagarde's, SO = saturate((n·v + V)^(2^(a α + b)) − 1 + V), α = r², with (a, b) = ({:e}, {:e}) in place \
+                     of (−16, −1); rms error {:.3e} against the published constants' {:.3e} (max {:.3e} against {:.3e}: the max sits \
+                     where no (a, b) reaches, glossy lobes outside a nearly open cone).",
+                    l[0],
+                    l[1],
+                    rms_error(pts, refs, |r, mu, v| lagarde_with(l, mu, v, r * r)),
+                    out[1].rms_error,
+                    max_error(pts, refs, |r, mu, v| lagarde_with(l, mu, v, r * r)),
+                    out[1].max_abs_error
+                ),
+            );
+            let k = r.jimenez;
+            let (jimenez_refit_item, _) = approximation_item(
+                "specular occlusion: Jimenez et al. 2016 cone–cone, refitted to the cone model",
+                "this crate: Jimenez's shape with the specular cone's k fitted minimax (F0 = 4 %) on this grid (fits/ggx_occlusion_refits.toml)",
+                pts,
+                refs,
+                |r, mu, v| jimenez_with(k, mu, v, r),
+                &format!(
+                    "Convention: Jimenez's, with cos α_s = 2^(k r²), k = {k:e} in place of −3.321928; max error {:.3e} against \
+                     the published constant's {:.3e}.",
+                    max_error(pts, refs, |r, mu, v| jimenez_with(k, mu, v, r)),
+                    jimenez_item.max_abs_error
+                ),
+            );
+            (Some(lagarde_refit_item), (jimenez_item, Some(jimenez_refit_item)))
+        }
+        Err(e) => {
+            let why = format!("the refits are not committed here: {e} (fits/{}.toml)", super::refit::SPEC);
+            out[1].findings.push(why.clone());
+            let mut j = jimenez_item;
+            j.findings.push(why);
+            (None, (j, None))
+        }
+    };
+    out.extend(lagarde_item);
+    out.push(jimenez_item.0);
+    out.extend(jimenez_item.1);
     out.extend(lut_items(generated, pts, refs));
-    out.push(multibounce_item());
+    out.push(multibounce_item(refits.as_ref().ok().map(|r| r.multibounce)));
     out
 }
 
 /// The multi-bounce item: Jimenez's fit against COD: WWII's interreflection model, and the
 /// same cubic refitted (minimax) to that model.
-fn multibounce_item() -> Item {
-    use crate::fit::simplex::nelder_mead;
-    // V and ρ at 65 uniform points each, [0, 1]² (the model is smooth: a uniform grid suffices).
+/// V and ρ at 65 uniform points each, [0, 1]² (the model is smooth: a uniform grid
+/// suffices), and COD: WWII's A′ = A/(1 − ρ + ρA) there (0 at A = 0).
+fn multibounce_grid() -> (Vec<Vec<f64>>, Vec<f64>) {
     let pts: Vec<Vec<f64>> = (0..=64).flat_map(|i| (0..=64).map(move |j| vec![i as f64 / 64.0, j as f64 / 64.0])).collect();
     let truth: Vec<f64> = pts.iter().map(|p| if p[0] == 0.0 { 0.0 } else { interreflected(p[0], p[1]) }).collect();
+    (pts, truth)
+}
+
+/// Max and rms error and the worst point of the multi-bounce cubic with constants `p`.
+pub(super) fn multibounce_errors(p: &[f64]) -> (f64, f64, Vec<f64>) {
+    let (pts, truth) = multibounce_grid();
+    let approx: Vec<f64> = pts.iter().map(|x| jimenez_multibounce(p, x[0], x[1])).collect();
+    measure(&pts, &truth, &approx)
+}
+
+/// The multi-bounce cubic refitted minimax to the COD model, from the published constants.
+pub(super) fn multibounce_refit() -> [f64; 6] {
+    let (pts, truth) = multibounce_grid();
     let max_err = |q: &[f64]| pts.iter().zip(&truth).map(|(p, t)| (jimenez_multibounce(q, p[0], p[1]) - t).abs()).fold(0.0, f64::max);
+    let (refit, _) = crate::fit::simplex::nelder_mead(max_err, &JIMENEZ_MULTIBOUNCE);
+    std::array::from_fn(|i| refit[i])
+}
+
+/// The multi-bounce item: Jimenez's fit against COD: WWII's interreflection model, and the
+/// same cubic refitted (minimax) to that model (the committed `refit`, when there is one).
+fn multibounce_item(refit: Option<[f64; 6]>) -> Item {
+    let (pts, truth) = multibounce_grid();
     let approx: Vec<f64> = pts.iter().map(|p| jimenez_multibounce(&JIMENEZ_MULTIBOUNCE, p[0], p[1])).collect();
     let mut item = Item::measured(
         "multi-bounce AO: Jimenez et al. 2016 against COD: WWII's interreflection model",
@@ -245,11 +299,11 @@ fn multibounce_item() -> Item {
         &truth,
         &approx,
     );
-    let (refit, refit_max) = nelder_mead(max_err, &JIMENEZ_MULTIBOUNCE);
-    let refit_vals: Vec<f64> = pts.iter().map(|p| jimenez_multibounce(&refit, p[0], p[1])).collect();
-    let (_, refit_rms, refit_worst) = measure(&pts, &truth, &refit_vals);
-    item.extra.push(("refit_max_abs_error".into(), refit_max));
-    item.extra.push(("refit_rms_error".into(), refit_rms));
+    let refit_errors = refit.map(|r| (r, multibounce_errors(&r)));
+    if let Some((_, (refit_max, refit_rms, _))) = &refit_errors {
+        item.extra.push(("refit_max_abs_error".into(), *refit_max));
+        item.extra.push(("refit_rms_error".into(), *refit_rms));
+    }
     item.findings.push(
         "Jimenez et al. fitted their cubic to multi-bounce ambient occlusion simulated in their test scenes, a target with \
          no closed form to restate; it is measured here against the one closed-form interreflection model at hand, COD: \
@@ -258,12 +312,15 @@ fn multibounce_item() -> Item {
          the fit's error against its own data."
             .into(),
     );
-    item.findings.push(format!(
-        "The same shape refitted minimax to the COD model: a, b, c = ({:.4}ρ {:+.4}, {:.4}ρ {:+.4}, {:.4}ρ {:+.4}); max {refit_max:.3e}, \
-         rms {refit_rms:.3e}, worst at [V, ρ] = {refit_worst:.3?} (published constants: max {:.3e}, rms {:.3e}). The cubic cannot \
-         follow the model's pole-like rise at ρ → 1, V → 0 (A′ = 1 for ρ = 1 and any A > 0).",
-        refit[0], refit[1], refit[2], refit[3], refit[4], refit[5], item.max_abs_error, item.rms_error
-    ));
+    item.findings.push(match refit_errors {
+        Some((refit, (refit_max, refit_rms, refit_worst))) => format!(
+            "The same shape refitted minimax to the COD model (fits/ggx_occlusion_refits.toml): a, b, c = ({:.4}ρ {:+.4}, {:.4}ρ {:+.4}, {:.4}ρ {:+.4}); max {refit_max:.3e}, \
+             rms {refit_rms:.3e}, worst at [V, ρ] = {refit_worst:.3?} (published constants: max {:.3e}, rms {:.3e}). The cubic cannot \
+             follow the model's pole-like rise at ρ → 1, V → 0 (A′ = 1 for ρ = 1 and any A > 0).",
+            refit[0], refit[1], refit[2], refit[3], refit[4], refit[5], item.max_abs_error, item.rms_error
+        ),
+        None => format!("The same shape refitted minimax to the COD model is not committed here (fits/{}.toml).", super::refit::SPEC),
+    });
     item
 }
 
@@ -403,17 +460,16 @@ mod tests {
         assert!(max_error(&pts, &refs, |r, _, _| if r == 0.2 { f64::NAN } else { r }).is_nan());
     }
 
-    /// The refits of Lagarde's and Jimenez's constants on the grid (printed: `cargo test --release
-    /// --lib occlusion_refits -- --nocapture`) are what they say: Lagarde's (a, b) a minimum of
+    /// The refits of Lagarde's and Jimenez's constants on the grid are what they say: Lagarde's (a, b) a minimum of
     /// the rms error and Jimenez's k one of the max error, each below the published constants'
     /// and not bettered by moving a parameter 1e-4 of itself either way (the simplex stops far
-    /// inside that), and they are the committed constants (the search is deterministic).
+    /// inside that), and they are the constants fits/ggx_occlusion_refits.toml committed (the
+    /// search is deterministic).
     #[test]
     fn occlusion_refits_minimise_their_errors() {
         let (l, j) = refits();
         let pts = grid();
         let refs = reference(&pts);
-        println!("LAGARDE_REFIT = [{:?}, {:?}]; JIMENEZ_REFIT = {:?}", l[0], l[1], j);
         let lagarde_rms = |p: [f64; 2]| rms_error(&pts, &refs, |r, mu, v| lagarde_with(p, mu, v, r * r));
         let jimenez_max = |k: f64| max_error(&pts, &refs, |r, mu, v| jimenez_with(k, mu, v, r));
         assert!(lagarde_rms(l) < lagarde_rms(LAGARDE), "{l:?}");
@@ -426,7 +482,8 @@ mod tests {
             }
             assert!(jimenez_max(j * (1.0 + s)) >= jimenez_max(j), "{} beats {j}", j * (1.0 + s));
         }
-        assert_eq!((l, j), (LAGARDE_REFIT, JIMENEZ_REFIT));
+        let committed = super::super::refit::repository();
+        assert_eq!((l, j), (committed.lagarde, committed.jimenez));
     }
 
     /// The typo finding's half-way points: where each reading's factor (gloss 0) is 1/2, found
@@ -510,6 +567,7 @@ mod tests {
         let generated = root.join("generated");
         let items = items_on(&generated, &pts, &refs);
         let readers = lut_readers(&generated);
+        let committed = super::super::refit::repository();
         assert_eq!(items.len(), 6 + readers.len());
         assert!(items[0].name.contains("adjusted cone") && items[items.len() - 1].name.starts_with("multi-bounce AO"));
         let outside: Vec<bool> = pts.iter().map(|p| p[1] < (1.0 - p[2]).sqrt()).collect();
@@ -517,9 +575,9 @@ mod tests {
         type So<'a> = Box<dyn Fn(&[f64; 3]) -> f64 + 'a>;
         let mut forms: Vec<(String, So)> = vec![
             ("Lagarde & de Rousiers 2014".into(), Box::new(|p| lagarde(p[1], p[2], p[0] * p[0]))),
-            ("Lagarde & de Rousiers 2014, refitted".into(), Box::new(|p| lagarde_with(LAGARDE_REFIT, p[1], p[2], p[0] * p[0]))),
+            ("Lagarde & de Rousiers 2014, refitted".into(), Box::new(|p| lagarde_with(committed.lagarde, p[1], p[2], p[0] * p[0]))),
             ("cone–cone intersection".into(), Box::new(|p| jimenez(p[1], p[2], p[0]))),
-            ("cone–cone, refitted".into(), Box::new(|p| jimenez_with(JIMENEZ_REFIT, p[1], p[2], p[0]))),
+            ("cone–cone, refitted".into(), Box::new(|p| jimenez_with(committed.jimenez, p[1], p[2], p[0]))),
         ];
         for r in &readers {
             forms.push((format!("3-D environment BRDF ({})", r.name()), Box::new(move |p| r.so(p[1], p[0] * p[0], p[2], F0))));
@@ -591,7 +649,7 @@ mod tests {
     /// its stated max error within 6·5e-5 = 3e-4.
     #[test]
     fn the_multibounce_item_is_re_measured() {
-        let item = multibounce_item();
+        let item = multibounce_item(Some(super::super::refit::repository().multibounce));
         let grid: Vec<[f64; 2]> = (0..=64).flat_map(|i| (0..=64).map(move |j| [i as f64 / 64.0, j as f64 / 64.0])).collect();
         let max_err = |p: &[f64]| {
             grid.iter()

@@ -10,12 +10,15 @@
 //!   Lawson minimax, sequential-LP polish, denominator proven positive), each channel on its own.
 //! - Kulla–Conty's F_avg: Nelder–Mead on the max error of each branch.
 //!
-//! Everything is deterministic (no random starts, sequential solvers). The constants below are
-//! what [`compute`] returned, printed by
-//! `cargo test --release -p shadefit --lib family::ggx::published::refit -- --ignored --nocapture`,
-//! which also checks that they are reproduced.
+//! Everything is deterministic (no random starts, sequential solvers). Each is a registered
+//! [`PublishedForm`] ([`FORMS`]): `fits/ggx_published_refits.toml` (`kind = "refit"`) runs the
+//! refits when built and commits the constants in generated/json/ggx_published_refits.json;
+//! validate, figures and benchmarks read them from there ([`Refits::committed`]).
 
-use super::forms::{Karis, KullaConty, Lazarov, MATERIALX, MaterialX};
+use super::forms::{KARIS, KARIS_FORM, KULLA_CONTY, KULLA_CONTY_FORM, Karis, KullaConty, LAZAROV, LAZAROV_FORM, Lazarov, MATERIALX, MATERIALX_FORM, MaterialX};
+use crate::fit::published::{Errors, FormError, PublishedForm, as_emitted};
+use crate::pipeline::BuildError;
+use std::path::Path;
 use super::grid::{self, Grid, Target};
 use crate::fit::model::{ModelParts, Term};
 use crate::fit::positivity::{Positivity, prove_denominator_positive};
@@ -126,7 +129,7 @@ pub fn kulla_conty(start: &KullaConty) -> KullaConty {
     KullaConty { above: [above[0], above[1]], below: [below[0], below[1], below[2], below[3]] }
 }
 
-/// Every refit, as committed below.
+/// Every refit, as the refit spec commits them.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Refits {
     pub karis_ue4: Karis,
@@ -136,41 +139,212 @@ pub struct Refits {
     pub kulla_conty: KullaConty,
 }
 
-/// Run every refit (a few seconds in release: the grids' integrals, then the solvers).
-pub fn compute() -> Refits {
-    use super::forms::{KARIS, KULLA_CONTY, LAZAROV};
-    let t = std::time::Instant::now();
-    let karis_ue4 = karis(Target::RoughnessUe4, &KARIS);
-    let karis_hc = karis(Target::Roughness, &KARIS);
-    let lazarov = lazarov(&LAZAROV);
-    let t1 = t.elapsed();
-    let materialx = materialx();
-    let t2 = t.elapsed();
-    let kulla_conty = kulla_conty(&KULLA_CONTY);
-    eprintln!("refits: Karis, Lazarov (with their grids) {t1:?}, MaterialX {:?}, Kulla–Conty {:?}", t2 - t1, t.elapsed() - t2);
-    Refits { karis_ue4, karis_hc, lazarov, materialx, kulla_conty }
+/// The refit spec that commits them (`fits/SPEC.toml`, `kind = "refit"`).
+pub const SPEC: &str = "ggx_published_refits";
+
+/// The registered names of the forms, as [`FORMS`] and the spec list them.
+pub const KARIS_HC: &str = "ggx-karis";
+pub const KARIS_UE4: &str = "ggx-karis-separable";
+pub const LAZAROV_NAME: &str = "ggx-lazarov";
+pub const MATERIALX_NAME: &str = "ggx-materialx";
+pub const KULLA_CONTY_NAME: &str = "ggx-fresnel-avg-dielectric";
+
+impl Refits {
+    /// The committed refits of `generated` (generated/json/ggx_published_refits.json, checked
+    /// against its spec).
+    pub fn committed(generated: &Path) -> Result<Refits, BuildError> {
+        let c = |form: &str| crate::family::committed_refit(generated, SPEC, form);
+        Ok(Refits {
+            karis_ue4: Karis::from_params(&c(KARIS_UE4)?),
+            karis_hc: Karis::from_params(&c(KARIS_HC)?),
+            lazarov: Lazarov::from_params(&c(LAZAROV_NAME)?),
+            materialx: MaterialX::from_params(&c(MATERIALX_NAME)?),
+            kulla_conty: KullaConty::from_params(&c(KULLA_CONTY_NAME)?),
+        })
+    }
+
+    /// Every constant rounded to f32, as the emitted code carries them.
+    pub fn emitted(&self) -> Refits {
+        Refits {
+            karis_ue4: Karis::from_params(&as_emitted(&self.karis_ue4.params())),
+            karis_hc: Karis::from_params(&as_emitted(&self.karis_hc.params())),
+            lazarov: Lazarov::from_params(&as_emitted(&self.lazarov.params())),
+            materialx: MaterialX::from_params(&as_emitted(&self.materialx.params())),
+            kulla_conty: KullaConty::from_params(&as_emitted(&self.kulla_conty.params())),
+        }
+    }
 }
 
-/// The committed refits (see the module doc for the command that reproduces them).
-pub const COMMITTED: Refits = Refits {
-    karis_ue4: Karis { c0: [-0.9441850444686232, -0.0018488478553383989, -0.6224102459540468, 0.005335536983318304], c1: [1.0048656482110063, 0.035720745729102506, 1.1064247655962771, -0.15154834572806947], k: -8.148840290268044, s: 1.0299811359667614 },
-    karis_hc: Karis { c0: [-1.0033356772659126, -0.029198445151315366, -0.5191666174126972, 0.021448281214781664], c1: [0.9959457964288359, 0.0408228744845678, 1.1444205814874064, -0.03865304564301961], k: -9.180113014439492, s: 1.0227145677300817 },
-    lazarov: Lazarov { slope: [1.1215121147716758, 0.49903548151203125, 0.018610064565292395, 0.2445833882877954], offset: [-0.01402274567213611, 0.651810620426457], k: -9.314638379575175 },
-    materialx: MaterialX {
-        r: [
-            [0.06037509230705989, 0.9345, 1.0, 1.0],
-            [0.03979220185303453, -2.323, 20.66125549800175, 0.2281],
-            [13.056495773690163, 2.229, 11.702307105652055, 15.94],
-            [18.575928654149163, -3.748, -47.32445013623611, -55.83],
-            [167.274019975316, 1.424, 127.47187976017383, 13.08],
-            [0.8505380552791594, -0.7684, 2.3104202579198447, 41.26],
-            [-292.4302433327376, 1.436, -87.13513310846379, 54.9],
-            [-8.655233739067464, 0.2913, 83.33102560302318, 300.2],
-            [111.21430675374712, 0.6286, -76.40613905233552, -285.1],
-        ],
+/// The committed refits of the repository's own generated/ (tests, and the family's emitted
+/// module tests).
+#[cfg(test)]
+pub fn repository() -> Refits {
+    Refits::committed(&Path::new(env!("CARGO_MANIFEST_DIR")).join("generated")).expect("the refits are committed")
+}
+
+/// Max and rms |error| of a pair form over both channels of its grid (validate's measure).
+fn pair_errors(g: &Grid, form: impl Fn(f64, f64) -> [f64; 2]) -> Errors {
+    let p = super::pair(g, form);
+    let (max_abs_error, rms_error, _) = crate::validate::measure(&p.points, &p.truth, &p.approx);
+    Errors { max_abs_error, rms_error }
+}
+
+/// A pair form's row on the standard grid of `target`.
+fn pair_row(form: &str, target: Target, published: impl Fn(f64, f64) -> [f64; 2], refit: impl Fn(f64, f64) -> [f64; 2]) -> FormError {
+    let g = grid::standard(target);
+    FormError {
+        form: form.into(),
+        grid: format!("n·v at 64 texel centres × {} ∈ [0, 1] (65), against {}", target.axis_name(), target.integral()),
+        published: pair_errors(g, published),
+        refit: pair_errors(g, refit),
+        points: 2 * g.values.len(),
+    }
+}
+
+/// Kulla–Conty's rows: each branch on its own η grid.
+fn kulla_conty_rows(published: &KullaConty, refit: &KullaConty) -> Vec<FormError> {
+    let errors = |above: bool, k: &KullaConty| {
+        let (eta, f) = grid::fresnel(above);
+        let points: Vec<Vec<f64>> = eta.iter().map(|&x| vec![x]).collect();
+        let approx: Vec<f64> = eta.iter().map(|&x| k.eval(x)).collect();
+        let (max_abs_error, rms_error, _) = crate::validate::measure(&points, f, &approx);
+        Errors { max_abs_error, rms_error }
+    };
+    [true, false]
+        .into_iter()
+        .map(|above| {
+            let n = grid::fresnel(above).0.len();
+            FormError {
+                form: if above { "Kulla–Conty F_avg, η ≥ 1 branch" } else { "Kulla–Conty F_avg, η < 1 branch" }.into(),
+                grid: format!("{n} values of η in {}, against the exact dielectric Fresnel average", if above { "[1, 3]" } else { "[1/3, 1)" }),
+                published: errors(above, published),
+                refit: errors(above, refit),
+                points: n,
+            }
+        })
+        .collect()
+}
+
+/// The MaterialX refit's denominators (r.z, r.w) proven positive on the clamped domain: the
+/// least of the two proven lower bounds. The model's denominators have the constant term 1, as
+/// the refit's (and the published form's) do; a form with another constant is refused.
+pub fn materialx_denominators_positive(m: &MaterialX) -> Result<f64, String> {
+    let model = materialx_model();
+    let domain = [MATERIALX_N_DOT_V, (0.0, 1.0)];
+    let mut lowest = f64::INFINITY;
+    for ch in 2..4 {
+        if m.r[0][ch] != 1.0 {
+            return Err(format!("channel {ch}: constant term {} (the proof's model has 1)", m.r[0][ch]));
+        }
+        // The model's coefficients: 9 numerator terms (unused here: r.x), then the 8
+        // denominator terms after the constant r[0] = 1.
+        let c: Vec<f64> = (0..9).map(|k| m.r[k][ch - 2]).chain((1..9).map(|k| m.r[k][ch])).collect();
+        match prove_denominator_positive(&model, &DVector::from_vec(c), &domain) {
+            Positivity::Proven { lower, .. } => lowest = lowest.min(lower),
+            Positivity::NotProven { lower, .. } => return Err(format!("channel {ch}: interval bound {lower:e}")),
+        }
+    }
+    Ok(lowest)
+}
+
+/// n·v range of the MaterialX refit's fitting grid (every other texel centre of 64).
+pub const MATERIALX_N_DOT_V: (f64, f64) = (1.0 / 128.0, 125.0 / 128.0);
+/// The MaterialX refit as the emitted code evaluates it: n·v clamped to [`MATERIALX_N_DOT_V`].
+pub fn materialx_refit(m: &MaterialX, n_dot_v: f64, alpha: f64) -> [f64; 2] {
+    m.eval(n_dot_v.clamp(MATERIALX_N_DOT_V.0, MATERIALX_N_DOT_V.1), alpha)
+}
+
+/// η range of the Fresnel-average grids (both branches).
+pub const ETA: (f64, f64) = (1.0 / 3.0, 3.0);
+
+const UNIT: (f64, f64) = (0.0, 1.0);
+
+/// The split-sum pair's doc ending.
+macro_rules! pair_doc {
+    ($what:literal) => {
+        concat!($what, ": (scale, bias) of the split sum: specular = F0·scale + bias.")
+    };
+}
+
+/// The published forms of the split sum and of the dielectric Fresnel average, as
+/// `fits/ggx_published_refits.toml` refits them (registered in the family's descriptor).
+pub static FORMS: [PublishedForm; 5] = FORMS_DEF;
+
+/// [`FORMS`] as a value (the family's descriptor lists every form of the family in one slice).
+pub const FORMS_DEF: [PublishedForm; 5] = [
+    PublishedForm {
+        name: KARIS_HC,
+        function: "karis",
+        doc: pair_doc!("Karis's EnvBRDFApprox refitted to the height-correlated integral, roughness r (α = r²)"),
+        args: &["roughness", "n_dot_v"],
+        domain: &[UNIT, UNIT],
+        program: Some(|| &*KARIS_FORM),
+        published: || KARIS.params(),
+        refit: || karis(Target::Roughness, &KARIS).params(),
+        measure: |p, r| {
+            let (p, r) = (Karis::from_params(p), Karis::from_params(r));
+            vec![pair_row("Karis 2014 EnvBRDFApprox", Target::Roughness, |m, x| p.eval(x, m), |m, x| r.eval(x, m))]
+        },
+        check: None,
     },
-    kulla_conty: KullaConty { above: [3.4117167821916192, 1.3185056200577647], below: [1.0220853548162951, -0.02626728001312509, -0.7609418016792393, -0.233917182444563] },
-};
+    PublishedForm {
+        name: KARIS_UE4,
+        function: "karis_separable",
+        doc: pair_doc!("Karis's EnvBRDFApprox refitted to UE4's separable Schlick–Smith G (k = α/2)"),
+        args: &["roughness", "n_dot_v"],
+        domain: &[UNIT, UNIT],
+        program: Some(|| &*KARIS_FORM),
+        published: || KARIS.params(),
+        refit: || karis(Target::RoughnessUe4, &KARIS).params(),
+        measure: |p, r| {
+            let (p, r) = (Karis::from_params(p), Karis::from_params(r));
+            vec![pair_row("Karis 2014 EnvBRDFApprox", Target::RoughnessUe4, |m, x| p.eval(x, m), |m, x| r.eval(x, m))]
+        },
+        check: None,
+    },
+    PublishedForm {
+        name: LAZAROV_NAME,
+        function: "lazarov",
+        doc: pair_doc!("Lazarov's Black Ops II form refitted (gloss g: α = sqrt(2/(8192^g + 2)))"),
+        args: &["gloss", "n_dot_v"],
+        domain: &[UNIT, UNIT],
+        program: Some(|| &*LAZAROV_FORM),
+        published: || LAZAROV.params(),
+        refit: || lazarov(&LAZAROV).params(),
+        measure: |p, r| {
+            let (p, r) = (Lazarov::from_params(p), Lazarov::from_params(r));
+            vec![pair_row("Lazarov 2013 (Black Ops II)", Target::Gloss, |m, g| p.eval(g, m), |m, g| r.eval(g, m))]
+        },
+        check: None,
+    },
+    PublishedForm {
+        name: MATERIALX_NAME,
+        function: "materialx",
+        doc: pair_doc!("MaterialX's rational pair refitted (n·v clamped to its fitted [1/128, 125/128])"),
+        args: &["n_dot_v", "alpha"],
+        domain: &[MATERIALX_N_DOT_V, UNIT],
+        program: Some(|| &*MATERIALX_FORM),
+        published: || MATERIALX.params(),
+        refit: || materialx().params(),
+        measure: |p, r| {
+            let (p, r) = (MaterialX::from_params(p), MaterialX::from_params(r));
+            vec![pair_row("MaterialX mx_ggx_dir_albedo_analytic", Target::Alpha, |m, a| p.eval(m, a), |m, a| materialx_refit(&r, m, a))]
+        },
+        check: Some(|c| materialx_denominators_positive(&MaterialX::from_params(c)).map(|lower| vec![("denominator_lower_bound".to_string(), lower)])),
+    },
+    PublishedForm {
+        name: KULLA_CONTY_NAME,
+        function: "fresnel_avg_dielectric",
+        doc: "Kulla–Conty's dielectric Fresnel average F_avg(η) refitted (η clamped to [1/3, 3]).",
+        args: &["eta"],
+        domain: &[ETA],
+        program: Some(|| &*KULLA_CONTY_FORM),
+        published: || KULLA_CONTY.params(),
+        refit: || kulla_conty(&KULLA_CONTY).params(),
+        measure: |p, r| kulla_conty_rows(&KullaConty::from_params(p), &KullaConty::from_params(r)),
+        check: None,
+    },
+];
 
 #[cfg(test)]
 mod tests {
@@ -186,7 +360,7 @@ mod tests {
     /// against the grid's integrals.
     #[test]
     fn a_sign_slip_in_any_committed_constant_raises_its_max_error() {
-        let c = &COMMITTED;
+        let c = &repository();
         let karis = |target: Target, k: &Karis| -> (Vec<f64>, Box<dyn Fn(&[f64]) -> f64>) {
             let g = grid::standard(target);
             (k.params(), Box::new(move |p: &[f64]| g.max_error(|m, r| Karis::from_params(p).eval(r, m))))
@@ -333,38 +507,5 @@ mod tests {
         }
         let e = (r.eval(0.55, 0.5)[0] - rational(&SCALE_NUM, &SCALE_DEN, 0.55, 0.5)).abs();
         assert!(e < 1e-7, "{e:e}");
-    }
-
-    fn rust_karis(name: &str, k: &Karis) -> String {
-        format!("    {name}: Karis {{ c0: {:?}, c1: {:?}, k: {:?}, s: {:?} }},\n", k.c0, k.c1, k.k, k.s)
-    }
-
-    /// Recomputes every refit, prints it as Rust and checks the committed constants. The
-    /// solvers are deterministic, so they agree to the last bit on one platform; 1e-12
-    /// relative allows another libm's exp2 (a few ulps in the objective can move a simplex).
-    #[test]
-    #[ignore = "refits every published form (a few seconds in release); run to regenerate COMMITTED"]
-    fn committed_refits_are_reproduced() {
-        let r = compute();
-        let mut s = String::from("pub const COMMITTED: Refits = Refits {\n");
-        s += &rust_karis("karis_ue4", &r.karis_ue4);
-        s += &rust_karis("karis_hc", &r.karis_hc);
-        let l = &r.lazarov;
-        s += &format!("    lazarov: Lazarov {{ slope: {:?}, offset: {:?}, k: {:?} }},\n", l.slope, l.offset, l.k);
-        s += "    materialx: MaterialX {\n        r: [\n";
-        for row in &r.materialx.r {
-            s += &format!("            {row:?},\n");
-        }
-        s += "        ],\n    },\n";
-        let k = &r.kulla_conty;
-        s += &format!("    kulla_conty: KullaConty {{ above: {:?}, below: {:?} }},\n}};", k.above, k.below);
-        println!("{s}");
-        let close = |a: &[f64], b: &[f64]| a.iter().zip(b).all(|(x, y)| (x - y).abs() <= 1e-12 * x.abs().max(1.0));
-        assert!(close(&r.karis_ue4.params(), &COMMITTED.karis_ue4.params()));
-        assert!(close(&r.karis_hc.params(), &COMMITTED.karis_hc.params()));
-        assert!(close(&r.lazarov.params(), &COMMITTED.lazarov.params()));
-        assert!(close(r.materialx.r.as_flattened(), COMMITTED.materialx.r.as_flattened()));
-        assert!(close(&r.kulla_conty.above, &COMMITTED.kulla_conty.above));
-        assert!(close(&r.kulla_conty.below, &COMMITTED.kulla_conty.below));
     }
 }
