@@ -178,25 +178,40 @@ fn run_merged(
     if check && let Some(journal) = emit::interrupted(&paths.generated) {
         return Err(Error::Interrupted { journal });
     }
-    let results: Vec<Result<(Built, f64), Error>> = selected
-        .par_iter()
-        .map(|s| {
-            let t = std::time::Instant::now();
-            let b = build_spec(s, mode, &paths.generated).map_err(|source| Error::Build { spec: s.file.name.clone(), source })?;
-            tick(selected.len());
-            Ok((b, t.elapsed().as_secs_f64()))
-        })
-        .collect();
-    let built: Vec<(Built, f64)> = results.into_iter().collect::<Result<_, _>>()?;
-    let scenes = load_scenes(paths)?;
+    let build_all = |specs: &[&Spec]| -> Result<Vec<(Built, f64)>, Error> {
+        let results: Vec<Result<(Built, f64), Error>> = specs
+            .par_iter()
+            .map(|s| {
+                let t = std::time::Instant::now();
+                let b = build_spec(s, mode, &paths.generated).map_err(|source| Error::Build { spec: s.file.name.clone(), source })?;
+                tick(selected.len());
+                Ok((b, t.elapsed().as_secs_f64()))
+            })
+            .collect();
+        results.into_iter().collect()
+    };
+    // Specs that read other specs' committed outputs (a refit of a form fitted to a committed
+    // table) are built after the others are written, so they read this build's outputs.
+    let (later, first): (Vec<&Spec>, Vec<&Spec>) = selected.iter().copied().partition(|s| !family::reads(s).is_empty());
+    let mut built = build_all(&first)?;
     let mut artifacts: Vec<_> = built.iter().flat_map(|(b, _)| b.artifacts.clone()).collect();
     // The scene modules read their specs' coefficients from generated/json: write this build's
     // first, so a scene never specialises the previous build's fit.
-    let spec_files = artifacts.len();
     let mut written = match tx.as_mut() {
         Some(tx) => tx.write(&artifacts)?,
         None => 0,
     };
+    let reading = build_all(&later)?;
+    let reading_files: Vec<_> = reading.iter().flat_map(|(b, _)| b.artifacts.clone()).collect();
+    if let Some(tx) = tx.as_mut() {
+        written += tx.write(&reading_files)?;
+    }
+    artifacts.extend(reading_files);
+    built.extend(reading);
+    // Summaries list the specs in the order they were selected.
+    built.sort_by_key(|(b, _)| selected.iter().position(|s| s.file.name == b.name));
+    let scenes = load_scenes(paths)?;
+    let spec_files = artifacts.len();
     let mut scene_times = Vec::new();
     if only.is_empty() {
         // Every scene module, with the node files of this build recorded for its cache.

@@ -77,6 +77,9 @@ pub mod gloss_table;
 #[path = "ms_diffuse_rational.rs"]
 pub mod ms_diffuse_rational;
 #[cfg(feature = "ms")]
+#[path = "ms_diffuse_refits.rs"]
+pub mod ms_diffuse_refits;
+#[cfg(feature = "ms")]
 #[path = "ms_diffuse_slices.rs"]
 pub mod ms_diffuse_slices;
 #[cfg(feature = "ms")]
@@ -157,6 +160,8 @@ pub mod wgsl {
     #[cfg(feature = "ms")]
     pub const MS_DIFFUSE_RATIONAL: &str = include_str!("../wgsl/ms_diffuse_rational.wgsl");
     #[cfg(feature = "ms")]
+    pub const MS_DIFFUSE_REFITS: &str = include_str!("../wgsl/ms_diffuse_refits.wgsl");
+    #[cfg(feature = "ms")]
     pub const MS_DIFFUSE_SLICES: &str = include_str!("../wgsl/ms_diffuse_slices.wgsl");
     #[cfg(feature = "ms")]
     pub const MS_DIFFUSE_SLICES_LAMBERT: &str = include_str!("../wgsl/ms_diffuse_slices_lambert.wgsl");
@@ -228,6 +233,8 @@ pub mod wgsl {
             "gloss_table" => Some(GLOSS_TABLE),
             #[cfg(feature = "ms")]
             "ms_diffuse_rational" => Some(MS_DIFFUSE_RATIONAL),
+            #[cfg(feature = "ms")]
+            "ms_diffuse_refits" => Some(MS_DIFFUSE_REFITS),
             #[cfg(feature = "ms")]
             "ms_diffuse_slices" => Some(MS_DIFFUSE_SLICES),
             #[cfg(feature = "ms")]
@@ -302,6 +309,8 @@ pub mod wgsl {
         "gloss_table",
         #[cfg(feature = "ms")]
         "ms_diffuse_rational",
+        #[cfg(feature = "ms")]
+        "ms_diffuse_refits",
         #[cfg(feature = "ms")]
         "ms_diffuse_slices",
         #[cfg(feature = "ms")]

@@ -169,6 +169,15 @@ pub static REFIT: SpecKind = SpecKind {
     shard: None,
 };
 
+/// The specs whose committed outputs `spec` reads when built (a refit spec's forms' `reads`;
+/// none for the other kinds): the build writes them first.
+pub fn reads(spec: &Spec) -> Vec<&'static str> {
+    match spec.file.kind {
+        crate::spec::Kind::Custom(k) if k == pipeline::refit::KIND => pipeline::refit::reads(spec, published_forms()),
+        _ => vec![],
+    }
+}
+
 /// The committed constants of `form` in the refit spec `spec` (generated/json/SPEC.json under
 /// `generated`, checked against fits/SPEC.toml): how a family's audit, figures and benchmarks
 /// read a refit.

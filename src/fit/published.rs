@@ -10,6 +10,7 @@
 
 use super::expr::program::Program;
 use serde::{Deserialize, Serialize};
+use std::path::Path;
 
 /// A published form, registered by a family.
 pub struct PublishedForm {
@@ -30,11 +31,16 @@ pub struct PublishedForm {
     pub program: Option<fn() -> &'static Program>,
     /// The published constants, in the program's order.
     pub published: fn() -> Vec<f64>,
-    /// The refit: deterministic, from nothing but the form and its integral.
-    pub refit: fn() -> Vec<f64>,
+    /// Specs whose committed outputs the refit and the measure read (e.g. a simulated table the
+    /// form approximates): their `fits/NAME.toml` texts enter the refit spec's input hash, and
+    /// their JSON is read from the generated folder being built.
+    pub reads: &'static [&'static str],
+    /// The refit: deterministic, from the form, its integral and the committed outputs of
+    /// `reads` in the generated folder given; `Err` says what is missing.
+    pub refit: fn(&Path) -> Result<Vec<f64>, String>,
     /// The errors of the published constants (first) and of refitted ones (second, as the
     /// emitted code carries them: f32 values) against the integral, one row per grid measured.
-    pub measure: fn(&[f64], &[f64]) -> Vec<FormError>,
+    pub measure: fn(&Path, &[f64], &[f64]) -> Result<Vec<FormError>, String>,
     /// A check the refitted constants must pass before they are emitted (e.g. a denominator
     /// proven positive on the clamp box): named figures for the JSON, or why they fail.
     pub check: Option<fn(&[f64]) -> Result<Vec<(String, f64)>, String>>,

@@ -138,6 +138,18 @@ fn forms<'a>(spec: &Spec, registry: &[&'a PublishedForm]) -> Result<(RefitFile, 
     Ok((f, forms))
 }
 
+/// The specs whose committed outputs the spec's forms read (`PublishedForm::reads`): the build
+/// writes those before it builds this spec.
+pub fn reads(spec: &Spec, registry: &[&PublishedForm]) -> Vec<&'static str> {
+    let mut names: Vec<&'static str> = match forms(spec, registry) {
+        Ok((_, forms)) => forms.iter().flat_map(|f| f.reads.iter().copied()).collect(),
+        Err(_) => vec![],
+    };
+    names.sort_unstable();
+    names.dedup();
+    names
+}
+
 /// The generator, the spec text and each named form's identity.
 pub fn input_hash(spec: &Spec, registry: &[&PublishedForm]) -> String {
     let mut h = Sha256::new();
@@ -147,9 +159,24 @@ pub fn input_hash(spec: &Spec, registry: &[&PublishedForm]) -> String {
     if let Ok((_, forms)) = forms(spec, registry) {
         for f in forms {
             h.update(format!("\n{}|{:?}|{:?}|{:?}|{:?}", f.name, f.args, f.domain, (f.published)(), f.program.map(|p| p())).as_bytes());
+            for read in f.reads {
+                h.update(format!("\n{read}: {}", read_hash(spec, read)).as_bytes());
+            }
         }
     }
     format!("sha256:{}", hex(&h.finalize()))
+}
+
+/// The input hash recorded by the committed JSON of the spec `name` that a form reads, in the
+/// generated/ folder beside the refit spec's fits/ folder ("missing" when there is none): a
+/// rebuilt table makes the refits that read it stale.
+fn read_hash(spec: &Spec, name: &str) -> String {
+    let generated = spec.path.parent().and_then(Path::parent).unwrap_or(Path::new("")).join("generated");
+    std::fs::read_to_string(generated.join("json").join(format!("{name}.json")))
+        .ok()
+        .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
+        .and_then(|v| v["input_hash"].as_str().map(String::from))
+        .unwrap_or_else(|| "missing".into())
 }
 
 /// The committed functions of a refit spec, checked against its input hash and its forms.
@@ -177,12 +204,13 @@ pub fn committed_constants(generated: &Path, name: &str, form: &str, catalog: &C
         .ok_or_else(|| BuildError::NoCommitted { spec: name.into(), why: format!("it does not refit '{form}'") })
 }
 
-/// Refit and measure one form.
-fn refit(prefix: &str, form: &PublishedForm) -> CommittedForm {
-    let constants = (form.refit)();
+/// Refit and measure one form (the committed outputs it reads are in `root`).
+fn refit(spec: &str, prefix: &str, form: &PublishedForm, root: &Path) -> Result<CommittedForm, BuildError> {
+    let failed = |why: String| BuildError::NoCommitted { spec: spec.into(), why: format!("the refit of '{}': {why}", form.name) };
+    let constants = (form.refit)(root).map_err(failed)?;
     let published = (form.published)();
-    let errors = (form.measure)(&published, &as_emitted(&constants));
-    CommittedForm { function: format!("{prefix}_{}", form.function), form: form.name.into(), constants, published_constants: published, checks: BTreeMap::new(), errors }
+    let errors = (form.measure)(root, &published, &as_emitted(&constants)).map_err(failed)?;
+    Ok(CommittedForm { function: format!("{prefix}_{}", form.function), form: form.name.into(), constants, published_constants: published, checks: BTreeMap::new(), errors })
 }
 
 pub fn build(spec: &Spec, mode: Mode, root: &Path, registry: &[&PublishedForm]) -> Result<Built, BuildError> {
@@ -191,7 +219,7 @@ pub fn build(spec: &Spec, mode: Mode, root: &Path, registry: &[&PublishedForm]) 
     let hash = input_hash(spec, registry);
     let (file, forms) = forms(spec, registry)?;
     let mut functions = match mode {
-        Mode::Fit => forms.par_iter().map(|f| refit(&prefix, f)).collect(),
+        Mode::Fit => forms.par_iter().map(|f| refit(&name, &prefix, f, root)).collect::<Result<Vec<_>, _>>()?,
         Mode::Committed => committed(spec, root, registry)?,
     };
     for (c, f) in functions.iter_mut().zip(&forms) {
@@ -286,8 +314,9 @@ mod tests {
         domain: &[(0.0, 2.0)],
         program: Some(|| &*LINE),
         published: || vec![1.0, -1.0],
-        refit: || vec![1.0, ((-2.0f64).exp() - 1.0) / 2.0],
-        measure: |p, r| vec![FormError { form: "a line".into(), grid: "201 points of [0, 2]".into(), points: 201, published: line_errors(p), refit: line_errors(r) }],
+        reads: &[],
+        refit: |_| Ok(vec![1.0, ((-2.0f64).exp() - 1.0) / 2.0]),
+        measure: |_, p, r| Ok(vec![FormError { form: "a line".into(), grid: "201 points of [0, 2]".into(), points: 201, published: line_errors(p), refit: line_errors(r) }]),
         check: None,
     };
 

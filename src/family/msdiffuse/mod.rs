@@ -8,6 +8,7 @@ pub mod integrals;
 pub mod merl;
 pub mod plot;
 pub mod published;
+pub mod refit;
 pub mod table;
 pub mod walk;
 
@@ -127,5 +128,5 @@ pub static FAMILY: Family = Family {
     scene_features: &[],
     commands: &[],
     axis_mappings: &[],
-    forms: &[],
+    forms: &refit::FORMS,
 };

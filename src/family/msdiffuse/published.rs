@@ -23,7 +23,7 @@
 
 use super::integrals::TALK_F0;
 use crate::shading::roughness::alpha_from_gloss;
-use crate::fit::{FitOptions, Objective, fit_rescaled};
+use crate::fit::{FitOptions, Objective, RationalModel, fit_rescaled};
 use crate::validate::Item;
 use serde_json::Value;
 use std::f64::consts::{FRAC_PI_2, PI};
@@ -34,16 +34,11 @@ pub const RATIONAL_NUM: [f64; 8] = [0.568, -0.692, -0.938, 1.326, 0.301, 1.96, -
 pub const RATIONAL_DEN: [f64; 8] = [1.0, 1.731, -0.997, -0.998, -0.843, 9.905, -0.971, 0.948];
 pub const TERMS: [&str; 8] = ["1", "x", "y", "x^2", "y^2", "x*y", "x^3", "y^3"];
 
-fn monomials(x: f64, y: f64) -> [f64; 8] {
-    [1.0, x, y, x * x, y * y, x * y, x * x * x, y * y * y]
-}
-
-/// The published rational R(x, y) (f in 1/sr at ρ = 1).
+/// The published rational R(x, y) (f in 1/sr at ρ = 1) with numerator and denominator
+/// constants `num`, `den`: the form's program ([`super::refit::RATIONAL_FORM`]) in f64.
 pub fn rational(num: &[f64; 8], den: &[f64; 8], x: f64, y: f64) -> f64 {
-    let m = monomials(x, y);
-    let p: f64 = num.iter().zip(&m).map(|(a, b)| a * b).sum();
-    let q: f64 = den.iter().zip(&m).map(|(a, b)| a * b).sum();
-    p / q
+    let c: Vec<f64> = num.iter().chain(den).copied().collect();
+    super::refit::RATIONAL_FORM.eval_f64(&[x, y], &c)[0]
 }
 
 fn pow5(x: f64) -> f64 {
@@ -174,8 +169,9 @@ impl Slices {
     }
 }
 
-/// The least-squares refit of the published form on (x, y) → f.
-pub fn refit(xs: &[[f64; 2]], f: &[f64]) -> Option<([f64; 8], [f64; 8])> {
+/// The published form as a rational model of features (x, y) = (n·h, l·h): [`TERMS`] over 1 +
+/// the same but the constant; coefficients are numerator then denominator.
+pub fn rational_model() -> Option<RationalModel> {
     let text = format!(
         "features = [\"x\", \"y\"]\nnumerator = [{}]\ndenominator = [{}]\n",
         TERMS.iter().map(|t| format!("\"{t}\"")).collect::<Vec<_>>().join(", "),
@@ -183,7 +179,12 @@ pub fn refit(xs: &[[f64; 2]], f: &[f64]) -> Option<([f64; 8], [f64; 8])> {
     );
     let path = Path::new("ms-diffuse refit");
     let ms: crate::spec::ModelSpec = crate::spec::parse_toml(path, &text).ok()?;
-    let model = ms.build(path, &text, vec!["x".into(), "y".into()], &|_| None).ok()?;
+    ms.build(path, &text, vec!["x".into(), "y".into()], &|_| None).ok()
+}
+
+/// The least-squares refit of the published form on (x, y) → f.
+pub fn refit(xs: &[[f64; 2]], f: &[f64]) -> Option<([f64; 8], [f64; 8])> {
+    let model = rational_model()?;
     let data = crate::fit::Data { x: xs.iter().map(|p| p.to_vec()).collect(), y: f.to_vec() };
     let fit = fit_rescaled(&model, &data, &FitOptions { objective: Objective::Lsq, ..FitOptions::default() }, "ms-diffuse refit").ok()?;
     let c = &fit.coefficients;
@@ -196,6 +197,14 @@ pub fn refit(xs: &[[f64; 2]], f: &[f64]) -> Option<([f64; 8], [f64; 8])> {
         den[j] = c[8 + j - 1];
     }
     Some((num, den))
+}
+
+/// The gloss-0 slice of committed slices: its points, the simulated π f there and the
+/// rational's (n·h, l·h).
+pub fn gloss_zero(s: &Slices) -> (Vec<Vec<f64>>, Vec<f64>, Vec<[f64; 2]>) {
+    let (pts, truth, cos) = s.pick(&s.at_gloss(0.0));
+    let xy = cos.iter().map(|c| [c.n_dot_h, c.l_dot_h]).collect();
+    (pts, truth, xy)
 }
 
 /// The committed gloss-dependent fit (`generated/json/ms_diffuse_rational.json`) as its emitted
@@ -300,8 +309,8 @@ pub fn items(generated: &Path) -> Vec<Item> {
             sorted[3 * sorted.len() / 4]
         ));
     }
-    let f_data: Vec<f64> = truth.iter().map(|v| v / PI).collect();
-    if let Some((num, den)) = refit(&xy, &f_data) {
+    match super::refit::committed(generated) {
+        Ok((num, den)) => {
         let approx: Vec<f64> = xy.iter().map(|p| PI * rational(&num, &den, p[0], p[1])).collect();
         let (m, r, _) = crate::validate::measure(&pts, &truth, &approx);
         it.extra.push(("refit_max_abs_error".into(), m));
@@ -313,6 +322,8 @@ pub fn items(generated: &Path) -> Vec<Item> {
             num.map(|c| (c * 1e4).round() / 1e4),
             den.map(|c| (c * 1e4).round() / 1e4)
         ));
+        }
+        Err(e) => it.findings.push(format!("The refit in the same form is not committed here: {e} (fits/{}.toml).", super::refit::SPEC)),
     }
     out.push(it);
 

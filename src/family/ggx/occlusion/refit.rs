@@ -51,8 +51,9 @@ pub fn repository() -> Refits {
 
 /// Lagarde's form over (n·v, V, α): saturate(exp2(2^(a α + b) · log2(max(n·v + V, 1e-30))) − 1 + V),
 /// the power written as exp2 · log2 as a shader's pow is, its base kept off 0 (where log2 is
-/// undefined in WGSL; the power of 1e-30 is below f32's smallest subnormal for every exponent
-/// above 0.05, and (a, b) give ≥ 2^−6 on α ∈ [0, 1]).
+/// undefined in WGSL). The floor never shows: n·v + V < 1e-30 means V < 1e-30, and then the
+/// power (≤ 1 for a base ≤ 1) minus 1 plus V is at most ~1e-30, which the saturate takes to 0
+/// or leaves below 1e-30, as the exact 0^e − 1 + V would give.
 pub static LAGARDE_FORM: LazyLock<Program> = LazyLock::new(|| {
     let base = max(var(0) + var(1), lit(1e-30));
     let power = exp2(exp2(k(0) * var(2) + k(1)) * Expr::Log2(Box::new(base)));
@@ -86,11 +87,12 @@ pub const FORMS_DEF: [PublishedForm; 3] = [
         domain: &[UNIT, UNIT, UNIT],
         program: Some(|| &*LAGARDE_FORM),
         published: || LAGARDE.to_vec(),
-        refit: || super::refits().0.to_vec(),
-        measure: |p, r| {
+        reads: &[],
+        refit: |_| Ok(super::refits().0.to_vec()),
+        measure: |_, p, r| Ok({
             let (p, r) = ([p[0], p[1]], [r[0], r[1]]);
             vec![so_row("Lagarde & de Rousiers 2014", |rr, mu, v| lagarde_with(p, mu, v, rr * rr), |rr, mu, v| lagarde_with(r, mu, v, rr * rr))]
-        },
+        }),
         check: None,
     },
     PublishedForm {
@@ -101,11 +103,12 @@ pub const FORMS_DEF: [PublishedForm; 3] = [
         domain: &[UNIT, UNIT, UNIT],
         program: None,
         published: || vec![JIMENEZ],
-        refit: || vec![super::refits().1],
-        measure: |p, r| {
+        reads: &[],
+        refit: |_| Ok(vec![super::refits().1]),
+        measure: |_, p, r| Ok({
             let (p, r) = (p[0], r[0]);
             vec![so_row("Jimenez et al. 2016 cone–cone", |rr, mu, v| jimenez_with(p, mu, v, rr), |rr, mu, v| jimenez_with(r, mu, v, rr))]
-        },
+        }),
         check: None,
     },
     PublishedForm {
@@ -116,8 +119,9 @@ pub const FORMS_DEF: [PublishedForm; 3] = [
         domain: &[UNIT, UNIT],
         program: Some(|| &*MULTIBOUNCE_FORM),
         published: || JIMENEZ_MULTIBOUNCE.to_vec(),
-        refit: || super::validation::multibounce_refit().to_vec(),
-        measure: |p, r| {
+        reads: &[],
+        refit: |_| Ok(super::validation::multibounce_refit().to_vec()),
+        measure: |_, p, r| Ok({
             let (pm, pr, _) = multibounce_errors(p);
             let (rm, rr, _) = multibounce_errors(r);
             vec![FormError {
@@ -127,7 +131,7 @@ pub const FORMS_DEF: [PublishedForm; 3] = [
                 published: crate::fit::published::Errors { max_abs_error: pm, rms_error: pr },
                 refit: crate::fit::published::Errors { max_abs_error: rm, rms_error: rr },
             }]
-        },
+        }),
         check: None,
     },
 ];
@@ -148,14 +152,19 @@ fn so_row(form: &str, published: impl Fn(f64, f64, f64) -> f64 + Sync, refit: im
 #[cfg(test)]
 mod tests {
     use super::*;
-    use super::super::{jimenez_multibounce, lagarde_with};
 
-    /// The programs are the forms: in f64 with f64 constants, Lagarde's equals `lagarde_with`
-    /// (pow against exp2·log2: a few ulps of values ≤ 2, 1e-14) and the multi-bounce cubic
-    /// equals `jimenez_multibounce` (the same operations: exactly) on an 11³ / 11² grid, with
-    /// the published and the committed constants.
+    /// The programs are the forms as their sources write them: in f64, Lagarde's equals
+    /// saturate((n·v + V)^(2^(aα + b)) − 1 + V) with `powf` (against exp2·log2: a few ulps of
+    /// values ≤ 2, 1e-14) and the multi-bounce cubic Jimenez et al.'s Eq. 10 written out (the
+    /// same operations: exactly), on an 11³ / 11² grid, with the published and the committed
+    /// constants.
     #[test]
     fn the_programs_are_the_forms() {
+        let lagarde_with = |[a, b]: [f64; 2], mu: f64, v: f64, alpha: f64| ((mu + v).powf((a * alpha + b).exp2()) - 1.0 + v).clamp(0.0, 1.0);
+        let jimenez_multibounce = |p: &[f64], v: f64, albedo: f64| {
+            let (a, b, c) = (p[0] * albedo + p[1], p[2] * albedo + p[3], p[4] * albedo + p[5]);
+            v.max(((a * v + b) * v + c) * v)
+        };
         let r = repository();
         for c in [LAGARDE, r.lagarde] {
             for i in 0..=10 {

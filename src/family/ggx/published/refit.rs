@@ -280,11 +280,12 @@ pub const FORMS_DEF: [PublishedForm; 5] = [
         domain: &[UNIT, UNIT],
         program: Some(|| &*KARIS_FORM),
         published: || KARIS.params(),
-        refit: || karis(Target::Roughness, &KARIS).params(),
-        measure: |p, r| {
+        reads: &[],
+        refit: |_| Ok(karis(Target::Roughness, &KARIS).params()),
+        measure: |_, p, r| Ok({
             let (p, r) = (Karis::from_params(p), Karis::from_params(r));
             vec![pair_row("Karis 2014 EnvBRDFApprox", Target::Roughness, |m, x| p.eval(x, m), |m, x| r.eval(x, m))]
-        },
+        }),
         check: None,
     },
     PublishedForm {
@@ -295,11 +296,12 @@ pub const FORMS_DEF: [PublishedForm; 5] = [
         domain: &[UNIT, UNIT],
         program: Some(|| &*KARIS_FORM),
         published: || KARIS.params(),
-        refit: || karis(Target::RoughnessUe4, &KARIS).params(),
-        measure: |p, r| {
+        reads: &[],
+        refit: |_| Ok(karis(Target::RoughnessUe4, &KARIS).params()),
+        measure: |_, p, r| Ok({
             let (p, r) = (Karis::from_params(p), Karis::from_params(r));
             vec![pair_row("Karis 2014 EnvBRDFApprox", Target::RoughnessUe4, |m, x| p.eval(x, m), |m, x| r.eval(x, m))]
-        },
+        }),
         check: None,
     },
     PublishedForm {
@@ -310,11 +312,12 @@ pub const FORMS_DEF: [PublishedForm; 5] = [
         domain: &[UNIT, UNIT],
         program: Some(|| &*LAZAROV_FORM),
         published: || LAZAROV.params(),
-        refit: || lazarov(&LAZAROV).params(),
-        measure: |p, r| {
+        reads: &[],
+        refit: |_| Ok(lazarov(&LAZAROV).params()),
+        measure: |_, p, r| Ok({
             let (p, r) = (Lazarov::from_params(p), Lazarov::from_params(r));
             vec![pair_row("Lazarov 2013 (Black Ops II)", Target::Gloss, |m, g| p.eval(g, m), |m, g| r.eval(g, m))]
-        },
+        }),
         check: None,
     },
     PublishedForm {
@@ -325,11 +328,12 @@ pub const FORMS_DEF: [PublishedForm; 5] = [
         domain: &[MATERIALX_N_DOT_V, UNIT],
         program: Some(|| &*MATERIALX_FORM),
         published: || MATERIALX.params(),
-        refit: || materialx().params(),
-        measure: |p, r| {
+        reads: &[],
+        refit: |_| Ok(materialx().params()),
+        measure: |_, p, r| Ok({
             let (p, r) = (MaterialX::from_params(p), MaterialX::from_params(r));
             vec![pair_row("MaterialX mx_ggx_dir_albedo_analytic", Target::Alpha, |m, a| p.eval(m, a), |m, a| materialx_refit(&r, m, a))]
-        },
+        }),
         check: Some(|c| materialx_denominators_positive(&MaterialX::from_params(c)).map(|lower| vec![("denominator_lower_bound".to_string(), lower)])),
     },
     PublishedForm {
@@ -340,8 +344,9 @@ pub const FORMS_DEF: [PublishedForm; 5] = [
         domain: &[ETA],
         program: Some(|| &*KULLA_CONTY_FORM),
         published: || KULLA_CONTY.params(),
-        refit: || kulla_conty(&KULLA_CONTY).params(),
-        measure: |p, r| kulla_conty_rows(&KullaConty::from_params(p), &KullaConty::from_params(r)),
+        reads: &[],
+        refit: |_| Ok(kulla_conty(&KULLA_CONTY).params()),
+        measure: |_, p, r| Ok(kulla_conty_rows(&KullaConty::from_params(p), &KullaConty::from_params(r))),
         check: None,
     },
 ];
