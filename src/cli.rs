@@ -366,11 +366,11 @@ fn emit_data_fit(
     fitted: fit::Fit,
     as_json: bool,
 ) -> Result<()> {
-    let csv_bytes = std::fs::read(data_path).map_err(|err| input_err(format!("{}: {err}", data_path.display())))?;
+    let csv_bytes = spec::input::read_input(data_path).map_err(|err| input_err(format!("{}: {err}", data_path.display())))?;
     let model_text = if model_arg.trim_start().starts_with("rational(") {
         None
     } else {
-        Some(std::fs::read_to_string(model_arg).map_err(|err| input_err(format!("{model_arg}: {err}")))?)
+        Some(spec::input::read_input_text(Path::new(model_arg)).map_err(|err| input_err(format!("{model_arg}: {err}")))?)
     };
     // The default name: the CSV's stem as a module name (lowercase, other characters '_').
     let stem: String = data_path
@@ -430,7 +430,7 @@ fn load_model(arg: &str, x_cols: &[String]) -> Result<RationalModel> {
     if !path.is_file() {
         return Err(input_err(format!("--model '{arg}' is neither rational(m,n) nor a model spec file")));
     }
-    let text = std::fs::read_to_string(path).map_err(|e| input_err(format!("{}: {e}", path.display())))?;
+    let text = spec::input::read_input_text(path).map_err(|e| input_err(format!("{}: {e}", path.display())))?;
     let ms: ModelSpec = spec::parse_toml(path, &text).map_err(input_err)?;
     let features = ms.features.clone().unwrap_or_else(|| x_cols.to_vec());
     if features.len() != x_cols.len() {

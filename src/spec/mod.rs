@@ -37,6 +37,7 @@
 //! ```
 
 pub mod data;
+pub mod input;
 pub mod names;
 pub mod table;
 
@@ -64,6 +65,11 @@ pub struct SpecError {
 impl SpecError {
     pub fn new(file: &Path, line: usize, field: &str, msg: impl Into<String>) -> Self {
         SpecError { file: file.display().to_string(), line, field: field.into(), msg: msg.into() }
+    }
+
+    /// A file that [`input::read_input`] did not read (line 0, field `(file)`).
+    pub fn unreadable(file: &Path, e: input::ReadError) -> Self {
+        SpecError::new(file, 0, "(file)", e.to_string())
     }
 }
 
@@ -681,8 +687,7 @@ impl Spec {
     }
 
     pub fn load(path: &Path, catalog: &Catalog) -> Result<Spec, SpecError> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| SpecError::new(path, 0, "(file)", format!("cannot read: {e}")))?;
+        let text = input::read_input_text(path).map_err(|e| SpecError::unreadable(path, e))?;
         Spec::parse(path, text, catalog)
     }
 

@@ -74,7 +74,7 @@ pub fn parse(args: &[String]) -> Result<Options, CommandError> {
 /// A PNG's channels as values in [0, 1]: (width, height, channels, values).
 fn read_png(path: &Path, what: &str) -> Result<(u32, u32, usize, Vec<f64>), CommandError> {
     let bad = |field: &str, why: String| input(format!("{}: {field}: {why} ({what})", path.display()));
-    let file = std::fs::File::open(path).map_err(|e| bad("file", e.to_string()))?;
+    let (file, _) = crate::spec::input::open_regular(path).map_err(|e| bad("file", e.to_string()))?;
     let decoder = png::Decoder::new(std::io::BufReader::new(file));
     let mut reader = decoder.read_info().map_err(|e| bad("png", e.to_string()))?;
     let info = reader.info().clone();
