@@ -420,6 +420,15 @@ fn emit_data_fit(
 
 /// `rational(m,n)` (one feature, named by the x column) or a model TOML file.
 fn load_model(arg: &str, x_cols: &[String]) -> Result<RationalModel> {
+    // The columns are the model's features: each must be writable in its terms, and once.
+    for (i, c) in x_cols.iter().enumerate() {
+        if let Some(why) = fit::model::check_feature_name(c) {
+            return Err(input_err(format!("--x: column '{c}' {why}")));
+        }
+        if x_cols[..i].contains(c) {
+            return Err(input_err(format!("--x: column '{c}' is given twice")));
+        }
+    }
     if arg.trim_start().starts_with("rational(") {
         if x_cols.len() != 1 {
             return Err(input_err(format!("{arg} is one-dimensional but --x names {} columns", x_cols.len())));

@@ -178,6 +178,15 @@ impl ModelSpec {
         }
         let parts0 = ModelParts { inputs: inputs.clone(), derived: derived.clone(), ..ModelParts::default() };
         let features = parts0.features();
+        if let Err(e) = crate::fit::model::check_features(&features) {
+            // A derived feature is its own key; inputs are the model file's features or the axes.
+            let field = match &e {
+                ModelError::BadFeature { name, .. } if self.derived.contains_key(name) => name.clone(),
+                _ if self.features.is_some() => "features".to_string(),
+                _ => "axis".to_string(),
+            };
+            return Err(err(&field, e));
+        }
         let parse_all = |field: &str, list: &[String]| -> Result<Vec<Term>, SpecError> {
             list.iter().map(|s| Term::parse(s, &features).map_err(|e| err(field, e))).collect()
         };
