@@ -23,6 +23,12 @@ fn input_err(e: impl std::fmt::Display) -> anyhow::Error {
 
 pub use crate::build::Paths;
 
+/// The environment variables the library reads, checked before any command runs, so that a
+/// bad value is reported as itself rather than at the first spec it would change.
+pub fn check_environment() -> Result<()> {
+    spec::grid_budget().map(|_| ()).map_err(input_err)
+}
+
 /// `name=value` arguments as a map (each name once, each value a number).
 fn parse_params(params: &[String]) -> Result<BTreeMap<String, f64>> {
     let mut named = BTreeMap::new();
