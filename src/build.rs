@@ -421,7 +421,7 @@ struct ShardFile {
 
 fn read_shard(path: &Path) -> Result<ShardFile, Error> {
     let bad = |why: String| Error::Shard(format!("{}: {why}", path.display()));
-    let bytes = std::fs::read(path).map_err(|e| bad(e.to_string()))?;
+    let bytes = crate::spec::input::read_input(path).map_err(|e| bad(e.to_string()))?;
     let mut lines = bytes.splitn(3, |&b| b == b'\n');
     if lines.next() != Some(SHARD_MAGIC.as_bytes()) {
         return Err(bad(format!("not a shard file (line 1 is not '{SHARD_MAGIC}')")));

@@ -23,6 +23,12 @@ fn input_err(e: impl std::fmt::Display) -> anyhow::Error {
 
 pub use crate::build::Paths;
 
+/// The environment variables the library reads, checked before any command runs, so that a
+/// bad value is reported as itself rather than at the first spec it would change.
+pub fn check_environment() -> Result<()> {
+    spec::grid_budget().map(|_| ()).map_err(input_err)
+}
+
 /// `name=value` arguments as a map (each name once, each value a number).
 fn parse_params(params: &[String]) -> Result<BTreeMap<String, f64>> {
     let mut named = BTreeMap::new();
@@ -366,11 +372,11 @@ fn emit_data_fit(
     fitted: fit::Fit,
     as_json: bool,
 ) -> Result<()> {
-    let csv_bytes = std::fs::read(data_path).map_err(|err| input_err(format!("{}: {err}", data_path.display())))?;
+    let csv_bytes = spec::input::read_input(data_path).map_err(|err| input_err(format!("{}: {err}", data_path.display())))?;
     let model_text = if model_arg.trim_start().starts_with("rational(") {
         None
     } else {
-        Some(std::fs::read_to_string(model_arg).map_err(|err| input_err(format!("{model_arg}: {err}")))?)
+        Some(spec::input::read_input_text(Path::new(model_arg)).map_err(|err| input_err(format!("{model_arg}: {err}")))?)
     };
     // The default name: the CSV's stem as a module name (lowercase, other characters '_').
     let stem: String = data_path
@@ -420,6 +426,15 @@ fn emit_data_fit(
 
 /// `rational(m,n)` (one feature, named by the x column) or a model TOML file.
 fn load_model(arg: &str, x_cols: &[String]) -> Result<RationalModel> {
+    // The columns are the model's features: each must be writable in its terms, and once.
+    for (i, c) in x_cols.iter().enumerate() {
+        if let Some(why) = fit::model::check_feature_name(c) {
+            return Err(input_err(format!("--x: column '{c}' {why}")));
+        }
+        if x_cols[..i].contains(c) {
+            return Err(input_err(format!("--x: column '{c}' is given twice")));
+        }
+    }
     if arg.trim_start().starts_with("rational(") {
         if x_cols.len() != 1 {
             return Err(input_err(format!("{arg} is one-dimensional but --x names {} columns", x_cols.len())));
@@ -430,7 +445,7 @@ fn load_model(arg: &str, x_cols: &[String]) -> Result<RationalModel> {
     if !path.is_file() {
         return Err(input_err(format!("--model '{arg}' is neither rational(m,n) nor a model spec file")));
     }
-    let text = std::fs::read_to_string(path).map_err(|e| input_err(format!("{}: {e}", path.display())))?;
+    let text = spec::input::read_input_text(path).map_err(|e| input_err(format!("{}: {e}", path.display())))?;
     let ms: ModelSpec = spec::parse_toml(path, &text).map_err(input_err)?;
     let features = ms.features.clone().unwrap_or_else(|| x_cols.to_vec());
     if features.len() != x_cols.len() {

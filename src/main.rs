@@ -181,7 +181,7 @@ fn main() -> ExitCode {
     }
     let cli = Cli::parse();
     let paths = Paths { fits: cli.fits, generated: cli.generated };
-    let result = match cli.command {
+    let result = cli::check_environment().and_then(|()| match cli.command {
         Command::List => cli::list(&paths),
         Command::Family(args) => cli::family_command(&args),
         Command::Eval { quantity, params, json, profile: None, kernel: None } => cli::eval(&quantity, &params, json),
@@ -202,7 +202,7 @@ fn main() -> ExitCode {
         Command::Bench { quick, json, only, family, python, no_python } => {
             cli::bench(&paths, &cli::BenchArgs { quick, json, only, family, python, no_python })
         }
-    };
+    });
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {

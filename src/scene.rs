@@ -182,8 +182,7 @@ pub fn max_err(truth: &[f64], approx: &[f64]) -> f64 {
 impl Scene {
     /// Read and check a manifest; `features` are every feature the families offer.
     pub fn load(path: &Path, features: &[&'static Feature]) -> Result<Scene, SpecError> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| SpecError::new(path, 0, "(file)", format!("cannot read: {e}")))?;
+        let text = crate::spec::input::read_input_text(path).map_err(|e| SpecError::unreadable(path, e))?;
         let file: SceneFile = parse_toml(path, &text)?;
         let at = |field: &str, msg: String| SpecError::new(path, line_of(&text, field), field, msg);
         // Line of the n-th `[[material]]` block, for errors inside it.

@@ -32,10 +32,49 @@ pub struct Term {
     pub monomials: Vec<Monomial>,
 }
 
+/// The highest power of one feature in a monomial, as `rational(m,n)`'s highest degree: past it
+/// the powers' columns of the fit are numerically dependent on [0, 1] (the Hilbert-like
+/// matrix of degree 12 already has condition number ~1e16), and an unbounded power makes the
+/// positivity proof's interval powers and the emitted code's products grow without limit.
+pub const MAX_DEGREE: u32 = 12;
+
+/// Why `name` cannot name a feature in a model's terms (`None`: it can). Terms split on `+`,
+/// `*` and `^`, trim spaces and read `1` as the constant, so a name holding one of those, an
+/// empty name or one with surrounding spaces could never be written in a term.
+pub fn check_feature_name(name: &str) -> Option<String> {
+    let why = if name.is_empty() {
+        "is empty".to_string()
+    } else if name.trim() != name {
+        "has leading or trailing spaces".to_string()
+    } else if name == "1" {
+        "is the constant term '1'".to_string()
+    } else if let Some(c) = name.chars().find(|c| matches!(c, '+' | '*' | '^')) {
+        format!("holds '{c}', an operator of terms (+, *, ^)")
+    } else {
+        return None;
+    };
+    Some(format!("cannot name a feature of a model: it {why}"))
+}
+
+/// Every feature name writable in terms ([`check_feature_name`]) and none given twice.
+pub fn check_features(names: &[String]) -> Result<(), ModelError> {
+    for (i, name) in names.iter().enumerate() {
+        if let Some(why) = check_feature_name(name) {
+            return Err(ModelError::BadFeature { name: name.clone(), why });
+        }
+        if names[..i].contains(name) {
+            return Err(ModelError::BadFeature { name: name.clone(), why: "is given twice".into() });
+        }
+    }
+    Ok(())
+}
+
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum ModelError {
     #[error("term '{term}': {why}")]
     BadTerm { term: String, why: String },
+    #[error("feature '{name}' {why}")]
+    BadFeature { name: String, why: String },
     #[error("'{0}' is not a model form: expected rational(m,n) or a model spec file")]
     BadForm(String),
     #[error("coefficient '{0}' named in a constraint is not a term of the model")]
@@ -72,6 +111,13 @@ impl Term {
                     let i = features.iter().position(|f| f == name).ok_or_else(|| {
                         bad(format!("unknown feature '{name}' (features: {})", features.join(", ")))
                     })?;
+                    // Checked before the sum, so that no power overflows it.
+                    if power > MAX_DEGREE || exps[i] + power > MAX_DEGREE {
+                        return Err(bad(format!(
+                            "the power of '{name}' is {}, above the highest degree a model takes ({MAX_DEGREE})",
+                            u64::from(exps[i]) + u64::from(power)
+                        )));
+                    }
                     exps[i] += power;
                 }
             }
@@ -275,6 +321,8 @@ pub struct RationalModel {
 
 impl RationalModel {
     /// Plain 1-D rational(m, n) in feature `x`: numerator 1..x^m, denominator 1 + x..x^n.
+    /// The feature must pass [`check_feature_name`] and m, n ≤ [`MAX_DEGREE`] (as
+    /// [`RationalModel::parse_form`] checks).
     pub fn rational_1d(feature: &str, m: u32, n: u32) -> RationalModel {
         let features = vec![feature.to_string()];
         let power = |p: u32| match p {
@@ -298,9 +346,10 @@ impl RationalModel {
         let (m, n) = inner.split_once(',').ok_or_else(|| ModelError::BadForm(form.to_string()))?;
         let m: u32 = m.trim().parse().map_err(|_| ModelError::BadForm(form.to_string()))?;
         let n: u32 = n.trim().parse().map_err(|_| ModelError::BadForm(form.to_string()))?;
-        if m > 12 || n > 12 {
-            return Err(ModelError::BadForm(format!("{form} (degrees above 12 are not supported)")));
+        if m > MAX_DEGREE || n > MAX_DEGREE {
+            return Err(ModelError::BadForm(format!("{form} (degrees above {MAX_DEGREE} are not supported)")));
         }
+        check_features(&[feature.to_string()])?;
         Ok(RationalModel::rational_1d(feature, m, n))
     }
 
@@ -503,6 +552,37 @@ impl Basis {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Names that terms could never write are refused as features, naming why, and so is a
+    /// name given twice; ordinary column names (upper case, digits, spaces inside) pass and
+    /// parse back as their own monomial.
+    #[test]
+    fn features_must_be_writable_in_terms() {
+        for (bad, why) in [("", "is empty"), (" x", "spaces"), ("1", "constant"), ("x^2", "'^'"), ("a*b", "'*'"), ("a + b", "'+'")] {
+            let e = check_feature_name(bad).unwrap_or_else(|| panic!("{bad:?} passed"));
+            assert!(e.contains(why), "{bad:?}: {e}");
+            assert!(RationalModel::parse_form("rational(1,1)", bad).is_err(), "{bad:?}");
+        }
+        for good in ["x", "X", "2", "n dot v", "alpha_t"] {
+            assert_eq!(check_feature_name(good), None, "{good:?}");
+            let t = Term::parse(&format!("{good}^2"), &[good.to_string()]).unwrap();
+            assert_eq!(t.monomials, vec![Monomial { exps: vec![2] }], "{good:?}");
+        }
+        let twice = check_features(&["a".into(), "b".into(), "a".into()]).unwrap_err().to_string();
+        assert_eq!(twice, "feature 'a' is given twice");
+    }
+
+    /// A feature's power in a monomial is at most MAX_DEGREE, written at once or as a product
+    /// (so no sum of powers overflows); MAX_DEGREE itself parses.
+    #[test]
+    fn powers_above_the_highest_degree_are_refused() {
+        let f = vec!["x".to_string(), "y".to_string()];
+        assert_eq!(Term::parse("x^12*y^12", &f).unwrap().monomials[0].exps, vec![12, 12]);
+        for bad in ["x^13", "x^99999", "x^4294967295", "x^12*x", "x^7*y*x^6", "x^4294967295*x^4294967295"] {
+            let e = Term::parse(bad, &f).unwrap_err().to_string();
+            assert!(e.contains("above the highest degree a model takes (12)"), "{bad}: {e}");
+        }
+    }
 
     /// offset + scale·x, on values exact in binary (so the expected sums are exact in f64 and
     /// f32 alike); and for scales ±1, the bits of the emitted forms `offset + x` and

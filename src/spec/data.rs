@@ -4,18 +4,27 @@ use super::SpecError;
 use crate::fit::Data;
 use std::path::Path;
 
-/// Read columns `x_cols` (features, in order) and `y_col` from a CSV file with a header.
-/// Every cell must be a finite number; errors name the file, the line and the column.
+/// Read columns `x_cols` (features, in order) and `y_col` from a CSV file with a header (read
+/// through `input::read_input`: a regular file within its byte limit). Every cell must be a
+/// finite number, and no two columns may share a header; errors name the file, the line and
+/// the column.
 pub fn read_csv(path: &Path, x_cols: &[String], y_col: &str) -> Result<Data, SpecError> {
-    let mut rdr = csv::ReaderBuilder::new()
-        .trim(csv::Trim::All)
-        .comment(Some(b'#'))
-        .from_path(path)
-        .map_err(|e| SpecError::new(path, 0, "(file)", format!("cannot read: {e}")))?;
+    let bytes = super::input::read_input(path).map_err(|e| SpecError::unreadable(path, e))?;
+    let mut rdr = csv::ReaderBuilder::new().trim(csv::Trim::All).comment(Some(b'#')).from_reader(&bytes[..]);
     let headers = rdr
         .headers()
         .map_err(|e| SpecError::new(path, 1, "(header)", e.to_string()))?
         .clone();
+    for (i, h) in headers.iter().enumerate() {
+        if let Some(j) = headers.iter().take(i).position(|g| g == h) {
+            return Err(SpecError::new(
+                path,
+                1,
+                h,
+                format!("the header '{h}' names columns {} and {}; each column needs a name of its own", j + 1, i + 1),
+            ));
+        }
+    }
     let find = |name: &str| {
         headers.iter().position(|h| h == name).ok_or_else(|| {
             SpecError::new(

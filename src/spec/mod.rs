@@ -37,6 +37,7 @@
 //! ```
 
 pub mod data;
+pub mod input;
 pub mod names;
 pub mod table;
 
@@ -64,6 +65,11 @@ pub struct SpecError {
 impl SpecError {
     pub fn new(file: &Path, line: usize, field: &str, msg: impl Into<String>) -> Self {
         SpecError { file: file.display().to_string(), line, field: field.into(), msg: msg.into() }
+    }
+
+    /// A file that [`input::read_input`] did not read (line 0, field `(file)`).
+    pub fn unreadable(file: &Path, e: input::ReadError) -> Self {
+        SpecError::new(file, 0, "(file)", e.to_string())
     }
 }
 
@@ -172,6 +178,15 @@ impl ModelSpec {
         }
         let parts0 = ModelParts { inputs: inputs.clone(), derived: derived.clone(), ..ModelParts::default() };
         let features = parts0.features();
+        if let Err(e) = crate::fit::model::check_features(&features) {
+            // A derived feature is its own key; inputs are the model file's features or the axes.
+            let field = match &e {
+                ModelError::BadFeature { name, .. } if self.derived.contains_key(name) => name.clone(),
+                _ if self.features.is_some() => "features".to_string(),
+                _ => "axis".to_string(),
+            };
+            return Err(err(&field, e));
+        }
         let parse_all = |field: &str, list: &[String]| -> Result<Vec<Term>, SpecError> {
             list.iter().map(|s| Term::parse(s, &features).map_err(|e| err(field, e))).collect()
         };
@@ -467,9 +482,29 @@ pub const GRID_BUDGET_VAR: &str = "SHADEFIT_GRID_BUDGET";
 /// one integral; the bundled specs' largest grid has about 10⁶).
 pub const DEFAULT_GRID_BUDGET: usize = 50_000_000;
 
-/// The grid budget: [`GRID_BUDGET_VAR`] when set to a whole number, else the default.
-pub fn grid_budget() -> usize {
-    std::env::var(GRID_BUDGET_VAR).ok().and_then(|v| v.trim().parse().ok()).unwrap_or(DEFAULT_GRID_BUDGET)
+/// The values [`GRID_BUDGET_VAR`] may take: from 2 (the smallest grid: one axis of the smallest
+/// count) to 10⁹ points (their values alone are 8 GB of f64).
+pub const GRID_BUDGET_RANGE: [usize; 2] = [2, 1_000_000_000];
+
+/// The grid budget: [`DEFAULT_GRID_BUDGET`] unless [`GRID_BUDGET_VAR`] is set, then its value,
+/// which must be a whole number in [`GRID_BUDGET_RANGE`] (the error names the variable).
+pub fn grid_budget() -> Result<usize, String> {
+    match std::env::var(GRID_BUDGET_VAR) {
+        Err(std::env::VarError::NotPresent) => Ok(DEFAULT_GRID_BUDGET),
+        Err(std::env::VarError::NotUnicode(v)) => Err(grid_budget_error(&v.to_string_lossy())),
+        Ok(v) => parse_grid_budget(&v),
+    }
+}
+
+/// A value of [`GRID_BUDGET_VAR`] read as [`grid_budget`] reads it.
+pub fn parse_grid_budget(v: &str) -> Result<usize, String> {
+    let [lo, hi] = GRID_BUDGET_RANGE;
+    v.trim().parse::<usize>().ok().filter(|n| (lo..=hi).contains(n)).ok_or_else(|| grid_budget_error(v))
+}
+
+fn grid_budget_error(v: &str) -> String {
+    let [lo, hi] = GRID_BUDGET_RANGE;
+    format!("{GRID_BUDGET_VAR}='{v}': must be a whole number of grid points in [{lo}, {hi}] (unset: {DEFAULT_GRID_BUDGET})")
 }
 
 #[derive(Debug, Clone, Deserialize, PartialEq)]
@@ -681,8 +716,7 @@ impl Spec {
     }
 
     pub fn load(path: &Path, catalog: &Catalog) -> Result<Spec, SpecError> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| SpecError::new(path, 0, "(file)", format!("cannot read: {e}")))?;
+        let text = input::read_input_text(path).map_err(|e| SpecError::unreadable(path, e))?;
         Spec::parse(path, text, catalog)
     }
 
@@ -825,7 +859,7 @@ impl Spec {
             ("count", "sampling", file.axis.iter().map(|a| a.count).collect::<Vec<_>>()),
             ("verify", "verification", file.axis.iter().map(|a| a.verify_count()).collect()),
         ] {
-            let budget = grid_budget();
+            let budget = grid_budget().map_err(|why| SpecError::new(path, 0, GRID_BUDGET_VAR, why))?;
             let points = counts.iter().try_fold(1usize, |acc, &n| acc.checked_mul(n));
             if points.is_none_or(|p| p > budget) {
                 let shown = points.map_or_else(|| "more than 2^64".to_string(), |p| p.to_string());
@@ -1007,4 +1041,22 @@ pub fn load_dir(dir: &Path, catalog: &Catalog) -> Result<Vec<Spec>, SpecError> {
         .collect();
     paths.sort();
     paths.iter().map(|p| Spec::load(p, catalog)).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The grid budget's variable takes whole numbers in its range only; anything else is an
+    /// error naming the variable, the value and the range (the process's environment is not
+    /// touched: tests run in parallel).
+    #[test]
+    fn the_grid_budget_takes_whole_numbers_in_its_range() {
+        assert_eq!(parse_grid_budget("2"), Ok(2));
+        assert_eq!(parse_grid_budget(" 1000000000 "), Ok(1_000_000_000));
+        for bad in ["abc", "-1", "1e30", "0", "1", "1000000001", "", "2.5", "99999999999999999999999"] {
+            let e = parse_grid_budget(bad).unwrap_err();
+            assert!(e.starts_with(&format!("{GRID_BUDGET_VAR}='{bad}': ")) && e.contains("[2, 1000000000]"), "{bad}: {e}");
+        }
+    }
 }

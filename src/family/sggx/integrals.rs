@@ -93,11 +93,28 @@ impl Aniso {
     }
 }
 
-/// The slide's M_n: the rotation about k × n taking k = (0, 0, 1) onto n = (x, y, z), z > −1.
+/// The slide's M_n: the rotation about k × n taking k = (0, 0, 1) onto the unit n = (x, y, z),
+/// for every n on the sphere.
+///
+/// The slide writes its entries with r = 1/(1 + z), which loses every digit as n → −k (1 + z
+/// cancels; at z = −1 it divides by zero). On the unit sphere 1 + z = (x² + y²)/(1 − z), so for
+/// z < 0 the same entries are written with the azimuth (c, s) = (x, y)/ρ, ρ = √(x² + y²):
+/// y² r = (1 − z) s², x y r = (1 − z) c s, x² r = (1 − z) c², each bounded by 2 and accurate to
+/// a few ulps. At n = −k itself (ρ = 0) the axis k × n is undefined; the limit along φ = 0 is
+/// taken (c, s) = (1, 0): the half turn about y, diag(−1, 1, −1). For z ≥ 0 the slide's
+/// arithmetic is kept as it is.
 pub fn rotation_to(n: V3) -> M3 {
     let (x, y, z) = (n.x, n.y, n.z);
-    let r = 1.0 / (1.0 + z);
-    M3::new(z + y * y * r, -x * y * r, x, -x * y * r, z + x * x * r, y, -x, -y, z)
+    let (yy, xy, xx) = if z >= 0.0 {
+        let r = 1.0 / (1.0 + z);
+        (y * y * r, x * y * r, x * x * r)
+    } else {
+        let rho = x.hypot(y);
+        let (c, s) = if rho > 0.0 { (x / rho, y / rho) } else { (1.0, 0.0) };
+        let w = 1.0 - z;
+        (w * s * s, w * c * s, w * c * c)
+    };
+    M3::new(z + yy, -xy, x, -xy, z + xx, y, -x, -y, z)
 }
 
 /// S = M_n [[B, 0], [0, 1]] M_nᵀ.
@@ -214,6 +231,33 @@ mod tests {
             assert!((m.determinant() - 1.0).abs() < 1e-14);
             assert!((m * V3::z() - n).amax() < 1e-15);
         }
+    }
+
+    /// Over the whole sphere, the south pole and its neighbourhood included (where the slide's
+    /// 1/(1 + z) loses every digit): orthonormal, proper, k onto n, and a rotation about k × n
+    /// (the axis is fixed). 4e-15: entries bounded by 2, each a few roundings; the axis is
+    /// normalised from a cross product whose length is sin θ ≥ 1e-9 / 2 here.
+    #[test]
+    fn rotation_is_exact_at_every_polar_angle_up_to_the_south_pole() {
+        let mut thetas: Vec<f64> = (0..=64).map(|i| PI * i as f64 / 64.0).collect();
+        thetas.extend([PI / 2.0 + 1e-12, PI - 1e-3, PI - 1e-6, PI - 1e-9, PI - 5e-10, 3.1415926, 3.14159265]);
+        for &t in &thetas {
+            for p in [0.0, 0.7, -2.5, PI] {
+                let n = direction(t, p);
+                let m = rotation_to(n);
+                assert!((m * m.transpose() - M3::identity()).amax() < 4e-15, "θ {t}, φ {p}: {m}");
+                assert!((m.determinant() - 1.0).abs() < 4e-15, "θ {t}, φ {p}");
+                assert!((m * V3::z() - n).amax() < 4e-15, "θ {t}, φ {p}");
+                let axis = V3::z().cross(&n);
+                if axis.norm() > 1e-10 {
+                    let u = axis / axis.norm();
+                    assert!((m * u - u).amax() < 4e-15, "θ {t}, φ {p}: axis");
+                }
+            }
+        }
+        // n = −k exactly: the half turn about y (the limit along φ = 0).
+        let m = rotation_to(V3::new(0.0, 0.0, -1.0));
+        assert_eq!(m, M3::new(-1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, -1.0));
     }
 
     #[test]

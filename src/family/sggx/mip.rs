@@ -1,9 +1,11 @@
 //! `shadefit aniso-mip`: the mip chain of a normal map and an aniso map by SGGX filtering.
 //!
-//! Inputs: a tangent-space normal map (PNG, RGB or RGBA, 8 or 16 bits; n = normalize(2c − 1),
-//! z clamped to ≥ 1e-3) and an aniso map in the course's encoding (PNG, RGB or RGBA, 8 or 16
+//! Inputs: a tangent-space normal map (PNG, RGB or RGBA, 8 or 16 bits; n = normalize(2c − 1);
+//! a normal with z ≤ 0, at or below the surface, is refused naming its pixel, and z is clamped
+//! to ≥ 1e-3) and an aniso map in the course's encoding (PNG, RGB or RGBA, 8 or 16
 //! bits: [√Sxx, ½ Sxy/√(Sxx Syy) + ½, √Syy], decoded as `DecodeSggx` does, so α ≥ α_min), of the
-//! same size. Every texel becomes S = M_n [[B, 0], [0, 1]] M_nᵀ; each level's S is the mean of
+//! same size, at most [`MAX_SIDE`] texels a side (checked on the PNG header, before the image
+//! is decoded). Every texel becomes S = M_n [[B, 0], [0, 1]] M_nᵀ; each level's S is the mean of
 //! a `footprint` × `footprint` box of the previous level's (2: the 2×2 children; 4: those and
 //! a ring around them, edges clamped); n′ by power iteration, the block normalised, encoded.
 //!
@@ -25,7 +27,13 @@ pub const COMMAND: FamilyCommand = FamilyCommand {
 };
 
 const USAGE: &str = "usage: shadefit aniso-mip --normal NORMAL.png --aniso ANISO.png --out PREFIX [--bits 8|16] [--footprint 2|4]
-  writes PREFIX.normal.ktx2 (RG UNORM) and PREFIX.aniso.ktx2 (RGBA UNORM), every mip level";
+  writes PREFIX.normal.ktx2 (RG UNORM) and PREFIX.aniso.ktx2 (RGBA UNORM), every mip level;
+  the maps: RGB or RGBA PNGs of one size, at most 8192 texels a side; normals with z > 0";
+
+/// The most texels a side of an input map may have: WebGPU's default `maxTextureDimension2D`
+/// (8192), the largest texture the emitted chains are sure to load. A map that size takes
+/// about 8 GB here (an SGGX matrix and the samples in f64 per texel).
+pub const MAX_SIDE: u32 = 8192;
 
 /// Options of one run.
 #[derive(Debug, Clone)]
@@ -74,10 +82,14 @@ pub fn parse(args: &[String]) -> Result<Options, CommandError> {
 /// A PNG's channels as values in [0, 1]: (width, height, channels, values).
 fn read_png(path: &Path, what: &str) -> Result<(u32, u32, usize, Vec<f64>), CommandError> {
     let bad = |field: &str, why: String| input(format!("{}: {field}: {why} ({what})", path.display()));
-    let file = std::fs::File::open(path).map_err(|e| bad("file", e.to_string()))?;
+    let (file, _) = crate::spec::input::open_regular(path).map_err(|e| bad("file", e.to_string()))?;
     let decoder = png::Decoder::new(std::io::BufReader::new(file));
     let mut reader = decoder.read_info().map_err(|e| bad("png", e.to_string()))?;
     let info = reader.info().clone();
+    if info.width > MAX_SIDE || info.height > MAX_SIDE {
+        let why = format!("{}×{} texels; each side must be at most {MAX_SIDE}", info.width, info.height);
+        return Err(bad("size", why));
+    }
     let channels = match info.color_type {
         png::ColorType::Rgb => 3,
         png::ColorType::Rgba => 4,
@@ -166,7 +178,14 @@ pub fn mip_chain(width: u32, height: u32, s0: Vec<M3>, bits: u32, footprint: usi
     (normal, aniso, report)
 }
 
-/// The texels' SGGX matrices from the two maps' values.
+/// The first texel (x, y) of a `width`-wide normal map whose normal has z ≤ 0 (at or below the
+/// surface, which a tangent-space normal cannot be), with its z.
+pub fn first_downward(normal: &[f64], nc: usize, width: u32) -> Option<((usize, usize), f64)> {
+    let w = width as usize;
+    normal.chunks_exact(nc).map(|c| 2.0 * c[2] - 1.0).enumerate().find(|&(_, z)| !(z > 0.0)).map(|(i, z)| ((i % w, i / w), z))
+}
+
+/// The texels' SGGX matrices from the two maps' values (normals with z > 0: [`first_downward`]).
 pub fn texels(normal: &[f64], nc: usize, aniso: &[f64], ac: usize, count: usize) -> Vec<M3> {
     (0..count)
         .into_par_iter()
@@ -220,6 +239,18 @@ pub fn run(args: &[String]) -> Result<String, CommandError> {
         }
     };
     let bar = if total >= 1 << 20 { indicatif::ProgressBar::new(total) } else { indicatif::ProgressBar::hidden() };
+    if let Some(((x, y), z)) = first_downward(&nv, nc, w) {
+        let c = &nv[(y * w as usize + x) * nc..][..3];
+        let n = [c[0], c[1], c[2]].map(|v| 2.0 * v - 1.0);
+        return Err(input(format!(
+            "{}: pixel ({x}, {y}): the normal ({:.4}, {:.4}, {:.4}) has z = {z:.4} ≤ 0, at or below the surface; \
+             a tangent-space normal map needs z > 0 (normal map)",
+            o.normal.display(),
+            n[0],
+            n[1],
+            n[2]
+        )));
+    }
     let s0 = texels(&nv, nc, &avals, ac, (w * h) as usize);
     let (normal, aniso, r) = mip_chain(w, h, s0, o.bits, o.footprint, &|n| bar.inc(n));
     bar.finish_and_clear();
@@ -262,6 +293,24 @@ mod tests {
         assert!((s[1].trace() - 1.65).abs() < 1e-12, "{}", s[1]);
     }
     use crate::family::sggx::integrals::{Aniso, direction, sggx_from};
+
+    /// A normal at or below the surface is found at its pixel: in a 2-wide RGB map, (0, 1)
+    /// holds the 8-bit codes (128, 128, 0), z = −1, and (1, 1) (200, 128, 30); an 8-bit code
+    /// cannot give z = 0 exactly (2c/255 − 1 = 0 needs c = 127.5), so 127 is the largest below
+    /// the surface and 128 the smallest above it. The help names the size limit.
+    #[test]
+    fn normals_at_or_below_the_surface_are_found_at_their_pixel() {
+        let map = |codes: &[[u8; 3]]| codes.iter().flatten().map(|&c| c as f64 / 255.0).collect::<Vec<_>>();
+        let up = [128, 128, 255];
+        assert_eq!(first_downward(&map(&[up, up, up, up]), 3, 2), None);
+        assert_eq!(first_downward(&map(&[up, up, [128, 128, 128], up]), 3, 2), None);
+        let (at, z) = first_downward(&map(&[up, up, [128, 128, 0], [200, 128, 30]]), 3, 2).unwrap();
+        assert_eq!((at, z), ((0, 1), -1.0));
+        let (at, z) = first_downward(&map(&[up, up, up, [200, 128, 127]]), 3, 2).unwrap();
+        assert_eq!(at, (1, 1));
+        assert!(z < 0.0 && z > -0.004, "{z}");
+        assert!(USAGE.contains(&format!("at most {MAX_SIDE} texels a side")));
+    }
 
     /// A PNG written here with the png crate: `data` is its samples in row order (big-endian
     /// pairs at 16 bits).

@@ -150,3 +150,43 @@ pub static FAMILY: Family = Family {
     axis_mappings: &[],
     forms: &[],
 };
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `sggx-projected-area` of an isotropic α = 1 texel is 1 along every ω: its block is the
+    /// identity, so S = M_n I M_nᵀ = I and σ(ω) = √(ωᵀ S ω) = 1 (the module's closed form);
+    /// equivalently D = 1/π on the sphere and ∫ ⟨ω, m⟩₊ / π dm = 1. Swept over θ_w ∈ [0, π]
+    /// with π itself and points within 1e-9 of it (the quadrature's frame about ω is M_ω, the
+    /// rotation onto ω, once unstable there), at `eval`'s tolerance 1e-12. 1e-12: that
+    /// tolerance; the integrand is constant, so the rule is exact to the roundings of D.
+    #[test]
+    fn an_isotropic_unit_texel_has_unit_projected_area_along_every_direction() {
+        let mut thetas: Vec<f64> = (0..=32).map(|i| PI * i as f64 / 32.0).collect();
+        thetas.extend([PI - 1e-6, PI - 1e-9, PI - 2e-10, 3.1415926, 3.14159265, PI]);
+        for (theta, phi) in [(0.0, 0.0), (0.9, 2.0)] {
+            for &tw in &thetas {
+                for pw in [0.0, 1.3] {
+                    let e = projected_area(&[theta, phi, 1.0, 1.0, 0.0, tw, pw], 1e-12);
+                    assert!((e.value - 1.0).abs() <= 1e-12, "n ({theta}, {phi}), θ_w {tw}, φ_w {pw}: {}", e.value);
+                }
+            }
+        }
+    }
+
+    /// An anisotropic tilted texel against its closed form √(ωᵀ S ω) as ω nears and reaches
+    /// −k: 1e-9 relative, the quadrature run at 1e-10 (the nested rule's estimate bounds its
+    /// error at that tolerance; a tenth of the margin is left for the estimate's own slack).
+    #[test]
+    fn the_projected_area_matches_its_closed_form_near_the_south_pole() {
+        let s = sggx_from(direction(0.4, 1.0), Aniso::from_alphas(0.5, 0.2, 0.3));
+        let lobe = Lobe::new(s).unwrap();
+        for tw in [PI - 1e-3, PI - 1e-9, PI] {
+            let w = direction(tw, 0.5);
+            let q = projected_area_quadrature(&lobe, w, 1e-10).value;
+            let exact = lobe.projected_area(&w);
+            assert!((q / exact - 1.0).abs() <= 1e-9, "θ_w {tw}: {q} vs {exact}");
+        }
+    }
+}

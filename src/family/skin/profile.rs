@@ -165,8 +165,8 @@ impl ProfileSection {
             } else {
                 file.parent().unwrap_or(Path::new("")).join(rel)
             };
-            let bytes = std::fs::read(&path).map_err(|e| {
-                SpecError::new(file, line, "profile.csv", format!("cannot read {}: {e}", path.display()))
+            let bytes = crate::spec::input::read_input(&path).map_err(|e| {
+                SpecError::new(file, line, "profile.csv", format!("{}: {e}", path.display()))
             })?;
             let profile = read_profile_csv(&path, &bytes)?;
             return Ok(LoadedProfile { profile, source: ProfileSource::Csv { written, path, bytes } });
@@ -284,7 +284,7 @@ pub fn read_profile_csv(path: &Path, bytes: &[u8]) -> Result<Profile, SpecError>
 /// A profile file for `shadefit eval --profile`: a TOML file with a `[profile]` section, or a
 /// CSV radial profile (by extension `.csv`).
 pub fn load_profile_file(path: &Path) -> Result<LoadedProfile, SpecError> {
-    let bytes = std::fs::read(path).map_err(|e| SpecError::new(path, 0, "(file)", format!("cannot read: {e}")))?;
+    let bytes = crate::spec::input::read_input(path).map_err(|e| SpecError::unreadable(path, e))?;
     if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("csv")) {
         let profile = read_profile_csv(path, &bytes)?;
         let written = path.display().to_string();
