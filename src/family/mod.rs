@@ -178,11 +178,10 @@ pub fn reads(spec: &Spec) -> Vec<&'static str> {
     }
 }
 
-/// The committed constants of `form` in the refit spec `spec` (generated/json/SPEC.json under
-/// `generated`, checked against fits/SPEC.toml): how a family's audit, figures and benchmarks
-/// read a refit.
-pub fn committed_refit(generated: &Path, spec: &str, form: &str) -> Result<Vec<f64>, BuildError> {
-    pipeline::refit::committed_constants(generated, spec, form, catalog(), published_forms())
+/// The committed refits of the refit spec `spec` (generated/json/SPEC.json under `generated`,
+/// checked against fits/SPEC.toml): how a family's audit, figures and benchmarks read a refit.
+pub fn committed_refits(generated: &Path, spec: &str) -> Result<pipeline::refit::CommittedRefits, BuildError> {
+    pipeline::refit::CommittedRefits::load(generated, spec, catalog(), published_forms())
 }
 
 /// The family that serves quantity `name`.

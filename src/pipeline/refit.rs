@@ -6,7 +6,7 @@
 //! with `json/NAME.json`, which commits the constants (f64 as refitted; the code carries them
 //! as f32) and the errors. `Mode::Committed` re-renders from that JSON. Everything else that
 //! uses a refit — `validate`, figures, benchmarks — reads its constants through
-//! [`committed_constants`], never a copy.
+//! [`CommittedRefits`], never a copy.
 //!
 //! The input hash covers the generator, the spec text and each named form's identity (name,
 //! arguments, domain, published constants, program): a changed form makes `build --check`
@@ -179,29 +179,45 @@ fn read_hash(spec: &Spec, name: &str) -> String {
         .unwrap_or_else(|| "missing".into())
 }
 
-/// The committed functions of a refit spec, checked against its input hash and its forms.
-fn committed(spec: &Spec, root: &Path, registry: &[&PublishedForm]) -> Result<Vec<CommittedForm>, BuildError> {
+/// The committed functions of a refit spec whose input hash is `hash`, checked against it and
+/// against the spec's `forms`.
+fn committed(spec: &Spec, root: &Path, hash: &str, forms: &[&PublishedForm]) -> Result<Vec<CommittedForm>, BuildError> {
     let name = &spec.file.name;
     let bad = |why: String| BuildError::NoCommitted { spec: name.clone(), why };
-    let v = committed_json_with_hash(root, spec, &input_hash(spec, registry))?;
+    let v = committed_json_with_hash(root, spec, hash)?;
     let functions: Vec<CommittedForm> = serde_json::from_value(v["functions"].clone()).map_err(|e| bad(format!("\"functions\": {e}")))?;
-    let (_, forms) = forms(spec, registry)?;
-    if functions.len() != forms.len() || functions.iter().zip(&forms).any(|(c, f)| c.form != f.name || c.constants.len() != (f.published)().len()) {
+    if functions.len() != forms.len() || functions.iter().zip(forms).any(|(c, f)| c.form != f.name || c.constants.len() != (f.published)().len()) {
         return Err(bad("its functions are not the spec's forms".into()));
     }
     Ok(functions)
 }
 
-/// The committed constants of `form` in the refit spec `name` (`fits/NAME.toml` beside
-/// `generated`, `generated/json/NAME.json`), checked against the spec's input hash: what every
-/// use of a refit outside its own module reads.
-pub fn committed_constants(generated: &Path, name: &str, form: &str, catalog: &Catalog, registry: &[&PublishedForm]) -> Result<Vec<f64>, BuildError> {
-    let spec = super::committed::load_spec(generated, name, catalog)?;
-    committed(&spec, generated, registry)?
-        .into_iter()
-        .find(|c| c.form == form)
-        .map(|c| c.constants)
-        .ok_or_else(|| BuildError::NoCommitted { spec: name.into(), why: format!("it does not refit '{form}'") })
+/// The committed refits of one refit spec, read once: what every use of a refit outside its
+/// own module reads.
+#[derive(Debug, Clone)]
+pub struct CommittedRefits {
+    spec: String,
+    forms: Vec<CommittedForm>,
+}
+
+impl CommittedRefits {
+    /// The refit spec `name` (`fits/NAME.toml` beside `generated`) and its committed
+    /// `generated/json/NAME.json`, checked against the spec's input hash.
+    pub fn load(generated: &Path, name: &str, catalog: &Catalog, registry: &[&PublishedForm]) -> Result<CommittedRefits, BuildError> {
+        let spec = super::committed::load_spec(generated, name, catalog)?;
+        let (_, forms) = forms(&spec, registry)?;
+        let forms = committed(&spec, generated, &input_hash(&spec, registry), &forms)?;
+        Ok(CommittedRefits { spec: name.into(), forms })
+    }
+
+    /// The committed constants of `form`.
+    pub fn constants(&self, form: &str) -> Result<Vec<f64>, BuildError> {
+        self.forms
+            .iter()
+            .find(|c| c.form == form)
+            .map(|c| c.constants.clone())
+            .ok_or_else(|| BuildError::NoCommitted { spec: self.spec.clone(), why: format!("it does not refit '{form}'") })
+    }
 }
 
 /// Refit and measure one form (the committed outputs it reads are in `root`).
@@ -220,7 +236,7 @@ pub fn build(spec: &Spec, mode: Mode, root: &Path, registry: &[&PublishedForm]) 
     let (file, forms) = forms(spec, registry)?;
     let mut functions = match mode {
         Mode::Fit => forms.par_iter().map(|f| refit(&name, &prefix, f, root)).collect::<Result<Vec<_>, _>>()?,
-        Mode::Committed => committed(spec, root, registry)?,
+        Mode::Committed => committed(spec, root, &hash, &forms)?,
     };
     for (c, f) in functions.iter_mut().zip(&forms) {
         if let Some(check) = f.check {
@@ -366,7 +382,7 @@ mod tests {
     /// Fit mode commits the refit's constants bit for bit, the errors its measure gives for the
     /// published and the f32-rounded refitted constants, and a WGSL/Rust function of the form
     /// with those f32 constants and the domain's clamp; Committed mode re-renders every file
-    /// byte for byte from the JSON; `committed_constants` reads the constants back through the
+    /// byte for byte from the JSON; `CommittedRefits` reads the constants back through the
     /// spec beside the folder. A JSON whose constants are not the spec's forms' is refused, and
     /// so is a refit that fails its form's check.
     #[test]
@@ -399,8 +415,9 @@ mod tests {
             assert_eq!(a.contents, b.contents, "{}", a.path.display());
         }
         let cat = catalog();
-        assert_eq!(committed_constants(&generated, "line_refits", "test-chord", &cat, &registry).unwrap(), chord);
-        assert!(committed_constants(&generated, "line_refits", "test-refused", &cat, &registry).is_err());
+        let refits = CommittedRefits::load(&generated, "line_refits", &cat, &registry).unwrap();
+        assert_eq!(refits.constants("test-chord").unwrap(), chord);
+        assert!(refits.constants("test-refused").is_err());
         // Tampered: one constant too many.
         let path = generated.join("json/line_refits.json");
         let mut v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();

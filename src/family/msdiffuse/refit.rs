@@ -21,8 +21,7 @@ pub const RATIONAL_NAME: &str = "ms-diffuse-rational";
 
 /// The committed refit in `generated`: numerator and denominator (constant 1 first).
 pub fn committed(generated: &Path) -> Result<([f64; 8], [f64; 8]), BuildError> {
-    let c = crate::family::committed_refit(generated, SPEC, RATIONAL_NAME)?;
-    Ok((std::array::from_fn(|j| c[j]), std::array::from_fn(|j| c[8 + j])))
+    Ok(halves(&crate::family::committed_refits(generated, SPEC)?.constants(RATIONAL_NAME)?))
 }
 
 /// The monomials of [`super::published::TERMS`] over (x, y) = (n·h, l·h): 1, x, y, x², y², xy, x³, y³.

@@ -37,7 +37,8 @@ pub struct Refits {
 impl Refits {
     /// The refits committed in `generated` (checked against their spec).
     pub fn committed(generated: &Path) -> Result<Refits, BuildError> {
-        let c = |form: &str| crate::family::committed_refit(generated, SPEC, form);
+        let refits = crate::family::committed_refits(generated, SPEC)?;
+        let c = |form: &str| refits.constants(form);
         let (l, j, m) = (c(LAGARDE_NAME)?, c(JIMENEZ_NAME)?, c(MULTIBOUNCE_NAME)?);
         Ok(Refits { lagarde: [l[0], l[1]], jimenez: j[0], multibounce: std::array::from_fn(|i| m[i]) })
     }
@@ -88,7 +89,7 @@ pub const FORMS_DEF: [PublishedForm; 3] = [
         program: Some(|| &*LAGARDE_FORM),
         published: || LAGARDE.to_vec(),
         reads: &[],
-        refit: |_| Ok(super::refits().0.to_vec()),
+        refit: |_| Ok(super::validation::lagarde_refit().to_vec()),
         measure: |_, p, r| Ok({
             let (p, r) = ([p[0], p[1]], [r[0], r[1]]);
             vec![so_row("Lagarde & de Rousiers 2014", |rr, mu, v| lagarde_with(p, mu, v, rr * rr), |rr, mu, v| lagarde_with(r, mu, v, rr * rr))]
@@ -104,7 +105,7 @@ pub const FORMS_DEF: [PublishedForm; 3] = [
         program: None,
         published: || vec![JIMENEZ],
         reads: &[],
-        refit: |_| Ok(vec![super::refits().1]),
+        refit: |_| Ok(vec![super::validation::jimenez_refit()]),
         measure: |_, p, r| Ok({
             let (p, r) = (p[0], r[0]);
             vec![so_row("Jimenez et al. 2016 cone–cone", |rr, mu, v| jimenez_with(p, mu, v, rr), |rr, mu, v| jimenez_with(r, mu, v, rr))]

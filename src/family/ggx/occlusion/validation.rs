@@ -60,11 +60,21 @@ fn rms_error(pts: &[[f64; 3]], refs: &[[f64; 4]], so: impl Fn(f64, f64, f64) -> 
 /// gives SO ≈ 0) and every (a, b) returns ≈ 1 there (the form tends to 1 as V → 1), so its
 /// constants are fitted for the least rms instead.
 pub fn refits() -> ([f64; 2], f64) {
-    use crate::fit::simplex::nelder_mead;
+    (lagarde_refit(), jimenez_refit())
+}
+
+/// Lagarde's (a, b) of [`refits`] (least rms).
+pub(super) fn lagarde_refit() -> [f64; 2] {
     let (pts, refs) = validation_grid();
-    let (l, _) = nelder_mead(|p| rms_error(pts, refs, |r, mu, v| lagarde_with([p[0], p[1]], mu, v, r * r)), &LAGARDE);
-    let (j, _) = nelder_mead(|p| max_error(pts, refs, |r, mu, v| jimenez_with(p[0], mu, v, r)), &[JIMENEZ]);
-    ([l[0], l[1]], j[0])
+    let (l, _) = crate::fit::simplex::nelder_mead(|p| rms_error(pts, refs, |r, mu, v| lagarde_with([p[0], p[1]], mu, v, r * r)), &LAGARDE);
+    [l[0], l[1]]
+}
+
+/// Jimenez's k of [`refits`] (minimax).
+pub(super) fn jimenez_refit() -> f64 {
+    let (pts, refs) = validation_grid();
+    let (j, _) = crate::fit::simplex::nelder_mead(|p| max_error(pts, refs, |r, mu, v| jimenez_with(p[0], mu, v, r)), &[JIMENEZ]);
+    j[0]
 }
 
 /// The validation grid and the references there, computed once (20480 points, two split sums each).
@@ -207,55 +217,54 @@ fn items_on(generated: &Path, pts: &[[f64; 3]], refs: &[[f64; 4]]) -> Vec<Item> 
          cuts it although the BRDF's own shadowing already accounts for that part."
     ));
     let refits = super::refit::Refits::committed(generated);
+    let lagarde_refit_item = refits.as_ref().ok().map(|r| {
+        let l = r.lagarde;
+        approximation_item(
+            "specular occlusion: Lagarde & de Rousiers 2014, refitted to the cone model",
+            "this crate: Lagarde's shape with (a, b) fitted for the least rms (F0 = 4 %; its minimax is degenerate) on this grid (fits/ggx_occlusion_refits.toml)",
+            pts,
+            refs,
+            |r, mu, v| lagarde_with(l, mu, v, r * r),
+            &format!(
+                "Convention: Lagarde's, SO = saturate((n·v + V)^(2^(a α + b)) − 1 + V), α = r², with (a, b) = ({:e}, {:e}) in place \
+                 of (−16, −1); rms error {:.3e} against the published constants' {:.3e} (max {:.3e} against {:.3e}: the max sits \
+                 where no (a, b) reaches, glossy lobes outside a nearly open cone).",
+                l[0],
+                l[1],
+                rms_error(pts, refs, |r, mu, v| lagarde_with(l, mu, v, r * r)),
+                lagarde_item.rms_error,
+                max_error(pts, refs, |r, mu, v| lagarde_with(l, mu, v, r * r)),
+                lagarde_item.max_abs_error
+            ),
+        )
+        .0
+    });
+    let jimenez_refit_item = refits.as_ref().ok().map(|r| {
+        let k = r.jimenez;
+        approximation_item(
+            "specular occlusion: Jimenez et al. 2016 cone–cone, refitted to the cone model",
+            "this crate: Jimenez's shape with the specular cone's k fitted minimax (F0 = 4 %) on this grid (fits/ggx_occlusion_refits.toml)",
+            pts,
+            refs,
+            |r, mu, v| jimenez_with(k, mu, v, r),
+            &format!(
+                "Convention: Jimenez's, with cos α_s = 2^(k r²), k = {k:e} in place of −3.321928; max error {:.3e} against \
+                 the published constant's {:.3e}.",
+                max_error(pts, refs, |r, mu, v| jimenez_with(k, mu, v, r)),
+                jimenez_item.max_abs_error
+            ),
+        )
+        .0
+    });
+    if let Err(e) = &refits {
+        let why = format!("the refits are not committed here: {e} (fits/{}.toml)", super::refit::SPEC);
+        lagarde_item.findings.push(why.clone());
+        jimenez_item.findings.push(why);
+    }
     let mut out = vec![typo_item(), lagarde_item];
-    let (lagarde_item, jimenez_item) = match &refits {
-        Ok(r) => {
-            let l = r.lagarde;
-            let (lagarde_refit_item, _) = approximation_item(
-                "specular occlusion: Lagarde & de Rousiers 2014, refitted to the cone model",
-                "this crate: Lagarde's shape with (a, b) fitted for the least rms (F0 = 4 %; its minimax is degenerate) on this grid (fits/ggx_occlusion_refits.toml)",
-                pts,
-                refs,
-                |r, mu, v| lagarde_with(l, mu, v, r * r),
-                &format!(
-                    "Convention: Lagarde's, SO = saturate((n·v + V)^(2^(a α + b)) − 1 + V), α = r², with (a, b) = ({:e}, {:e}) in place \
-                     of (−16, −1); rms error {:.3e} against the published constants' {:.3e} (max {:.3e} against {:.3e}: the max sits \
-                     where no (a, b) reaches, glossy lobes outside a nearly open cone).",
-                    l[0],
-                    l[1],
-                    rms_error(pts, refs, |r, mu, v| lagarde_with(l, mu, v, r * r)),
-                    out[1].rms_error,
-                    max_error(pts, refs, |r, mu, v| lagarde_with(l, mu, v, r * r)),
-                    out[1].max_abs_error
-                ),
-            );
-            let k = r.jimenez;
-            let (jimenez_refit_item, _) = approximation_item(
-                "specular occlusion: Jimenez et al. 2016 cone–cone, refitted to the cone model",
-                "this crate: Jimenez's shape with the specular cone's k fitted minimax (F0 = 4 %) on this grid (fits/ggx_occlusion_refits.toml)",
-                pts,
-                refs,
-                |r, mu, v| jimenez_with(k, mu, v, r),
-                &format!(
-                    "Convention: Jimenez's, with cos α_s = 2^(k r²), k = {k:e} in place of −3.321928; max error {:.3e} against \
-                     the published constant's {:.3e}.",
-                    max_error(pts, refs, |r, mu, v| jimenez_with(k, mu, v, r)),
-                    jimenez_item.max_abs_error
-                ),
-            );
-            (Some(lagarde_refit_item), (jimenez_item, Some(jimenez_refit_item)))
-        }
-        Err(e) => {
-            let why = format!("the refits are not committed here: {e} (fits/{}.toml)", super::refit::SPEC);
-            out[1].findings.push(why.clone());
-            let mut j = jimenez_item;
-            j.findings.push(why);
-            (None, (j, None))
-        }
-    };
-    out.extend(lagarde_item);
-    out.push(jimenez_item.0);
-    out.extend(jimenez_item.1);
+    out.extend(lagarde_refit_item);
+    out.push(jimenez_item);
+    out.extend(jimenez_refit_item);
     out.extend(lut_items(generated, pts, refs));
     out.push(multibounce_item(refits.as_ref().ok().map(|r| r.multibounce)));
     out

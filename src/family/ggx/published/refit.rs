@@ -153,7 +153,8 @@ impl Refits {
     /// The committed refits of `generated` (generated/json/ggx_published_refits.json, checked
     /// against its spec).
     pub fn committed(generated: &Path) -> Result<Refits, BuildError> {
-        let c = |form: &str| crate::family::committed_refit(generated, SPEC, form);
+        let refits = crate::family::committed_refits(generated, SPEC)?;
+        let c = |form: &str| refits.constants(form);
         Ok(Refits {
             karis_ue4: Karis::from_params(&c(KARIS_UE4)?),
             karis_hc: Karis::from_params(&c(KARIS_HC)?),
