@@ -88,6 +88,18 @@ pub mod ms_diffuse_slices_lambert;
 #[cfg(feature = "sggx")]
 #[path = "sggx_decode.rs"]
 pub mod sggx_decode;
+#[cfg(feature = "sheen")]
+#[path = "sheen_albedo_rational.rs"]
+pub mod sheen_albedo_rational;
+#[cfg(feature = "sheen")]
+#[path = "sheen_albedo_table.rs"]
+pub mod sheen_albedo_table;
+#[cfg(feature = "sheen")]
+#[path = "sheen_dfg_filament.rs"]
+pub mod sheen_dfg_filament;
+#[cfg(feature = "sheen")]
+#[path = "sheen_published_refits.rs"]
+pub mod sheen_published_refits;
 #[cfg(feature = "skin")]
 #[path = "skin_punctual_lut.rs"]
 pub mod skin_punctual_lut;
@@ -167,6 +179,14 @@ pub mod wgsl {
     pub const MS_DIFFUSE_SLICES_LAMBERT: &str = include_str!("../wgsl/ms_diffuse_slices_lambert.wgsl");
     #[cfg(feature = "sggx")]
     pub const SGGX_DECODE: &str = include_str!("../wgsl/sggx_decode.wgsl");
+    #[cfg(feature = "sheen")]
+    pub const SHEEN_ALBEDO_RATIONAL: &str = include_str!("../wgsl/sheen_albedo_rational.wgsl");
+    #[cfg(feature = "sheen")]
+    pub const SHEEN_ALBEDO_TABLE: &str = include_str!("../wgsl/sheen_albedo_table.wgsl");
+    #[cfg(feature = "sheen")]
+    pub const SHEEN_DFG_FILAMENT: &str = include_str!("../wgsl/sheen_dfg_filament.wgsl");
+    #[cfg(feature = "sheen")]
+    pub const SHEEN_PUBLISHED_REFITS: &str = include_str!("../wgsl/sheen_published_refits.wgsl");
     #[cfg(feature = "skin")]
     pub const SKIN_PUNCTUAL_LUT: &str = include_str!("../wgsl/skin_punctual_lut.wgsl");
     #[cfg(feature = "skin")]
@@ -241,6 +261,14 @@ pub mod wgsl {
             "ms_diffuse_slices_lambert" => Some(MS_DIFFUSE_SLICES_LAMBERT),
             #[cfg(feature = "sggx")]
             "sggx_decode" => Some(SGGX_DECODE),
+            #[cfg(feature = "sheen")]
+            "sheen_albedo_rational" => Some(SHEEN_ALBEDO_RATIONAL),
+            #[cfg(feature = "sheen")]
+            "sheen_albedo_table" => Some(SHEEN_ALBEDO_TABLE),
+            #[cfg(feature = "sheen")]
+            "sheen_dfg_filament" => Some(SHEEN_DFG_FILAMENT),
+            #[cfg(feature = "sheen")]
+            "sheen_published_refits" => Some(SHEEN_PUBLISHED_REFITS),
             #[cfg(feature = "skin")]
             "skin_punctual_lut" => Some(SKIN_PUNCTUAL_LUT),
             #[cfg(feature = "skin")]
@@ -317,6 +345,14 @@ pub mod wgsl {
         "ms_diffuse_slices_lambert",
         #[cfg(feature = "sggx")]
         "sggx_decode",
+        #[cfg(feature = "sheen")]
+        "sheen_albedo_rational",
+        #[cfg(feature = "sheen")]
+        "sheen_albedo_table",
+        #[cfg(feature = "sheen")]
+        "sheen_dfg_filament",
+        #[cfg(feature = "sheen")]
+        "sheen_published_refits",
         #[cfg(feature = "skin")]
         "skin_punctual_lut",
         #[cfg(feature = "skin")]
@@ -370,6 +406,12 @@ pub const FUNCTIONS: &[EmittedFunction] = &[
     EmittedFunction { module: "gloss_table", name: "gloss_to_normal_length_lut", domain: &[[0e0, 1e0]], cpu: Cpu::One(gloss_table::gloss_to_normal_length_lut) },
     #[cfg(feature = "ms")]
     EmittedFunction { module: "ms_diffuse_rational", name: "ms_diffuse_rational", domain: &[[2.7621358e-3, 1e0], [1e-1, 1e0], [1e-1, 1e0]], cpu: Cpu::Three(ms_diffuse_rational::ms_diffuse_rational) },
+    #[cfg(feature = "sheen")]
+    EmittedFunction { module: "sheen_albedo_rational", name: "sheen_albedo", domain: &[[1e-2, 1e0], [7.8125e-3, 1e0]], cpu: Cpu::Two(sheen_albedo_rational::sheen_albedo) },
+    #[cfg(feature = "sheen")]
+    EmittedFunction { module: "sheen_albedo_table", name: "sheen_albedo_lut", domain: &[[0e0, 1e0], [5.4772254e-2, 1e0]], cpu: Cpu::Two(sheen_albedo_table::sheen_albedo_lut) },
+    #[cfg(feature = "sheen")]
+    EmittedFunction { module: "sheen_dfg_filament", name: "sheen_dfg_filament", domain: &[[0e0, 1e0], [0e0, 1e0]], cpu: Cpu::Two(sheen_dfg_filament::sheen_dfg_filament) },
     #[cfg(feature = "scenes")]
     EmittedFunction { module: "scene_cobblestone_gloss", name: "cobblestone_gloss_to_normal_length", domain: &[[3e-1, 9e-1]], cpu: Cpu::One(scene_cobblestone_gloss::cobblestone_gloss_to_normal_length) },
     #[cfg(feature = "scenes")]

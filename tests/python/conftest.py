@@ -15,6 +15,8 @@ generated/json files against independent scipy/nlopt computations:
                         `shadefit eval` at a subset of its grid;
 * test_skin.py       -- `shadefit eval` of the skin quantities against scipy, the skin LUT files;
 * test_fuzz.py       -- `shadefit eval` of the fuzz quantities (P_s, G, Q, R) against scipy/numpy;
+* test_sheen.py      -- `shadefit eval` of the Charlie sheen quantities (Λ, E under three
+                        visibilities, E_avg) against nested scipy quad of their definitions;
 * test_notebooks.py  -- every notebook in notebooks/ executed headless without a cell error.
 
 Artefacts go to tests/python/out/ (gitignored; $SHADEFIT_PYTEST_OUT overrides).

@@ -8,7 +8,11 @@
 //! Roughness: α is the distribution's exponent parameter (D ∝ sin^(1/α)θh); glTF, three.js and
 //! Filament take α = r² of a perceptual sheen roughness r (the `roughness` alias).
 
+pub mod forms;
+pub mod grid;
+pub mod lut;
 pub mod published;
+pub mod refit;
 
 use super::Family;
 use crate::bench::FamilyBench;
@@ -19,7 +23,7 @@ use crate::shading::hemisphere::{LobeParams, eval_albedo, eval_albedo_avg};
 use std::collections::BTreeMap;
 use std::sync::{Arc, Mutex};
 
-const ALPHA: ParamSpec = ParamSpec {
+pub(crate) const ALPHA: ParamSpec = ParamSpec {
     name: "alpha",
     // The exact-Lambda tables meet 1e-13 from 3e-3 (shading::charlie): below it μΛ(μ) needs
     // more than 4096 Chebyshev nodes (D ∝ sin^333 θh there).
@@ -29,15 +33,17 @@ const ALPHA: ParamSpec = ParamSpec {
     integer: false,
     default: None,
 };
-const ROUGHNESS: ParamSpec = ParamSpec {
-    name: "roughness",
-    min: 0.05477225575051661,
-    max: 1.0,
-    doc: "perceptual sheen roughness (alpha = roughness²)",
-    integer: false,
-    default: None,
-};
-const ROUGHNESS_ALIAS: (ParamSpec, usize, fn(f64) -> f64) = (ROUGHNESS, 0, crate::shading::roughness::alpha_from_roughness);
+/// α of the lobes without the exact Λ (Ashikhmin's V, Estevez–Kulla's curve): their albedo
+/// integrals converge from 1e-6 (D ∝ sin^1000000 θh; `the_albedo_converges_at_the_least_alpha`),
+/// which reaches the first texel centre of a 255-row grid in α = r² (3.8e-6).
+pub(crate) const ALPHA_WIDE: ParamSpec = ParamSpec { min: 1e-6, ..ALPHA };
+const fn roughness_of(min: f64) -> (ParamSpec, usize, fn(f64) -> f64) {
+    let r = ParamSpec { name: "roughness", min, max: 1.0, doc: "perceptual sheen roughness (alpha = roughness²)", integer: false, default: None };
+    (r, 0, crate::shading::roughness::alpha_from_roughness)
+}
+/// √(3e-3) and √(1e-6): the roughness of the least α.
+const ROUGHNESS_ALIAS: (ParamSpec, usize, fn(f64) -> f64) = roughness_of(0.05477225575051661);
+const ROUGHNESS_ALIAS_WIDE: (ParamSpec, usize, fn(f64) -> f64) = roughness_of(0.001);
 /// Λ grows like 1/μ at grazing: μ = 1e-6 is Λ ~ 1e6.
 const MU_LAMBDA: ParamSpec = ParamSpec { name: "n_dot_v", min: 1e-6, max: 1.0, doc: "cosine of the direction", integer: false, default: None };
 const N_DOT_V: ParamSpec = ParamSpec { name: "n_dot_v", min: 0.0, max: 1.0, doc: "n·v", integer: false, default: None };
@@ -101,18 +107,19 @@ fn sheen_lambda(p: &[f64], tol: f64) -> Estimate {
 }
 
 const fn quantity(name: &'static str, doc: &'static str, params: &'static [ParamSpec], eval: fn(&[f64], f64) -> Estimate) -> QuantityDef {
-    QuantityDef { name, doc, params, aliases: &[ROUGHNESS_ALIAS], eval, inverse: None, channels: &[], eval_channels: None, basis: None }
+    let aliases: &'static [(ParamSpec, usize, fn(f64) -> f64)] = if params[0].min < ALPHA.min { &[ROUGHNESS_ALIAS_WIDE] } else { &[ROUGHNESS_ALIAS] };
+    QuantityDef { name, doc, params, aliases, eval, inverse: None, channels: &[], eval_channels: None, basis: None }
 }
 
 /// The family's quantities, in `eval --help` order.
 pub static QUANTITIES: &[QuantityDef] = &[
     quantity("sheen-lambda", "exact Smith Lambda(mu) of the Charlie distribution (from its projected area)", &[ALPHA, MU_LAMBDA], sheen_lambda),
     quantity("sheen-albedo", "Charlie E(mu) with height-correlated Smith G2 of the exact Lambda", &[ALPHA, N_DOT_V], eval_albedo::<Smith>),
-    quantity("sheen-albedo-ek", "Charlie E(mu) with Estevez-Kulla's Lambda curve (glTF KHR_materials_sheen)", &[ALPHA, N_DOT_V_EK], eval_albedo::<EstevezKulla>),
-    quantity("sheen-albedo-ashikhmin", "Charlie E(mu) with V = 1/(4(n·l + n·v - n·l n·v)) (Filament cloth, three.js)", &[ALPHA, N_DOT_V], eval_albedo::<Ashikhmin>),
+    quantity("sheen-albedo-ek", "Charlie E(mu) with Estevez-Kulla's Lambda curve (glTF KHR_materials_sheen)", &[ALPHA_WIDE, N_DOT_V_EK], eval_albedo::<EstevezKulla>),
+    quantity("sheen-albedo-ashikhmin", "Charlie E(mu) with V = 1/(4(n·l + n·v - n·l n·v)) (Filament cloth, three.js)", &[ALPHA_WIDE, N_DOT_V], eval_albedo::<Ashikhmin>),
     quantity("sheen-albedo-avg", "E_avg = 2 int E(mu) mu dmu of sheen-albedo (exact Smith)", &[ALPHA], eval_albedo_avg::<Smith>),
-    quantity("sheen-albedo-avg-ek", "E_avg of sheen-albedo-ek (Estevez-Kulla's curve)", &[ALPHA], eval_albedo_avg::<EstevezKulla>),
-    quantity("sheen-albedo-avg-ashikhmin", "E_avg of sheen-albedo-ashikhmin", &[ALPHA], eval_albedo_avg::<Ashikhmin>),
+    quantity("sheen-albedo-avg-ek", "E_avg of sheen-albedo-ek (Estevez-Kulla's curve)", &[ALPHA_WIDE], eval_albedo_avg::<EstevezKulla>),
+    quantity("sheen-albedo-avg-ashikhmin", "E_avg of sheen-albedo-ashikhmin", &[ALPHA_WIDE], eval_albedo_avg::<Ashikhmin>),
 ];
 
 /// The sheen family's descriptor (registered in `crate::family::FAMILIES`).
@@ -129,5 +136,37 @@ pub static FAMILY: Family = Family {
     scene_features: &[],
     commands: &[],
     axis_mappings: &[],
-    forms: &[],
+    forms: &refit::FORMS,
 };
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::shading::hemisphere::albedo;
+
+    /// At the least α of the wide domain the albedo under Ashikhmin's V and Estevez–Kulla's
+    /// curve at tolerance 1e-8 is the one at 1e-12 within 1e-8 relative to max(E, 1) (E reaches
+    /// ~400 at grazing there): the integrator's ξ = sin^k θh variable follows the narrow lobe.
+    #[test]
+    fn the_albedo_converges_at_the_least_alpha() {
+        for alpha in [ALPHA_WIDE.min, 1e-5, 1e-4] {
+            for mu in [1e-6, 1e-3, 0.01, 0.05] {
+                for lobe in [Charlie::new(alpha), Charlie::estevez_kulla(alpha)] {
+                    let (coarse, fine) = (albedo(&lobe, mu, 1e-8), albedo(&lobe, mu, 1e-12));
+                    assert!((coarse.value - fine.value).abs() <= 1e-8 * fine.value.max(1.0), "α {alpha} μ {mu} {:?}: {coarse:?} vs {fine:?}", lobe.visibility);
+                }
+            }
+        }
+    }
+
+    /// The aliases map r to α = r² with the domain of their quantity: r's least value squared is
+    /// the least α.
+    #[test]
+    fn each_roughness_alias_reaches_its_quantitys_least_alpha() {
+        for q in QUANTITIES {
+            let (r, index, to_alpha) = q.aliases[0];
+            assert_eq!(index, 0);
+            assert!((to_alpha(r.min) - q.params[0].min).abs() <= 1e-15 * q.params[0].min, "{}: {} vs {}", q.name, to_alpha(r.min), q.params[0].min);
+        }
+    }
+}
