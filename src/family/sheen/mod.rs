@@ -8,14 +8,15 @@
 //! Roughness: α is the distribution's exponent parameter (D ∝ sin^(1/α)θh); glTF, three.js and
 //! Filament take α = r² of a perceptual sheen roughness r (the `roughness` alias).
 
+pub mod bench;
 pub mod forms;
 pub mod grid;
 pub mod lut;
+pub mod plot;
 pub mod published;
 pub mod refit;
 
 use super::Family;
-use crate::bench::FamilyBench;
 use crate::integrate::Estimate;
 use crate::quantity::{ParamSpec, QuantityDef};
 use crate::shading::charlie::{Charlie, LambdaTable, Visibility, lambda_exact};
@@ -75,7 +76,7 @@ pub fn smith(alpha: f64) -> Charlie {
     Charlie::with(alpha, Visibility::Smith(lambda_table(alpha)))
 }
 
-struct Smith;
+pub(crate) struct Smith;
 impl LobeParams for Smith {
     type Lobe = Charlie;
     const COUNT: usize = 1;
@@ -84,7 +85,7 @@ impl LobeParams for Smith {
     }
 }
 
-struct EstevezKulla;
+pub(crate) struct EstevezKulla;
 impl LobeParams for EstevezKulla {
     type Lobe = Charlie;
     const COUNT: usize = 1;
@@ -93,7 +94,7 @@ impl LobeParams for EstevezKulla {
     }
 }
 
-struct Ashikhmin;
+pub(crate) struct Ashikhmin;
 impl LobeParams for Ashikhmin {
     type Lobe = Charlie;
     const COUNT: usize = 1;
@@ -131,8 +132,8 @@ pub static FAMILY: Family = Family {
     spec_kinds: &[],
     eval_options: None,
     validate: published::items,
-    figures: |_, _| Ok(vec![]),
-    bench: FamilyBench::NONE,
+    figures: plot::figures,
+    bench: bench::BENCH,
     scene_features: &[],
     commands: &[],
     axis_mappings: &[],
@@ -151,9 +152,9 @@ mod tests {
     fn the_albedo_converges_at_the_least_alpha() {
         for alpha in [ALPHA_WIDE.min, 1e-5, 1e-4] {
             for mu in [1e-6, 1e-3, 0.01, 0.05] {
-                for lobe in [Charlie::new(alpha), Charlie::estevez_kulla(alpha)] {
+                for (name, lobe) in [("Ashikhmin", Charlie::new(alpha)), ("Estevez–Kulla", Charlie::estevez_kulla(alpha))] {
                     let (coarse, fine) = (albedo(&lobe, mu, 1e-8), albedo(&lobe, mu, 1e-12));
-                    assert!((coarse.value - fine.value).abs() <= 1e-8 * fine.value.max(1.0), "α {alpha} μ {mu} {:?}: {coarse:?} vs {fine:?}", lobe.visibility);
+                    assert!((coarse.value - fine.value).abs() <= 1e-8 * fine.value.max(1.0), "α {alpha} μ {mu} {name}: {coarse:?} vs {fine:?}");
                 }
             }
         }

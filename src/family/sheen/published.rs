@@ -122,7 +122,9 @@ fn finding_of(name: &str) -> &'static str {
     match name {
         "sheen-threejs" | "sheen-threejs-2021" => {
             "three.js shades sheen with BRDF_Sheen = D_Charlie(α = r²)·V_Neubelt (Ashikhmin's V) and scales the layer below by \
-             1 − max3(sheenColor)·IBLSheenBRDF: this fit is that E."
+             1 − max3(sheenColor)·IBLSheenBRDF: this fit is that E. (three.js also saturates V_Neubelt at 1 and floors sin²θh \
+             at 2⁻⁷ in D_Charlie, fp16 guards that change E only at grazing views of smooth sheen and near the normal as r → 1; \
+             the integral here is the lobe without them.)"
         }
         "sheen-materialx" => {
             "MaterialX's sheen D takes its roughness as α (invRoughness = 1/roughness, clamped at 0.005) with Neubelt's smoother \
