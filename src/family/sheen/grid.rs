@@ -45,6 +45,8 @@ pub enum Visibility {
     EstevezKulla,
     /// Height-correlated Smith with the exact Λ of the distribution.
     Smith,
+    /// Not Charlie's D: Ashikhmin's velvet D with Neubelt's V (`super::velvet`).
+    Velvet,
 }
 
 /// How a form's roughness argument gives the lobe's α.
@@ -83,13 +85,15 @@ impl Target {
     }
 
     /// Every target, in [`Target::index`] order.
-    pub const ALL: [Target; 6] = [
+    pub const ALL: [Target; 8] = [
         Target::new(Visibility::Ashikhmin, Convention::Squared),
         Target::new(Visibility::EstevezKulla, Convention::Squared),
         Target::new(Visibility::Smith, Convention::Squared),
+        Target::new(Visibility::Velvet, Convention::Squared),
         Target::new(Visibility::Ashikhmin, Convention::Linear),
         Target::new(Visibility::EstevezKulla, Convention::Linear),
         Target::new(Visibility::Smith, Convention::Linear),
+        Target::new(Visibility::Velvet, Convention::Linear),
     ];
 
     fn index(self) -> usize {
@@ -101,6 +105,7 @@ impl Target {
             Visibility::Ashikhmin => "sheen-albedo-ashikhmin",
             Visibility::EstevezKulla => "sheen-albedo-ek",
             Visibility::Smith => "sheen-albedo",
+            Visibility::Velvet => "sheen-albedo-velvet",
         }
     }
 
@@ -110,6 +115,7 @@ impl Target {
             Visibility::Ashikhmin => "ashikhmin",
             Visibility::EstevezKulla => "ek",
             Visibility::Smith => "smith",
+            Visibility::Velvet => "velvet",
         };
         format!("{v}_{}", if self.convention == Convention::Squared { "r2" } else { "r" })
     }
@@ -119,6 +125,7 @@ impl Target {
             Visibility::Ashikhmin => "Charlie D × Ashikhmin's V",
             Visibility::EstevezKulla => "Charlie D × Smith G2 of Estevez–Kulla's Λ curve",
             Visibility::Smith => "Charlie D × Smith G2 of the exact Λ",
+            Visibility::Velvet => "Ashikhmin's velvet D × Neubelt's V",
         };
         format!("E of {v} at {}", self.convention.describe())
     }
@@ -126,7 +133,7 @@ impl Target {
     /// E at every grid point (computed once per process; n·v = 0 is taken at the quantity's
     /// least n·v, 1e-6 under Estevez–Kulla's curve, whose E is unbounded at 0).
     pub fn albedo(self) -> &'static [f64] {
-        static CACHE: [OnceLock<Vec<f64>>; 6] = [const { OnceLock::new() }; 6];
+        static CACHE: [OnceLock<Vec<f64>>; 8] = [const { OnceLock::new() }; 8];
         CACHE[self.index()].get_or_init(|| {
             let q = QUANTITIES.iter().find(|q| q.name == self.quantity()).expect("a sheen quantity");
             points().par_iter().map(|p| (q.eval)(&[self.convention.alpha(p[0]), p[1].max(q.params[1].min)], TOL).value).collect()

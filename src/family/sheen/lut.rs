@@ -21,6 +21,7 @@
 
 use super::QUANTITIES;
 use crate::validate::Item;
+use std::path::Path;
 use rayon::prelude::*;
 use std::f64::consts::PI;
 
@@ -116,11 +117,23 @@ pub fn filament_row_roughness(j: usize, h: usize) -> f64 {
     ((j as f64 + 1.5) / h as f64).min(1.0)
 }
 
-pub fn items() -> Vec<Item> {
-    vec![filament_item(), sampler_item()]
+pub fn items(generated: &Path) -> Vec<Item> {
+    vec![filament_item(generated), sampler_item()]
 }
 
-fn filament_item() -> Item {
+/// The committed `sheen_dfg_filament` table's values (its JSON; storage order, n·v fastest).
+fn committed_table(generated: &Path) -> Result<Vec<f64>, String> {
+    let path = generated.join("json").join(format!("{}.json", TABLE));
+    let text = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let json: serde_json::Value = serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+    let values: Vec<f64> = json["values"].as_array().map(|v| v.iter().filter_map(|x| x.as_f64()).collect()).unwrap_or_default();
+    if values.len() == FILAMENT_SIZE * FILAMENT_SIZE { Ok(values) } else { Err(format!("{} holds {} values, not {FILAMENT_SIZE}²", path.display(), values.len())) }
+}
+
+/// shadefit's table in Filament's layout (`fits/sheen_dfg_filament.toml`).
+const TABLE: &str = "sheen_dfg_filament";
+
+fn filament_item(generated: &Path) -> Item {
     let n = FILAMENT_SIZE;
     let first = first_row(n);
     let rows: Vec<(Vec<f64>, f64, f64, f64)> = (first * n..n * n)
@@ -150,6 +163,21 @@ fn filament_item() -> Item {
     item.extra.push(("max_abs_error_at_stored_roughness".into(), m_own));
     item.extra.push(("rms_error_at_stored_roughness".into(), rms_own));
     let grazing = texels.iter().fold(0.0f64, |m, v| m.max(*v));
+    let same_layout = match committed_table(generated) {
+        Ok(table) => {
+            // The committed table's texels (f16, as its R16Float texture) at the same points.
+            let ours: Vec<f64> = (first * n..n * n).map(|k| half::f16::from_f64(table[k]).to_f64()).collect();
+            let (m, rms, _) = crate::validate::measure(&pts, &read, &ours);
+            item.extra.push(("refit_max_abs_error".into(), m));
+            item.extra.push(("refit_rms_error".into(), rms));
+            format!(
+                "shadefit's table in the same layout (fits/{TABLE}.toml: the integral at the texel centres the shader reads, R16Float): \
+                 max {m:.3e} ({:.3}× Filament's), rms {rms:.3e} at the same texels — f16 rounding only.",
+                m / item.max_abs_error
+            )
+        }
+        Err(why) => format!("shadefit's table in the same layout is not committed here: {why}."),
+    };
     item.findings = vec![
         format!(
             "Each texel against E of Filament's cloth lobe (Charlie D × Ashikhmin V, α = r²) at the roughness it was computed for \
@@ -164,6 +192,7 @@ fn filament_item() -> Item {
              1 − max3(sheenColor)·dfg.z then goes negative there).",
             item.max_abs_error, item.rms_error
         ),
+        same_layout,
     ];
     item
 }

@@ -15,6 +15,7 @@ pub mod lut;
 pub mod plot;
 pub mod published;
 pub mod refit;
+pub mod velvet;
 
 use super::Family;
 use crate::integrate::Estimate;
@@ -103,6 +104,27 @@ impl LobeParams for Ashikhmin {
     }
 }
 
+pub(crate) struct VelvetLobe;
+impl LobeParams for VelvetLobe {
+    type Lobe = velvet::Velvet;
+    const COUNT: usize = 1;
+    fn lobe(p: &[f64]) -> velvet::Velvet {
+        velvet::Velvet::new(p[0])
+    }
+}
+
+/// glTF's albedo scaling of the layer under the sheen (KHR_materials_sheen, "Albedo scaling"):
+/// min(1 − c E(n·v), 1 − c E(n·l)), c = max3(sheenColor), E under Estevez–Kulla's curve (the
+/// spec's sheen BRDF); its error c·max of the two E's.
+fn albedo_scaling(p: &[f64], tol: f64) -> Estimate {
+    let (alpha, c) = (p[0], p[3]);
+    let (ev, el) = (eval_albedo::<EstevezKulla>(&[alpha, p[1]], tol), eval_albedo::<EstevezKulla>(&[alpha, p[2]], tol));
+    Estimate { value: (1.0 - c * ev.value).min(1.0 - c * el.value), error: c * ev.error.max(el.error), evals: ev.evals + el.evals }
+}
+
+const N_DOT_L_EK: ParamSpec = ParamSpec { name: "n_dot_l", min: 1e-6, max: 1.0, doc: "n·l", integer: false, default: None };
+const SHEEN_COLOR: ParamSpec = ParamSpec { name: "sheen_color", min: 0.0, max: 1.0, doc: "max3(sheenColor)", integer: false, default: None };
+
 fn sheen_lambda(p: &[f64], tol: f64) -> Estimate {
     lambda_exact(p[0], p[1], tol)
 }
@@ -118,6 +140,13 @@ pub static QUANTITIES: &[QuantityDef] = &[
     quantity("sheen-albedo", "Charlie E(mu) with height-correlated Smith G2 of the exact Lambda", &[ALPHA, N_DOT_V], eval_albedo::<Smith>),
     quantity("sheen-albedo-ek", "Charlie E(mu) with Estevez-Kulla's Lambda curve (glTF KHR_materials_sheen)", &[ALPHA_WIDE, N_DOT_V_EK], eval_albedo::<EstevezKulla>),
     quantity("sheen-albedo-ashikhmin", "Charlie E(mu) with V = 1/(4(n·l + n·v - n·l n·v)) (Filament cloth, three.js)", &[ALPHA_WIDE, N_DOT_V], eval_albedo::<Ashikhmin>),
+    quantity("sheen-albedo-velvet", "E(mu) of Ashikhmin's velvet D with Neubelt's V (Filament's cloth before Charlie; the glTF IBL Sampler's D_Ashikhmin)", &[ALPHA, N_DOT_V], eval_albedo::<VelvetLobe>),
+    quantity(
+        "sheen-albedo-scaling",
+        "glTF's albedo scaling min(1 - c E(n.v), 1 - c E(n.l)) of the layer below the sheen (E: sheen-albedo-ek, c = max3(sheenColor))",
+        &[ALPHA_WIDE, N_DOT_V_EK, N_DOT_L_EK, SHEEN_COLOR],
+        albedo_scaling,
+    ),
     quantity("sheen-albedo-avg", "E_avg = 2 int E(mu) mu dmu of sheen-albedo (exact Smith)", &[ALPHA], eval_albedo_avg::<Smith>),
     quantity("sheen-albedo-avg-ek", "E_avg of sheen-albedo-ek (Estevez-Kulla's curve)", &[ALPHA_WIDE], eval_albedo_avg::<EstevezKulla>),
     quantity("sheen-albedo-avg-ashikhmin", "E_avg of sheen-albedo-ashikhmin", &[ALPHA_WIDE], eval_albedo_avg::<Ashikhmin>),

@@ -8,7 +8,7 @@
 //! - glTF's sheen albedo E under that curve against E under the exact Λ (what the curve costs);
 //! - the published E fits (three.js 2025 and 2021, MaterialX, Babylon, Filament's unused cloth
 //!   fits), each against the integral its source's BRDF defines, and against every other
-//!   candidate (three visibilities × α = r or r²) as extras: the closest candidate says what a
+//!   candidate (four lobes × α = r or r²) as extras: the closest candidate says what a
 //!   fit was made for when its source does not;
 //! - Filament's DFG blue channel and the glTF IBL Sampler's Charlie LUT, regenerated with their
 //!   own estimators ([`super::lut`]), as tables.
@@ -25,8 +25,7 @@ pub fn items(generated: &Path) -> Vec<Item> {
     for (name, form) in &REFITTED[1..] {
         items.push(form_item(generated, name, form));
     }
-    items.push(filament_ashikhmin());
-    items.extend(super::lut::items());
+    items.extend(super::lut::items(generated));
     items
 }
 
@@ -63,7 +62,7 @@ fn candidates(item: &mut Item, values: &[f64], saturates: bool) {
         }
     }
     item.findings.push(format!(
-        "Closest of the six candidate integrals (Ashikhmin's V, Estevez–Kulla's Λ curve, the exact Λ; α = r² or r{}): {} (max {:.3e}).",
+        "Closest of the eight candidate integrals (Charlie's D with Ashikhmin's V, Estevez–Kulla's Λ curve or the exact Λ, and Ashikhmin's velvet D with Neubelt's V; α = r² or r{}): {} (max {:.3e}).",
         if saturates { "; saturated as the form is" } else { "" },
         best.1.describe(),
         best.0
@@ -114,6 +113,7 @@ fn source_of(name: &str) -> &'static str {
         "sheen-threejs-2021" => "mrdoob/three.js PR #23069 (r13x–r180), lights_physical_pars_fragment",
         "sheen-materialx" => "AcademySoftwareFoundation/MaterialX libraries/pbrlib/genglsl/lib/mx_microfacet_sheen.glsl (PR #691)",
         "sheen-babylon" => "BabylonJS/Babylon.js packages/dev/core/src/Shaders/ShadersInclude/pbrBRDFFunctions.fx (commented out: NOT USED)",
+        "sheen-filament-cloth-ashikhmin" => "google/filament libs/ibl/src/CubemapIBL.cpp (prefilteredDFG_Cloth_Ashikhmin, marked __UNUSED)",
         _ => "google/filament libs/ibl/src/CubemapIBL.cpp (prefilteredDFG_Cloth_Charlie, marked __UNUSED)",
     }
 }
@@ -135,36 +135,15 @@ fn finding_of(name: &str) -> &'static str {
             "Babylon keeps it under SHEEN_SOFTER, the branch that shades with Estevez–Kulla's visibility (visibility_CharlieSheen) at \
              α = r² (convertRoughnessToAverageSlope); the branch is commented out and Babylon reads E from its BRDF texture instead."
         }
+        "sheen-filament-cloth-ashikhmin" => {
+            "Named for Ashikhmin's velvet distribution, Filament's cloth D before Charlie's (a = linear roughness = r², as the \
+             IBL Sampler's D_Ashikhmin), with Neubelt's V; its second channel is 0.03 times the first."
+        }
         _ => {
             "Filament's cloth shades with D_Charlie and V_Ashikhmin (Neubelt) at α = r² (linear roughness = perceptual²); the fit's \
              second channel is 0.0095 times the first, and min(c, 18) caps it where E grows at grazing views of smooth cloth."
         }
     }
-}
-
-/// Filament's `prefilteredDFG_Cloth_Ashikhmin`: named for Ashikhmin's distribution (Filament's
-/// cloth D before Charlie), which is not a lobe here; measured against the Charlie candidates
-/// only, to show it is not their fit, and not refitted.
-fn filament_ashikhmin() -> Item {
-    use super::forms::{FILAMENT_ASHIKHMIN, FILAMENT_ASHIKHMIN_PUBLISHED};
-    let pts = grid::points();
-    let values: Vec<f64> = pts.iter().map(|p| FILAMENT_ASHIKHMIN.eval_f64(&[p[1], p[0]], &FILAMENT_ASHIKHMIN_PUBLISHED)[0]).collect();
-    let truth = Target::ALL[0].albedo();
-    let mut item = Item::measured(
-        "Filament prefilteredDFG_Cloth_Ashikhmin (first channel)",
-        "google/filament libs/ibl/src/CubemapIBL.cpp (prefilteredDFG_Cloth_Ashikhmin, marked __UNUSED)",
-        &grid::domain(Convention::Squared),
-        &pts,
-        truth,
-        &values,
-    );
-    candidates(&mut item, &values, false);
-    item.findings.push(
-        "Named for Ashikhmin's distribution D (Filament's cloth lobe before it took Charlie's), which shadefit does not integrate: \
-         it is measured against the Charlie lobes only and not refitted (a refit would have to know its target)."
-            .into(),
-    );
-    item
 }
 
 /// Estevez–Kulla's Λ curve against the exact Λ, through G1 = 1/(1 + Λ).

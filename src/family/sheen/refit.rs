@@ -182,14 +182,28 @@ pub static FILAMENT_CHARLIE_FORM: Form = Form {
     solver: Solver::NelderMead,
 };
 
+const VELVET_R2: Target = Target::new(Visibility::Velvet, Convention::Squared);
+
+pub static FILAMENT_ASHIKHMIN_FORM: Form = Form {
+    label: "Filament prefilteredDFG_Cloth_Ashikhmin (first channel)",
+    program: &FILAMENT_ASHIKHMIN,
+    published: &FILAMENT_ASHIKHMIN_PUBLISHED,
+    inputs: n_dot_v_first,
+    measured: value,
+    truth: || VELVET_R2.albedo().to_vec(),
+    against: || VELVET_R2.describe(),
+    solver: Solver::NelderMead,
+};
+
 /// Every refitted form with its registered name, in [`FORMS`] order.
-pub static REFITTED: [(&str, &Form); 6] = [
+pub static REFITTED: [(&str, &Form); 7] = [
     ("sheen-estevez-kulla-lambda", &EK),
     ("sheen-threejs", &THREEJS_NEW),
     ("sheen-threejs-2021", &THREEJS_OLD),
     ("sheen-materialx", &MATERIALX_FORM),
     ("sheen-babylon", &BABYLON_FORM),
     ("sheen-filament-cloth-charlie", &FILAMENT_CHARLIE_FORM),
+    ("sheen-filament-cloth-ashikhmin", &FILAMENT_ASHIKHMIN_FORM),
 ];
 
 /// The committed constants of form `name` in `generated`.
@@ -275,7 +289,7 @@ macro_rules! form {
 
 /// The published sheen forms, as `fits/sheen_published_refits.toml` refits them (registered in
 /// the family's descriptor).
-pub static FORMS: [PublishedForm; 6] = [
+pub static FORMS: [PublishedForm; 7] = [
     form!(
         0,
         "lambda",
@@ -329,4 +343,69 @@ pub static FORMS: [PublishedForm; 6] = [
         // (k₂ + 1 − n·v)⁶⁴: a power of a positive base only (WGSL's pow is undefined below 0).
         |c| finite_with_positive(c, &[2])
     ),
+    form!(
+        6,
+        "filament_cloth_ashikhmin",
+        "Filament's (unused) prefilteredDFG_Cloth_Ashikhmin, first channel, refitted minimax to E of Ashikhmin's velvet D·Neubelt's V at α = r² (r clamped to [0.1, 1]).",
+        &["n_dot_v", "roughness"],
+        &[UNIT, R],
+        // 2^(−(s − k₁)²/(2 k₂)): a Gaussian of positive width.
+        |c| finite_with_positive(c, &[2])
+    ),
 ];
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use shadefit_runtime::sheen_published_refits as g;
+    use std::path::Path;
+
+    /// The emitted Rust of every refitted form is its program's f32 evaluation bit for bit at
+    /// the committed constants, on inputs clamped to its box as the emitted code clamps them
+    /// (NaN → the lower end), and finite for every special value and across the box.
+    #[test]
+    fn the_emitted_refits_are_their_programs_and_finite() {
+        let generated = Path::new(env!("CARGO_MANIFEST_DIR")).join("generated");
+        let functions: [fn(f32, f32) -> f32; 7] = [
+            g::sheen_refit_lambda,
+            g::sheen_refit_threejs,
+            g::sheen_refit_threejs_2021,
+            g::sheen_refit_materialx,
+            g::sheen_refit_babylon,
+            g::sheen_refit_filament_cloth_charlie,
+            g::sheen_refit_filament_cloth_ashikhmin,
+        ];
+        let special = [f32::NAN, f32::INFINITY, f32::NEG_INFINITY, -1.0, 0.0, 1e-45, 1e-3, 0.1, 0.25, 0.4999, 0.5, 0.75, 0.9999, 1.0, 2.0, f32::MAX];
+        for ((name, form), f) in REFITTED.iter().zip(functions) {
+            let c: Vec<f32> = committed(&generated, name).expect("the refit is committed").iter().map(|&v| v as f32).collect();
+            let spec = FORMS.iter().find(|p| p.name == *name).expect("registered");
+            let clamp = |v: f32, (lo, hi): (f64, f64)| crate::fit::expr::sanitize(v, lo as f32, hi as f32);
+            for &x in &special {
+                for &y in &special {
+                    let want = form.program.eval_f32(&[clamp(x, spec.domain[0]), clamp(y, spec.domain[1])], &c)[0];
+                    let got = f(x, y);
+                    assert_eq!(got.to_bits(), want.to_bits(), "{name} ({x}, {y})");
+                    assert!(got.is_finite(), "{name} ({x}, {y}): {got}");
+                }
+            }
+            for i in 0..=64 {
+                for j in 0..=64 {
+                    let v = f(i as f32 / 64.0, j as f32 / 64.0);
+                    assert!(v.is_finite(), "{name} at ({i}/64, {j}/64): {v}");
+                }
+            }
+        }
+    }
+
+    /// Each committed refit beats its published form by the margin on the grid it was
+    /// fitted on (max error ≤ 0.8× the published), measured here through the form.
+    #[test]
+    fn every_refit_beats_its_published_form() {
+        let generated = Path::new(env!("CARGO_MANIFEST_DIR")).join("generated");
+        for (name, form) in &REFITTED {
+            let c = crate::fit::published::as_emitted(&committed(&generated, name).unwrap());
+            let (p, r) = (form.errors(form.published), form.errors(&c));
+            assert!(r.max_abs_error <= 0.8 * p.max_abs_error, "{name}: refit {} vs published {}", r.max_abs_error, p.max_abs_error);
+        }
+    }
+}
