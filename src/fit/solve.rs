@@ -303,6 +303,18 @@ pub fn fit_from(
     fit_start(model, data, theta0, opts, what, false).map(|(f, _)| f)
 }
 
+/// A refit of a published rational: [`fit`] (its linearised starts), else [`fit_from`] the
+/// published coefficients `start`, with `opts`; the first whose denominator is proven positive on
+/// `domain` (interval arithmetic), or `None` when neither is.
+pub fn fit_proven_positive(model: &RationalModel, data: &Data, start: &[f64], opts: &FitOptions, domain: &[(f64, f64)], what: &str) -> Option<DVector<f64>> {
+    let positive = |c: &DVector<f64>| matches!(prove_denominator_positive(model, c, domain), Positivity::Proven { .. });
+    fit(model, data, opts, what)
+        .ok()
+        .map(|f| f.coefficients)
+        .filter(|c| positive(c))
+        .or_else(|| fit_from(model, data, DVector::from_vec(start.to_vec()), opts, what).ok().map(|f| f.coefficients).filter(|c| positive(c)))
+}
+
 /// A start of [`fit`]'s multi-start: a full run, or one stopped by [`Stall`] with the lowest
 /// rss its progress allows it.
 enum Outcome {

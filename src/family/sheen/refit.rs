@@ -242,18 +242,7 @@ fn materialx_rational(truth: &[f64]) -> Option<Vec<f64>> {
     let model = materialx_model();
     let data = Data { x: grid::points().iter().map(|p| vec![p[1], p[0]]).collect(), y: truth.to_vec() };
     let opts = FitOptions { objective: Objective::Minimax, ..FitOptions::default() };
-    let positive = |c: &DVector<f64>| matches!(prove_denominator_positive(&model, c, &MATERIALX_BOX), Positivity::Proven { .. });
-    crate::fit::fit(&model, &data, &opts, "materialx sheen refit")
-        .ok()
-        .map(|f| f.coefficients)
-        .filter(|c| positive(c))
-        .or_else(|| {
-            crate::fit::solve::fit_from(&model, &data, DVector::from_vec(MATERIALX_PUBLISHED.to_vec()), &opts, "materialx sheen refit")
-                .ok()
-                .map(|f| f.coefficients)
-                .filter(|c| positive(c))
-        })
-        .map(|c| c.as_slice().to_vec())
+    crate::fit::solve::fit_proven_positive(&model, &data, &MATERIALX_PUBLISHED, &opts, &MATERIALX_BOX, "materialx sheen refit").map(|c| c.as_slice().to_vec())
 }
 
 /// MaterialX's denominator proven positive on the clamp box (interval arithmetic).
@@ -378,7 +367,8 @@ mod tests {
         let special = [f32::NAN, f32::INFINITY, f32::NEG_INFINITY, -1.0, 0.0, 1e-45, 1e-3, 0.1, 0.25, 0.4999, 0.5, 0.75, 0.9999, 1.0, 2.0, f32::MAX];
         for ((name, form), f) in REFITTED.iter().zip(functions) {
             let c: Vec<f32> = committed(&generated, name).expect("the refit is committed").iter().map(|&v| v as f32).collect();
-            let spec = FORMS.iter().find(|p| p.name == *name).expect("registered");
+            let form_name: &str = &name;
+            let spec = FORMS.iter().find(|p| p.name == form_name).expect("registered");
             let clamp = |v: f32, (lo, hi): (f64, f64)| crate::fit::expr::sanitize(v, lo as f32, hi as f32);
             for &x in &special {
                 for &y in &special {

@@ -81,17 +81,7 @@ pub fn materialx_on(g: &Grid) -> MaterialX {
         // α = 0 and 1), else the published constants of that channel.
         let published: Vec<f64> = (0..9).map(|k| MATERIALX.r[k][ch]).chain((1..9).map(|k| MATERIALX.r[k][ch + 2])).collect();
         let opts = FitOptions { objective: Objective::Minimax, ..FitOptions::default() };
-        let positive = |c: &DVector<f64>| matches!(prove_denominator_positive(&model, c, &domain), Positivity::Proven { .. });
-        let c = crate::fit::fit(&model, &data, &opts, "materialx refit")
-            .ok()
-            .map(|f| f.coefficients)
-            .filter(|c| positive(c))
-            .or_else(|| {
-                crate::fit::solve::fit_from(&model, &data, DVector::from_vec(published.clone()), &opts, "materialx refit")
-                    .ok()
-                    .map(|f| f.coefficients)
-                    .filter(|c| positive(c))
-            })
+        let c = crate::fit::solve::fit_proven_positive(&model, &data, &published, &opts, &domain, "materialx refit")
             .unwrap_or_else(|| DVector::from_vec(published));
         let c = &c;
         for k in 0..9 {
