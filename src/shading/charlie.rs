@@ -5,7 +5,7 @@
 //! f    = D V
 //! V    = 1 / (4 (μl + μv − μl μv))                 Neubelt–Pettineo / Ashikhmin (Filament's cloth)
 //! V    = 1 / ((1 + Λ(μv) + Λ(μl)) 4 μv μl)         height-correlated Smith, with
-//!        Λ the exact Smith Λ of D (below), or Estevez–Kulla's fitted curve (glTF's sheen)
+//!        Λ the exact Smith Λ of D (below), or Estevez–Kulla's fitted curve (glTF's KHR_materials_sheen)
 //! ```
 //! D is normalised in projected area, ∫ D μh dω_h = 1, and its measure D μh dω_h has a closed
 //! CDF: with k = 2 + 1/α, ∫₀^θ k sin^(k−2)θ' cos θ' sin θ' dθ' = sin^k θ, so ξ = sin^k θh and
