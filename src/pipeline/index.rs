@@ -159,4 +159,30 @@ mod tests {
         assert_eq!(dropped_modules(g, &index_of(&["kept", "new"])), ["gone"]);
         assert!(dropped_modules(g, &index_of(&["gone", "kept"])).is_empty());
     }
+
+    /// The items an index declares besides its modules are refused as spec names: its root
+    /// modules (`wgsl`), and the constants of its `wgsl` module (`NAMES`), which a module's
+    /// constant (its name upper-cased) would redeclare. Read from an index of no spec, so an item
+    /// added to it and not to the reserved names fails here.
+    #[test]
+    fn the_index_items_are_reserved_spec_names() {
+        let text = String::from_utf8(runtime_index(&[]).contents).unwrap();
+        // Root items start their line; an index of no spec declares only its own.
+        let roots: Vec<String> =
+            text.lines().filter_map(|l| l.strip_prefix("pub mod ")).map(|r| r.trim_end_matches([';', '{', ' ']).to_string()).collect();
+        assert!(roots.contains(&"wgsl".to_string()), "{roots:?}");
+        let wgsl_block = text
+            .split_once("pub mod wgsl {")
+            .and_then(|(_, b)| b.split_once("\n}\n"))
+            .map(|(b, _)| b)
+            .expect("the index has its wgsl module");
+        let consts: Vec<String> = wgsl_block
+            .lines()
+            .filter_map(|l| l.trim().strip_prefix("pub const ")?.split_once(':').map(|(n, _)| n.to_lowercase()))
+            .collect();
+        assert!(consts.contains(&"names".to_string()), "{consts:?}");
+        for n in roots.into_iter().chain(consts) {
+            assert!(crate::spec::names::check_spec_name(&n).is_some(), "'{n}', an item of the runtime index, is accepted as a spec name");
+        }
+    }
 }
