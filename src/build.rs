@@ -45,6 +45,15 @@ pub enum Error {
     Interrupted { journal: PathBuf },
     #[error("{0}")]
     Shard(String),
+    #[error("no spec (*.toml) in {}: nothing to build", dir.display())]
+    NoSpecs { dir: PathBuf },
+    #[error(
+        "{} lists module(s) {modules} whose files are in {}, but no spec in {} (nor scene in its scenes/) builds them: \
+         this build would drop them from the runtime crate. Build with the fits folder that holds their specs (--fits), \
+         or, to retire a module, delete its files from {} first (`shadefit build --check` lists them)",
+        index.display(), generated.display(), fits.display(), generated.display()
+    )]
+    DropsModules { index: PathBuf, modules: String, generated: PathBuf, fits: PathBuf },
 }
 
 impl Error {
@@ -53,7 +62,7 @@ impl Error {
         use crate::fit::FitError;
         use crate::pipeline::SceneError;
         match self {
-            Error::Spec(_) | Error::UnknownSpec { .. } | Error::Shard(_) => true,
+            Error::Spec(_) | Error::UnknownSpec { .. } | Error::Shard(_) | Error::NoSpecs { .. } | Error::DropsModules { .. } => true,
             // A spec whose model cannot avoid a pole on its domain or whose basis is degenerate on
             // its samples (e.g. fixed denominator coefficients forcing a pole), or a scene naming a spec that fits/ lacks: the spec or
             // the manifest is what must change.
@@ -131,6 +140,22 @@ pub fn target_artifacts(artifacts: &[Artifact], module_targets: &(dyn Fn(&str) -
     Ok(out)
 }
 
+/// Refuses to write `index` over the runtime index in generated/ when it would drop modules whose
+/// files are there ([`pipeline::dropped_modules`]): a fits folder without their specs (another
+/// `--fits`, or one holding only the `--only` spec) is not a reason to remove them from the crate.
+fn keep_modules(paths: &Paths, index: &Artifact) -> Result<(), Error> {
+    let dropped = pipeline::dropped_modules(&paths.generated, index);
+    if dropped.is_empty() {
+        return Ok(());
+    }
+    Err(Error::DropsModules {
+        index: paths.generated.join(pipeline::INDEX_PATH),
+        modules: dropped.join(", "),
+        generated: paths.generated.clone(),
+        fits: paths.fits.clone(),
+    })
+}
+
 /// The scene manifests in `fits/scenes`.
 pub fn load_scenes(paths: &Paths) -> Result<Vec<Scene>, Error> {
     Ok(Scene::load_dir(&paths.fits.join("scenes"), &family::scene_features())?)
@@ -167,6 +192,9 @@ fn run_merged(
     mut merged: std::collections::BTreeMap<String, Vec<u8>>,
 ) -> Result<Summary, Error> {
     let mut specs = load_specs(paths, only)?;
+    if specs.is_empty() {
+        return Err(Error::NoSpecs { dir: paths.fits.clone() });
+    }
     for s in &mut specs {
         s.merged = merged.remove(&s.file.name).map(std::sync::Arc::new);
     }
@@ -177,6 +205,13 @@ fn run_merged(
     let mut tx = if check { None } else { Some(Transaction::begin(&paths.generated)?) };
     if check && let Some(journal) = emit::interrupted(&paths.generated) {
         return Err(Error::Interrupted { journal });
+    }
+    // The runtime index lists every spec in the folder and every scene, built now or not; it is
+    // known before anything is built, and a build that would drop modules stops here.
+    let scenes = load_scenes(paths)?;
+    let index = scene::runtime_index(&specs, &scenes);
+    if tx.is_some() {
+        keep_modules(paths, &index)?;
     }
     let build_all = |specs: &[&Spec]| -> Result<Vec<(Built, f64)>, Error> {
         let results: Vec<Result<(Built, f64), Error>> = specs
@@ -210,7 +245,6 @@ fn run_merged(
     built.extend(reading);
     // Summaries list the specs in the order they were selected.
     built.sort_by_key(|(b, _)| selected.iter().position(|s| s.file.name == b.name));
-    let scenes = load_scenes(paths)?;
     let spec_files = artifacts.len();
     let mut scene_times = Vec::new();
     if only.is_empty() {
@@ -232,7 +266,7 @@ fn run_merged(
             scene_times.push((sc.module(), t.elapsed().as_secs_f64()));
         }
     }
-    artifacts.push(scene::runtime_index(&specs, &scenes));
+    artifacts.push(index);
     // Other targets of every module (spec or scene), from the WGSL just rendered.
     let module_targets = |module: &str| {
         let mut t: Vec<Target> = extra.to_vec();
@@ -278,6 +312,8 @@ pub fn run_scene(paths: &Paths, file: &Path, force: bool, extra: &[Target]) -> R
         scenes.push(sc.clone());
     }
     let mut tx = Transaction::begin(&paths.generated)?;
+    // The index the scene's build writes lists the same specs and scenes.
+    keep_modules(paths, &scene::runtime_index(&specs, &scenes))?;
     // Every module in the `--target` targets and its spec's own, as `build` writes them.
     let translate = |module: &str, text: &str| -> Result<Vec<Artifact>, BuildError> {
         let mut t: Vec<Target> = extra.to_vec();

@@ -9,7 +9,7 @@ use common::*;
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::io::Read;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
@@ -58,6 +58,11 @@ struct Edit {
 
 fn apply(dir: &Path, case: &str, e: &Edit) {
     let p = dir.join(&e.file);
+    if e.text.is_some() || e.hex.is_some() {
+        // A created file may lie in a folder the scratch project lacks (generated/src, another
+        // fits folder).
+        std::fs::create_dir_all(p.parent().unwrap()).unwrap();
+    }
     match (&e.replace, &e.text, &e.hex, e.remove) {
         (Some([old, new]), None, None, false) => {
             let t = std::fs::read_to_string(&p).unwrap_or_else(|_| panic!("{case}: no {}", e.file));
@@ -78,9 +83,9 @@ fn apply(dir: &Path, case: &str, e: &Edit) {
     }
 }
 
-/// Every file under `dir` (relative paths, sorted); folders alone are not listed.
-fn files_under(dir: &Path) -> Vec<PathBuf> {
-    let mut out: Vec<PathBuf> = snapshot(dir).into_iter().map(|(p, _)| p).collect();
+/// The entries directly in `dir` (files and folders; none when it does not exist).
+fn entries_in(dir: &Path) -> Vec<std::ffi::OsString> {
+    let mut out: Vec<_> = std::fs::read_dir(dir).map(|r| r.map(|e| e.unwrap().file_name()).collect()).unwrap_or_default();
     out.sort();
     out
 }
@@ -142,7 +147,8 @@ fn every_hostile_input_gets_its_exit_code_and_message() {
         for e in &c.edit {
             apply(d.path(), &c.name, e);
         }
-        let before = files_under(d.path());
+        let before = snapshot(d.path());
+        let generated_before = entries_in(&d.path().join("generated"));
         let r = run_within(&c.args, d.path(), &c.env, CASE_LIMIT);
         let (out, err) = (&r.stdout, &r.stderr);
         let mut why = Vec::new();
@@ -167,13 +173,19 @@ fn every_hostile_input_gets_its_exit_code_and_message() {
                 why.push(format!("printed {got:?}, expected {want} ± {tol:e}"));
             }
         }
-        if c.exit != 0 && std::fs::read_dir(d.path().join("generated")).map(|r| r.count()).unwrap_or(0) != 0 {
+        // A case's edits may put files in generated/ (an index to keep): a failed run leaves
+        // generated/ with the same entries and every file with the same bytes.
+        if c.exit != 0 && entries_in(&d.path().join("generated")) != generated_before {
             why.push("wrote into generated/".into());
         }
-        let after = files_under(d.path());
+        let after = snapshot(d.path());
         if c.exit != 0 && after != before {
-            let new: Vec<String> = after.iter().filter(|p| !before.contains(p)).map(|p| p.display().to_string()).collect();
-            why.push(format!("wrote {}", new.join(", ")));
+            let mut changed: Vec<String> =
+                after.iter().filter(|f| !before.contains(f)).map(|(p, _)| p.display().to_string()).collect();
+            changed.extend(
+                before.iter().filter(|(p, _)| !after.iter().any(|(q, _)| q == p)).map(|(p, _)| format!("removed {}", p.display())),
+            );
+            why.push(format!("wrote {}", changed.join(", ")));
         }
         if !why.is_empty() {
             failures.push(format!("{} ({:.2} s): {}\n  stderr: {}", c.name, r.wall.as_secs_f64(), why.join("; "), err.trim()));

@@ -2,6 +2,27 @@
 
 use super::*;
 
+/// The file of the runtime index, relative to generated/.
+pub const INDEX_PATH: &str = "src/emitted.rs";
+
+/// The module names an index text declares (`pub mod NAME;` lines; the `wgsl` block is not one).
+pub fn index_modules(text: &str) -> Vec<String> {
+    text.lines().filter_map(|l| l.trim().strip_prefix("pub mod ")?.strip_suffix(';').map(str::to_string)).collect()
+}
+
+/// What writing `index` over the runtime index in `generated` would drop from the runtime crate:
+/// the modules the index on disk lists that `index` does not, among those whose module file
+/// (`src/NAME.rs`) is still in `generated`. A listed module whose file is gone is not counted:
+/// dropping it repairs the index.
+pub fn dropped_modules(generated: &Path, index: &Artifact) -> Vec<String> {
+    let Ok(old) = std::fs::read_to_string(generated.join(INDEX_PATH)) else { return Vec::new() };
+    let new = index_modules(&String::from_utf8_lossy(&index.contents));
+    index_modules(&old)
+        .into_iter()
+        .filter(|m| !new.contains(m) && generated.join("src").join(format!("{m}.rs")).is_file())
+        .collect()
+}
+
 /// The runtime crate's index of emitted modules (generated/src/emitted.rs), included by the
 /// crate's hand-written `lib.rs`.
 pub fn runtime_index(specs: &[Spec]) -> Artifact {
@@ -104,5 +125,64 @@ pub fn runtime_index_with_scenes(specs: &[Spec], scenes: &[SceneIndex]) -> Artif
         }
     }
     s.push_str("];\n");
-    Artifact { path: "src/emitted.rs".into(), contents: s.into() }
+    Artifact { path: INDEX_PATH.into(), contents: s.into() }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn index_of(modules: &[&str]) -> Artifact {
+        let mut s = String::from("// index\n");
+        for m in modules {
+            s.push_str(&format!("#[cfg(feature = \"f\")]\n#[path = \"{m}.rs\"]\npub mod {m};\n"));
+        }
+        s.push_str("pub mod wgsl {\n}\n");
+        Artifact { path: INDEX_PATH.into(), contents: s.into() }
+    }
+
+    /// A module the index on disk lists is dropped by an index without it while its file is
+    /// there, and not once its file is gone; a new index that keeps it, or adds others, drops
+    /// nothing; no index on disk, nothing to drop.
+    #[test]
+    fn an_index_drops_the_modules_it_omits_whose_files_remain() {
+        let d = tempfile::tempdir().unwrap();
+        let g = d.path();
+        assert!(dropped_modules(g, &index_of(&[])).is_empty());
+        std::fs::create_dir_all(g.join("src")).unwrap();
+        std::fs::write(g.join(INDEX_PATH), &index_of(&["kept", "gone", "retired"]).contents).unwrap();
+        for m in ["kept", "gone"] {
+            std::fs::write(g.join("src").join(format!("{m}.rs")), "").unwrap();
+        }
+        assert_eq!(index_modules(&String::from_utf8_lossy(&index_of(&["a", "b"]).contents)), ["a", "b"]);
+        assert_eq!(dropped_modules(g, &index_of(&[])), ["kept", "gone"]);
+        assert_eq!(dropped_modules(g, &index_of(&["kept", "new"])), ["gone"]);
+        assert!(dropped_modules(g, &index_of(&["gone", "kept"])).is_empty());
+    }
+
+    /// The items an index declares besides its modules are refused as spec names: its root
+    /// modules (`wgsl`), and the constants of its `wgsl` module (`NAMES`), which a module's
+    /// constant (its name upper-cased) would redeclare. Read from an index of no spec, so an item
+    /// added to it and not to the reserved names fails here.
+    #[test]
+    fn the_index_items_are_reserved_spec_names() {
+        let text = String::from_utf8(runtime_index(&[]).contents).unwrap();
+        // Root items start their line; an index of no spec declares only its own.
+        let roots: Vec<String> =
+            text.lines().filter_map(|l| l.strip_prefix("pub mod ")).map(|r| r.trim_end_matches([';', '{', ' ']).to_string()).collect();
+        assert!(roots.contains(&"wgsl".to_string()), "{roots:?}");
+        let wgsl_block = text
+            .split_once("pub mod wgsl {")
+            .and_then(|(_, b)| b.split_once("\n}\n"))
+            .map(|(b, _)| b)
+            .expect("the index has its wgsl module");
+        let consts: Vec<String> = wgsl_block
+            .lines()
+            .filter_map(|l| l.trim().strip_prefix("pub const ")?.split_once(':').map(|(n, _)| n.to_lowercase()))
+            .collect();
+        assert!(consts.contains(&"names".to_string()), "{consts:?}");
+        for n in roots.into_iter().chain(consts) {
+            assert!(crate::spec::names::check_spec_name(&n).is_some(), "'{n}', an item of the runtime index, is accepted as a spec name");
+        }
+    }
 }

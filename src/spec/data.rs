@@ -6,8 +6,8 @@ use std::path::Path;
 
 /// Read columns `x_cols` (features, in order) and `y_col` from a CSV file with a header (read
 /// through `input::read_input`: a regular file within its byte limit). Every cell must be a
-/// finite number, and no two columns may share a header; errors name the file, the line and
-/// the column.
+/// finite number, no two columns may share a header, and each feature column must take two
+/// values at least; errors name the file, the line and the column.
 pub fn read_csv(path: &Path, x_cols: &[String], y_col: &str) -> Result<Data, SpecError> {
     let bytes = super::input::read_input(path).map_err(|e| SpecError::unreadable(path, e))?;
     let mut rdr = csv::ReaderBuilder::new().trim(csv::Trim::All).comment(Some(b'#')).from_reader(&bytes[..]);
@@ -60,6 +60,19 @@ pub fn read_csv(path: &Path, x_cols: &[String], y_col: &str) -> Result<Data, Spe
     }
     if data.is_empty() {
         return Err(SpecError::new(path, 2, "(rows)", "no data rows"));
+    }
+    // A feature that takes one value only spans nothing: a model in it is fitted at a single
+    // abscissa, where a rational may put its pole anywhere else. The header names the column.
+    for (j, name) in x_cols.iter().enumerate() {
+        let v = data.x[0][j];
+        if data.x.iter().all(|p| p[j] == v) {
+            return Err(SpecError::new(
+                path,
+                1,
+                name,
+                format!("column '{name}' takes one value only ({v:?} on all {} rows): a fit needs each feature to span a range", data.len()),
+            ));
+        }
     }
     Ok(data)
 }

@@ -38,6 +38,21 @@ const WGSL: &[&str] = &[
 /// the emitted index and the hand-written runtime module.
 const RESERVED_MODULES: &[&str] = &["lib", "emitted", "runtime", "main"];
 
+/// Names the runtime crate uses beside the emitted modules, which a spec's module would collide
+/// with:
+/// - the crate root (`generated/src/lib.rs`): its module `runtime` and what it re-exports from
+///   it (`compose`, `compose_shader`, `compose_shader_named`, `gpu`, `lut`, `skin`): a `pub mod`
+///   of the same name in the index it includes does not compile (E0255);
+/// - the index (`pipeline::runtime_index`): its module `wgsl`, and in it the list `NAMES`, which
+///   the constant of a module named `names` (the name upper-cased) would redeclare (E0428);
+/// - the hand-written WGSL libraries (`runtime::library`: `skin_curvature`), imported as
+///   `shadefit::NAME` like the emitted modules.
+///
+/// Tests read lib.rs, runtime/mod.rs and an index and fail on any name they declare that is not
+/// here (this module's tests and `pipeline::index`'s).
+const RUNTIME_NAMES: &[&str] =
+    &["runtime", "compose", "compose_shader", "compose_shader_named", "gpu", "lut", "skin", "wgsl", "names", "skin_curvature"];
+
 /// Scene modules are named `scene_MANIFEST`.
 pub const SCENE_PREFIX: &str = "scene_";
 
@@ -93,6 +108,9 @@ pub fn check_spec_name(s: &str) -> Option<String> {
     if RESERVED_MODULES.contains(&s) {
         return Some(format!("'{s}' is a file of the runtime crate (reserved: {})", RESERVED_MODULES.join(", ")));
     }
+    if RUNTIME_NAMES.contains(&s) {
+        return Some(format!("'{s}' is a name the runtime crate uses (reserved: {})", RUNTIME_NAMES.join(", ")));
+    }
     if s.starts_with(SCENE_PREFIX) {
         return Some(format!("'{s}' starts with '{SCENE_PREFIX}', the prefix of scene modules"));
     }
@@ -117,9 +135,74 @@ mod tests {
         for good in ["x", "t", "f", "k2x", "x0a", "alpha", "n_dot_v", "schlick_k"] {
             assert_eq!(check_argument(good), None, "{good}");
         }
-        for good in ["gloss_length", "x", "_x", "n_dot_v", "alpha2", "scene"] {
+        for good in ["gloss_length", "x", "_x", "n_dot_v", "alpha2", "scene", "lut2", "skin_lut", "functions"] {
             assert_eq!(check_identifier(good), None, "{good}");
             assert_eq!(check_spec_name(good), None, "{good}");
+        }
+    }
+
+    /// The lowercase names a Rust source declares at its top level: `mod NAME`, and what each
+    /// `use` brings in (a path's last segment, each item of a `{…}` list, the alias of `as`).
+    /// Upper-case names (types, constants) cannot be a spec's module name.
+    pub(crate) fn declared_names(text: &str) -> Vec<String> {
+        let mut out = Vec::new();
+        let lowercase = |n: &str| is_identifier(n).then(|| n.to_string());
+        for line in text.lines().map(str::trim).filter(|l| !l.starts_with("//")) {
+            let line = line.strip_prefix("pub ").unwrap_or(line);
+            if let Some(rest) = line.strip_prefix("mod ") {
+                out.extend(lowercase(rest.trim_end_matches([';', '{', ' '])));
+            } else if let Some(rest) = line.strip_prefix("use ") {
+                let path = rest.trim_end_matches(';');
+                let items: Vec<&str> = match path.split_once('{') {
+                    Some((_, list)) => list.trim_end_matches('}').split(',').collect(),
+                    None => vec![path.rsplit("::").next().unwrap_or(path)],
+                };
+                for item in items.iter().map(|i| i.trim()).filter(|i| !i.is_empty()) {
+                    out.extend(lowercase(item.rsplit(" as ").next().unwrap_or(item).trim()));
+                }
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn declared_names_reads_modules_uses_lists_and_aliases() {
+        let text = "//! mod doc;\nmod a;\npub mod b {\n#[cfg(x)]\npub use c::d;\nuse e::{f, G, h as i};\npub struct Z;\n";
+        assert_eq!(declared_names(text), ["a", "b", "d", "f", "i"]);
+    }
+
+    /// Every name the runtime crate's root declares or re-exports (generated/src/lib.rs), every
+    /// module of its hand-written runtime (runtime/mod.rs), every hand-written WGSL library it
+    /// resolves (the `"NAME" =>` arms of `runtime::library`) and every hand-written file or folder
+    /// in generated/src (no `@generated` header) is refused as a spec name: read from the files,
+    /// so a name added there and not to the reserved lists fails here.
+    #[test]
+    fn every_name_the_runtime_crate_uses_is_reserved() {
+        let src = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("generated/src");
+        let read = |p: &str| std::fs::read_to_string(src.join(p)).unwrap_or_else(|e| panic!("{p}: {e}"));
+        let lib = declared_names(&read("lib.rs"));
+        for n in ["runtime", "compose", "gpu", "lut", "skin"] {
+            assert!(lib.contains(&n.to_string()), "lib.rs is read: {n} in {lib:?}");
+        }
+        let runtime = read("runtime/mod.rs");
+        let libraries: Vec<String> = runtime
+            .lines()
+            .filter_map(|l| l.trim().strip_prefix('"')?.split_once("\" =>").map(|(n, _)| n.to_string()))
+            .collect();
+        assert!(libraries.contains(&"skin_curvature".to_string()), "runtime::library is read: {libraries:?}");
+        let mut hand_written = Vec::new();
+        for e in std::fs::read_dir(&src).unwrap() {
+            let p = e.unwrap().path();
+            let stem = p.file_stem().unwrap().to_string_lossy().into_owned();
+            let generated = p.is_file()
+                && std::fs::read_to_string(&p).is_ok_and(|t| t.lines().next().is_some_and(|l| l.contains("@generated by")));
+            if !generated {
+                hand_written.push(stem);
+            }
+        }
+        assert!(hand_written.contains(&"lib".to_string()) && hand_written.contains(&"runtime".to_string()), "{hand_written:?}");
+        for n in lib.iter().chain(&declared_names(&runtime)).chain(&libraries).chain(&hand_written) {
+            assert!(check_spec_name(n).is_some(), "'{n}', a name of the runtime crate, is accepted as a spec name");
         }
     }
 }
