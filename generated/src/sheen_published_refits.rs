@@ -42,7 +42,7 @@ pub fn sheen_refit_threejs(roughness: f32, n_dot_v: f32) -> f32 {
 
 /// three.js's 2021 IBLSheenBRDF refitted minimax to min(1, E) of its D_Charlie(r²)·V_Neubelt (r clamped to [0.1, 1]).
 /// three.js IBLSheenBRDF (2021): max abs 4.298e-1 (published 7.879e-1, 0.55x), rms 1.213e-1 (published 2.876e-1) over 627 values; roughness r ∈ [0.1, 1] (19 uniform), n·v ∈ [0, 1] (33 uniform), against min(1, E of Charlie D × Ashikhmin's V at α = r²).
-pub fn sheen_refit_threejs_2021(roughness: f32, n_dot_v: f32) -> f32 {
+pub fn sheen_refit_threejs_legacy(roughness: f32, n_dot_v: f32) -> f32 {
     let roughness = input(roughness, 1e-1_f32, 1e0_f32);
     let n_dot_v = input(n_dot_v, 0e0_f32, 1e0_f32);
     let r2 = roughness * roughness;

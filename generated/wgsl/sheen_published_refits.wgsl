@@ -50,7 +50,7 @@ fn sheen_refit_threejs(roughness: f32, n_dot_v: f32) -> f32 {
 
 // three.js's 2021 IBLSheenBRDF refitted minimax to min(1, E) of its D_Charlie(r²)·V_Neubelt (r clamped to [0.1, 1]).
 // three.js IBLSheenBRDF (2021): max abs 4.298e-1 (published 7.879e-1, 0.55x), rms 1.213e-1 (published 2.876e-1) over 627 values; roughness r ∈ [0.1, 1] (19 uniform), n·v ∈ [0, 1] (33 uniform), against min(1, E of Charlie D × Ashikhmin's V at α = r²).
-fn sheen_refit_threejs_2021(roughness: f32, n_dot_v: f32) -> f32 {
+fn sheen_refit_threejs_legacy(roughness: f32, n_dot_v: f32) -> f32 {
     let r2 = sheen_published_refits_input(roughness, 1e-1f, 1e0f) * sheen_published_refits_input(roughness, 1e-1f, 1e0f);
     let a = select(-1.1122581e1f * r2 + 1.1510209e1f * sheen_published_refits_input(roughness, 1e-1f, 1e0f) + -6.1037583e0f, -5.148408e2f * r2 + 1.8011287e2f * sheen_published_refits_input(roughness, 1e-1f, 1e0f) + -2.4383598e1f, sheen_published_refits_input(roughness, 1e-1f, 1e0f) < 0.25f);
     let b = select(1.8726265e0f * r2 + -1.5635695e0f * sheen_published_refits_input(roughness, 1e-1f, 1e0f) + 1.1140665e0f, 6.564379e1f * r2 + -2.1075264e1f * sheen_published_refits_input(roughness, 1e-1f, 1e0f) + 3.3068874e0f, sheen_published_refits_input(roughness, 1e-1f, 1e0f) < 0.25f);

@@ -301,7 +301,7 @@ pub static FORMS: [PublishedForm; 7] = [
     ),
     form!(
         2,
-        "threejs_2021",
+        "threejs_legacy",
         "three.js's 2021 IBLSheenBRDF refitted minimax to min(1, E) of its D_Charlie(r²)·V_Neubelt (r clamped to [0.1, 1]).",
         &["roughness", "n_dot_v"],
         &[R, UNIT],
@@ -358,7 +358,7 @@ mod tests {
         let functions: [fn(f32, f32) -> f32; 7] = [
             g::sheen_refit_lambda,
             g::sheen_refit_threejs,
-            g::sheen_refit_threejs_2021,
+            g::sheen_refit_threejs_legacy,
             g::sheen_refit_materialx,
             g::sheen_refit_babylon,
             g::sheen_refit_filament_cloth_charlie,
