@@ -14,9 +14,11 @@ fn files(d: &Path) -> Vec<(PathBuf, Vec<u8>)> {
 }
 
 /// A project with the committed generated/ and a gloss table spec edited, so that a build
-/// replaces its files (and the runtime index keeps its bytes).
+/// replaces its files (and the runtime index, which lists the scenes of fits/scenes too, keeps
+/// its bytes).
 fn project() -> tempfile::TempDir {
     let d = scratch();
+    copy_dir(&root().join("fits/scenes"), &d.path().join("fits/scenes"));
     copy_dir(&root().join("generated"), &d.path().join("generated"));
     let p = d.path().join("fits/gloss_table.toml");
     let t = std::fs::read_to_string(&p).unwrap().replace("count = 256", "count = 128");
