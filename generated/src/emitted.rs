@@ -411,7 +411,7 @@ pub const FUNCTIONS: &[EmittedFunction] = &[
     #[cfg(feature = "sheen")]
     EmittedFunction { module: "sheen_albedo_table", name: "sheen_albedo_lut", domain: &[[0e0, 1e0], [5.4772254e-2, 1e0]], cpu: Cpu::Two(sheen_albedo_table::sheen_albedo_lut) },
     #[cfg(feature = "sheen")]
-    EmittedFunction { module: "sheen_dfg_filament", name: "sheen_dfg_filament", domain: &[[0e0, 1e0], [0e0, 1e0]], cpu: Cpu::Two(sheen_dfg_filament::sheen_dfg_filament) },
+    EmittedFunction { module: "sheen_dfg_filament", name: "sheen_dfg_lut", domain: &[[0e0, 1e0], [0e0, 1e0]], cpu: Cpu::Two(sheen_dfg_filament::sheen_dfg_lut) },
     #[cfg(feature = "scenes")]
     EmittedFunction { module: "scene_cobblestone_gloss", name: "cobblestone_gloss_to_normal_length", domain: &[[3e-1, 9e-1]], cpu: Cpu::One(scene_cobblestone_gloss::cobblestone_gloss_to_normal_length) },
     #[cfg(feature = "scenes")]

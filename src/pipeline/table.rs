@@ -202,7 +202,10 @@ pub fn table_from_values(spec: &Spec, values: Vec<f64>, reference: &Reference) -
     let counts: Vec<usize> = axes.iter().map(|(a, _, _)| a.count).collect();
     let points = table_points(spec);
     assert_eq!(values.len(), points.len() * width, "{name}: {width} values a table point");
-    let v32: Vec<f32> = values.iter().map(|&v| v as f32).collect();
+    // f32 values as the emitted code and textures carry them; subnormals flushed to zero of
+    // the same sign (GPUs flush them, so a subnormal constant is not what a shader computes
+    // with; the change is below 1.2e-38).
+    let v32: Vec<f32> = values.iter().map(|&v| v as f32).map(|v| if v.is_subnormal() { 0.0f32.copysign(v) } else { v }).collect();
     let d32: Vec<(f32, f32)> = axes.iter().map(|(a, _, _)| (a.range[0] as f32, a.range[1] as f32)).collect();
     let (vx, truth) = (&reference.points, &reference.values);
     let approx32: Vec<f32> = vx

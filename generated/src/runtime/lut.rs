@@ -105,6 +105,22 @@ pub const TABLES: &[Table] = &[
         values: &crate::gloss_table::GLOSS_TABLE_TABLE,
         ktx2: Some(crate::gloss_table::GLOSS_TABLE_KTX2),
     },
+    #[cfg(feature = "sheen")]
+    Table {
+        module: "sheen_albedo_table",
+        function: "sheen_albedo_lut",
+        domain: &crate::sheen_albedo_table::SHEEN_ALBEDO_TABLE_DOMAIN,
+        values: &crate::sheen_albedo_table::SHEEN_ALBEDO_TABLE_TABLE,
+        ktx2: Some(crate::sheen_albedo_table::SHEEN_ALBEDO_TABLE_KTX2),
+    },
+    #[cfg(feature = "sheen")]
+    Table {
+        module: "sheen_dfg_filament",
+        function: "sheen_dfg_lut",
+        domain: &crate::sheen_dfg_filament::SHEEN_DFG_FILAMENT_DOMAIN,
+        values: &crate::sheen_dfg_filament::SHEEN_DFG_FILAMENT_TABLE,
+        ktx2: Some(crate::sheen_dfg_filament::SHEEN_DFG_FILAMENT_KTX2),
+    },
 ];
 
 /// The table of a module, if it is a table module compiled in.
@@ -131,10 +147,12 @@ impl Table {
         let src = self.emitted_wgsl();
         let counts: Vec<u32> = (0..self.domain.len())
             .map(|k| {
-                let pat = format!("let i{k} = min(u32(t{k}), ");
+                // `let iK = min(u32(tK), LASTu);` at nodes, `min(u32(max(tK, 0.0f)), LASTu);` at
+                // texel centres: LAST is the last cell's index, the count minus 2.
+                let pat = format!("let i{k} = min(u32(");
                 let at = src.find(&pat).unwrap_or_else(|| panic!("{}: no `{pat}` in the WGSL", self.module));
-                let rest = &src[at + pat.len()..];
-                let last: u32 = rest[..rest.find("u)").expect("`LASTu)`")].parse().expect("integer LAST");
+                let line = &src[at..at + src[at..].find('\n').expect("a line")];
+                let last: u32 = line.rsplit(", ").next().and_then(|r| r.strip_suffix("u);")).and_then(|n| n.parse().ok()).expect("integer LAST");
                 last + 2
             })
             .collect();
