@@ -26,9 +26,10 @@ pub fn n_dot_v(j: usize) -> f64 {
     j as f64 / (NV - 1) as f64
 }
 
-/// The grid's points [r, n·v].
-pub fn points() -> Vec<Vec<f64>> {
-    (0..NR * NV).map(|k| vec![roughness(k / NV), n_dot_v(k % NV)]).collect()
+/// The grid's points [r, n·v] (built once: the refits' objectives read them at every step).
+pub fn points() -> &'static [Vec<f64>] {
+    static POINTS: OnceLock<Vec<Vec<f64>>> = OnceLock::new();
+    POINTS.get_or_init(|| (0..NR * NV).map(|k| vec![roughness(k / NV), n_dot_v(k % NV)]).collect())
 }
 
 /// The domain line of an item on this grid.

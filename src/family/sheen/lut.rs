@@ -30,9 +30,9 @@ pub fn hammersley(i: u32, n: u32) -> (f64, f64) {
     (i as f64 / n as f64, i.reverse_bits() as f64 * (0.5 / 2147483648.0))
 }
 
+/// D_Charlie at n·h (both sources: (2 + 1/α) (1 − NoH²)^(1/(2α)) / 2π).
 fn d_charlie(noh: f64, alpha: f64) -> f64 {
-    let inv = 1.0 / alpha;
-    (2.0 + inv) * (1.0 - noh * noh).max(0.0).powf(0.5 * inv) / (2.0 * PI)
+    crate::shading::charlie::d_charlie(alpha, (1.0 - noh * noh).max(0.0).sqrt())
 }
 
 fn v_ashikhmin(nov: f64, nol: f64) -> f64 {

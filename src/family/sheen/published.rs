@@ -55,7 +55,7 @@ fn candidates(item: &mut Item, values: &[f64], saturates: bool) {
     let mut best = (f64::INFINITY, Target::ALL[0]);
     for t in Target::ALL {
         let truth: Vec<f64> = t.albedo().iter().map(|&e| if saturates { e.min(1.0) } else { e }).collect();
-        let (m, _, _) = crate::validate::measure(&grid::points(), &truth, values);
+        let (m, _, _) = crate::validate::measure(grid::points(), &truth, values);
         item.extra.push((format!("max_abs_error_vs_{}", t.key()), m));
         if m < best.0 {
             best = (m, t);
@@ -203,7 +203,7 @@ fn gltf_albedo() -> Item {
         "glTF sheen albedo E under Estevez–Kulla's Λ curve",
         "KHR_materials_sheen (V_Sheen with lambdaSheen); the exact Smith Λ of the Charlie distribution",
         &grid::domain(Convention::Squared),
-        &grid::points(),
+        grid::points(),
         exact,
         ek,
     );

@@ -84,8 +84,7 @@ impl Form {
     }
 
     fn max_error(&self, c: &[f64], truth: &[f64]) -> f64 {
-        let pts = grid::points();
-        pts.iter().zip(truth).fold(0.0f64, |m, (p, t)| {
+        grid::points().iter().zip(truth).fold(0.0f64, |m, (p, t)| {
             let e = ((self.measured)(self.program.eval_f64(&(self.inputs)(p[0], p[1]), c)[0]) - t).abs();
             if e.is_nan() { f64::INFINITY } else { m.max(e) }
         })
@@ -101,7 +100,7 @@ impl Form {
     }
 
     pub fn errors(&self, c: &[f64]) -> Errors {
-        let (max_abs_error, rms_error, _) = crate::validate::measure(&grid::points(), &(self.truth)(), &self.values(c));
+        let (max_abs_error, rms_error, _) = crate::validate::measure(grid::points(), &(self.truth)(), &self.values(c));
         Errors { max_abs_error, rms_error }
     }
 
