@@ -28,7 +28,9 @@
 //!   and 0.5 ulp on the CPU: Δq = (Δa − qΔb)/b to first order (the rest in `rem`), plus a new
 //!   ε of 3 ulp of the quotient.
 //! - Subnormals may be flushed to zero: an argument or result below f32::MIN_POSITIVE in
-//!   magnitude gets a new ε of its own magnitude.
+//!   magnitude gets a new ε of its own magnitude. A normal CPU value v whose GPU side may be
+//!   subnormal (|v| − bound < MIN_POSITIVE) may come back as 0: the deviation is then |v|,
+//!   so it gets a new ε of |v| − bound (what the old bound lacks, less than MIN_POSITIVE).
 //! - sqrt: 5 ulp of the result (1/inverseSqrt), plus min(Δ/(2√x), √Δ) for an input deviation Δ.
 //! - sin/cos: WGSL (and Vulkan's SPIR-V precision table) allow an absolute error of 2^-11
 //!   for arguments in [−π, π] (no bound outside: the evaluation panics if either side's
@@ -338,7 +340,14 @@ impl Program {
 
     /// An f32 value; a subnormal may be flushed to zero on the GPU.
     fn f(&self, v: f32, g: f32, d: Dev, shape: Shape) -> V {
-        let d = if v != 0.0 && v.abs() < f32::MIN_POSITIVE { self.fresh(d, v.abs() as f64) } else { d };
+        let d = if v != 0.0 && v.abs() < f32::MIN_POSITIVE {
+            self.fresh(d, v.abs() as f64)
+        } else if v.is_finite() && v != 0.0 {
+            let short = v.abs() as f64 - d.radius();
+            if short > 0.0 && short < f32::MIN_POSITIVE as f64 { self.fresh(d, short) } else { d }
+        } else {
+            d
+        };
         let g = if self.gpu.get().flush_subnormals && g.abs() < f32::MIN_POSITIVE { 0.0 * g.signum() } else { g };
         V::F { v, g, d, shape }
     }
