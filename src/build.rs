@@ -4,6 +4,12 @@
 //! before the scene modules (which read their specs' coefficients from generated/json); the
 //! runtime index last. `--check` renders everything in memory and compares instead of writing.
 //!
+//! A build skips a spec whose last build is still current ([`RECORD_PATH`] records its input
+//! hash and the SHA-256 of each file it wrote; both must match) and a scene module whose JSON
+//! says the same of it and its nodes; `--force` rebuilds them. The input hash covers the spec
+//! text (and what its kind reads) and the generator version, not the code: after changing the
+//! code, `build --force` (`build --check` re-renders everything and finds what changed).
+//!
 //! Family spec kinds and scene features come from the registry (`crate::family`); the stages
 //! below never name a family.
 
@@ -14,6 +20,7 @@ use crate::pipeline::{self, BuildError, Built, CustomBuild, Mode};
 use crate::scene::{self, Scene, SceneReport};
 use crate::spec::{self, Spec, SpecError};
 use rayon::prelude::*;
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 /// Errors of a build. [`Error::is_input`] tells the user's input (exit 2) from a failed job.
@@ -166,6 +173,8 @@ pub fn load_scenes(paths: &Paths) -> Result<Vec<Scene>, Error> {
 pub struct Summary {
     pub built: Vec<(Built, f64)>,
     pub scenes: Vec<(String, f64)>,
+    /// Specs and scene modules skipped as up to date (their files reused as they are).
+    pub up_to_date: Vec<String>,
     /// Files rendered in all (written or unchanged).
     pub files: usize,
     pub written: usize,
@@ -174,11 +183,78 @@ pub struct Summary {
     pub specs: usize,
 }
 
-/// `shadefit build [--only A,B] [--check] [--target T,..]`; `tick(total)` is called once per
-/// spec built. Every WGSL module is also written in `extra` targets and its spec's own
+/// `shadefit build [--only A,B] [--check] [--force] [--target T,..]`; `tick(total)` is called
+/// once per spec built. Every WGSL module is also written in `extra` targets and its spec's own
 /// (`[emit] targets`); with neither, the outputs are the WGSL modules and their siblings only.
-pub fn run(paths: &Paths, only: &[String], check: bool, extra: &[Target], tick: &(dyn Fn(usize) + Sync)) -> Result<Summary, Error> {
-    run_merged(paths, only, check, extra, tick, Default::default())
+/// Without `force` (and without `check`, which renders everything), specs and scene modules
+/// whose last build is current are skipped.
+pub fn run(paths: &Paths, only: &[String], check: bool, force: bool, extra: &[Target], tick: &(dyn Fn(usize) + Sync)) -> Result<Summary, Error> {
+    run_merged(paths, only, check, force, extra, tick, Default::default())
+}
+
+/// The build record, in generated/: for each spec, the input hash of its last build and the
+/// SHA-256 of every file that build wrote.
+pub const RECORD_PATH: &str = "build-record.json";
+
+/// Spec name → (input hash, file → SHA-256).
+type Record = BTreeMap<String, (String, BTreeMap<String, String>)>;
+
+fn sha(bytes: &[u8]) -> String {
+    use sha2::{Digest, Sha256};
+    pipeline::hex(&Sha256::digest(bytes))
+}
+
+/// The record in `generated` (empty when there is none or it does not parse: then nothing is
+/// skipped).
+fn read_record(generated: &Path) -> Record {
+    let v: serde_json::Value = match std::fs::read(generated.join(RECORD_PATH)).ok().and_then(|b| serde_json::from_slice(&b).ok()) {
+        Some(v) => v,
+        None => return Record::new(),
+    };
+    let Some(specs) = v["specs"].as_object() else { return Record::new() };
+    specs
+        .iter()
+        .filter_map(|(name, e)| {
+            let files = e["files"].as_object()?.iter().map(|(p, h)| Some((p.clone(), h.as_str()?.to_string()))).collect::<Option<_>>()?;
+            Some((name.clone(), (e["input_hash"].as_str()?.to_string(), files)))
+        })
+        .collect()
+}
+
+fn render_record(record: &Record) -> Artifact {
+    let specs: serde_json::Map<String, serde_json::Value> = record
+        .iter()
+        .map(|(name, (hash, files))| (name.clone(), serde_json::json!({"input_hash": hash, "files": files})))
+        .collect();
+    let v = serde_json::json!({
+        "description": "What each spec's last `shadefit build` wrote: its input hash and the SHA-256 of each file. \
+            `build` skips a spec whose hash and files still match; `build --force` rebuilds it.",
+        "generator": emit::GENERATOR,
+        "specs": specs,
+    });
+    let mut text = serde_json::to_string_pretty(&v).expect("JSON values serialise");
+    text.push('\n');
+    Artifact { path: RECORD_PATH.into(), contents: text.into_bytes() }
+}
+
+fn record_entry(hash: String, artifacts: &[Artifact]) -> (String, BTreeMap<String, String>) {
+    (hash, artifacts.iter().map(|a| (a.path.display().to_string(), sha(&a.contents))).collect())
+}
+
+/// The files of `name`'s last build, read back, when its record holds `hash` and every recorded
+/// file is on disk unchanged.
+fn reuse(generated: &Path, record: &Record, name: &str, hash: &str) -> Option<Vec<Artifact>> {
+    let (h, files) = record.get(name)?;
+    if h != hash || files.is_empty() {
+        return None;
+    }
+    files
+        .iter()
+        .map(|(p, want)| {
+            let contents = std::fs::read(generated.join(p)).ok()?;
+            (&sha(&contents) == want).then(|| Artifact { path: p.into(), contents })
+        })
+        .collect()
 }
 
 /// [`run`] with the cells `merge` gathered, by spec name, handed to those specs' builders
@@ -187,6 +263,7 @@ fn run_merged(
     paths: &Paths,
     only: &[String],
     check: bool,
+    force: bool,
     extra: &[Target],
     tick: &(dyn Fn(usize) + Sync),
     mut merged: std::collections::BTreeMap<String, Vec<u8>>,
@@ -213,6 +290,10 @@ fn run_merged(
     if tx.is_some() {
         keep_modules(paths, &index)?;
     }
+    let previous = read_record(&paths.generated);
+    let mut record: Record = previous.clone();
+    // Specs no longer in the folder leave the record.
+    record.retain(|name, _| specs.iter().any(|s| &s.file.name == name));
     let build_all = |specs: &[&Spec]| -> Result<Vec<(Built, f64)>, Error> {
         let results: Vec<Result<(Built, f64), Error>> = specs
             .par_iter()
@@ -225,9 +306,25 @@ fn run_merged(
             .collect();
         results.into_iter().collect()
     };
+    // The selected specs to reuse (current, not forced, not handed merged cells); the rest are
+    // built.
+    let mut reused: Vec<(String, Vec<Artifact>)> = Vec::new();
+    let mut needs_build = |s: &Spec, rebuilt: &[String]| -> bool {
+        let skip = !check && !force && s.merged.is_none() && family::reads(s).iter().all(|r| !rebuilt.iter().any(|b| b == r));
+        match skip.then(|| reuse(&paths.generated, &previous, &s.file.name, &hash_of(s))).flatten() {
+            Some(files) => {
+                tick(selected.len());
+                reused.push((s.file.name.clone(), files));
+                false
+            }
+            None => true,
+        }
+    };
     // Specs that read other specs' committed outputs (a refit of a form fitted to a committed
-    // table) are built after the others are written, so they read this build's outputs.
+    // table) are built after the others are written, so they read this build's outputs; one
+    // is rebuilt whenever a spec it reads was.
     let (later, first): (Vec<&Spec>, Vec<&Spec>) = selected.iter().copied().partition(|s| !family::reads(s).is_empty());
+    let first: Vec<&Spec> = first.into_iter().filter(|s| needs_build(s, &[])).collect();
     let mut built = build_all(&first)?;
     let mut artifacts: Vec<_> = built.iter().flat_map(|(b, _)| b.artifacts.clone()).collect();
     // The scene modules read their specs' coefficients from generated/json: write this build's
@@ -236,6 +333,8 @@ fn run_merged(
         Some(tx) => tx.write(&artifacts)?,
         None => 0,
     };
+    let rebuilt: Vec<String> = built.iter().map(|(b, _)| b.name.clone()).collect();
+    let later: Vec<&Spec> = later.into_iter().filter(|s| needs_build(s, &rebuilt)).collect();
     let reading = build_all(&later)?;
     let reading_files: Vec<_> = reading.iter().flat_map(|(b, _)| b.artifacts.clone()).collect();
     if let Some(tx) = tx.as_mut() {
@@ -245,19 +344,36 @@ fn run_merged(
     built.extend(reading);
     // Summaries list the specs in the order they were selected.
     built.sort_by_key(|(b, _)| selected.iter().position(|s| s.file.name == b.name));
-    let spec_files = artifacts.len();
+    reused.sort_by_key(|(n, _)| selected.iter().position(|s| &s.file.name == n));
+    let mut up_to_date: Vec<String> = reused.iter().map(|(n, _)| n.clone()).collect();
+    for (b, _) in &built {
+        let spec = specs.iter().find(|s| s.file.name == b.name).expect("built specs are loaded specs");
+        record.insert(b.name.clone(), record_entry(hash_of(spec), &b.artifacts));
+    }
+    // Every file of a spec: those just built and those reused (the same bytes, so unchanged).
+    let spec_files = |name: &str| -> Option<&[Artifact]> {
+        built.iter().find(|(b, _)| b.name == name).map(|(b, _)| b.artifacts.as_slice()).or_else(|| reused.iter().find(|(n, _)| n == name).map(|(_, f)| f.as_slice()))
+    };
+    artifacts.extend(reused.iter().flat_map(|(_, f)| f.iter().cloned()));
+    let spec_count = artifacts.len();
     let mut scene_times = Vec::new();
     if only.is_empty() {
-        // Every scene module, with the node files of this build recorded for its cache.
+        // Every scene module, with the node files of this build recorded for its cache; one
+        // whose last build is current is reused (after the spec files are written: it compares
+        // its nodes' recorded files with those on disk).
         for sc in &scenes {
             let t = std::time::Instant::now();
+            if !check && !force && let Some(files) = scene::fresh_files(sc, &specs, &paths.generated) {
+                artifacts.extend(files);
+                up_to_date.push(sc.module());
+                continue;
+            }
             let nodes: Vec<scene::NodeRecord> = scene::plan(sc)
                 .nodes
                 .iter()
                 .filter_map(|n| {
-                    let (b, _) = built.iter().find(|(b, _)| &b.name == n)?;
                     let spec = specs.iter().find(|s| &s.file.name == n)?;
-                    Some(scene::node_record(n, pipeline::input_hash(spec), &b.artifacts))
+                    Some(scene::node_record(n, pipeline::input_hash(spec), spec_files(n)?))
                 })
                 .collect();
             let sb = scene::build_scene(sc, &specs, &paths.generated, &nodes)
@@ -266,6 +382,7 @@ fn run_merged(
             scene_times.push((sc.module(), t.elapsed().as_secs_f64()));
         }
     }
+    artifacts.push(render_record(&record));
     artifacts.push(index);
     // Other targets of every module (spec or scene), from the WGSL just rendered.
     let module_targets = |module: &str| {
@@ -296,10 +413,10 @@ fn run_merged(
     }
     if let Some(mut tx) = tx {
         // The spec files were written above; now the scene modules and the runtime index.
-        written += tx.write(&artifacts[spec_files..])?;
+        written += tx.write(&artifacts[spec_count..])?;
         tx.commit()?;
     }
-    Ok(Summary { built, scenes: scene_times, files: artifacts.len(), written, stale, specs: selected.len() })
+    Ok(Summary { built, scenes: scene_times, up_to_date, files: artifacts.len(), written, stale, specs: selected.len() })
 }
 
 /// `shadefit build --scene FILE [--force]`: only the nodes the scene reaches, each only when its
@@ -337,8 +454,24 @@ pub fn run_scene(paths: &Paths, file: &Path, force: bool, extra: &[Target]) -> R
     all.sort();
     all.dedup();
     tx.write(&targets::package_files(&all))?;
+    // The nodes rebuilt now, in the build record, so a later `build` skips them.
+    if !report.built.is_empty() {
+        write_scene_nodes(paths, &specs, &report, &mut tx)?;
+    }
     tx.commit()?;
     Ok(report)
+}
+
+fn write_scene_nodes(paths: &Paths, specs: &[Spec], report: &SceneReport, tx: &mut Transaction) -> Result<(), Error> {
+    let mut record = read_record(&paths.generated);
+    record.retain(|name, _| specs.iter().any(|s| &s.file.name == name));
+    for (name, _, files) in report.nodes.iter().filter(|(n, _, _)| report.built.contains(n)) {
+        if let Some(spec) = specs.iter().find(|s| &s.file.name == name) {
+            record.insert(name.clone(), (hash_of(spec), files.clone()));
+        }
+    }
+    tx.write(&[render_record(&record)])?;
+    Ok(())
 }
 
 /// Whether a spec's committed outputs were generated from it, by hashes alone.
@@ -529,7 +662,7 @@ pub fn merge(paths: &Paths, files: &[PathBuf], tick: &(dyn Fn(usize) + Sync)) ->
         }
         merged.insert(name, payload);
     }
-    run_merged(paths, &names, false, &[], tick, merged)
+    run_merged(paths, &names, false, true, &[], tick, merged)
 }
 
 #[cfg(test)]

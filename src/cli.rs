@@ -130,10 +130,10 @@ pub fn merge(paths: &Paths, files: &[PathBuf]) -> Result<()> {
     Ok(())
 }
 
-pub fn build(paths: &Paths, only: &[String], check: bool, targets: &[crate::emit::targets::Target]) -> Result<()> {
+pub fn build(paths: &Paths, only: &[String], check: bool, force: bool, targets: &[crate::emit::targets::Target]) -> Result<()> {
     let start = std::time::Instant::now();
     let pb = progress(0, if check { "check" } else { "build" });
-    let summary = build::run(paths, only, check, targets, &|total| {
+    let summary = build::run(paths, only, check, force, targets, &|total| {
         pb.set_length(total as u64);
         pb.inc(1);
     });
@@ -158,6 +158,9 @@ pub fn build(paths: &Paths, only: &[String], check: bool, targets: &[crate::emit
     }
     for (n, t) in &summary.scenes {
         println!("{n:<22} scene module  [{t:.1} s]");
+    }
+    for n in &summary.up_to_date {
+        println!("{n:<22} up to date (skipped; --force rebuilds)");
     }
     println!(
         "{} file(s) written, {} unchanged; {:.1} s wall on {} thread(s)",

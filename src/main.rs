@@ -59,8 +59,10 @@ enum Command {
         /// whose inputs and files are unchanged since its last build.
         #[arg(long, conflicts_with_all = ["only", "check"])]
         scene: Option<PathBuf>,
-        /// With --scene: rebuild every reached node.
-        #[arg(long, requires = "scene")]
+        /// Rebuild every selected spec (with --scene: every reached node), even those whose
+        /// last build is current (same input hash, files unchanged). The input hash covers
+        /// the specs, not the code: after changing the code, build with --force.
+        #[arg(long, conflicts_with = "check")]
         force: bool,
         /// Comma-separated outputs besides the WGSL modules, for every module: wgsl (the
         /// modules, always written), wgsl-plain, hlsl, glsl (450 core), glsl-es (ES 300), msl,
@@ -190,7 +192,7 @@ fn main() -> ExitCode {
         }
         Command::Build { scene: Some(file), force, target, .. } => cli::build_scene(&paths, &file, force, &target),
         Command::Build { only, shard: Some(shard), shard_dir, .. } => cli::build_shard(&paths, &only, &shard, &shard_dir),
-        Command::Build { only, check, target, .. } => cli::build(&paths, &only, check, &target),
+        Command::Build { only, check, force, target, .. } => cli::build(&paths, &only, check, force, &target),
         Command::Merge { files } => cli::merge(&paths, &files),
         Command::Fit { data, x, y, model, objective, json, emit, target, name, function, args } => {
             let emit = emit.map(|dir| cli::FitEmit { dir, targets: target, name, function, args });

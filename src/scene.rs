@@ -437,12 +437,44 @@ fn recorded_fresh(generated: &Path, rec: &Value, hash: &str) -> bool {
         })
 }
 
+/// The scene module's files as its last build wrote them, read back, when that build is still
+/// current: its JSON records the scene's input hash, its files and every reached node's files
+/// are unchanged on disk, and the nodes it records are the plan's.
+pub fn fresh_files(scene: &Scene, specs: &[Spec], generated: &Path) -> Option<Vec<Artifact>> {
+    let p = plan(scene);
+    let json_rel = Path::new("json").join(format!("{}.json", scene.module()));
+    let text = std::fs::read(generated.join(&json_rel)).ok()?;
+    let previous: Value = serde_json::from_slice(&text).ok()?;
+    if !recorded_fresh(generated, &previous, &scene_hash(scene, specs, &p).ok()?) {
+        return None;
+    }
+    let nodes = previous["nodes"].as_array()?;
+    if nodes.len() != p.nodes.len() {
+        return None;
+    }
+    for n in &p.nodes {
+        let rec = nodes.iter().find(|r| r["name"].as_str() == Some(n.as_str()))?;
+        if !recorded_fresh(generated, rec, &input_hash(find(&scene.file.name, specs, n).ok()?)) {
+            return None;
+        }
+    }
+    let mut out: Vec<Artifact> = previous["files"]
+        .as_object()?
+        .keys()
+        .map(|rel| Some(Artifact { path: rel.into(), contents: std::fs::read(generated.join(rel)).ok()? }))
+        .collect::<Option<_>>()?;
+    out.push(Artifact { path: json_rel, contents: text });
+    Some(out)
+}
+
 /// Outcome of `build --scene`.
 pub struct SceneReport {
     pub built: Vec<String>,
     pub up_to_date: Vec<String>,
     pub skipped: Vec<String>,
     pub records: Vec<Value>,
+    /// Each reached spec node as the scene JSON records it (built now or carried over).
+    pub nodes: Vec<NodeRecord>,
     pub written: usize,
 }
 
@@ -523,7 +555,7 @@ pub fn build(
     artifacts.extend(translated);
     written += tx.write(&artifacts)?;
     let skipped = specs.iter().map(|s| s.file.name.clone()).filter(|n| !p.nodes.contains(n)).collect();
-    Ok(SceneReport { built, up_to_date, skipped, records, written })
+    Ok(SceneReport { built, up_to_date, skipped, records, nodes, written })
 }
 
 /// The runtime index with every scene's functions (read from the scenes' committed JSON-free

@@ -127,6 +127,68 @@ fn build_check_passes_on_committed_tree_and_catches_a_changed_spec() {
     assert_eq!(before, snapshot(&d.path().join("generated")));
 }
 
+/// The specs `build` printed as built (a verification line) and as skipped.
+fn built_and_skipped(o: &std::process::Output) -> (Vec<String>, Vec<String>) {
+    let out = String::from_utf8_lossy(&o.stdout);
+    let names = |tag: &str| out.lines().filter(|l| l.contains(tag)).map(|l| l.split_whitespace().next().unwrap().to_string()).collect();
+    (names(" max abs "), names(" up to date (skipped"))
+}
+
+#[test]
+fn build_skips_specs_whose_last_build_is_current_and_force_rebuilds_them() {
+    let d = scratch();
+    let only = ["build", "--only", "ggx_albedo_avg,skin_sh_lut"];
+    let g = d.path().join("generated");
+    let o = shadefit(&only, Some(d.path()));
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(built_and_skipped(&o), (vec!["ggx_albedo_avg".into(), "skin_sh_lut".into()], vec![]));
+    let cold = snapshot(&g);
+    assert!(cold.iter().any(|(p, _)| p.as_os_str() == "build-record.json"), "the build records what it wrote");
+
+    // Warm: both skipped, nothing written.
+    let o = shadefit(&only, Some(d.path()));
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(built_and_skipped(&o), (vec![], vec!["ggx_albedo_avg".into(), "skin_sh_lut".into()]));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("0 file(s) written"));
+    assert_eq!(cold, snapshot(&g));
+
+    // A file edited by hand: that spec alone is rebuilt, and its file restored.
+    let wgsl = g.join("wgsl/skin_sh_lut.wgsl");
+    let text = std::fs::read_to_string(&wgsl).unwrap();
+    std::fs::write(&wgsl, text.replace("fn ", "fn  ")).unwrap();
+    let o = shadefit(&only, Some(d.path()));
+    assert_eq!(built_and_skipped(&o), (vec!["skin_sh_lut".into()], vec!["ggx_albedo_avg".into()]));
+    assert_eq!(cold, snapshot(&g));
+
+    // A deleted file, likewise.
+    std::fs::remove_file(g.join("json/ggx_albedo_avg.json")).unwrap();
+    let o = shadefit(&only, Some(d.path()));
+    assert_eq!(built_and_skipped(&o), (vec!["ggx_albedo_avg".into()], vec!["skin_sh_lut".into()]));
+    assert_eq!(cold, snapshot(&g));
+
+    // An edited spec (a comment changes its text, so its input hash): rebuilt, then current.
+    let spec = d.path().join("fits/ggx_albedo_avg.toml");
+    let t = std::fs::read_to_string(&spec).unwrap();
+    std::fs::write(&spec, format!("{t}\n# edited\n")).unwrap();
+    let o = shadefit(&only, Some(d.path()));
+    assert_eq!(built_and_skipped(&o), (vec!["ggx_albedo_avg".into()], vec!["skin_sh_lut".into()]));
+    let o = shadefit(&only, Some(d.path()));
+    assert_eq!(built_and_skipped(&o).0, Vec::<String>::new());
+    std::fs::write(&spec, t).unwrap();
+
+    // --force rebuilds both, to the same bytes as the cold build.
+    let mut forced = only.to_vec();
+    forced.push("--force");
+    let o = shadefit(&forced, Some(d.path()));
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(built_and_skipped(&o), (vec!["ggx_albedo_avg".into(), "skin_sh_lut".into()], vec![]));
+    assert_eq!(cold, snapshot(&g));
+
+    // --check renders everything and does not take --force.
+    let o = shadefit(&["build", "--check", "--force"], Some(d.path()));
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+}
+
 #[test]
 fn build_check_rejects_f32_coefficients_that_are_not_the_fit_s() {
     // `build --check` reads a fit's f32 arrays from the committed JSON; they must be f32 values
