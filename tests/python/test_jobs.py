@@ -1,8 +1,9 @@
 """The farm job files (jobs/slurm, jobs/kubernetes): the Slurm scripts run here as an array job
 would run them (SLURM_ARRAY_TASK_ID/COUNT set by hand, no scheduler) on a small spec, merged, and
 compared byte for byte with one build; `bash -n` on both; the Kubernetes manifests parsed (PyYAML)
-and checked for what an Indexed Job needs. Neither Slurm nor a Kubernetes API server runs here:
-`sbatch` and `kubectl apply` themselves are not exercised."""
+and checked for what an Indexed Job needs. `scripts/slurm-test` (in the full suite) submits the
+same scripts to a real one-node Slurm; no Kubernetes API server runs here, so `kubectl apply`
+itself is not exercised."""
 
 import os
 import shutil
