@@ -567,6 +567,7 @@ pub fn shard(paths: &Paths, only: &[String], (k, n): (u64, u64), out: &Path) -> 
             "cells": [range.start, range.end],
             "total_cells": total,
             "payload_bytes": payload.len(),
+            "payload_sha256": sha(&payload),
         });
         let mut bytes = format!("{SHARD_MAGIC}\n{header}\n").into_bytes();
         bytes.extend_from_slice(&payload);
@@ -598,7 +599,18 @@ fn read_shard(path: &Path) -> Result<ShardFile, Error> {
     let header: serde_json::Value = lines.next().and_then(|h| serde_json::from_slice(h).ok()).ok_or_else(|| bad("line 2 is not a JSON header".into()))?;
     let payload = lines.next().unwrap_or_default().to_vec();
     let field = |f: &str| header[f].as_u64().ok_or_else(|| bad(format!("header field '{f}' is missing")));
-    let cells = [header["cells"][0].as_u64(), header["cells"][1].as_u64()];
+    let text = |f: &str| header[f].as_str().ok_or_else(|| bad(format!("header field '{f}' is missing")));
+    if text("generator")? != emit::GENERATOR {
+        return Err(bad(format!("made by {} (this is {}); run its shards again", text("generator")?, emit::GENERATOR)));
+    }
+    // A checksum of the payload: a corrupted or edited cell is refused, not merged.
+    if sha(&payload) != text("payload_sha256")? {
+        return Err(bad("the payload does not match its checksum (header field 'payload_sha256'): the file is corrupted or was edited; run its shard again".into()));
+    }
+    let cells = match header["cells"].as_array().map(Vec::as_slice) {
+        Some([a, b]) => [a.as_u64(), b.as_u64()],
+        _ => [None, None],
+    };
     let sf = ShardFile {
         spec: header["spec"].as_str().ok_or_else(|| bad("header field 'spec' is missing".into()))?.to_string(),
         hash: header["input_hash"].as_str().ok_or_else(|| bad("header field 'input_hash' is missing".into()))?.to_string(),
@@ -649,7 +661,8 @@ pub fn merge(paths: &Paths, files: &[PathBuf], tick: &(dyn Fn(usize) + Sync)) ->
                 return Err(at(format!("shard {}/{} of {} cells does not belong with {}-way shards of {total} cells", p.k, p.n, p.total, n)));
             }
             if p.k != i as u64 {
-                return Err(at(format!("shard {} is {}; each of 0..{n} must be given once", i, if p.k < i as u64 { "given twice" } else { "missing" })));
+                let why = if p.k < i as u64 { format!("shard {} is given twice", p.k) } else { format!("shard {i} is missing") };
+                return Err(at(format!("{why}; each of 0..{n} must be given once")));
             }
             let r = shard_range(total, p.k, n);
             if p.cells != [r.start, r.end] {

@@ -82,7 +82,20 @@ fn bad_shard_sets_are_input_errors_and_write_nothing() {
     };
     expect_2(&["merge", &shard(0), &shard(2)], "shard 1 is missing");
     expect_2(&["merge", &shard(0), &shard(1)], "2 of 3 shards given");
-    expect_2(&["merge", &shard(0), &shard(1), &shard(1)], "given twice");
+    expect_2(&["merge", &shard(0), &shard(1), &shard(1)], "shard 1 is given twice");
+    expect_2(&["merge", &shard(0), &shard(1), &shard(1), &shard(2)], "shard 1 is given twice");
+    // Header fields that do not belong: another generator, three cell bounds.
+    for (from, to, fragment) in [("\"generator\":\"shadefit ", "\"generator\":\"shadefit 9", "run its shards again"), ("\"cells\":[", "\"cells\":[0,", "'cells'")] {
+        let bytes = std::fs::read(p.path().join(shard(0))).unwrap();
+        // The magic and header lines are text; the payload after them is kept byte for byte.
+        let end = bytes.iter().enumerate().filter(|(_, b)| **b == b'\n').nth(1).unwrap().0;
+        let head = String::from_utf8(bytes[..end].to_vec()).unwrap();
+        assert!(head.contains(from), "{from} is not in the header {head}");
+        let mut edited = head.replacen(from, to, 1).into_bytes();
+        edited.extend_from_slice(&bytes[end..]);
+        std::fs::write(p.path().join("shards/edited.shard"), edited).unwrap();
+        expect_2(&["merge", "shards/edited.shard", &shard(1), &shard(2)], fragment);
+    }
     expect_2(&["build", "--shard", "3/3"], "0 <= K < N");
     expect_2(&["build", "--shard", "x"], "K/N");
     std::fs::write(p.path().join("shards/junk.shard"), "not a shard\n").unwrap();
@@ -93,8 +106,9 @@ fn bad_shard_sets_are_input_errors_and_write_nothing() {
 }
 
 /// `merge` builds from the shards' cells, not by computing them again: a shard whose first
-/// cell's value is changed in its payload (one mantissa bit, the payload's size kept) merges into
-/// a JSON that differs from the single build's, and only in that value.
+/// cell's value is changed in its payload (one mantissa bit, the payload's size kept) is refused
+/// for its checksum; with the checksum of the changed payload it merges into a JSON that differs
+/// from the single build's, and only in that value.
 #[test]
 fn merge_builds_from_the_shards_cells() {
     let one = project(SPEC);
@@ -113,6 +127,22 @@ fn merge_builds_from_the_shards_cells() {
     let changed = f64::from_le_bytes(bytes[start..start + 8].try_into().unwrap());
     assert!(changed != cell && (changed - cell).abs() <= 2f64.powi(-31) * cell.abs(), "{cell} → {changed}");
     std::fs::write(&path, &bytes).unwrap();
+    // The payload's checksum no longer matches: refused, naming the file.
+    let r = run(many.path(), &["merge", path.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&r.stderr).to_string();
+    assert_eq!(r.status.code(), Some(2), "{err}");
+    assert!(err.contains("checksum") && err.contains(&path.file_name().unwrap().to_string_lossy().to_string()), "{err}");
+    // With the checksum of the changed payload in the header, the changed cell is merged.
+    use sha2::Digest;
+    let header_end = start - 1;
+    let header_start = bytes.iter().position(|b| *b == b'\n').unwrap() + 1;
+    let mut header: serde_json::Value = serde_json::from_slice(&bytes[header_start..header_end]).unwrap();
+    let sum: String = sha2::Sha256::digest(&bytes[start..]).iter().map(|b| format!("{b:02x}")).collect();
+    header["payload_sha256"] = serde_json::json!(sum);
+    let mut rewritten = bytes[..header_start].to_vec();
+    rewritten.extend(header.to_string().into_bytes());
+    rewritten.extend(&bytes[header_end..]);
+    std::fs::write(&path, &rewritten).unwrap();
     let r = run(many.path(), &["merge", path.to_str().unwrap()]);
     assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
     let got = std::fs::read_to_string(many.path().join("generated/json/msd_s.json")).unwrap();
