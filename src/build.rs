@@ -199,21 +199,17 @@ pub const RECORD_PATH: &str = "build-record.json";
 /// Spec name → (input hash, file → SHA-256).
 type Record = BTreeMap<String, (String, BTreeMap<String, String>)>;
 
-fn sha(bytes: &[u8]) -> String {
-    use sha2::{Digest, Sha256};
-    pipeline::hex(&Sha256::digest(bytes))
-}
-
-/// The record in `generated` (empty when there is none or it does not parse: then nothing is
-/// skipped).
-fn read_record(generated: &Path) -> Record {
+/// The record in `generated`, less the specs no longer in `specs` (empty when there is none or it
+/// does not parse: then nothing is skipped).
+fn read_record(generated: &Path, specs: &[Spec]) -> Record {
     let v: serde_json::Value = match std::fs::read(generated.join(RECORD_PATH)).ok().and_then(|b| serde_json::from_slice(&b).ok()) {
         Some(v) => v,
         None => return Record::new(),
     };
-    let Some(specs) = v["specs"].as_object() else { return Record::new() };
-    specs
+    let Some(entries) = v["specs"].as_object() else { return Record::new() };
+    entries
         .iter()
+        .filter(|(name, _)| specs.iter().any(|s| &&s.file.name == name))
         .filter_map(|(name, e)| {
             let files = e["files"].as_object()?.iter().map(|(p, h)| Some((p.clone(), h.as_str()?.to_string()))).collect::<Option<_>>()?;
             Some((name.clone(), (e["input_hash"].as_str()?.to_string(), files)))
@@ -237,24 +233,11 @@ fn render_record(record: &Record) -> Artifact {
     Artifact { path: RECORD_PATH.into(), contents: text.into_bytes() }
 }
 
-fn record_entry(hash: String, artifacts: &[Artifact]) -> (String, BTreeMap<String, String>) {
-    (hash, artifacts.iter().map(|a| (a.path.display().to_string(), sha(&a.contents))).collect())
-}
-
 /// The files of `name`'s last build, read back, when its record holds `hash` and every recorded
 /// file is on disk unchanged.
 fn reuse(generated: &Path, record: &Record, name: &str, hash: &str) -> Option<Vec<Artifact>> {
-    let (h, files) = record.get(name)?;
-    if h != hash || files.is_empty() {
-        return None;
-    }
-    files
-        .iter()
-        .map(|(p, want)| {
-            let contents = std::fs::read(generated.join(p)).ok()?;
-            (&sha(&contents) == want).then(|| Artifact { path: p.into(), contents })
-        })
-        .collect()
+    let (_, files) = record.get(name).filter(|(h, _)| h == hash)?;
+    pipeline::read_unchanged(generated, files.iter().map(|(p, d)| (p.as_str(), d.as_str())))
 }
 
 /// [`run`] with the cells `merge` gathered, by spec name, handed to those specs' builders
@@ -290,10 +273,8 @@ fn run_merged(
     if tx.is_some() {
         keep_modules(paths, &index)?;
     }
-    let previous = read_record(&paths.generated);
+    let previous = read_record(&paths.generated, &specs);
     let mut record: Record = previous.clone();
-    // Specs no longer in the folder leave the record.
-    record.retain(|name, _| specs.iter().any(|s| &s.file.name == name));
     let build_all = |specs: &[&Spec]| -> Result<Vec<(Built, f64)>, Error> {
         let results: Vec<Result<(Built, f64), Error>> = specs
             .par_iter()
@@ -348,7 +329,8 @@ fn run_merged(
     let mut up_to_date: Vec<String> = reused.iter().map(|(n, _)| n.clone()).collect();
     for (b, _) in &built {
         let spec = specs.iter().find(|s| s.file.name == b.name).expect("built specs are loaded specs");
-        record.insert(b.name.clone(), record_entry(hash_of(spec), &b.artifacts));
+        let (name, hash, files) = scene::node_record(&b.name, hash_of(spec), &b.artifacts);
+        record.insert(name, (hash, files));
     }
     // Every file of a spec: those just built and those reused (the same bytes, so unchanged).
     let spec_files = |name: &str| -> Option<&[Artifact]> {
@@ -359,15 +341,9 @@ fn run_merged(
     let mut scene_times = Vec::new();
     if only.is_empty() {
         // Every scene module, with the node files of this build recorded for its cache; one
-        // whose last build is current is reused (after the spec files are written: it compares
-        // its nodes' recorded files with those on disk).
+        // whose JSON already records those nodes and its current input hash is reused.
         for sc in &scenes {
             let t = std::time::Instant::now();
-            if !check && !force && let Some(files) = scene::fresh_files(sc, &specs, &paths.generated) {
-                artifacts.extend(files);
-                up_to_date.push(sc.module());
-                continue;
-            }
             let nodes: Vec<scene::NodeRecord> = scene::plan(sc)
                 .nodes
                 .iter()
@@ -376,6 +352,11 @@ fn run_merged(
                     Some(scene::node_record(n, pipeline::input_hash(spec), spec_files(n)?))
                 })
                 .collect();
+            if !check && !force && let Some(files) = scene::fresh_files(sc, &specs, &paths.generated, &nodes) {
+                artifacts.extend(files);
+                up_to_date.push(sc.module());
+                continue;
+            }
             let sb = scene::build_scene(sc, &specs, &paths.generated, &nodes)
                 .map_err(|source| Error::Scene { scene: sc.file.name.clone(), source })?;
             artifacts.extend(sb.artifacts);
@@ -463,8 +444,7 @@ pub fn run_scene(paths: &Paths, file: &Path, force: bool, extra: &[Target]) -> R
 }
 
 fn write_scene_nodes(paths: &Paths, specs: &[Spec], report: &SceneReport, tx: &mut Transaction) -> Result<(), Error> {
-    let mut record = read_record(&paths.generated);
-    record.retain(|name, _| specs.iter().any(|s| &s.file.name == name));
+    let mut record = read_record(&paths.generated, specs);
     for (name, _, files) in report.nodes.iter().filter(|(n, _, _)| report.built.contains(n)) {
         if let Some(spec) = specs.iter().find(|s| &s.file.name == name) {
             record.insert(name.clone(), (hash_of(spec), files.clone()));
@@ -567,7 +547,7 @@ pub fn shard(paths: &Paths, only: &[String], (k, n): (u64, u64), out: &Path) -> 
             "cells": [range.start, range.end],
             "total_cells": total,
             "payload_bytes": payload.len(),
-            "payload_sha256": sha(&payload),
+            "payload_sha256": pipeline::sha256_hex(&payload),
         });
         let mut bytes = format!("{SHARD_MAGIC}\n{header}\n").into_bytes();
         bytes.extend_from_slice(&payload);
@@ -604,7 +584,7 @@ fn read_shard(path: &Path) -> Result<ShardFile, Error> {
         return Err(bad(format!("made by {} (this is {}); run its shards again", text("generator")?, emit::GENERATOR)));
     }
     // A checksum of the payload: a corrupted or edited cell is refused, not merged.
-    if sha(&payload) != text("payload_sha256")? {
+    if pipeline::sha256_hex(&payload) != text("payload_sha256")? {
         return Err(bad("the payload does not match its checksum (header field 'payload_sha256'): the file is corrupted or was edited; run its shard again".into()));
     }
     let cells = match header["cells"].as_array().map(Vec::as_slice) {

@@ -306,10 +306,6 @@ pub fn scene_hash(scene: &Scene, specs: &[Spec], plan: &Plan) -> Result<String, 
     Ok(format!("sha256:{}", pipeline::hex(&h.finalize())))
 }
 
-fn sha(bytes: &[u8]) -> String {
-    pipeline::hex(&Sha256::digest(bytes))
-}
-
 /// The scene node's artifacts (WGSL + Rust module, JSON) and the scalar functions it emits
 /// (name, arity, domain) for the runtime index.
 pub struct SceneBuild {
@@ -323,7 +319,12 @@ pub type NodeRecord = (String, String, BTreeMap<String, String>);
 
 /// The cache record of a node from the artifacts it was built into.
 pub fn node_record(name: &str, input_hash: String, artifacts: &[Artifact]) -> NodeRecord {
-    (name.to_string(), input_hash, artifacts.iter().map(|a| (a.path.display().to_string(), sha(&a.contents))).collect())
+    (name.to_string(), input_hash, artifacts.iter().map(|a| (a.path.display().to_string(), pipeline::sha256_hex(&a.contents))).collect())
+}
+
+/// The scene JSON's `nodes`: each node's name, input hash and files.
+fn node_json(nodes: &[NodeRecord]) -> Vec<Value> {
+    nodes.iter().map(|(n, h, files)| json!({"name": n, "input_hash": h, "files": files})).collect()
 }
 
 /// Build the scene module; `nodes` are the reached spec nodes, recorded in the scene JSON.
@@ -395,8 +396,7 @@ pub fn build_scene(
         functions.push((e.name.clone(), e.domain.clone()));
     }
     let records: Vec<Value> = emitted.iter().map(|e| e.record.clone()).chain(constants.iter().map(|c| c.record.clone())).collect();
-    let node_records: Vec<Value> =
-        nodes.iter().map(|(n, h, files)| json!({"name": n, "input_hash": h, "files": files})).collect();
+    let node_records = node_json(nodes);
     let reached: Vec<&str> = p.nodes.iter().map(String::as_str).collect();
     let all: Vec<&str> = specs.iter().map(|s| s.file.name.as_str()).collect();
     let skipped: Vec<&str> = all.iter().copied().filter(|n| !reached.contains(n)).collect();
@@ -413,8 +413,8 @@ pub fn build_scene(
         "skipped": skipped,
         "specialised": records,
         "files": {
-            wgsl_a.path.display().to_string(): sha(&wgsl_a.contents),
-            rust_a.path.display().to_string(): sha(&rust_a.contents),
+            wgsl_a.path.display().to_string(): pipeline::sha256_hex(&wgsl_a.contents),
+            rust_a.path.display().to_string(): pipeline::sha256_hex(&rust_a.contents),
         },
     });
     let mut text = serde_json::to_string_pretty(&json).expect("JSON values serialise");
@@ -430,39 +430,29 @@ fn indent(s: &str) -> String {
 /// Whether a recorded node (from the scene's JSON) is up to date: same input hash and every
 /// recorded file unchanged on disk.
 fn recorded_fresh(generated: &Path, rec: &Value, hash: &str) -> bool {
-    rec["input_hash"].as_str() == Some(hash)
-        && rec["files"].as_object().is_some_and(|files| {
-            !files.is_empty()
-                && files.iter().all(|(p, h)| std::fs::read(generated.join(p)).is_ok_and(|b| Some(sha(&b).as_str()) == h.as_str()))
-        })
+    rec["input_hash"].as_str() == Some(hash) && recorded_files(generated, rec).is_some()
+}
+
+/// The files a record (`"files": {path: SHA-256}`) lists, read back when every one is unchanged.
+fn recorded_files(generated: &Path, rec: &Value) -> Option<Vec<Artifact>> {
+    let files = rec["files"].as_object()?;
+    pipeline::read_unchanged(generated, files.iter().map(|(p, h)| Some((p.as_str(), h.as_str()?))).collect::<Option<Vec<_>>>()?)
 }
 
 /// The scene module's files as its last build wrote them, read back, when that build is still
-/// current: its JSON records the scene's input hash, its files and every reached node's files
-/// are unchanged on disk, and the nodes it records are the plan's.
-pub fn fresh_files(scene: &Scene, specs: &[Spec], generated: &Path) -> Option<Vec<Artifact>> {
-    let p = plan(scene);
+/// current: its JSON records the scene's input hash and exactly `nodes` (this build's records of
+/// the reached nodes), and its files are unchanged on disk.
+pub fn fresh_files(scene: &Scene, specs: &[Spec], generated: &Path, nodes: &[NodeRecord]) -> Option<Vec<Artifact>> {
     let json_rel = Path::new("json").join(format!("{}.json", scene.module()));
     let text = std::fs::read(generated.join(&json_rel)).ok()?;
     let previous: Value = serde_json::from_slice(&text).ok()?;
-    if !recorded_fresh(generated, &previous, &scene_hash(scene, specs, &p).ok()?) {
+    let recorded = node_json(nodes);
+    if previous["input_hash"].as_str() != Some(scene_hash(scene, specs, &plan(scene)).ok()?.as_str())
+        || previous["nodes"].as_array() != Some(&recorded)
+    {
         return None;
     }
-    let nodes = previous["nodes"].as_array()?;
-    if nodes.len() != p.nodes.len() {
-        return None;
-    }
-    for n in &p.nodes {
-        let rec = nodes.iter().find(|r| r["name"].as_str() == Some(n.as_str()))?;
-        if !recorded_fresh(generated, rec, &input_hash(find(&scene.file.name, specs, n).ok()?)) {
-            return None;
-        }
-    }
-    let mut out: Vec<Artifact> = previous["files"]
-        .as_object()?
-        .keys()
-        .map(|rel| Some(Artifact { path: rel.into(), contents: std::fs::read(generated.join(rel)).ok()? }))
-        .collect::<Option<_>>()?;
+    let mut out = recorded_files(generated, &previous)?;
     out.push(Artifact { path: json_rel, contents: text });
     Some(out)
 }

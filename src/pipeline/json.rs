@@ -8,6 +8,24 @@ pub fn hex(bytes: &[u8]) -> String {
     bytes.iter().map(|b| format!("{b:02x}")).collect()
 }
 
+/// Lowercase hex of the SHA-256 of `bytes`.
+pub fn sha256_hex(bytes: &[u8]) -> String {
+    hex(&Sha256::digest(bytes))
+}
+
+/// The files `(path under generated, SHA-256)` read back from `generated`, when each is there
+/// with that digest (`None` otherwise, or when there are none).
+pub fn read_unchanged<'a>(generated: &Path, files: impl IntoIterator<Item = (&'a str, &'a str)>) -> Option<Vec<Artifact>> {
+    let out: Vec<Artifact> = files
+        .into_iter()
+        .map(|(p, want)| {
+            let contents = std::fs::read(generated.join(p)).ok()?;
+            (sha256_hex(&contents) == want).then(|| Artifact { path: p.into(), contents })
+        })
+        .collect::<Option<_>>()?;
+    (!out.is_empty()).then_some(out)
+}
+
 pub fn input_hash(spec: &Spec) -> String {
     let mut h = Sha256::new();
     h.update(GENERATOR.as_bytes());

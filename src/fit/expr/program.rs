@@ -20,20 +20,12 @@ pub struct Lanes<T> {
     pub v: [T; 4],
 }
 
-// A scalar's four lanes are equal (every constructor keeps them so): an operation on scalars
-// computes one lane and fills the others with it, the same values as computing all four.
 impl<T: Float> Lanes<T> {
     fn zip(self, o: Self, f: impl Fn(T, T) -> T) -> Self {
         debug_assert!(self.len == o.len || self.len == 1 || o.len == 1, "lanes {} and {}", self.len, o.len);
-        if self.len == 1 && o.len == 1 {
-            return Lanes::of(f(self.v[0], o.v[0]));
-        }
         Lanes { len: self.len.max(o.len), v: std::array::from_fn(|k| f(self.v[k], o.v[k])) }
     }
     fn map(self, f: impl Fn(T) -> T) -> Self {
-        if self.len == 1 {
-            return Lanes::of(f(self.v[0]));
-        }
         Lanes { len: self.len, v: self.v.map(f) }
     }
 }

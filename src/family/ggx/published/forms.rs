@@ -55,13 +55,7 @@ pub static KARIS_FORM: LazyLock<Program> = LazyLock::new(|| {
 impl Karis {
     /// [A, B] at perceptual roughness `r` and n·v.
     pub fn eval(&self, r: f64, n_dot_v: f64) -> [f64; 2] {
-        let p: [f64; 10] = from_fn(|i| match i {
-            0..4 => self.c0[i],
-            4..8 => self.c1[i - 4],
-            8 => self.k,
-            _ => self.s,
-        });
-        pair(&KARIS_FORM, [r, n_dot_v], &p)
+        pair(&KARIS_FORM, [r, n_dot_v], &self.params())
     }
 
     pub fn params(&self) -> Vec<f64> {
