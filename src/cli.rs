@@ -474,10 +474,30 @@ fn selected_families(names: &[String]) -> Result<Vec<&'static family::Family>> {
     Ok(all.iter().filter(|f| names.is_empty() || names.iter().any(|n| n == f.name)).copied().collect())
 }
 
-/// `shadefit validate [--family A,B] [--json]`: the families' published constants measured.
-pub fn validate(paths: &Paths, families: &[String], as_json: bool) -> Result<()> {
-    let validators: Vec<fn(&Path) -> Vec<crate::validate::Item>> = selected_families(families)?.iter().map(|f| f.validate).collect();
-    let items = crate::validate::all(&paths.generated, &validators);
+/// `shadefit validate [--family A,B] [--only SPEC,…] [--json]`: the families' published
+/// constants and the form specs of `fits/` measured. With neither option, every family and
+/// every form spec; with either, only what they name.
+pub fn validate(paths: &Paths, families: &[String], only: &[String], as_json: bool) -> Result<()> {
+    let everything = families.is_empty() && only.is_empty();
+    let selected = if everything || !families.is_empty() { selected_families(families)? } else { vec![] };
+    let validators: Vec<fn(&Path) -> Vec<crate::validate::Item>> = selected.iter().map(|f| f.validate).collect();
+    let mut items = crate::validate::all(&paths.generated, &validators);
+    let forms: Vec<Spec> = if everything && !paths.fits.is_dir() {
+        vec![]
+    } else if everything || !only.is_empty() {
+        let form_kind = spec::Kind::Custom(pipeline::form::KIND);
+        let specs: Vec<Spec> = load_specs(paths, &[])?.into_iter().filter(|s| s.file.kind == form_kind).collect();
+        if let Some(bad) = only.iter().find(|n| !specs.iter().any(|s| &s.file.name == *n)) {
+            let known: Vec<&str> = specs.iter().map(|s| s.file.name.as_str()).collect();
+            return Err(input_err(format!("--only: no form spec '{bad}' in {} (form specs: {})", paths.fits.display(), known.join(", "))));
+        }
+        specs.into_iter().filter(|s| everything || only.contains(&s.file.name)).collect()
+    } else {
+        vec![]
+    };
+    for s in &forms {
+        items.push(crate::validate::form_item(s, &paths.generated, family::catalog()).map_err(input_err)?);
+    }
     if as_json {
         println!("{}", serde_json::to_string_pretty(&json!({ "items": items }))?);
         return Ok(());
@@ -495,6 +515,46 @@ pub fn validate(paths: &Paths, families: &[String], as_json: bool) -> Result<()>
             println!("  finding: {f}");
         }
         println!();
+    }
+    Ok(())
+}
+
+/// `shadefit measure FILE.toml [--refit] [--json]`: a form spec's published constants (and,
+/// with `--refit`, refitted ones) measured against its quantity on its grid; writes nothing.
+pub fn measure(path: &Path, refit: bool, as_json: bool) -> Result<()> {
+    use pipeline::form::{Form, KIND, measure_and_refit};
+    let catalog = family::catalog();
+    let spec = Spec::load(path, catalog).map_err(input_err)?;
+    if spec.file.kind != spec::Kind::Custom(KIND) {
+        return Err(input_err(format!("{}: kind = \"{}\", not a form spec (kind = \"{KIND}\")", path.display(), spec.file.kind.name())));
+    }
+    let form = Form::from_spec(&spec, catalog).map_err(input_err)?;
+    let (_, c) = measure_and_refit(&form, refit);
+    if as_json {
+        let mut v = json!({
+            "name": form.name, "quantity": form.quantity.name, "source": form.source, "grid": form.grid_doc(),
+            "max_error_estimate": c.max_error_estimate, "published": c.published_errors,
+        });
+        if refit {
+            v["refit"] = json!({ "constants": c.constants, "errors": c.refit_errors });
+        }
+        println!("{}", serde_json::to_string_pretty(&v)?);
+        return Ok(());
+    }
+    println!("{} ({})\n  grid: {}\n  integrals: largest error estimate {:.1e}", form.name, form.source, form.grid_doc(), c.max_error_estimate);
+    let show = |what: &str, e: &pipeline::form::Errors| {
+        let a = &e.all;
+        println!("  {what}: {} values, max abs {:.3e}, rms {:.3e}, mean signed {:.3e}, worst at {:?} ({})", a.points, a.max_abs_error, a.rms_error, a.mean_signed_error, a.worst, a.worst_output);
+        for (o, s) in &e.outputs {
+            println!("    {o}: max abs {:.3e}, rms {:.3e}, mean signed {:.3e}, worst at {:?}", s.max_abs_error, s.rms_error, s.mean_signed_error, s.worst);
+        }
+    };
+    show("published", &c.published_errors);
+    if refit {
+        show("refit (f32 constants)", &c.refit_errors);
+        for k in &c.constants {
+            println!("    {} = {:e} (published {:e})", k.name, k.refit, k.published);
+        }
     }
     Ok(())
 }

@@ -145,6 +145,21 @@ enum Command {
         /// `shadefit families`).
         #[arg(long, value_delimiter = ',')]
         family: Vec<String>,
+        /// Form specs (kind = "form") of --fits to measure, comma-separated (default: all; with
+        /// --only and no --family, no family is measured).
+        #[arg(long, value_delimiter = ',')]
+        only: Vec<String>,
+    },
+    /// Measure a form spec (kind = "form": your own formula) against its integral on its grid,
+    /// writing nothing; --refit also refits its constants.
+    Measure {
+        /// The form spec file.
+        file: PathBuf,
+        /// Refit every constant as `build` does and measure the refit too.
+        #[arg(long)]
+        refit: bool,
+        #[arg(long)]
+        json: bool,
     },
     /// Run time against error: integrators, fit solvers, tables against numpy/scipy, shader forms.
     Bench {
@@ -200,7 +215,8 @@ fn main() -> ExitCode {
         }
         Command::Samples { name, json } => cli::samples(&paths, &name, json),
         Command::Plot { out } => cli::plot(&paths, &out),
-        Command::Validate { json, family } => cli::validate(&paths, &family, json),
+        Command::Validate { json, family, only } => cli::validate(&paths, &family, &only, json),
+        Command::Measure { file, refit, json } => cli::measure(&file, refit, json),
         Command::Bench { quick, json, only, family, python, no_python } => {
             cli::bench(&paths, &cli::BenchArgs { quick, json, only, family, python, no_python })
         }

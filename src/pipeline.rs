@@ -42,6 +42,7 @@ pub mod data;
 pub mod fields;
 pub mod grid;
 pub mod module;
+pub mod form;
 pub mod refit;
 mod error;
 mod fitted;

@@ -16,6 +16,16 @@ pub struct ParamSpec {
     /// The value `eval` uses when the parameter is not given (None: it must be given). Specs
     /// still name every parameter as an axis.
     pub default: Option<f64>,
+    /// A value outside [min, max] where the quantity is defined as its limit (GGX's α = 0, the
+    /// mirror), which `eval` and specs accept as well.
+    pub limit: Option<f64>,
+}
+
+impl ParamSpec {
+    /// Whether `v` is a value of the parameter: inside [min, max] or its limit (NaN is not).
+    pub fn admits(&self, v: f64) -> bool {
+        (v >= self.min && v <= self.max) || self.limit == Some(v)
+    }
 }
 
 /// A quantity `shadefit eval` serves and specs sample.
@@ -98,7 +108,7 @@ impl QuantityDef {
                         expected: names.join(", "),
                     });
                 };
-            if !(value >= spec.min && value <= spec.max) {
+            if !spec.admits(value) {
                 return Err(QuantityError::OutOfDomain {
                     quantity: self.name.into(),
                     param: key.clone(),
@@ -114,7 +124,8 @@ impl QuantityDef {
                 return Err(QuantityError::Duplicate { quantity: self.name.into(), param: key.clone() });
             }
             let canonical = conv.map_or(value, |f| f(value));
-            out[idx] = Some(canonical.clamp(self.params[idx].min, self.params[idx].max));
+            let p = &self.params[idx];
+            out[idx] = Some(if p.limit == Some(canonical) { canonical } else { canonical.clamp(p.min, p.max) });
         }
         out.into_iter()
             .zip(self.params)

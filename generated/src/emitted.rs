@@ -106,6 +106,9 @@ pub mod skin_punctual_lut;
 #[cfg(feature = "skin")]
 #[path = "skin_sh_lut.rs"]
 pub mod skin_sh_lut;
+#[cfg(feature = "ggx")]
+#[path = "studio_env_brdf.rs"]
+pub mod studio_env_brdf;
 #[cfg(feature = "scenes")]
 #[path = "scene_cobblestone_gloss.rs"]
 pub mod scene_cobblestone_gloss;
@@ -191,6 +194,8 @@ pub mod wgsl {
     pub const SKIN_PUNCTUAL_LUT: &str = include_str!("../wgsl/skin_punctual_lut.wgsl");
     #[cfg(feature = "skin")]
     pub const SKIN_SH_LUT: &str = include_str!("../wgsl/skin_sh_lut.wgsl");
+    #[cfg(feature = "ggx")]
+    pub const STUDIO_ENV_BRDF: &str = include_str!("../wgsl/studio_env_brdf.wgsl");
     #[cfg(feature = "scenes")]
     pub const SCENE_COBBLESTONE_GLOSS: &str = include_str!("../wgsl/scene_cobblestone_gloss.wgsl");
     #[cfg(feature = "scenes")]
@@ -273,6 +278,8 @@ pub mod wgsl {
             "skin_punctual_lut" => Some(SKIN_PUNCTUAL_LUT),
             #[cfg(feature = "skin")]
             "skin_sh_lut" => Some(SKIN_SH_LUT),
+            #[cfg(feature = "ggx")]
+            "studio_env_brdf" => Some(STUDIO_ENV_BRDF),
             #[cfg(feature = "scenes")]
             "scene_cobblestone_gloss" => Some(SCENE_COBBLESTONE_GLOSS),
             #[cfg(feature = "scenes")]
@@ -357,6 +364,8 @@ pub mod wgsl {
         "skin_punctual_lut",
         #[cfg(feature = "skin")]
         "skin_sh_lut",
+        #[cfg(feature = "ggx")]
+        "studio_env_brdf",
         #[cfg(feature = "scenes")]
         "scene_cobblestone_gloss",
         #[cfg(feature = "scenes")]

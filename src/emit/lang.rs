@@ -29,17 +29,13 @@ impl Lang {
         }
     }
 
-    /// `fn NAME(args) -> RET {` in the language (args: (name, doc)).
-    pub fn signature(self, name: &str, args: &[&str], vec2: bool) -> String {
+    /// `fn NAME(args) -> RET {` in the language: RET is f32 for `width` 1, else a vector of
+    /// `width` lanes (`vecN<f32>`, `[f32; N]`).
+    pub fn signature(self, name: &str, args: &[&str], width: usize) -> String {
+        let a: Vec<String> = args.iter().map(|a| format!("{a}: f32")).collect();
         match self {
-            Lang::Wgsl => {
-                let a: Vec<String> = args.iter().map(|a| format!("{a}: f32")).collect();
-                format!("fn {name}({}) -> {} {{\n", a.join(", "), if vec2 { "vec2<f32>" } else { "f32" })
-            }
-            Lang::Rust => {
-                let a: Vec<String> = args.iter().map(|a| format!("{a}: f32")).collect();
-                format!("pub fn {name}({}) -> {} {{\n", a.join(", "), if vec2 { "[f32; 2]" } else { "f32" })
-            }
+            Lang::Wgsl => format!("fn {name}({}) -> {} {{\n", a.join(", "), if width == 1 { "f32".to_string() } else { format!("vec{width}<f32>") }),
+            Lang::Rust => format!("pub fn {name}({}) -> {} {{\n", a.join(", "), if width == 1 { "f32".to_string() } else { format!("[f32; {width}]") }),
         }
     }
 

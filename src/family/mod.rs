@@ -141,7 +141,7 @@ pub fn catalog() -> &'static Catalog {
     static CATALOG: OnceLock<Catalog> = OnceLock::new();
     CATALOG.get_or_init(|| Catalog {
         quantities: FAMILIES.iter().flat_map(|f| f.quantities.iter()).collect(),
-        kinds: FAMILIES.iter().flat_map(|f| f.spec_kinds.iter().map(|k| &k.spec)).chain([&REFIT.spec]).collect(),
+        kinds: FAMILIES.iter().flat_map(|f| f.spec_kinds.iter().map(|k| &k.spec)).chain([&REFIT.spec, &FORM.spec]).collect(),
         features: FAMILIES.iter().flat_map(|f| f.quantities.iter().map(|q| (q.name, f.feature))).collect(),
         mappings: FAMILIES.iter().flat_map(|f| f.axis_mappings.iter().copied()).collect(),
     })
@@ -149,7 +149,7 @@ pub fn catalog() -> &'static Catalog {
 
 /// The family spec kind named `name`.
 pub fn spec_kind(name: &str) -> Option<&'static SpecKind> {
-    FAMILIES.iter().flat_map(|f| f.spec_kinds.iter()).chain([&REFIT]).find(|k| k.spec.name == name)
+    FAMILIES.iter().flat_map(|f| f.spec_kinds.iter()).chain([&REFIT, &FORM]).find(|k| k.spec.name == name)
 }
 
 /// Every family's published forms, in registry order.
@@ -167,6 +167,18 @@ pub static REFIT: SpecKind = SpecKind {
         input_hash: |spec| pipeline::refit::input_hash(spec, published_forms()),
     },
     build: |spec, mode, root| pipeline::refit::build(spec, mode, root, published_forms()),
+    shard: None,
+};
+
+/// The generic kind `form` (`pipeline::form`): the user's own formula for any quantity.
+pub static FORM: SpecKind = SpecKind {
+    spec: KindDef {
+        name: pipeline::form::KIND,
+        spec_file: |path, text| pipeline::form::spec_file(path, text, catalog()),
+        samples_note: "{name} measures a formula on its own grid: `shadefit measure fits/{name}.toml` prints it",
+        input_hash: pipeline::input_hash,
+    },
+    build: |spec, mode, root| pipeline::form::build(spec, mode, root, catalog()),
     shard: None,
 };
 

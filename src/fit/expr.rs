@@ -11,7 +11,9 @@
 //! `.zw`); Rust as f32 methods (`x.max(lo).min(hi)`: NaN → lo, as the evaluator), its vectors
 //! as arrays, one expression per lane.
 
+pub mod parse;
 pub mod program;
+pub mod tape;
 
 use crate::fit::model::{RationalModel, Term};
 use nalgebra::DVector;

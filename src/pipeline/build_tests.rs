@@ -11,7 +11,7 @@ use crate::spec::Catalog;
 pub(crate) static EXP: QuantityDef = QuantityDef {
     name: "exp-decay",
     doc: "e^-x (a closed form the build's results are checked against)",
-    params: &[ParamSpec { name: "x", min: 0.0, max: 2.0, doc: "argument", integer: false, default: None }],
+    params: &[ParamSpec { name: "x", min: 0.0, max: 2.0, doc: "argument", integer: false, limit: None, default: None }],
     aliases: &[],
     eval: |p, _| Estimate { value: (-p[0]).exp(), error: 0.0, evals: 1 },
     inverse: Some(|y| -y.ln()),
@@ -326,8 +326,8 @@ static FIELDS_Q: QuantityDef = QuantityDef {
     name: "quadratic-fields",
     doc: "a quadratic in u whose coefficients are rationals in o",
     params: &[
-        ParamSpec { name: "o", min: 0.0, max: 1.0, doc: "outer", integer: false, default: None },
-        ParamSpec { name: "u", min: -1.0, max: 1.0, doc: "inner", integer: false, default: None },
+        ParamSpec { name: "o", min: 0.0, max: 1.0, doc: "outer", integer: false, limit: None, default: None },
+        ParamSpec { name: "u", min: -1.0, max: 1.0, doc: "inner", integer: false, limit: None, default: None },
     ],
     aliases: &[],
     eval: |p, _| Estimate { value: fields_value(p[0], p[1]), error: 0.0, evals: 1 },
@@ -701,10 +701,10 @@ fn the_runtime_index_lists_only_scalar_functions() {
 }
 
 /// e^−x and e^−2x as the two channels of one quantity.
-static EXP_PAIR: QuantityDef = QuantityDef {
+pub(crate) static EXP_PAIR: QuantityDef = QuantityDef {
     name: "exp-pair",
     doc: "e^-x (channel slow) and e^-2x (channel fast)",
-    params: &[ParamSpec { name: "x", min: 0.0, max: 2.0, doc: "argument", integer: false, default: None }],
+    params: &[ParamSpec { name: "x", min: 0.0, max: 2.0, doc: "argument", integer: false, limit: None, default: None }],
     aliases: &[],
     eval: |p, _| Estimate { value: (-p[0]).exp(), error: 0.0, evals: 1 },
     inverse: None,

@@ -49,9 +49,9 @@ impl LobeParams for UnitLinear {
     }
 }
 
-const RHO: ParamSpec = ParamSpec { name: "rho", min: 0.0, max: 1.0, doc: "albedo scale", integer: false, default: None };
-const N_DOT_V: ParamSpec = ParamSpec { name: "n_dot_v", min: 0.0, max: 1.0, doc: "n·v", integer: false, default: None };
-const COS_CONE: ParamSpec = ParamSpec { name: "cos_cone", min: 0.0, max: 1.0, doc: "cone", integer: false, default: Some(0.0) };
+const RHO: ParamSpec = ParamSpec { name: "rho", min: 0.0, max: 1.0, doc: "albedo scale", integer: false, limit: None, default: None };
+const N_DOT_V: ParamSpec = ParamSpec { name: "n_dot_v", min: 0.0, max: 1.0, doc: "n·v", integer: false, limit: None, default: None };
+const COS_CONE: ParamSpec = ParamSpec { name: "cos_cone", min: 0.0, max: 1.0, doc: "cone", integer: false, limit: None, default: Some(0.0) };
 
 static ALBEDO: QuantityDef = QuantityDef {
     name: "linear-albedo",

@@ -262,7 +262,7 @@ pub fn build(spec: &Spec, mode: Mode, root: &Path, registry: &[&PublishedForm]) 
             match f.program {
                 Some(program) => {
                     let program = program();
-                    s += &lang.signature(&c.function, f.args, program.width() == 2);
+                    s += &lang.signature(&c.function, f.args, program.width());
                     s += &form_body(lang, &name, program, &as_emitted(&c.constants), f.args, f.domain);
                 }
                 None => {

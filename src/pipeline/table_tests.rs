@@ -18,9 +18,9 @@ static TRI: QuantityDef = QuantityDef {
     name: "tri-closed",
     doc: "three closed forms over (x, y, z): two multilinear, one quadratic",
     params: &[
-        ParamSpec { name: "x", min: 0.0, max: 2.0, doc: "first", integer: false, default: None },
-        ParamSpec { name: "y", min: -1.0, max: 1.0, doc: "second", integer: false, default: Some(0.0) },
-        ParamSpec { name: "z", min: 0.0, max: 1.0, doc: "third", integer: false, default: Some(0.0) },
+        ParamSpec { name: "x", min: 0.0, max: 2.0, doc: "first", integer: false, limit: None, default: None },
+        ParamSpec { name: "y", min: -1.0, max: 1.0, doc: "second", integer: false, limit: None, default: Some(0.0) },
+        ParamSpec { name: "z", min: 0.0, max: 1.0, doc: "third", integer: false, limit: None, default: Some(0.0) },
     ],
     aliases: &[],
     eval: |p, _| Estimate { value: tri(p)[0], error: 0.0, evals: 1 },
@@ -34,7 +34,7 @@ static TRI: QuantityDef = QuantityDef {
 static IDENT: QuantityDef = QuantityDef {
     name: "ident-closed",
     doc: "its parameter",
-    params: &[ParamSpec { name: "a", min: 0.0, max: 1.0, doc: "the value", integer: false, default: None }],
+    params: &[ParamSpec { name: "a", min: 0.0, max: 1.0, doc: "the value", integer: false, limit: None, default: None }],
     aliases: &[],
     eval: |p, _| Estimate { value: p[0], error: 0.0, evals: 1 },
     inverse: None,

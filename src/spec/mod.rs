@@ -90,7 +90,7 @@ pub fn line_of(text: &str, key: &str) -> usize {
     1
 }
 
-fn line_of_offset(text: &str, offset: usize) -> usize {
+pub fn line_of_offset(text: &str, offset: usize) -> usize {
     text[..offset.min(text.len())].bytes().filter(|&b| b == b'\n').count() + 1
 }
 
@@ -842,7 +842,7 @@ impl Spec {
                     return Err(at(field, format!("applies to kind = \"table\" only, not \"{}\"", file.kind.name())));
                 }
                 // A table's mapped range is checked with its mapping (table_layout).
-            } else if !(lo.is_finite() && hi.is_finite() && lo < hi && lo >= p.min && hi <= p.max) {
+            } else if !(lo.is_finite() && hi.is_finite() && lo < hi && p.admits(lo) && p.admits(hi)) {
                 return Err(at(
                     "range",
                     format!("axis '{}' range [{lo}, {hi}] must be finite, increasing and inside [{}, {}]", a.name, p.min, p.max),
@@ -914,7 +914,7 @@ impl Spec {
 /// The layout of a kind = "table" spec: its channels (named ones of a vector quantity, each
 /// once), and each axis's placement and mapping, whose range of arguments must lie where the
 /// mapping is defined and map inside the parameter's domain.
-fn table_layout(path: &Path, text: &str, file: &SpecFile, quantity: &QuantityDef, catalog: &Catalog) -> Result<TableLayout, SpecError> {
+pub(crate) fn table_layout(path: &Path, text: &str, file: &SpecFile, quantity: &QuantityDef, catalog: &Catalog) -> Result<TableLayout, SpecError> {
     let at = |field: &str, msg: String| SpecError::new(path, line_of(text, field), field, msg);
     let mut channels = Vec::new();
     if let Some(names) = &file.channels {
@@ -955,7 +955,7 @@ fn table_layout(path: &Path, text: &str, file: &SpecFile, quantity: &QuantityDef
             };
             let [tlo, thi] = mapping.argument;
             let (plo, phi) = ((mapping.to_parameter)(first), (mapping.to_parameter)(last));
-            let inside = |v: f64| v >= p.min && v <= p.max;
+            let inside = |v: f64| p.admits(v);
             if !(lo.is_finite() && hi.is_finite() && lo < hi && first >= tlo && last <= thi && inside(plo) && inside(phi)) {
                 return Err(at(
                     "range",

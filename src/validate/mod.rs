@@ -4,6 +4,9 @@
 //! findings: what the numbers say about the published constants (noise, typos, conventions).
 
 use crate::pipeline::committed::Refit;
+use crate::pipeline::{self, form::{Committed, Form, measure_and_refit}};
+use crate::fit::published::as_emitted;
+use crate::spec::{Spec, SpecError};
 use crate::spec::Catalog;
 use serde::Serialize;
 use std::path::Path;
@@ -63,6 +66,51 @@ impl Item {
 /// Every item of the given validators (one per family, in registry order).
 pub fn all(generated: &Path, validators: &[fn(&Path) -> Vec<Item>]) -> Vec<Item> {
     validators.iter().flat_map(|v| v(generated)).collect()
+}
+
+/// One `validate` item of a form spec: the published constants measured against the integral,
+/// with the committed refit beside them when it is committed for this version of the spec.
+pub fn form_item(spec: &Spec, generated: &Path, catalog: &Catalog) -> Result<Item, SpecError> {
+    let form = Form::from_spec(spec, catalog)?;
+    let (truth, c) = measure_and_refit(&form, false);
+    let e = &c.published_errors.all;
+    let mut worst: Vec<f64> = form.args.iter().map(|a| e.worst[a]).collect();
+    worst.push(form.outputs.iter().position(|o| *o == e.worst_output).unwrap_or(0) as f64);
+    let mut item = Item {
+        name: format!("form {}: {}", form.name, spec.file.description),
+        source: form.source.clone(),
+        domain: format!("{}; worst point is [{}, output ({})]", form.grid_doc(), form.args.join(", "), form.outputs.join(", ")),
+        points: e.points,
+        max_abs_error: e.max_abs_error,
+        rms_error: e.rms_error,
+        worst_point: worst,
+        extra: vec![("mean_signed_error".into(), e.mean_signed_error)],
+        findings: vec![],
+    };
+    for (o, s) in &c.published_errors.outputs {
+        item.extra.push((format!("{o}_max_abs_error"), s.max_abs_error));
+    }
+    match pipeline::committed_json_with_hash(generated, spec, &pipeline::input_hash(spec)).ok().and_then(|v| serde_json::from_value::<Committed>(v["form"].clone()).ok()) {
+        Some(k) => {
+            let refit: Vec<f64> = k.constants.iter().map(|k| k.refit).collect();
+            let r = form.errors(&truth, &as_emitted(&refit)).all;
+            item.extra.push(("refit_max_abs_error".into(), r.max_abs_error));
+            item.extra.push(("refit_rms_error".into(), r.rms_error));
+            item.findings.push(format!(
+                "shadefit's refit ({:?}, same form, generated/json/{}.json): max {:.3e} ({:.2}× the published), rms {:.3e} ({:.2}×), worst at {:?} ({}).",
+                form.objective,
+                form.name,
+                r.max_abs_error,
+                r.max_abs_error / e.max_abs_error,
+                r.rms_error,
+                r.rms_error / e.rms_error,
+                r.worst,
+                r.worst_output
+            ));
+        }
+        None => item.findings.push(format!("The refit is not committed for this version of the spec: run `shadefit build --only {}`.", form.name)),
+    }
+    Ok(item)
 }
 
 /// The number printed right after `key` in a finding's text: the longest run of digits,

@@ -25,9 +25,9 @@ pub fn k_from_spread(spread: f64) -> f64 {
     -0.99 * (1.0 - spread)
 }
 
-const K: ParamSpec = ParamSpec { name: "k", min: -0.99, max: 0.0, doc: "Schlick asymmetry k = -0.99 (1 - spread)", integer: false, default: None };
-const U_DOT_T: ParamSpec = ParamSpec { name: "u_dot_t", min: -1.0, max: 1.0, doc: "cosine of light and fiber", integer: false, default: None };
-const SPREAD: ParamSpec = ParamSpec { name: "spread", min: 0.0, max: 1.0, doc: "the course's spread", integer: false, default: None };
+const K: ParamSpec = ParamSpec { name: "k", min: -0.99, max: 0.0, doc: "Schlick asymmetry k = -0.99 (1 - spread)", integer: false, limit: None, default: None };
+const U_DOT_T: ParamSpec = ParamSpec { name: "u_dot_t", min: -1.0, max: 1.0, doc: "cosine of light and fiber", integer: false, limit: None, default: None };
+const SPREAD: ParamSpec = ParamSpec { name: "spread", min: 0.0, max: 1.0, doc: "the course's spread", integer: false, limit: None, default: None };
 
 /// The family's quantities, in `eval --help` order.
 pub static QUANTITIES: &[QuantityDef] = &[

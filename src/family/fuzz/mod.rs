@@ -61,9 +61,9 @@ fn fuzz_r(p: &[f64], tol: f64) -> Estimate {
 }
 
 const HALF_PI: f64 = std::f64::consts::FRAC_PI_2;
-const ALPHA: ParamSpec = ParamSpec { name: "alpha", min: 0.01, max: 1.0, doc: "SGGX fiber alpha", integer: false, default: None };
-const THETA_F: ParamSpec = ParamSpec { name: "theta_f", min: 0.0, max: HALF_PI, doc: "fiber polar angle (rad)", integer: false, default: None };
-const DENSITY: ParamSpec = ParamSpec { name: "d", min: 0.0, max: 50.0, doc: "fuzz density (optical thickness)", integer: false, default: None };
+const ALPHA: ParamSpec = ParamSpec { name: "alpha", min: 0.01, max: 1.0, doc: "SGGX fiber alpha", integer: false, limit: None, default: None };
+const THETA_F: ParamSpec = ParamSpec { name: "theta_f", min: 0.0, max: HALF_PI, doc: "fiber polar angle (rad)", integer: false, limit: None, default: None };
+const DENSITY: ParamSpec = ParamSpec { name: "d", min: 0.0, max: 50.0, doc: "fuzz density (optical thickness)", integer: false, limit: None, default: None };
 
 /// The family's quantities, in `eval --help` order.
 pub static QUANTITIES: &[QuantityDef] = &[
@@ -73,13 +73,14 @@ pub static QUANTITIES: &[QuantityDef] = &[
         params: &[
             ALPHA,
             THETA_F,
-            ParamSpec { name: "theta_u", min: 0.0, max: std::f64::consts::PI, doc: "light polar angle (rad)", integer: false, default: None },
+            ParamSpec { name: "theta_u", min: 0.0, max: std::f64::consts::PI, doc: "light polar angle (rad)", integer: false, limit: None, default: None },
             ParamSpec {
                 name: "phi_u",
                 min: -std::f64::consts::PI,
                 max: 2.0 * std::f64::consts::PI,
                 doc: "light azimuth from the fiber azimuth (rad)",
                 integer: false,
+                limit: None,
                 default: None,
             },
         ],
@@ -93,7 +94,7 @@ pub static QUANTITIES: &[QuantityDef] = &[
     QuantityDef {
         name: "fuzz-g",
         doc: "hemispherical average G(d, mu_v) of the single-scattering fuzz layer",
-        params: &[ParamSpec { name: "mu_v", min: 0.0, max: 1.0, doc: "n·v", integer: false, default: None }, DENSITY],
+        params: &[ParamSpec { name: "mu_v", min: 0.0, max: 1.0, doc: "n·v", integer: false, limit: None, default: None }, DENSITY],
         aliases: &[],
         eval: fuzz_g,
         inverse: None,

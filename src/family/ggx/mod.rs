@@ -28,34 +28,41 @@ const ALPHA: ParamSpec = ParamSpec {
     max: 1.0,
     doc: "GGX alpha (perceptual roughness²)",
     integer: false,
+    limit: None,
     default: None,
 };
+/// [`ALPHA`] reaching α = 0, where the split sum is its mirror limit (scale = 1 − (1 − μ)⁵,
+/// bias = (1 − μ)⁵, `shading::hemisphere::split_sum`).
+const ALPHA_OR_MIRROR: ParamSpec = ParamSpec { limit: Some(0.0), ..ALPHA };
 const ROUGHNESS: ParamSpec = ParamSpec {
     name: "roughness",
     min: 1e-3,
     max: 1.0,
     doc: "perceptual roughness (alpha = roughness²)",
     integer: false,
+    limit: None,
     default: None,
 };
-const N_DOT_V: ParamSpec = ParamSpec { name: "n_dot_v", min: 0.0, max: 1.0, doc: "n·v", integer: false, default: None };
+const N_DOT_V: ParamSpec = ParamSpec { name: "n_dot_v", min: 0.0, max: 1.0, doc: "n·v", integer: false, limit: None, default: None };
 const COS_CONE: ParamSpec = ParamSpec {
     name: "cos_cone",
     min: 0.0,
     max: 1.0,
     doc: "cosine of the visibility cone's half-angle (0: the hemisphere)",
     integer: false,
+    limit: None,
     default: Some(0.0),
 };
 
-const N_DOT_L: ParamSpec = ParamSpec { name: "n_dot_l", min: 0.0, max: 1.0, doc: "n·l", integer: false, default: None };
-const F0: ParamSpec = ParamSpec { name: "f0", min: 0.0, max: 1.0, doc: "Schlick reflectance at normal incidence (1: F = 1)", integer: false, default: None };
+const N_DOT_L: ParamSpec = ParamSpec { name: "n_dot_l", min: 0.0, max: 1.0, doc: "n·l", integer: false, limit: None, default: None };
+const F0: ParamSpec = ParamSpec { name: "f0", min: 0.0, max: 1.0, doc: "Schlick reflectance at normal incidence (1: F = 1)", integer: false, limit: None, default: None };
 const SCHEME: ParamSpec = ParamSpec {
     name: "scheme",
     min: 0.0,
     max: 5.0,
     doc: "compensation scheme: 0 single, 1 Kulla-Conty, 2 Turquin, 3 Fdez-Aguera, 4 Cycles, 5 bevy<=0.18",
     integer: true,
+    limit: None,
     default: None,
 };
 
@@ -97,7 +104,7 @@ pub static QUANTITIES: &[QuantityDef] = &[
     QuantityDef {
         name: "ggx-env",
         doc: "split-sum environment BRDF [scale, bias] (F = F0·scale + bias), lights in a cone",
-        params: &[ALPHA, N_DOT_V, COS_CONE],
+        params: &[ALPHA_OR_MIRROR, N_DOT_V, COS_CONE],
         aliases: &[ROUGHNESS_ALIAS],
         eval: eval_split_sum_scale::<HeightCorrelated>,
         inverse: None,
@@ -108,7 +115,7 @@ pub static QUANTITIES: &[QuantityDef] = &[
     QuantityDef {
         name: "ggx-env-ue4",
         doc: "[scale, bias] with UE4's separable Schlick-Smith G (k = alpha/2), hemisphere",
-        params: &[ALPHA, N_DOT_V],
+        params: &[ALPHA_OR_MIRROR, N_DOT_V],
         aliases: &[ROUGHNESS_ALIAS],
         eval: eval_split_sum_scale::<Ue4>,
         inverse: None,
@@ -141,7 +148,7 @@ pub static QUANTITIES: &[QuantityDef] = &[
     QuantityDef {
         name: "fresnel-avg-schlick",
         doc: "cosine-weighted Schlick Fresnel average F0 + (1 - F0)/21 (closed form)",
-        params: &[ParamSpec { name: "f0", min: 0.0, max: 1.0, doc: "reflectance at normal incidence", integer: false, default: None }],
+        params: &[ParamSpec { name: "f0", min: 0.0, max: 1.0, doc: "reflectance at normal incidence", integer: false, limit: None, default: None }],
         aliases: &[],
         eval: fresnel_avg_schlick,
         inverse: None,
@@ -152,7 +159,7 @@ pub static QUANTITIES: &[QuantityDef] = &[
     QuantityDef {
         name: "fresnel-avg-dielectric",
         doc: "cosine-weighted dielectric Fresnel average for relative index eta (numerical)",
-        params: &[ParamSpec { name: "eta", min: 0.1, max: 10.0, doc: "relative index of refraction", integer: false, default: None }],
+        params: &[ParamSpec { name: "eta", min: 0.1, max: 10.0, doc: "relative index of refraction", integer: false, limit: None, default: None }],
         aliases: &[],
         eval: fresnel_avg_dielectric,
         inverse: None,

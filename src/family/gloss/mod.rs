@@ -26,7 +26,7 @@ fn gloss_combine(p: &[f64], _tol: f64) -> Estimate {
     Estimate { value: integrals::combine(p[0], p[1]), error: 1e5 * 8.0 * f64::EPSILON, evals: 130 }
 }
 
-const GLOSS: ParamSpec = ParamSpec { name: "gloss", min: 0.0, max: 1.0, doc: "gloss g", integer: false, default: None };
+const GLOSS: ParamSpec = ParamSpec { name: "gloss", min: 0.0, max: 1.0, doc: "gloss g", integer: false, limit: None, default: None };
 
 /// The family's quantities, in `eval --help` order.
 pub static QUANTITIES: &[QuantityDef] = &[
@@ -37,7 +37,7 @@ pub static QUANTITIES: &[QuantityDef] = &[
         aliases: &[(
             // α at gloss 1 is sqrt(2/262145) = 0.00276213059566896…; the bound sits just below it
             // and the converted gloss is clamped to 1.
-            ParamSpec { name: "alpha", min: 0.0027621305956689, max: 1.0, doc: "GGX alpha", integer: false, default: None },
+            ParamSpec { name: "alpha", min: 0.0027621305956689, max: 1.0, doc: "GGX alpha", integer: false, limit: None, default: None },
             0,
             integrals::gloss_from_alpha,
         )],
@@ -50,7 +50,7 @@ pub static QUANTITIES: &[QuantityDef] = &[
     QuantityDef {
         name: "gloss-from-length",
         doc: "gloss whose GGX average normal length is `length` (clamped to the table ends)",
-        params: &[ParamSpec { name: "length", min: 0.0, max: 1.0, doc: "normal length", integer: false, default: None }],
+        params: &[ParamSpec { name: "length", min: 0.0, max: 1.0, doc: "normal length", integer: false, limit: None, default: None }],
         aliases: &[],
         eval: gloss_from_length,
         inverse: None,
@@ -62,8 +62,8 @@ pub static QUANTITIES: &[QuantityDef] = &[
         name: "gloss-combine",
         doc: "gloss of two combined glosses (Reoriented Normal Mapping of their NDFs)",
         params: &[
-            ParamSpec { name: "x", min: 0.0, max: 1.0, doc: "first gloss", integer: false, default: None },
-            ParamSpec { name: "y", min: 0.0, max: 1.0, doc: "second gloss", integer: false, default: None },
+            ParamSpec { name: "x", min: 0.0, max: 1.0, doc: "first gloss", integer: false, limit: None, default: None },
+            ParamSpec { name: "y", min: 0.0, max: 1.0, doc: "second gloss", integer: false, limit: None, default: None },
         ],
         aliases: &[],
         eval: gloss_combine,

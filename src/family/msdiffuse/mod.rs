@@ -49,7 +49,7 @@ fn ms_diffuse_albedo(p: &[f64], tol: f64) -> Estimate {
 }
 
 const fn p(name: &'static str, min: f64, max: f64, doc: &'static str, default: Option<f64>) -> ParamSpec {
-    ParamSpec { name, min, max, doc, integer: false, default }
+    ParamSpec { name, min, max, doc, integer: false, limit: None, default }
 }
 
 const GLOSS: ParamSpec = p("gloss", 0.0, 1.0, "WWII gloss (alpha = sqrt(2/(1 + 2^(18 gloss))))", None);
@@ -60,6 +60,7 @@ const WALKS: ParamSpec = ParamSpec {
     max: 1.0,
     doc: "0: the specular share is gone (the talk); 1: it continues the walk",
     integer: true,
+    limit: None,
     default: Some(0.0),
 };
 

@@ -18,11 +18,11 @@ use integrals::{Aniso, Lobe, direction, extract, filter, rotation_to, sggx_from}
 use std::f64::consts::PI;
 
 const fn p(name: &'static str, min: f64, max: f64, doc: &'static str) -> ParamSpec {
-    ParamSpec { name, min, max, doc, integer: false, default: None }
+    ParamSpec { name, min, max, doc, integer: false, limit: None, default: None }
 }
 
 const fn pd(name: &'static str, min: f64, max: f64, doc: &'static str, default: f64) -> ParamSpec {
-    ParamSpec { name, min, max, doc, integer: false, default: Some(default) }
+    ParamSpec { name, min, max, doc, integer: false, limit: None, default: Some(default) }
 }
 
 /// α ∈ [0.001, 1]: the course's α_min to the largest GGX roughness.

@@ -33,6 +33,7 @@ pub(crate) const ALPHA: ParamSpec = ParamSpec {
     max: 1.0,
     doc: "Charlie alpha (D ∝ sin^(1/alpha); sheen roughness²)",
     integer: false,
+    limit: None,
     default: None,
 };
 /// α of the lobes without the exact Λ (Ashikhmin's V, Estevez–Kulla's curve): their albedo
@@ -40,18 +41,18 @@ pub(crate) const ALPHA: ParamSpec = ParamSpec {
 /// which reaches the first texel centre of a 255-row grid in α = r² (3.8e-6).
 pub(crate) const ALPHA_WIDE: ParamSpec = ParamSpec { min: 1e-6, ..ALPHA };
 const fn roughness_of(min: f64) -> (ParamSpec, usize, fn(f64) -> f64) {
-    let r = ParamSpec { name: "roughness", min, max: 1.0, doc: "perceptual sheen roughness (alpha = roughness²)", integer: false, default: None };
+    let r = ParamSpec { name: "roughness", min, max: 1.0, doc: "perceptual sheen roughness (alpha = roughness²)", integer: false, limit: None, default: None };
     (r, 0, crate::shading::roughness::alpha_from_roughness)
 }
 /// √(3e-3) and √(1e-6): the roughness of the least α.
 const ROUGHNESS_ALIAS: (ParamSpec, usize, fn(f64) -> f64) = roughness_of(0.05477225575051661);
 const ROUGHNESS_ALIAS_WIDE: (ParamSpec, usize, fn(f64) -> f64) = roughness_of(0.001);
 /// Λ grows like 1/μ at grazing: μ = 1e-6 is Λ ~ 1e6.
-const MU_LAMBDA: ParamSpec = ParamSpec { name: "n_dot_v", min: 1e-6, max: 1.0, doc: "cosine of the direction", integer: false, default: None };
-const N_DOT_V: ParamSpec = ParamSpec { name: "n_dot_v", min: 0.0, max: 1.0, doc: "n·v", integer: false, default: None };
+const MU_LAMBDA: ParamSpec = ParamSpec { name: "n_dot_v", min: 1e-6, max: 1.0, doc: "cosine of the direction", integer: false, limit: None, default: None };
+const N_DOT_V: ParamSpec = ParamSpec { name: "n_dot_v", min: 0.0, max: 1.0, doc: "n·v", integer: false, limit: None, default: None };
 /// Under Estevez–Kulla's curve E grows without bound as n·v → 0 (its Λ(0) = e^L(0) is finite,
 /// so G2/(4 μv) ~ 1/(4 μv Λ(0)) ⇒ E ~ 1/μv below μv ≈ 1e-9): the domain starts at 1e-6.
-const N_DOT_V_EK: ParamSpec = ParamSpec { name: "n_dot_v", min: 1e-6, max: 1.0, doc: "n·v", integer: false, default: None };
+const N_DOT_V_EK: ParamSpec = ParamSpec { name: "n_dot_v", min: 1e-6, max: 1.0, doc: "n·v", integer: false, limit: None, default: None };
 
 /// The exact Λ of one α, built once per process (a pure function of α: the cache changes no
 /// bit of any result). At most [`CACHE_LIMIT`] are kept.
@@ -122,8 +123,8 @@ fn albedo_scaling(p: &[f64], tol: f64) -> Estimate {
     Estimate { value: (1.0 - c * ev.value).min(1.0 - c * el.value), error: c * ev.error.max(el.error), evals: ev.evals + el.evals }
 }
 
-const N_DOT_L_EK: ParamSpec = ParamSpec { name: "n_dot_l", min: 1e-6, max: 1.0, doc: "n·l", integer: false, default: None };
-const SHEEN_COLOR: ParamSpec = ParamSpec { name: "sheen_color", min: 0.0, max: 1.0, doc: "max3(sheenColor)", integer: false, default: None };
+const N_DOT_L_EK: ParamSpec = ParamSpec { name: "n_dot_l", min: 1e-6, max: 1.0, doc: "n·l", integer: false, limit: None, default: None };
+const SHEEN_COLOR: ParamSpec = ParamSpec { name: "sheen_color", min: 0.0, max: 1.0, doc: "max3(sheenColor)", integer: false, limit: None, default: None };
 
 fn sheen_lambda(p: &[f64], tol: f64) -> Estimate {
     lambda_exact(p[0], p[1], tol)

@@ -47,14 +47,14 @@ fn skin_sh(p: &[f64], tol: f64) -> Estimate {
 }
 
 const CURVATURE: ParamSpec =
-    ParamSpec { name: "curvature", min: 0.0, max: 100.0, doc: "curvature (1/mm)", integer: false, default: None };
+    ParamSpec { name: "curvature", min: 0.0, max: 100.0, doc: "curvature (1/mm)", integer: false, limit: None, default: None };
 
 /// The family's quantities, in `eval --help` order.
 pub static QUANTITIES: &[QuantityDef] = &[
     QuantityDef {
         name: "skin-punctual",
         doc: "pre-integrated skin diffusion for a punctual light (linear profile on a ring), RGB",
-        params: &[CURVATURE, ParamSpec { name: "n_dot_l", min: -1.0, max: 1.0, doc: "n·l", integer: false, default: None }],
+        params: &[CURVATURE, ParamSpec { name: "n_dot_l", min: -1.0, max: 1.0, doc: "n·l", integer: false, limit: None, default: None }],
         aliases: &[],
         eval: skin_punctual,
         inverse: None,
@@ -65,7 +65,7 @@ pub static QUANTITIES: &[QuantityDef] = &[
     QuantityDef {
         name: "skin-sh",
         doc: "per-band factor scaling clamped-cosine SH irradiance by skin scattering (sphere), RGB",
-        params: &[CURVATURE, ParamSpec { name: "band", min: 0.0, max: 2.0, doc: "SH band l", integer: true, default: None }],
+        params: &[CURVATURE, ParamSpec { name: "band", min: 0.0, max: 2.0, doc: "SH band l", integer: true, limit: None, default: None }],
         aliases: &[],
         eval: skin_sh,
         inverse: None,

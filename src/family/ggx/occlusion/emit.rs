@@ -160,7 +160,7 @@ fn build(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> {
         for (h, e) in HELPERS.iter().zip(&errs) {
             let c = lang.comment();
             s += &format!("\n{c} {}\n{c} f32 code against the formula: max abs {}.\n", h.doc, fmt_err(*e));
-            s += &lang.signature(&format!("{prefix}_{}", h.suffix), h.args, false);
+            s += &lang.signature(&format!("{prefix}_{}", h.suffix), h.args, 1);
             s += &h.form().render(lang.syntax(), &|i| lang.clamp(&name, h.args[i], 0.0, 1.0), &[], &|_| unreachable!("no constants"));
             s += "}\n";
         }
