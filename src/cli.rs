@@ -305,6 +305,7 @@ pub fn fit_data(
     as_json: bool,
     emit: Option<&FitEmit>,
 ) -> Result<()> {
+    check_columns(data_path, x_cols, y_col)?;
     let model = load_model(model_arg, x_cols)?;
     let targets = match emit {
         Some(e) => crate::emit::targets::parse_list(&e.targets).map_err(|why| input_err(format!("--target: {why}")))?,
@@ -427,22 +428,28 @@ fn emit_data_fit(
     Ok(())
 }
 
-/// `rational(m,n)` (one feature, named by the x column) or a model TOML file.
-fn load_model(arg: &str, x_cols: &[String]) -> Result<RationalModel> {
+/// The columns `fit --data` names, before the CSV is read: each `--x` column writable in
+/// terms and named once, and `--y` not one of them. Errors name the CSV file and the column.
+fn check_columns(csv: &Path, x_cols: &[String], y_col: &str) -> Result<()> {
     // The columns are the model's features: each must be writable in its terms, and once.
     for (i, c) in x_cols.iter().enumerate() {
         if let Some(why) = fit::model::check_feature_name(c) {
-            return Err(input_err(format!("--x: column '{c}' {why}")));
+            return Err(input_err(format!("{}: --x: column '{c}' {why}", csv.display())));
         }
         if x_cols[..i].contains(c) {
-            return Err(input_err(format!("--x: column '{c}' is given twice")));
+            return Err(input_err(format!("{}: --x: column '{c}' is given twice", csv.display())));
         }
     }
+    if x_cols.iter().any(|c| c == y_col) {
+        return Err(input_err(format!("{}: --y: column '{y_col}' is also an --x column (a feature cannot be its own target)", csv.display())));
+    }
+    Ok(())
+}
+
+/// `rational(m,n)` (of total degree in the x columns) or a model TOML file.
+fn load_model(arg: &str, x_cols: &[String]) -> Result<RationalModel> {
     if arg.trim_start().starts_with("rational(") {
-        if x_cols.len() != 1 {
-            return Err(input_err(format!("{arg} is one-dimensional but --x names {} columns", x_cols.len())));
-        }
-        return RationalModel::parse_form(arg, &x_cols[0]).map_err(input_err);
+        return RationalModel::parse_form_over(arg, x_cols).map_err(input_err);
     }
     let path = Path::new(arg);
     if !path.is_file() {

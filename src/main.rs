@@ -96,8 +96,10 @@ enum Command {
         /// Target column.
         #[arg(long)]
         y: String,
-        /// `rational(m,n)` (degree m over degree n in the one --x column) or a model spec TOML
-        /// file (README "Spec files": the [model] keys plus `features`).
+        /// `rational(m,n)` (total degree m over total degree n in the --x columns: every
+        /// monomial of degree ≤ m over 1 + every monomial of degree 1..n; degrees ≤ 12, at most
+        /// 64 coefficients) or a model spec TOML file (README "Spec files": the [model] keys
+        /// plus `features`).
         #[arg(long)]
         model: String,
         /// lsq: least squares; minimax: the smallest maximum error; l4: Σ r⁴, between the two.
