@@ -472,7 +472,7 @@ fn parse_domain(items: &[String], x_cols: &[String]) -> Result<Vec<(String, [f64
             Ok(v)
         };
         let (lo, hi) = (number(lo)?, number(hi)?);
-        if !(lo < hi) {
+        if lo >= hi {
             return Err(bad(format!("the lower bound {lo:?} is not below the upper bound {hi:?}")));
         }
         if !x_cols.iter().any(|c| c == name) {
