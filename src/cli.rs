@@ -294,6 +294,8 @@ pub struct FitEmit {
     pub name: Option<String>,
     pub function: Option<String>,
     pub args: Option<Vec<String>>,
+    /// `--domain` items, `COLUMN=LO:HI` each.
+    pub domain: Vec<String>,
 }
 
 pub fn fit_data(
@@ -305,12 +307,18 @@ pub fn fit_data(
     as_json: bool,
     emit: Option<&FitEmit>,
 ) -> Result<()> {
+    check_columns(data_path, x_cols, y_col)?;
     let model = load_model(model_arg, x_cols)?;
-    let targets = match emit {
-        Some(e) => crate::emit::targets::parse_list(&e.targets).map_err(|why| input_err(format!("--target: {why}")))?,
-        None => Vec::new(),
+    let (targets, domain) = match emit {
+        Some(e) => (
+            crate::emit::targets::parse_list(&e.targets).map_err(|why| input_err(format!("--target: {why}")))?,
+            parse_domain(&e.domain, x_cols)?,
+        ),
+        None => (Vec::new(), Vec::new()),
     };
     let data: Data = read_csv(data_path, x_cols, y_col).map_err(input_err)?;
+    // The box is checked against the rows before the fit runs (and again where it is made).
+    pipeline::data::data_box(x_cols, &data, &domain).map_err(|why| input_err(format!("{}: {why}", data_path.display())))?;
     let opts = FitOptions { objective, ..FitOptions::default() };
     let f = match fit::fit_rescaled(&model, &data, &opts, &data_path.display().to_string()) {
         // Too few rows for the model, or none: the user's input.
@@ -354,7 +362,7 @@ pub fn fit_data(
         );
     }
     if let Some(e) = emit {
-        emit_data_fit(e, &targets, data_path, x_cols, y_col, model_arg, objective, model, data, f, as_json)?;
+        emit_data_fit(e, &targets, &domain, data_path, x_cols, y_col, model_arg, objective, model, data, f, as_json)?;
     }
     Ok(())
 }
@@ -365,6 +373,7 @@ pub fn fit_data(
 fn emit_data_fit(
     e: &FitEmit,
     targets: &[crate::emit::targets::Target],
+    domain: &[(String, [f64; 2])],
     data_path: &Path,
     x_cols: &[String],
     y_col: &str,
@@ -403,6 +412,7 @@ fn emit_data_fit(
         name: &name,
         function: &function,
         args: e.args.as_deref(),
+        domain,
     };
     let built = match pipeline::data::fit_and_render(&req, model, data, fitted) {
         Err(err @ pipeline::BuildError::Input { .. }) => return Err(input_err(err)),
@@ -427,22 +437,59 @@ fn emit_data_fit(
     Ok(())
 }
 
-/// `rational(m,n)` (one feature, named by the x column) or a model TOML file.
-fn load_model(arg: &str, x_cols: &[String]) -> Result<RationalModel> {
+/// The columns `fit --data` names, before the CSV is read: each `--x` column writable in
+/// terms and named once, and `--y` not one of them. Errors name the CSV file and the column.
+fn check_columns(csv: &Path, x_cols: &[String], y_col: &str) -> Result<()> {
     // The columns are the model's features: each must be writable in its terms, and once.
     for (i, c) in x_cols.iter().enumerate() {
         if let Some(why) = fit::model::check_feature_name(c) {
-            return Err(input_err(format!("--x: column '{c}' {why}")));
+            return Err(input_err(format!("{}: --x: column '{c}' {why}", csv.display())));
         }
         if x_cols[..i].contains(c) {
-            return Err(input_err(format!("--x: column '{c}' is given twice")));
+            return Err(input_err(format!("{}: --x: column '{c}' is given twice", csv.display())));
         }
     }
-    if arg.trim_start().starts_with("rational(") {
-        if x_cols.len() != 1 {
-            return Err(input_err(format!("{arg} is one-dimensional but --x names {} columns", x_cols.len())));
+    if x_cols.iter().any(|c| c == y_col) {
+        return Err(input_err(format!("{}: --y: column '{y_col}' is also an --x column (a feature cannot be its own target)", csv.display())));
+    }
+    Ok(())
+}
+
+/// `--domain COLUMN=LO:HI,…`: the emitted code's clamp box on the named `--x` columns, each
+/// once, with finite bounds LO < HI. Errors name the flag and the item.
+fn parse_domain(items: &[String], x_cols: &[String]) -> Result<Vec<(String, [f64; 2])>> {
+    let mut out: Vec<(String, [f64; 2])> = Vec::new();
+    for item in items {
+        let bad = |why: String| input_err(format!("--domain '{item}': {why}"));
+        let (name, bounds) = item.split_once('=').ok_or_else(|| bad("expected COLUMN=LO:HI".into()))?;
+        let (lo, hi) = bounds.split_once(':').ok_or_else(|| bad("expected COLUMN=LO:HI".into()))?;
+        let (name, lo, hi) = (name.trim(), lo.trim(), hi.trim());
+        let number = |s: &str| -> Result<f64> {
+            let v: f64 = s.parse().map_err(|_| bad(format!("'{s}' is not a number")))?;
+            if !v.is_finite() {
+                return Err(bad(format!("the bound '{s}' is not finite")));
+            }
+            Ok(v)
+        };
+        let (lo, hi) = (number(lo)?, number(hi)?);
+        if lo >= hi {
+            return Err(bad(format!("the lower bound {lo:?} is not below the upper bound {hi:?}")));
         }
-        return RationalModel::parse_form(arg, &x_cols[0]).map_err(input_err);
+        if !x_cols.iter().any(|c| c == name) {
+            return Err(bad(format!("'{name}' is not an --x column (--x: {})", x_cols.join(", "))));
+        }
+        if out.iter().any(|(n, _)| n == name) {
+            return Err(bad(format!("column '{name}' is given twice")));
+        }
+        out.push((name.to_string(), [lo, hi]));
+    }
+    Ok(out)
+}
+
+/// `rational(m,n)` (of total degree in the x columns) or a model TOML file.
+fn load_model(arg: &str, x_cols: &[String]) -> Result<RationalModel> {
+    if arg.trim_start().starts_with("rational(") {
+        return RationalModel::parse_form_over(arg, x_cols).map_err(input_err);
     }
     let path = Path::new(arg);
     if !path.is_file() {

@@ -96,8 +96,10 @@ enum Command {
         /// Target column.
         #[arg(long)]
         y: String,
-        /// `rational(m,n)` (degree m over degree n in the one --x column) or a model spec TOML
-        /// file (README "Spec files": the [model] keys plus `features`).
+        /// `rational(m,n)` (total degree m over total degree n in the --x columns: every
+        /// monomial of degree ≤ m over 1 + every monomial of degree 1..n; degrees ≤ 12, at most
+        /// 64 coefficients) or a model spec TOML file (README "Spec files": the [model] keys
+        /// plus `features`).
         #[arg(long)]
         model: String,
         /// lsq: least squares; minimax: the smallest maximum error; l4: Σ r⁴, between the two.
@@ -108,7 +110,8 @@ enum Command {
         json: bool,
         /// Also emit the fit like a spec's into this folder: wgsl/NAME.wgsl, src/NAME.rs and
         /// json/NAME.json (the fit report, f32 coefficients, positivity bound), inputs clamped
-        /// to the data's range; refused unless the denominator is proven positive there.
+        /// to the data's range (or --domain); refused unless the denominator is proven positive
+        /// there.
         #[arg(long, value_name = "DIR")]
         emit: Option<PathBuf>,
         /// With --emit: more outputs (wgsl-plain, hlsl, glsl, glsl-es, msl, spirv, c).
@@ -123,6 +126,11 @@ enum Command {
         /// With --emit: the function's argument names, one per --x column (default: the columns).
         #[arg(long, value_delimiter = ',', requires = "emit")]
         args: Option<Vec<String>>,
+        /// With --emit: the clamp box on some --x columns, COLUMN=LO:HI comma-separated (e.g.
+        /// a=0:1,b=-2:2; finite bounds, LO < HI, containing the column's data); the others
+        /// keep their data's range.
+        #[arg(long, value_delimiter = ',', requires = "emit", value_name = "COLUMN=LO:HI")]
+        domain: Vec<String>,
     },
     /// Print the fitting samples of one spec (grid points and the integral there).
     Samples {
@@ -209,8 +217,8 @@ fn main() -> ExitCode {
         Command::Build { only, shard: Some(shard), shard_dir, .. } => cli::build_shard(&paths, &only, &shard, &shard_dir),
         Command::Build { only, check, force, target, .. } => cli::build(&paths, &only, check, force, &target),
         Command::Merge { files } => cli::merge(&paths, &files),
-        Command::Fit { data, x, y, model, objective, json, emit, target, name, function, args } => {
-            let emit = emit.map(|dir| cli::FitEmit { dir, targets: target, name, function, args });
+        Command::Fit { data, x, y, model, objective, json, emit, target, name, function, args, domain } => {
+            let emit = emit.map(|dir| cli::FitEmit { dir, targets: target, name, function, args, domain });
             cli::fit_data(&data, &x, &y, &model, objective, json, emit.as_ref())
         }
         Command::Samples { name, json } => cli::samples(&paths, &name, json),

@@ -373,6 +373,128 @@ fn bad_csv_exit_2_names_file_line_column() {
     assert_eq!(o.status.code(), Some(2));
 }
 
+/// y = (1 + a + 0.5 b²)/(1 + 0.25 a b) on a 9 × 9 grid of a ∈ [0, 1], b ∈ [−1, 1] (|y| ≤ 10/3,
+/// the denominator ≥ 0.75 there), each value written to round-trip f64: an exact member of
+/// rational(2,2) in total degree, 81 rows for its 11 coefficients.
+fn two_column_csv(dir: &std::path::Path) -> PathBuf {
+    let f = |a: f64, b: f64| (1.0 + a + 0.5 * b * b) / (1.0 + 0.25 * a * b);
+    let mut csv = String::from("a,b,y\n");
+    for i in 0..9 {
+        for j in 0..9 {
+            let (a, b) = (i as f64 / 8.0, -1.0 + j as f64 / 4.0);
+            csv.push_str(&format!("{a:?},{b:?},{:?}\n", f(a, b)));
+        }
+    }
+    let p = dir.join("two.csv");
+    std::fs::write(&p, csv).unwrap();
+    p
+}
+
+#[test]
+fn two_columns_recover_a_rational_of_total_degree_and_emit_its_domain() {
+    let d = tempfile::tempdir().unwrap();
+    let csv = two_column_csv(d.path());
+    let base = ["fit", "--data", csv.to_str().unwrap(), "--x", "a,b", "--y", "y", "--model", "rational(2,2)"];
+    let v = fit_json(&[&base[..], &["--json"]].concat());
+    let strings = |k: &str| v[k].as_array().unwrap().iter().map(|t| t.as_str().unwrap().to_string()).collect::<Vec<_>>();
+    assert_eq!(strings("numerator_terms"), ["1", "a", "b", "a^2", "a*b", "b^2"]);
+    assert_eq!(strings("denominator_terms"), ["1", "a", "b", "a^2", "a*b", "b^2"]);
+    let floats = |k: &str| v[k].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect::<Vec<_>>();
+    // The coefficients' error is at most the condition number (asserted below 1e3) times the
+    // data's error (each y rounded to f64: ½ ulp of |y| ≤ 10/3, 2.2e-16 relative) plus LM's
+    // relative tolerances (1e-15): about 1e-12; 1e-10 leaves a wide margin.
+    let cond = v["condition_number"].as_f64().unwrap();
+    assert!(cond < 1e3, "condition number {cond}");
+    for (got, want) in floats("numerator").iter().zip([1.0, 1.0, 0.0, 0.0, 0.0, 0.5]) {
+        assert!((got - want).abs() < 1e-10, "numerator {:?}", floats("numerator"));
+    }
+    for (got, want) in floats("denominator").iter().zip([1.0, 0.0, 0.0, 0.0, 0.25, 0.0]) {
+        assert!((got - want).abs() < 1e-10, "denominator {:?}", floats("denominator"));
+    }
+    // Exact data: the residuals are the data's rounding through that fit, below 1e-12 (|y| ≤
+    // 10/3 and the coefficients within 1e-10 would allow ~1e-9; the fit does far better).
+    assert!(v["max_abs_error"].as_f64().unwrap() < 1e-12, "{v}");
+
+    // Emitted with --domain on both columns, wider than the data (the denominator stays ≥
+    // 1 − 0.25·2·1.5 = 0.25 on it): a function of two arguments clamping to that box. The
+    // columns a and b are locals of the emitted bodies, so the arguments are renamed.
+    let emit = |out: &std::path::Path, extra: &[&str]| {
+        let o = shadefit(&[&base[..], &["--emit", out.to_str().unwrap(), "--args", "u,v", "--target", "wgsl-plain"], extra].concat(), None);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let wgsl = std::fs::read_to_string(out.join("wgsl/two.wgsl")).unwrap();
+        let rust = std::fs::read_to_string(out.join("src/two.rs")).unwrap();
+        let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("json/two.json")).unwrap()).unwrap();
+        (wgsl, rust, json)
+    };
+    // The clamp's bounds of one argument, read back from `two_input(ARG, LO, HI)` (WGSL) or
+    // `input(ARG, LO, HI)` (Rust).
+    let bounds = |text: &str, call: &str| -> Vec<f32> {
+        let rest = text.split(call).nth(1).unwrap_or_else(|| panic!("{call} not in {text}"));
+        rest.split(')').next().unwrap().split(", ").map(|b| b.trim_end_matches("_f32").trim_end_matches('f').parse().unwrap()).collect()
+    };
+    let out = d.path().join("wide");
+    let (wgsl, rust, json) = emit(&out, &["--domain", "a=0:2,b=-1.5:1.5"]);
+    assert!(wgsl.contains("fn two(u: f32, v: f32) -> f32"), "{wgsl}");
+    assert!(rust.contains("pub fn two(u: f32, v: f32) -> f32"), "{rust}");
+    assert_eq!((bounds(&wgsl, "two_input(u, "), bounds(&wgsl, "two_input(v, ")), (vec![0.0, 2.0], vec![-1.5, 1.5]));
+    assert_eq!((bounds(&rust, "input(u, "), bounds(&rust, "input(v, ")), (vec![0.0, 2.0], vec![-1.5, 1.5]));
+    let ranges: Vec<Vec<f64>> = json["axes"].as_array().unwrap().iter().map(|a| a["range"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect()).collect();
+    assert_eq!(ranges, [vec![0.0, 2.0], vec![-1.5, 1.5]]);
+    assert!(wgsl.lines().nth(1).unwrap().ends_with("--domain a=0.0:2.0,b=-1.5:1.5"), "{wgsl}");
+    // The proof's bound is Q's minimum on the box, 0.25 at (2, ±1.5), less the fit's tiny
+    // other denominator coefficients (≤ 1e-10 each, five terms of magnitude ≤ 4): 0.2 is safe.
+    let lower = json["model"]["denominator_lower_bound"].as_f64().unwrap();
+    assert!(lower > 0.2 && lower <= 0.25 + 1e-9, "denominator bound {lower}");
+    // The f32 code: 11 terms of |value| ≤ 4 in f32 arithmetic, a few ulps of 4 (2^-21 each)
+    // per operation: 1e-5 bounds its error on the rows with room.
+    assert!(json["verification"]["max_abs_error_f32"].as_f64().unwrap() < 1e-5, "{}", json["verification"]);
+    // naga parses and validates the plain WGSL of a two-argument function.
+    let plain = std::fs::read_to_string(out.join("wgsl-plain/two.wgsl")).unwrap();
+    let m = naga::front::wgsl::parse_str(&plain).unwrap_or_else(|e| panic!("{}", e.emit_to_string(&plain)));
+    naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::default())
+        .validate(&m)
+        .unwrap_or_else(|e| panic!("{}", e.emit_to_string(&plain)));
+    // A domain on one column only: the other keeps its data's range, [-1, 1].
+    let (wgsl, _, _) = emit(&d.path().join("one"), &["--domain", "a=-0.5:1"]);
+    assert_eq!((bounds(&wgsl, "two_input(u, "), bounds(&wgsl, "two_input(v, ")), (vec![-0.5, 1.0], vec![-1.0, 1.0]));
+}
+
+#[test]
+fn bad_columns_and_domains_exit_2_naming_the_file_the_column_or_the_flag_and_write_nothing() {
+    let d = tempfile::tempdir().unwrap();
+    let csv = two_column_csv(d.path());
+    let out = d.path().join("out");
+    let run = |x: &str, y: &str, extra: &[&str]| {
+        let args = [&["fit", "--data", csv.to_str().unwrap(), "--x", x, "--y", y, "--model", "rational(2,2)", "--emit", out.to_str().unwrap(), "--args", "u,v"][..], extra].concat();
+        shadefit(&args, None)
+    };
+    for (x, y, extra, want) in [
+        ("a,c", "y", &[][..], &["two.csv:1", "'c'", "no such column"][..]),
+        ("a,a", "y", &[], &["two.csv", "--x: column 'a' is given twice"]),
+        ("a,b", "b", &[], &["two.csv", "--y: column 'b' is also an --x column"]),
+        ("a,b", "y", &["--domain", "a=0..1"], &["--domain 'a=0..1'", "COLUMN=LO:HI"]),
+        ("a,b", "y", &["--domain", "a=0:1:2"], &["--domain 'a=0:1:2'", "not a number"]),
+        ("a,b", "y", &["--domain", "a=nan:1"], &["--domain 'a=nan:1'", "not finite"]),
+        ("a,b", "y", &["--domain", "a=0:inf"], &["--domain 'a=0:inf'", "not finite"]),
+        ("a,b", "y", &["--domain", "a=1:0"], &["--domain 'a=1:0'", "not below"]),
+        ("a,b", "y", &["--domain", "a=1:1"], &["--domain 'a=1:1'", "not below"]),
+        ("a,b", "y", &["--domain", "c=0:1"], &["--domain 'c=0:1'", "'c' is not an --x column"]),
+        ("a,b", "y", &["--domain", "y=0:1"], &["--domain 'y=0:1'", "'y' is not an --x column"]),
+        ("a,b", "y", &["--domain", "a=0:1,a=0:2"], &["--domain 'a=0:2'", "given twice"]),
+        // The data's a spans [0, 1], b [-1, 1]: a box short of either end is refused.
+        ("a,b", "y", &["--domain", "a=0:0.5"], &["two.csv", "--domain a=0.0:0.5", "column 'a'", "[0.0, 1.0]"]),
+        ("a,b", "y", &["--domain", "b=-0.5:2"], &["two.csv", "--domain b=-0.5:2.0", "column 'b'", "[-1.0, 1.0]"]),
+    ] {
+        let o = run(x, y, extra);
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{x} {y} {extra:?}: {e}");
+        for w in want {
+            assert!(e.contains(w), "{x} {y} {extra:?}: {e} lacks {w:?}");
+        }
+        assert!(!out.exists(), "{x} {y} {extra:?}: nothing written");
+    }
+}
+
 #[test]
 fn refit_reproduces_committed_coefficients() {
     // The slow job of the freshness story: refit from scratch and compare with what is

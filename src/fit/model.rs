@@ -38,6 +38,15 @@ pub struct Term {
 /// positivity proof's interval powers and the emitted code's products grow without limit.
 pub const MAX_DEGREE: u32 = 12;
 
+/// The most coefficients `rational(m,n)` may have, numerator and denominator together: in k
+/// features its total-degree form has C(m+k, k) + C(n+k, k) − 1 of them, which grows fast with
+/// k (3 features at degree 12: 909). One feature reaches 25 (`rational(12,12)`); 64 takes two
+/// features to total degree 6 over 6 and three to 4 over 3. Past it the f32 re-optimisation's
+/// coordinate sweeps (each coefficient's neighbours re-evaluated on every row: the cost grows
+/// with the square of the count) and the emitted function's size grow without much use; a
+/// model file chooses the terms of a larger model.
+pub const MAX_TERMS: usize = 64;
+
 /// Why `name` cannot name a feature in a model's terms (`None`: it can). Terms split on `+`,
 /// `*` and `^`, trim spaces and read `1` as the constant, so a name holding one of those, an
 /// empty name or one with surrounding spaces could never be written in a term.
@@ -77,6 +86,8 @@ pub enum ModelError {
     BadFeature { name: String, why: String },
     #[error("'{0}' is not a model form: expected rational(m,n) or a model spec file")]
     BadForm(String),
+    #[error("{form} in {features} features has {count} coefficients, above the {MAX_TERMS} a form takes (a model file chooses its terms)")]
+    TooManyTerms { form: String, features: usize, count: u128 },
     #[error("coefficient '{0}' named in a constraint is not a term of the model")]
     UnknownCoefficient(String),
     #[error("pin at {at:?}: {why}")]
@@ -324,20 +335,34 @@ impl RationalModel {
     /// The feature must pass [`check_feature_name`] and m, n ≤ [`MAX_DEGREE`] (as
     /// [`RationalModel::parse_form`] checks).
     pub fn rational_1d(feature: &str, m: u32, n: u32) -> RationalModel {
-        let features = vec![feature.to_string()];
-        let power = |p: u32| match p {
-            0 => "1".to_string(),
-            1 => feature.to_string(),
-            _ => format!("{feature}^{p}"),
+        RationalModel::rational_total(&[feature.to_string()], m, n)
+    }
+
+    /// rational(m, n) of total degree in `features`: the numerator every monomial of total
+    /// degree ≤ m (the constant first), the denominator 1 + every monomial of total degree
+    /// 1..=n, each in [`total_degree_monomials`]'s order (in one feature: 1, x, …, x^m over
+    /// 1 + x, …, x^n). The features must pass [`check_features`], m, n ≤ [`MAX_DEGREE`] and the
+    /// coefficients number at most [`MAX_TERMS`] (as [`RationalModel::parse_form`] checks).
+    pub fn rational_total(features: &[String], m: u32, n: u32) -> RationalModel {
+        let terms = |lo, hi| -> Vec<Term> {
+            total_degree_monomials(features.len(), lo, hi)
+                .iter()
+                .map(|e| Term::parse(&monomial_label(features, e), features).expect("valid term"))
+                .collect()
         };
-        let numerator = (0..=m).map(|p| Term::parse(&power(p), &features).expect("valid term")).collect();
-        let denominator = (1..=n).map(|p| Term::parse(&power(p), &features).expect("valid term")).collect();
-        RationalModel::new(ModelParts { inputs: features, numerator, denominator, ..ModelParts::default() })
+        let (numerator, denominator) = (terms(0, m), terms(1, n));
+        RationalModel::new(ModelParts { inputs: features.to_vec(), numerator, denominator, ..ModelParts::default() })
             .expect("an unconstrained rational model is always valid")
     }
 
     /// Parse `rational(m,n)` (feature name given).
     pub fn parse_form(form: &str, feature: &str) -> Result<RationalModel, ModelError> {
+        RationalModel::parse_form_over(form, &[feature.to_string()])
+    }
+
+    /// Parse `rational(m,n)` over one feature or several (degrees are total degrees, see
+    /// [`RationalModel::rational_total`]).
+    pub fn parse_form_over(form: &str, features: &[String]) -> Result<RationalModel, ModelError> {
         let f = form.trim();
         let inner = f
             .strip_prefix("rational(")
@@ -349,8 +374,12 @@ impl RationalModel {
         if m > MAX_DEGREE || n > MAX_DEGREE {
             return Err(ModelError::BadForm(format!("{form} (degrees above {MAX_DEGREE} are not supported)")));
         }
-        check_features(&[feature.to_string()])?;
-        Ok(RationalModel::rational_1d(feature, m, n))
+        check_features(features)?;
+        let count = monomials_up_to(features.len(), m) + monomials_up_to(features.len(), n) - 1;
+        if count > MAX_TERMS as u128 {
+            return Err(ModelError::TooManyTerms { form: f.to_string(), features: features.len(), count });
+        }
+        Ok(RationalModel::rational_total(features, m, n))
     }
 
     pub fn new(parts: ModelParts) -> Result<RationalModel, ModelError> {
@@ -526,6 +555,56 @@ impl RationalModel {
     }
 }
 
+/// The exponents of every monomial in `k` features of total degree `lo..=hi`: by degree, and
+/// within one degree the first feature's power highest first, then the second's, … (in (a, b)
+/// at degree 2: a², a·b, b²).
+pub fn total_degree_monomials(k: usize, lo: u32, hi: u32) -> Vec<Vec<u32>> {
+    // Every exponent vector of k entries summing to d, in that order, appended to `out`.
+    fn of_degree(k: usize, d: u32, prefix: &mut Vec<u32>, out: &mut Vec<Vec<u32>>) {
+        if k == 0 {
+            if d == 0 {
+                out.push(prefix.clone());
+            }
+            return;
+        }
+        for e in (0..=d).rev() {
+            prefix.push(e);
+            of_degree(k - 1, d - e, prefix, out);
+            prefix.pop();
+        }
+    }
+    let mut out = Vec::new();
+    for d in lo..=hi {
+        of_degree(k, d, &mut Vec::with_capacity(k), &mut out);
+    }
+    out
+}
+
+/// The number of monomials in `k` features of total degree ≤ `d`, C(d + k, k) (saturating at
+/// `u128::MAX`).
+fn monomials_up_to(k: usize, d: u32) -> u128 {
+    // C(d + i, i) = C(d + i − 1, i − 1)·(d + i)/i, exact at each step.
+    let mut c: u128 = 1;
+    for i in 1..=k as u128 {
+        c = match c.checked_mul(u128::from(d) + i) {
+            Some(v) => v / i,
+            None => return u128::MAX,
+        };
+    }
+    c
+}
+
+/// A monomial written as a term: `1`, `a`, `a^2*b`.
+fn monomial_label(features: &[String], exps: &[u32]) -> String {
+    let factors: Vec<String> = features
+        .iter()
+        .zip(exps)
+        .filter(|&(_, &e)| e > 0)
+        .map(|(f, &e)| if e == 1 { f.clone() } else { format!("{f}^{e}") })
+        .collect();
+    if factors.is_empty() { "1".to_string() } else { factors.join("*") }
+}
+
 /// Precomputed basis values at one sample.
 #[derive(Debug, Clone)]
 pub struct Basis {
@@ -648,6 +727,62 @@ mod tests {
         for form in ["rational(13,0)", "rational(0,13)", "rational(13,13)", "rational(2)", "rational(a,1)", "poly(2,1)", "rational(2,1"] {
             assert!(matches!(RationalModel::parse_form(form, "x"), Err(ModelError::BadForm(_))), "{form}");
         }
+    }
+
+    /// `rational(2,2)` in two features (total degree): the numerator is the C(4, 2) = 6
+    /// monomials of degree ≤ 2, the denominator 1 and the 5 of degree 1..2, listed here by
+    /// hand; each term is its one monomial. The value at (a, b) = (2, 3) with coefficients
+    /// 1..11 is the polynomials summed by hand: (1 + 2·2 + 3·3 + 4·4 + 5·6 + 6·9) /
+    /// (1 + 7·2 + 8·3 + 9·4 + 10·6 + 11·9) = 114/234, exact in binary up to the one division.
+    #[test]
+    fn total_degree_forms_in_two_features() {
+        let ab = vec!["a".to_string(), "b".to_string()];
+        let m = RationalModel::parse_form_over("rational(2,2)", &ab).unwrap();
+        let labels = |ts: &[Term]| ts.iter().map(|t| t.label.clone()).collect::<Vec<_>>();
+        assert_eq!(labels(&m.numerator), ["1", "a", "b", "a^2", "a*b", "b^2"]);
+        assert_eq!(labels(&m.denominator), ["a", "b", "a^2", "a*b", "b^2"]);
+        let exps = |ts: &[Term]| ts.iter().map(|t| t.monomials.iter().map(|m| m.exps.clone()).collect::<Vec<_>>()).collect::<Vec<_>>();
+        let want = [vec![0, 0], vec![1, 0], vec![0, 1], vec![2, 0], vec![1, 1], vec![0, 2]];
+        assert_eq!(exps(&m.numerator), want.iter().map(|e| vec![e.clone()]).collect::<Vec<_>>());
+        assert_eq!(exps(&m.denominator), want[1..].iter().map(|e| vec![e.clone()]).collect::<Vec<_>>());
+        assert_eq!((m.n_inputs, m.n_free()), (2, 11));
+        let c = DVector::from_iterator(11, (1..=11).map(f64::from));
+        assert_eq!(m.eval_full(&c, &[2.0, 3.0]), 114.0 / 234.0);
+        // In three features the counts are C(m + 3, 3): 4 and 10 at degrees 1 and 2.
+        let abc = vec!["a".to_string(), "b".to_string(), "c".to_string()];
+        let m = RationalModel::parse_form_over("rational(1,2)", &abc).unwrap();
+        assert_eq!(labels(&m.numerator), ["1", "a", "b", "c"]);
+        assert_eq!(labels(&m.denominator), ["a", "b", "c", "a^2", "a*b", "a*c", "b^2", "b*c", "c^2"]);
+    }
+
+    /// One feature is the 1-D form exactly (the same terms in the same order); the cap on
+    /// coefficients is C(m+k, k) + C(n+k, k) − 1 ≤ 64: two features at (6,6) have 28 + 27 = 55,
+    /// at (7,6) 36 + 27 = 63, at (7,7) 36 + 35 = 71 (refused); 65 features at (1,0) have 66;
+    /// the degree cap and the feature checks come first.
+    #[test]
+    fn total_degree_forms_keep_the_one_feature_form_and_cap_the_terms() {
+        for (m, n) in [(0, 0), (2, 1), (3, 3), (12, 12)] {
+            let a = RationalModel::parse_form_over(&format!("rational({m},{n})"), &["x".to_string()]).unwrap();
+            let power = |p: u32| if p == 0 { "1".to_string() } else if p == 1 { "x".to_string() } else { format!("x^{p}") };
+            let want: Vec<String> = (0..=m).map(|p| format!("num[{}]", power(p))).chain((1..=n).map(|p| format!("den[{}]", power(p)))).collect();
+            assert_eq!(a.coefficient_labels(), want, "rational({m},{n})");
+            assert_eq!(a.numerator, RationalModel::parse_form(&format!("rational({m},{n})"), "x").unwrap().numerator);
+        }
+        let ab = vec!["a".to_string(), "b".to_string()];
+        assert_eq!(RationalModel::parse_form_over("rational(6,6)", &ab).unwrap().n_full(), 55);
+        assert_eq!(RationalModel::parse_form_over("rational(7,6)", &ab).unwrap().n_full(), 63);
+        let e = RationalModel::parse_form_over("rational(7,7)", &ab).unwrap_err();
+        assert_eq!(e, ModelError::TooManyTerms { form: "rational(7,7)".into(), features: 2, count: 71 });
+        let many: Vec<String> = (0..65).map(|i| format!("x{i}")).collect();
+        assert!(matches!(RationalModel::parse_form_over("rational(1,0)", &many), Err(ModelError::TooManyTerms { count: 66, .. })));
+        assert_eq!(RationalModel::parse_form_over("rational(1,0)", &many[..63]).unwrap().n_full(), 64);
+        // The counts: C(4, 2) = 6, C(15, 3) = 455, C(1, 1) = 1; C(10012, 12) ≈ 2e39 is past
+        // u128 (3.4e38) and saturates rather than wrapping.
+        assert_eq!((monomials_up_to(2, 2), monomials_up_to(3, 12), monomials_up_to(1, 0)), (6, 455, 1));
+        assert_eq!(monomials_up_to(10_000, 12), u128::MAX);
+        assert!(matches!(RationalModel::parse_form_over("rational(13,1)", &ab), Err(ModelError::BadForm(_))));
+        let twice = RationalModel::parse_form_over("rational(1,1)", &["a".into(), "a".into()]).unwrap_err();
+        assert_eq!(twice.to_string(), "feature 'a' is given twice");
     }
 
     #[test]

@@ -2,8 +2,9 @@
 //!
 //! The CSV's rows are the fitting samples and the verification points both: there is no
 //! integral to sample elsewhere. The fit is made into a spec in memory, of kind `fit`, with one
-//! axis per `--x` column spanning that column's range (the box the emitted code clamps its
-//! inputs to and the positivity proof covers), and goes through the build's own steps: f32
+//! axis per `--x` column spanning that column's range, or the `--domain` bounds given for it
+//! (which must contain its rows): the box the emitted code clamps its inputs to and the
+//! positivity proof covers. It goes through the build's own steps: f32
 //! rounding and re-optimisation on the rows, the proof that the denominator is positive on the
 //! box (a fit whose denominator is not proven positive is refused), verification in f64 and in
 //! the emitted f32 arithmetic, and the WGSL module, Rust module and JSON of a fit spec, plus any
@@ -46,6 +47,8 @@ pub struct DataFit<'a> {
     pub name: &'a str,
     pub function: &'a str,
     pub args: Option<&'a [String]>,
+    /// `--domain`: the box's bounds on the columns it names (the others span their rows).
+    pub domain: &'a [(String, [f64; 2])],
 }
 
 impl DataFit<'_> {
@@ -64,8 +67,31 @@ impl DataFit<'_> {
         if let Some(a) = self.args {
             c.push_str(&format!(" --args {}", a.join(",")));
         }
+        if !self.domain.is_empty() {
+            let items: Vec<String> = self.domain.iter().map(|(n, [lo, hi])| format!("{n}={lo:?}:{hi:?}")).collect();
+            c.push_str(&format!(" --domain {}", items.join(",")));
+        }
         c
     }
+}
+
+/// The box of a data fit, per `x` column: the range its rows span, or the `domain` bounds
+/// given for it, which must contain every row. The error names `--domain` and the column.
+pub fn data_box(x: &[String], data: &Data, domain: &[(String, [f64; 2])]) -> Result<Vec<[f64; 2]>, String> {
+    let mut out = Vec::with_capacity(x.len());
+    for (j, col) in x.iter().enumerate() {
+        let (lo, hi) = data.x.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p[j]), hi.max(p[j])));
+        match domain.iter().find(|(n, _)| n == col) {
+            Some((_, [dlo, dhi])) if !(*dlo <= lo && hi <= *dhi) => {
+                return Err(format!(
+                    "--domain {col}={dlo:?}:{dhi:?}: the data of column '{col}' lies outside it (its rows span [{lo:?}, {hi:?}])"
+                ));
+            }
+            Some((_, b)) => out.push(*b),
+            None => out.push([lo, hi]),
+        }
+    }
+    Ok(out)
 }
 
 /// The spec a data fit stands for. Errors name the option at fault.
@@ -90,9 +116,9 @@ fn spec_of(req: &DataFit, model: RationalModel, data: &Data) -> Result<Spec, Bui
             return Err(input(format!("argument '{a}' is named twice")));
         }
     }
+    let bounds = data_box(req.x, data, req.domain).map_err(input)?;
     let mut axis = Vec::new();
-    for (j, col) in req.x.iter().enumerate() {
-        let (lo, hi) = data.x.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p[j]), hi.max(p[j])));
+    for (j, (col, &[lo, hi])) in req.x.iter().zip(&bounds).enumerate() {
         if !(lo < hi) {
             return Err(input(format!("column '{col}' takes one value only: the fit's box needs a range")));
         }
