@@ -201,6 +201,11 @@ fn string_position(text: &str, span: std::ops::Range<usize>, column: usize) -> (
 impl Form {
     /// Parse and check a form spec's text.
     pub fn parse(path: &Path, text: &str, catalog: &Catalog) -> Result<Form, SpecError> {
+        Form::parse_file(path, text, catalog).map(|(form, _)| form)
+    }
+
+    /// [`Form::parse`], with the spec file it read.
+    fn parse_file(path: &Path, text: &str, catalog: &Catalog) -> Result<(Form, FormFile), SpecError> {
         let f: FormFile = parse_toml(path, text)?;
         let at = |field: &str, msg: String| SpecError::new(path, line_of(text, field), field, msg);
         let quantity = catalog.lookup(&f.quantity).map_err(|e| at("quantity", e.to_string()))?;
@@ -359,7 +364,7 @@ impl Form {
             let line = spec::line_of_offset(text, f.outputs[o].span().start);
             return Err(SpecError::new(path, line, o, format!("output '{o}' is not finite at {} with the published constants", point.join(", "))));
         }
-        Ok(form)
+        Ok((form, f))
     }
 
     /// The form of a loaded spec (checked when the spec was parsed).
@@ -438,8 +443,7 @@ pub fn spec_file(path: &Path, text: &str, catalog: &Catalog) -> Result<Option<Sp
     if !is_kind(text, KIND) {
         return Ok(None);
     }
-    let form = Form::parse(path, text, catalog)?;
-    let f: FormFile = parse_toml(path, text)?;
+    let (form, f) = Form::parse_file(path, text, catalog)?;
     let axes = f.axis.iter().map(|a| serde_json::json!({"name": a.name, "range": a.range, "count": a.count})).collect();
     let common = CustomSpec { kind: KIND, name: &form.name, quantity: &f.quantity, description: &f.description, tolerance: form.tolerance, axes, function: &form.function };
     common.spec_file(path, text).map(Some)

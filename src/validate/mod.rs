@@ -4,7 +4,7 @@
 //! findings: what the numbers say about the published constants (noise, typos, conventions).
 
 use crate::pipeline::committed::Refit;
-use crate::pipeline::{self, form::{Committed, Form, measure_and_refit}};
+use crate::pipeline::{self, form::{Committed, Form}};
 use crate::fit::published::as_emitted;
 use crate::spec::{Spec, SpecError};
 use crate::spec::Catalog;
@@ -72,8 +72,9 @@ pub fn all(generated: &Path, validators: &[fn(&Path) -> Vec<Item>]) -> Vec<Item>
 /// with the committed refit beside them when it is committed for this version of the spec.
 pub fn form_item(spec: &Spec, generated: &Path, catalog: &Catalog) -> Result<Item, SpecError> {
     let form = Form::from_spec(spec, catalog)?;
-    let (truth, c) = measure_and_refit(&form, false);
-    let e = &c.published_errors.all;
+    let truth = form.truth();
+    let published = form.errors(&truth, &form.published);
+    let e = &published.all;
     let mut worst: Vec<f64> = form.args.iter().map(|a| e.worst[a]).collect();
     worst.push(form.outputs.iter().position(|o| *o == e.worst_output).unwrap_or(0) as f64);
     let mut item = Item {
@@ -87,7 +88,7 @@ pub fn form_item(spec: &Spec, generated: &Path, catalog: &Catalog) -> Result<Ite
         extra: vec![("mean_signed_error".into(), e.mean_signed_error)],
         findings: vec![],
     };
-    for (o, s) in &c.published_errors.outputs {
+    for (o, s) in &published.outputs {
         item.extra.push((format!("{o}_max_abs_error"), s.max_abs_error));
     }
     match pipeline::committed_json_with_hash(generated, spec, &pipeline::input_hash(spec)).ok().and_then(|v| serde_json::from_value::<Committed>(v["form"].clone()).ok()) {
