@@ -29,6 +29,12 @@ pub fn check_environment() -> Result<()> {
     spec::grid_budget().map(|_| ()).map_err(input_err)
 }
 
+/// Registers the lobe specs of `fits` (their quantities join the catalog); a bad one is bad
+/// input naming its file, line and field.
+pub fn register_lobes(fits: &std::path::Path) -> Result<()> {
+    crate::family::register_lobes(fits).map(|_| ()).map_err(input_err)
+}
+
 /// `name=value` arguments as a map (each name once, each value a number).
 fn parse_params(params: &[String]) -> Result<BTreeMap<String, f64>> {
     let mut named = BTreeMap::new();

@@ -196,6 +196,26 @@ fn parse_target(s: &str) -> Result<shadefit::emit::targets::Target, String> {
     Ok(shadefit::emit::targets::parse_list(&[s])?[0])
 }
 
+/// The `--fits` folder the arguments name (`--fits DIR` or `--fits=DIR`, the last one wins),
+/// or the default, before clap parses them.
+fn fits_folder(args: impl Iterator<Item = std::ffi::OsString>) -> PathBuf {
+    let mut out = PathBuf::from("fits");
+    let mut args = args.skip(1);
+    while let Some(a) = args.next() {
+        if a == "--" {
+            break;
+        }
+        if a == "--fits" {
+            if let Some(v) = args.next() {
+                out = PathBuf::from(v);
+            }
+        } else if let Some(v) = a.to_str().and_then(|s| s.strip_prefix("--fits=")) {
+            out = PathBuf::from(v);
+        }
+    }
+    out
+}
+
 fn main() -> ExitCode {
     // A closed pipe ends the process quietly, as it does other command-line tools (Rust ignores
     // SIGPIPE by default, and printing to a closed pipe would then panic).
@@ -204,9 +224,14 @@ fn main() -> ExitCode {
     unsafe {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
+    // The lobe specs of the specs folder serve quantities (`eval NAME-albedo`, table specs of
+    // them, `eval --help`): they are read before the arguments are parsed; an error in one is
+    // reported by every command that reads the catalog.
+    let lobes = cli::register_lobes(&fits_folder(std::env::args_os()));
     let cli = Cli::parse();
     let paths = Paths { fits: cli.fits, generated: cli.generated };
-    let result = cli::check_environment().and_then(|()| match cli.command {
+    let reads_catalog = !matches!(cli.command, Command::Family(_) | Command::Fit { .. });
+    let result = cli::check_environment().and_then(|()| if reads_catalog { lobes } else { Ok(()) }).and_then(|()| match cli.command {
         Command::List => cli::list(&paths),
         Command::Family(args) => cli::family_command(&args),
         Command::Eval { quantity, params, json, profile: None, kernel: None } => cli::eval(&quantity, &params, json),

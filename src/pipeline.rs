@@ -43,6 +43,7 @@ pub mod fields;
 pub mod grid;
 pub mod module;
 pub mod form;
+pub mod lobe;
 pub mod refit;
 mod error;
 mod fitted;

@@ -28,8 +28,13 @@ impl ParamSpec {
     }
 }
 
+/// A quantity's evaluator at canonical parameters (already inside the domain) to an absolute
+/// tolerance: a function, or a closure over a lobe read from a spec (`kind = "lobe"`).
+pub type Eval = &'static (dyn Fn(&[f64], f64) -> Estimate + Sync);
+/// A vector quantity's evaluator of every channel.
+pub type EvalChannels = &'static (dyn Fn(&[f64], f64) -> Vec<Estimate> + Sync);
+
 /// A quantity `shadefit eval` serves and specs sample.
-#[derive(Debug)]
 pub struct QuantityDef {
     pub name: &'static str,
     pub doc: &'static str,
@@ -38,17 +43,28 @@ pub struct QuantityDef {
     /// Alternative parameters: (spec, conversion to the canonical parameter of the same index).
     pub aliases: &'static [(ParamSpec, usize, fn(f64) -> f64)],
     /// Evaluate at canonical parameters (already inside the domain) to an absolute tolerance.
-    pub eval: fn(&[f64], f64) -> Estimate,
+    pub eval: Eval,
     /// For 1-D quantities: the inverse map value → parameter, used to report a fit's error in
     /// parameter units (e.g. the parameter recovered from a fitted value).
     pub inverse: Option<fn(f64) -> f64>,
     /// Vector-valued quantities (e.g. RGB): channel names and the evaluator of all channels.
     /// Their `eval` returns channel 0; a fit or table spec takes one (`channel`).
     pub channels: &'static [&'static str],
-    pub eval_channels: Option<fn(&[f64], f64) -> Vec<Estimate>>,
+    pub eval_channels: Option<EvalChannels>,
     /// For two-stage fits (`kind = "fields"`): the linear basis in the quantity's trailing
     /// ("inner") parameters whose coefficients become fields over the leading ones.
     pub basis: Option<&'static InnerBasis>,
+}
+
+impl std::fmt::Debug for QuantityDef {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("QuantityDef")
+            .field("name", &self.name)
+            .field("params", &self.params)
+            .field("channels", &self.channels)
+            .field("basis", &self.basis)
+            .finish_non_exhaustive()
+    }
 }
 
 /// A linear basis f(outer, inner) ≈ Σ_k c_k(outer) b_k(args(outer, inner)): the terms are

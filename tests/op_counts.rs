@@ -79,6 +79,7 @@ fn rows() -> Vec<Row> {
                 "table" => "table, const array",
                 "skin-lut" if sampled => "LUT, KTX2 texture",
                 "skin-lut" => "LUT, const array",
+                "lobe" => "a lobe spec's BRDF",
                 _ => "?",
             };
             let note = if sampled { storage.clone().unwrap_or_default() } else { String::new() };
@@ -211,6 +212,10 @@ fn counts_match_hand_counts() {
         assert_eq!(c.const_loads, 4);
         assert!(c.mul >= 18 && c.add >= 9, "{c:?}");
     }
-    assert!(rows.iter().all(|r| r.error.is_some() || r.form == "hand-written"), "every emitted file has a measured error");
+    // A lobe spec's BRDF approximates nothing: it is the lobe (its header says so).
+    assert!(
+        rows.iter().all(|r| r.error.is_some() || r.form == "hand-written" || r.form == "a lobe spec's BRDF"),
+        "every emitted file has a measured error"
+    );
 }
 

@@ -106,6 +106,9 @@ pub mod skin_punctual_lut;
 #[cfg(feature = "skin")]
 #[path = "skin_sh_lut.rs"]
 pub mod skin_sh_lut;
+#[cfg(feature = "lobes")]
+#[path = "studio_cloth.rs"]
+pub mod studio_cloth;
 #[cfg(feature = "ggx")]
 #[path = "studio_env_brdf.rs"]
 pub mod studio_env_brdf;
@@ -194,6 +197,8 @@ pub mod wgsl {
     pub const SKIN_PUNCTUAL_LUT: &str = include_str!("../wgsl/skin_punctual_lut.wgsl");
     #[cfg(feature = "skin")]
     pub const SKIN_SH_LUT: &str = include_str!("../wgsl/skin_sh_lut.wgsl");
+    #[cfg(feature = "lobes")]
+    pub const STUDIO_CLOTH: &str = include_str!("../wgsl/studio_cloth.wgsl");
     #[cfg(feature = "ggx")]
     pub const STUDIO_ENV_BRDF: &str = include_str!("../wgsl/studio_env_brdf.wgsl");
     #[cfg(feature = "scenes")]
@@ -278,6 +283,8 @@ pub mod wgsl {
             "skin_punctual_lut" => Some(SKIN_PUNCTUAL_LUT),
             #[cfg(feature = "skin")]
             "skin_sh_lut" => Some(SKIN_SH_LUT),
+            #[cfg(feature = "lobes")]
+            "studio_cloth" => Some(STUDIO_CLOTH),
             #[cfg(feature = "ggx")]
             "studio_env_brdf" => Some(STUDIO_ENV_BRDF),
             #[cfg(feature = "scenes")]
@@ -364,6 +371,8 @@ pub mod wgsl {
         "skin_punctual_lut",
         #[cfg(feature = "skin")]
         "skin_sh_lut",
+        #[cfg(feature = "lobes")]
+        "studio_cloth",
         #[cfg(feature = "ggx")]
         "studio_env_brdf",
         #[cfg(feature = "scenes")]

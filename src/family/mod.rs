@@ -140,16 +140,20 @@ pub fn families() -> &'static [&'static Family] {
 pub fn catalog() -> &'static Catalog {
     static CATALOG: OnceLock<Catalog> = OnceLock::new();
     CATALOG.get_or_init(|| Catalog {
-        quantities: FAMILIES.iter().flat_map(|f| f.quantities.iter()).collect(),
-        kinds: FAMILIES.iter().flat_map(|f| f.spec_kinds.iter().map(|k| &k.spec)).chain([&REFIT.spec, &FORM.spec]).collect(),
-        features: FAMILIES.iter().flat_map(|f| f.quantities.iter().map(|q| (q.name, f.feature))).collect(),
+        quantities: FAMILIES.iter().flat_map(|f| f.quantities.iter()).chain(lobe_quantities().iter().copied()).collect(),
+        kinds: FAMILIES.iter().flat_map(|f| f.spec_kinds.iter().map(|k| &k.spec)).chain([&REFIT.spec, &FORM.spec, &LOBE.spec]).collect(),
+        features: FAMILIES
+            .iter()
+            .flat_map(|f| f.quantities.iter().map(|q| (q.name, f.feature)))
+            .chain(lobe_quantities().iter().map(|q| (q.name, LOBES_FEATURE)))
+            .collect(),
         mappings: FAMILIES.iter().flat_map(|f| f.axis_mappings.iter().copied()).collect(),
     })
 }
 
 /// The family spec kind named `name`.
 pub fn spec_kind(name: &str) -> Option<&'static SpecKind> {
-    FAMILIES.iter().flat_map(|f| f.spec_kinds.iter()).chain([&REFIT, &FORM]).find(|k| k.spec.name == name)
+    FAMILIES.iter().flat_map(|f| f.spec_kinds.iter()).chain([&REFIT, &FORM, &LOBE]).find(|k| k.spec.name == name)
 }
 
 /// Every family's published forms, in registry order.
@@ -182,6 +186,44 @@ pub static FORM: SpecKind = SpecKind {
     shard: None,
 };
 
+/// The generic kind `lobe` (`pipeline::lobe`): the user's own BRDF lobe, its quantities
+/// registered from the specs folder ([`register_lobes`]).
+pub static LOBE: SpecKind = SpecKind {
+    spec: KindDef {
+        name: pipeline::lobe::KIND,
+        spec_file: pipeline::lobe::spec_file,
+        samples_note: "{name} is a lobe: `shadefit eval {name}-albedo …` integrates it, and table specs sample its quantities",
+        input_hash: pipeline::input_hash,
+    },
+    build: pipeline::lobe::build,
+    shard: None,
+};
+
+/// The runtime crate's feature of the lobe specs' modules (and of tables of their quantities).
+pub const LOBES_FEATURE: &str = "lobes";
+
+static LOBES: OnceLock<Vec<&'static pipeline::lobe::LobeDef>> = OnceLock::new();
+
+/// Registers the lobe specs (`kind = "lobe"`) directly in `dir` — the `--fits` folder — so that
+/// the catalog serves their quantities; call it before anything reads the catalog (a later
+/// call, or one after the catalog was built, changes nothing). Returns how many it registered.
+pub fn register_lobes(dir: &Path) -> Result<usize, crate::spec::SpecError> {
+    if LOBES.get().is_some() {
+        return Ok(0);
+    }
+    let known: Vec<&str> = FAMILIES.iter().flat_map(|f| f.quantities.iter().map(|q| q.name)).collect();
+    let defs = pipeline::lobe::read_dir(dir, &known)?;
+    let n = defs.len();
+    let _ = LOBES.set(defs.into_iter().map(|d| &*Box::leak(Box::new(d))).collect());
+    Ok(n)
+}
+
+/// The registered lobes' quantities (none before [`register_lobes`]).
+fn lobe_quantities() -> &'static [&'static QuantityDef] {
+    static Q: OnceLock<Vec<&'static QuantityDef>> = OnceLock::new();
+    Q.get_or_init(|| LOBES.get_or_init(Vec::new).iter().flat_map(|d| pipeline::lobe::quantities(d)).collect())
+}
+
 /// The specs whose committed outputs `spec` reads when built (a refit spec's forms' `reads`;
 /// none for the other kinds): the build writes them first.
 pub fn reads(spec: &Spec) -> Vec<&'static str> {
@@ -210,7 +252,7 @@ pub fn scene_features() -> Vec<&'static Feature> {
 /// The `eval --help` text: every quantity with its parameters and what it is.
 pub fn eval_help() -> String {
     let mut out = String::from("Quantities:\n");
-    for q in FAMILIES.iter().flat_map(|f| f.quantities.iter()) {
+    for q in FAMILIES.iter().flat_map(|f| f.quantities.iter()).chain(lobe_quantities().iter().copied()) {
         let mut params: Vec<String> = q
             .params
             .iter()

@@ -13,7 +13,7 @@ pub(crate) static EXP: QuantityDef = QuantityDef {
     doc: "e^-x (a closed form the build's results are checked against)",
     params: &[ParamSpec { name: "x", min: 0.0, max: 2.0, doc: "argument", integer: false, limit: None, default: None }],
     aliases: &[],
-    eval: |p, _| Estimate { value: (-p[0]).exp(), error: 0.0, evals: 1 },
+    eval: &|p, _| Estimate { value: (-p[0]).exp(), error: 0.0, evals: 1 },
     inverse: Some(|y| -y.ln()),
     channels: &[],
     eval_channels: None,
@@ -330,7 +330,7 @@ static FIELDS_Q: QuantityDef = QuantityDef {
         ParamSpec { name: "u", min: -1.0, max: 1.0, doc: "inner", integer: false, limit: None, default: None },
     ],
     aliases: &[],
-    eval: |p, _| Estimate { value: fields_value(p[0], p[1]), error: 0.0, evals: 1 },
+    eval: &|p, _| Estimate { value: fields_value(p[0], p[1]), error: 0.0, evals: 1 },
     inverse: None,
     channels: &[],
     eval_channels: None,
@@ -635,7 +635,7 @@ static RIPPLED: crate::quantity::InnerBasis = crate::quantity::InnerBasis {
 
 static RIPPLED_Q: QuantityDef = QuantityDef {
     name: "rippled-fields",
-    eval: |p, _| Estimate { value: fields_value(p[0], p[1]) + 0.02 * (7.0 * p[0]).sin() * p[1] * p[1], error: 0.0, evals: 1 },
+    eval: &|p, _| Estimate { value: fields_value(p[0], p[1]) + 0.02 * (7.0 * p[0]).sin() * p[1] * p[1], error: 0.0, evals: 1 },
     basis: Some(&RIPPLED),
     ..FIELDS_Q
 };
@@ -706,10 +706,10 @@ pub(crate) static EXP_PAIR: QuantityDef = QuantityDef {
     doc: "e^-x (channel slow) and e^-2x (channel fast)",
     params: &[ParamSpec { name: "x", min: 0.0, max: 2.0, doc: "argument", integer: false, limit: None, default: None }],
     aliases: &[],
-    eval: |p, _| Estimate { value: (-p[0]).exp(), error: 0.0, evals: 1 },
+    eval: &|p, _| Estimate { value: (-p[0]).exp(), error: 0.0, evals: 1 },
     inverse: None,
     channels: &["slow", "fast"],
-    eval_channels: Some(|p, _| {
+    eval_channels: Some(&|p, _| {
         [1.0f64, 2.0].iter().map(|k| Estimate { value: (-k * p[0]).exp(), error: 0.0, evals: 1 }).collect()
     }),
     basis: None,

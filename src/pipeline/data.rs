@@ -24,7 +24,7 @@ static DATA: QuantityDef = QuantityDef {
     doc: "values read from a CSV file (shadefit fit --data)",
     params: &[],
     aliases: &[],
-    eval: |_, _| Estimate { value: f64::NAN, error: f64::NAN, evals: 0 },
+    eval: &|_, _| Estimate { value: f64::NAN, error: f64::NAN, evals: 0 },
     inverse: None,
     channels: &[],
     eval_channels: None,

@@ -191,7 +191,7 @@ pub struct Form {
 }
 
 /// The spec-file column (1-based) of character `column` of the TOML string at `span`.
-fn string_position(text: &str, span: std::ops::Range<usize>, column: usize) -> (usize, usize) {
+pub(crate) fn string_position(text: &str, span: std::ops::Range<usize>, column: usize) -> (usize, usize) {
     let line = spec::line_of_offset(text, span.start);
     let line_start = text[..span.start].rfind('\n').map_or(0, |i| i + 1);
     let quote = text[span.start..].chars().next().map_or(0, char::len_utf8);

@@ -23,10 +23,10 @@ static TRI: QuantityDef = QuantityDef {
         ParamSpec { name: "z", min: 0.0, max: 1.0, doc: "third", integer: false, limit: None, default: Some(0.0) },
     ],
     aliases: &[],
-    eval: |p, _| Estimate { value: tri(p)[0], error: 0.0, evals: 1 },
+    eval: &|p, _| Estimate { value: tri(p)[0], error: 0.0, evals: 1 },
     inverse: None,
     channels: &["u", "v", "w"],
-    eval_channels: Some(|p, _| tri(p).iter().map(|&value| Estimate { value, error: 0.0, evals: 1 }).collect()),
+    eval_channels: Some(&|p, _| tri(p).iter().map(|&value| Estimate { value, error: 0.0, evals: 1 }).collect()),
     basis: None,
 };
 
@@ -36,7 +36,7 @@ static IDENT: QuantityDef = QuantityDef {
     doc: "its parameter",
     params: &[ParamSpec { name: "a", min: 0.0, max: 1.0, doc: "the value", integer: false, limit: None, default: None }],
     aliases: &[],
-    eval: |p, _| Estimate { value: p[0], error: 0.0, evals: 1 },
+    eval: &|p, _| Estimate { value: p[0], error: 0.0, evals: 1 },
     inverse: None,
     channels: &[],
     eval_channels: None,

@@ -8,6 +8,8 @@
 //! - [`trowbridge_reitz`]: the GGX lobe (height-correlated and separable Schlick–Smith
 //!   masking), D and Λ; [`lambert`]: Lambert's lobe; [`charlie`]: the Charlie cloth lobe with
 //!   Ashikhmin's visibility;
+//! - [`written`]: a lobe given as its BRDF function alone (a user's lobe spec) in the cosine
+//!   or GGX's measure;
 //! - [`fresnel`]: Schlick's and the dielectric Fresnel and their averages;
 //! - [`roughness`]: α from perceptual roughness and from WWII's Gloss.
 //!
@@ -20,6 +22,7 @@ pub mod lambert;
 pub mod lobe;
 pub mod roughness;
 pub mod trowbridge_reitz;
+pub mod written;
 
 pub use lobe::Lobe;
 

@@ -14,7 +14,11 @@ use crate::bench::{FamilyBench, Mode};
 use crate::integrate::Estimate;
 
 /// Integrator ladders.
-pub static INTEGRATORS: &[IntegratorBench] = &[IntegratorBench { order: 5, run: env_integrators }];
+pub static INTEGRATORS: &[IntegratorBench] =
+    &[IntegratorBench { order: 5, run: env_integrators }, IntegratorBench { order: 6, run: written_lobe_integrators }];
+
+/// GGX written as a lobe spec (`kind = "lobe"`), the lobe of tests/lobe_cli.rs.
+const GGX_WRITTEN: &str = include_str!("../../../tests/data/lobes/ggx_written.toml");
 
 pub static BENCH: FamilyBench =
     FamilyBench { integrators: INTEGRATORS, fits: published::FITS, tables: lut::TABLES, forms: published::FORMS };
@@ -71,6 +75,42 @@ fn env_integrators(mode: &Mode) -> Vec<IntegratorRow> {
             reference,
             || Run::fixed(pts.iter().flat_map(|p| hammersley_env(p[0], p[1], p[2], n)).collect(), n as u64),
         ));
+    }
+    rows
+}
+
+/// The cost of generality: E(μ) and E_avg of GGX through the built-in lobe (its weight in a
+/// cancelled closed form, its horizon pole declared) and through the same lobe written as a
+/// lobe spec (the expression's tape, the cautious azimuth fallback), at the same tolerances,
+/// against the built-in at 1e-12: the rows' times at equal error are the price of a user lobe.
+fn written_lobe_integrators(mode: &Mode) -> Vec<IntegratorRow> {
+    use crate::pipeline::lobe::LobeDef;
+    use crate::shading::hemisphere;
+    let def = LobeDef::parse(std::path::Path::new("tests/data/lobes/ggx_written.toml"), GGX_WRITTEN).expect("the written GGX lobe spec is valid");
+    let alphas: Vec<f64> = pick(mode, &[1e-3, 0.1, 0.5, 1.0], &[1e-3, 1e-2, 0.05, 0.1, 0.2, 0.3, 0.5, 0.7, 1.0]);
+    let mus: Vec<f64> = pick(mode, &[0.0, 0.3, 1.0], &[0.0, 0.01, 0.1, 0.3, 0.5, 0.7, 0.9, 1.0]);
+    let pts: Vec<[f64; 2]> = alphas.iter().flat_map(|&a| mus.iter().map(move |&m| [a, m])).collect();
+    let truth: Vec<f64> = pts.iter().map(|p| ggx::albedo(p[0], p[1], 1e-12).value).collect();
+    let reference = ("built-in lobe, adaptive at tol 1e-12", truth.as_slice());
+    let mut rows = Vec::new();
+    for tol in pick(mode, &[1e-8], &[1e-6, 1e-8, 1e-10]) {
+        rows.push(row(mode, "ggx-albedo", "built-in GGX lobe (shadefit)", format!("tol {tol:.0e}"), reference, || {
+            Run::from_estimates(pts.iter().map(|p| ggx::albedo(p[0], p[1], tol)).collect())
+        }));
+        rows.push(row(mode, "ggx-albedo", "GGX written as a lobe spec (kind = \"lobe\")", format!("tol {tol:.0e}"), reference, || {
+            Run::from_estimates(pts.iter().map(|p| hemisphere::albedo(&def.lobe(&p[..1]), p[1], tol)).collect())
+        }));
+    }
+    let avg_alphas = pick(mode, &[0.1], &[1e-3, 0.1, 0.5, 1.0]);
+    let avg_truth: Vec<f64> = avg_alphas.iter().map(|&a| ggx::albedo_avg(a, 1e-12).value).collect();
+    let reference = ("built-in lobe, adaptive at tol 1e-12", avg_truth.as_slice());
+    for tol in pick(mode, &[1e-6], &[1e-6, 1e-8]) {
+        rows.push(row(mode, "ggx-albedo-avg", "built-in GGX lobe (shadefit)", format!("tol {tol:.0e}"), reference, || {
+            Run::from_estimates(avg_alphas.iter().map(|&a| ggx::albedo_avg(a, tol)).collect())
+        }));
+        rows.push(row(mode, "ggx-albedo-avg", "GGX written as a lobe spec (kind = \"lobe\")", format!("tol {tol:.0e}"), reference, || {
+            Run::from_estimates(avg_alphas.iter().map(|&a| hemisphere::albedo_avg(&def.lobe(&[a]), tol)).collect())
+        }));
     }
     rows
 }

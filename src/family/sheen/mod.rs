@@ -130,27 +130,27 @@ fn sheen_lambda(p: &[f64], tol: f64) -> Estimate {
     lambda_exact(p[0], p[1], tol)
 }
 
-const fn quantity(name: &'static str, doc: &'static str, params: &'static [ParamSpec], eval: fn(&[f64], f64) -> Estimate) -> QuantityDef {
+const fn quantity(name: &'static str, doc: &'static str, params: &'static [ParamSpec], eval: crate::quantity::Eval) -> QuantityDef {
     let aliases: &'static [(ParamSpec, usize, fn(f64) -> f64)] = if params[0].min < ALPHA.min { &[ROUGHNESS_ALIAS_WIDE] } else { &[ROUGHNESS_ALIAS] };
     QuantityDef { name, doc, params, aliases, eval, inverse: None, channels: &[], eval_channels: None, basis: None }
 }
 
 /// The family's quantities, in `eval --help` order.
 pub static QUANTITIES: &[QuantityDef] = &[
-    quantity("sheen-lambda", "exact Smith Lambda(mu) of the Charlie distribution (from its projected area)", &[ALPHA, MU_LAMBDA], sheen_lambda),
-    quantity("sheen-albedo", "Charlie E(mu) with height-correlated Smith G2 of the exact Lambda", &[ALPHA, N_DOT_V], eval_albedo::<Smith>),
-    quantity("sheen-albedo-ek", "Charlie E(mu) with Estevez-Kulla's Lambda curve (glTF KHR_materials_sheen)", &[ALPHA_WIDE, N_DOT_V_EK], eval_albedo::<EstevezKulla>),
-    quantity("sheen-albedo-ashikhmin", "Charlie E(mu) with V = 1/(4(n·l + n·v - n·l n·v)) (Filament cloth, three.js)", &[ALPHA_WIDE, N_DOT_V], eval_albedo::<Ashikhmin>),
-    quantity("sheen-albedo-velvet", "E(mu) of Ashikhmin's velvet D with Neubelt's V (Filament's cloth before Charlie; the glTF IBL Sampler's D_Ashikhmin)", &[ALPHA, N_DOT_V], eval_albedo::<VelvetLobe>),
+    quantity("sheen-lambda", "exact Smith Lambda(mu) of the Charlie distribution (from its projected area)", &[ALPHA, MU_LAMBDA], &sheen_lambda),
+    quantity("sheen-albedo", "Charlie E(mu) with height-correlated Smith G2 of the exact Lambda", &[ALPHA, N_DOT_V], &eval_albedo::<Smith>),
+    quantity("sheen-albedo-ek", "Charlie E(mu) with Estevez-Kulla's Lambda curve (glTF KHR_materials_sheen)", &[ALPHA_WIDE, N_DOT_V_EK], &eval_albedo::<EstevezKulla>),
+    quantity("sheen-albedo-ashikhmin", "Charlie E(mu) with V = 1/(4(n·l + n·v - n·l n·v)) (Filament cloth, three.js)", &[ALPHA_WIDE, N_DOT_V], &eval_albedo::<Ashikhmin>),
+    quantity("sheen-albedo-velvet", "E(mu) of Ashikhmin's velvet D with Neubelt's V (Filament's cloth before Charlie; the glTF IBL Sampler's D_Ashikhmin)", &[ALPHA, N_DOT_V], &eval_albedo::<VelvetLobe>),
     quantity(
         "sheen-albedo-scaling",
         "glTF's albedo scaling min(1 - c E(n.v), 1 - c E(n.l)) of the layer below the sheen (E: sheen-albedo-ek, c = max3(sheenColor))",
         &[ALPHA_WIDE, N_DOT_V_EK, N_DOT_L_EK, SHEEN_COLOR],
-        albedo_scaling,
+        &albedo_scaling,
     ),
-    quantity("sheen-albedo-avg", "E_avg = 2 int E(mu) mu dmu of sheen-albedo (exact Smith)", &[ALPHA], eval_albedo_avg::<Smith>),
-    quantity("sheen-albedo-avg-ek", "E_avg of sheen-albedo-ek (Estevez-Kulla's curve)", &[ALPHA_WIDE], eval_albedo_avg::<EstevezKulla>),
-    quantity("sheen-albedo-avg-ashikhmin", "E_avg of sheen-albedo-ashikhmin", &[ALPHA_WIDE], eval_albedo_avg::<Ashikhmin>),
+    quantity("sheen-albedo-avg", "E_avg = 2 int E(mu) mu dmu of sheen-albedo (exact Smith)", &[ALPHA], &eval_albedo_avg::<Smith>),
+    quantity("sheen-albedo-avg-ek", "E_avg of sheen-albedo-ek (Estevez-Kulla's curve)", &[ALPHA_WIDE], &eval_albedo_avg::<EstevezKulla>),
+    quantity("sheen-albedo-avg-ashikhmin", "E_avg of sheen-albedo-ashikhmin", &[ALPHA_WIDE], &eval_albedo_avg::<Ashikhmin>),
 ];
 
 /// The sheen family's descriptor (registered in `crate::family::FAMILIES`).

@@ -14,7 +14,24 @@
 //! Functions: `min(a, b)`, `max(a, b)`, `clamp(x, lo, hi)`, `saturate(x)`, `mix(a, b, t)`,
 //! `sqrt`, `inversesqrt`, `exp2`, `log2`, `exp`, `log`, `abs`, `pow(x, p)` with a number p,
 //! and `select(f, t, a < b)` (t where the comparison holds, else f, as WGSL's `select`; the
-//! comparison is one of `<`, `>`, `<=`, `>=`). `x^n` with a whole n in 2…8 is written as n − 1
+//! comparison is one of `<`, `>`, `<=`, `>=`).
+//!
+//! The shading terms of the lobe layer, by name (expanded into the operations above, so that
+//! they are integrated, refitted and emitted like any formula; α is the GGX/Charlie roughness,
+//! r² for perceptual roughness r):
+//! ```text
+//! d_ggx(n_dot_h, alpha)                   α²/(π (1 − n·h² + n·h² α²)²)     Trowbridge–Reitz NDF
+//! v_smith_ggx_correlated(n_dot_v, n_dot_l, alpha)
+//!                                         ½/(n·l √(n·v² (1 − α²) + α²) + n·v √(n·l² (1 − α²) + α²))
+//!                                         height-correlated Smith G2/(4 n·v n·l) (Heitz 2014, Eq. 99)
+//! v_smith_schlick(n_dot_v, n_dot_l, k)    ¼/((n·v (1 − k) + k)(n·l (1 − k) + k))   separable
+//!                                         Schlick–Smith (UE4: k = α/2 for image-based light)
+//! d_charlie(n_dot_h, alpha)               (2 + 1/α) max(1 − n·h², 0)^(1/(2α)) / (2π)
+//!                                         the Charlie cloth NDF (Estevez & Kulla 2017)
+//! v_neubelt(n_dot_v, n_dot_l)             ¼/(n·l + n·v − n·l n·v)   Neubelt & Pettineo 2013
+//! f_schlick(f0, f90, v_dot_h)             f0 + (f90 − f0)(1 − v·h)⁵   Schlick 1994
+//! ```
+//! Their π is the scope's `pi`. `x^n` with a whole n in 2…8 is written as n − 1
 //! multiplications (what a shader author writes), any other exponent as `pow`. `exp(x)` is
 //! `exp2(x·log2 e)` and `log(x)` is `log2(x)·ln 2`, as shaders compute them. Numbers are f32
 //! literals, as the emitted code carries them: a value to be measured in f64 or refitted belongs
@@ -87,6 +104,12 @@ pub const FUNCTIONS: &[(&str, usize)] = &[
     ("abs", 1),
     ("pow", 2),
     ("select", 3),
+    ("d_ggx", 2),
+    ("v_smith_ggx_correlated", 3),
+    ("v_smith_schlick", 3),
+    ("d_charlie", 2),
+    ("v_neubelt", 2),
+    ("f_schlick", 3),
 ];
 
 /// Whether `name` is a word of the language (a function or `pi`): no argument, constant or
@@ -390,7 +413,10 @@ impl Parser<'_> {
                     _ => Expr::Less(b(y), b(x), b(f), b(t)),
                 }
             }
-            _ => unreachable!("every function is listed"),
+            term => {
+                let pi = self.scope.resolve("pi").expect("pi is always a name");
+                shading_term(term, (0..n).map(|_| next().expr()).collect(), pi)
+            }
         })
     }
 
@@ -420,6 +446,43 @@ impl Arg {
             Arg::Expr(e) => e,
             _ => unreachable!("only pow's and select's last arguments are not expressions"),
         }
+    }
+}
+
+/// The shading terms (see the module doc) written in the IR's operations; `pi` is the scope's.
+fn shading_term(name: &str, args: Vec<Expr>, pi: Expr) -> Expr {
+    let one = || Expr::Lit(1.0);
+    let lit = Expr::Lit;
+    let a = |k: usize| args[k].clone();
+    match name {
+        "d_ggx" => {
+            let a2 = a(1) * a(1);
+            // 1 − n·h²(1 − α²) as (1 − n·h²) + n·h² α²: in f32, α² − 1 rounds to −1 for α
+            // below ~2.4e-4 and the peak's denominator to 0.
+            let c2 = a(0) * a(0);
+            let q = (one() - c2.clone()) + c2 * a2.clone();
+            a2 / (pi * (q.clone() * q))
+        }
+        "v_smith_ggx_correlated" => {
+            let a2 = a(2) * a(2);
+            let root = |x: Expr| Expr::Sqrt(Box::new(x.clone() * x * (one() - a2.clone()) + a2.clone()));
+            lit(0.5) / (a(1) * root(a(0)) + a(0) * root(a(1)))
+        }
+        "v_smith_schlick" => {
+            let g = |x: Expr| x * (one() - a(2)) + a(2);
+            lit(0.25) / (g(a(0)) * g(a(1)))
+        }
+        "d_charlie" => {
+            let s2 = Expr::Max(Box::new(one() - a(0) * a(0)), Box::new(lit(0.0)));
+            let power = Expr::Exp2(Box::new(Expr::Log2(Box::new(s2)) * (lit(0.5) / a(1))));
+            (lit(2.0) + one() / a(1)) * power / (lit(2.0) * pi)
+        }
+        "v_neubelt" => lit(0.25) / (a(1) + a(0) - a(1) * a(0)),
+        "f_schlick" => {
+            let m = one() - a(2);
+            a(0) + (a(1) - a(0)) * (m.clone() * m.clone() * m.clone() * m.clone() * m)
+        }
+        _ => unreachable!("every function is listed"),
     }
 }
 
@@ -551,5 +614,37 @@ mod tests {
         assert!(err(&deep).message.contains("nested more than"));
         assert!(err(&"-".repeat(MAX_DEPTH + 1)).message.contains("nested more than"));
         assert!(err(&"x+".repeat(MAX_LEN)).message.contains("longer than"));
+    }
+
+    /// The shading terms are the shading layer's closed forms: with inputs (n·v, n·l, n·h, v·h,
+    /// α) and `pi` bound to π in f64 (a lobe's scope), each agrees with the f64 function of
+    /// the layer (or the formula as published) to ~10 roundings of values ≤ 1e6 (1e-12
+    /// relative); the literals ½ and ¼ are exact in f32.
+    #[test]
+    fn the_shading_terms_are_the_shading_layers_functions() {
+        use crate::shading::{charlie, trowbridge_reitz};
+        let (inputs, constants) = (names(&["nv", "nl", "nh", "vh", "a"]), names(&["pi"]));
+        let term = |text: &str, x: [f64; 5]| {
+            let e = parse(text, Scope { inputs: &inputs, constants: &constants, lets: &[] }).unwrap();
+            eval_f64(&e, &x, &[std::f64::consts::PI], &[])
+        };
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * b.abs().max(1e-300);
+        for &[nv, nl, nh, vh, a] in &[[0.3, 0.7, 0.9, 0.6, 0.2], [1.0, 0.05, 0.999, 0.1, 0.01], [0.0, 0.5, 0.4, 0.8, 1.0]] {
+            let x = [nv, nl, nh, vh, a];
+            assert!(close(term("d_ggx(nh, a)", x), trowbridge_reitz::d(a, nh)), "d_ggx at {x:?}");
+            // G2/(4 n·v n·l) = 1/(4 n·v n·l (1 + Λv + Λl)), Λ of GGX (Heitz 2014, Eq. 72).
+            let g2 = 1.0 / (1.0 + trowbridge_reitz::lambda(a, nv) + trowbridge_reitz::lambda(a, nl));
+            if nv > 0.0 {
+                assert!(close(term("v_smith_ggx_correlated(nv, nl, a)", x), g2 / (4.0 * nv * nl)), "V at {x:?}");
+            }
+            let k = 0.5 * a;
+            assert!(close(term("v_smith_schlick(nv, nl, a / 2)", x), 0.25 / ((nv * (1.0 - k) + k) * (nl * (1.0 - k) + k))));
+            let sh = (1.0 - nh * nh).sqrt();
+            assert!(close(term("d_charlie(nh, a)", x), charlie::d_charlie(a, sh)), "d_charlie at {x:?}");
+            assert!(close(term("v_neubelt(nv, nl)", x), 0.25 / (nl + nv - nl * nv)));
+            assert!(close(term("f_schlick(a, 1, vh)", x), a + (1.0 - a) * (1.0 - vh).powi(5)));
+        }
+        assert_eq!(term("d_charlie(nh, a)", [0.5, 0.5, 1.0, 1.0, 0.3]), 0.0, "Charlie's D vanishes at n·h = 1");
+        assert!(err("d_ggx(x)").message.contains("expected ','"), "{}", err("d_ggx(x)").message);
     }
 }
