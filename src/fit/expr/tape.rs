@@ -2,7 +2,9 @@
 //! loops of refits (one objective evaluation visits every point of a grid). The operations are
 //! those of [`super::eval_as`] on one lane in the same order (f64's `min`/`max`, clamp as
 //! `max(lo).min(hi)`, literals as their f32 values), so a tape's results are bit for bit the
-//! program's `eval_f64`; it skips the tree walk and the four lanes a program value carries.
+//! program's `eval_f64`; it skips the tree walk and the four lanes a program value carries, and
+//! computes a repeated sub-expression once (the same operation of the same registers is one
+//! register: pure operations give the same bits).
 
 use super::Expr;
 use super::program::Program;
@@ -75,6 +77,11 @@ fn emit(e: &Expr, ops: &mut Vec<Op>, lets: &[usize]) -> Option<usize> {
         // compiled.
         Expr::Coef(..) | Expr::Vector(_) | Expr::Splat(..) | Expr::Swizzle(..) => return None,
     };
+    // An operation already on the tape (the same operation of the same registers) is that
+    // register: the shading terms repeat their arguments, bindings repeat sub-expressions.
+    if let Some(i) = ops.iter().position(|o| *o == op) {
+        return Some(i);
+    }
     ops.push(op);
     Some(ops.len() - 1)
 }
