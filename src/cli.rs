@@ -533,8 +533,15 @@ fn selected_families(names: &[String]) -> Result<Vec<&'static family::Family>> {
 pub fn validate(paths: &Paths, families: &[String], only: &[String], as_json: bool) -> Result<()> {
     let everything = families.is_empty() && only.is_empty();
     let selected = if everything || !families.is_empty() { selected_families(families)? } else { vec![] };
-    let validators: Vec<fn(&Path) -> Vec<crate::validate::Item>> = selected.iter().map(|f| f.validate).collect();
-    let mut items = crate::validate::all(&paths.generated, &validators);
+    // One step per family and per form spec, drawn on a terminal only (indicatif hides itself
+    // on a pipe, so `--json` and CI output stay clean).
+    let pb = progress(selected.len(), "validate");
+    let mut items = Vec::new();
+    for f in &selected {
+        pb.set_message(format!("validate {}", f.name));
+        items.extend(crate::validate::all(&paths.generated, &[f.validate]));
+        pb.inc(1);
+    }
     let forms: Vec<Spec> = if everything && !paths.fits.is_dir() {
         vec![]
     } else if everything || !only.is_empty() {
@@ -548,9 +555,13 @@ pub fn validate(paths: &Paths, families: &[String], only: &[String], as_json: bo
     } else {
         vec![]
     };
+    pb.set_length((selected.len() + forms.len()) as u64);
     for s in &forms {
+        pb.set_message(format!("validate {}", s.file.name));
         items.push(crate::validate::form_item(s, &paths.generated, family::catalog()).map_err(input_err)?);
+        pb.inc(1);
     }
+    pb.finish_and_clear();
     if as_json {
         println!("{}", serde_json::to_string_pretty(&json!({ "items": items }))?);
         return Ok(());
@@ -628,9 +639,38 @@ pub fn family_command(args: &[String]) -> Result<()> {
 }
 
 pub fn plot(paths: &Paths, out: &Path) -> Result<()> {
+    use crate::plot::user;
     let mut files = Vec::new();
+    // A family whose committed files are not in --generated (a user's own project builds its own
+    // specs only) is skipped with a note; any other failure stops the run.
     for f in family::families() {
-        files.extend((f.figures)(out, &paths.generated)?);
+        match (f.figures)(out, &paths.generated) {
+            Ok(v) => files.extend(v),
+            Err(e) if e.path().is_some_and(|p| !p.exists()) => {
+                eprintln!("note: {}: figures left out from here on ({} is absent: the family's committed files are not in {})", f.name, e.path().expect("a path").display(), paths.generated.display());
+            }
+            Err(e) => return Err(e.into()),
+        }
+    }
+    // The user's form and lobe specs in --fits.
+    for s in load_specs(paths, &[])? {
+        match &s.file.kind {
+            spec::Kind::Custom(k) if *k == crate::pipeline::form::KIND => {
+                let form = crate::pipeline::form::Form::from_spec(&s, family::catalog()).map_err(input_err)?;
+                let hash = crate::pipeline::input_hash(&s);
+                let committed = crate::pipeline::committed_json_with_hash(&paths.generated, &s, &hash)
+                    .ok()
+                    .and_then(|v| serde_json::from_value::<crate::pipeline::form::Committed>(v["form"].clone()).ok());
+                match committed {
+                    Some(c) => files.extend(user::form_figures(&form, &c, out)?),
+                    None => eprintln!("note: {}: no figures (its refit is not committed in {}: run `shadefit build`)", s.file.name, paths.generated.display()),
+                }
+            }
+            spec::Kind::Custom(k) if *k == crate::pipeline::lobe::KIND => {
+                files.extend(user::lobe_figures(&crate::pipeline::lobe::LobeDef::from_spec(&s).map_err(input_err)?, out)?);
+            }
+            _ => {}
+        }
     }
     for f in &files {
         println!("{}", f.display());

@@ -155,3 +155,26 @@ fn a_lobe_spec_builds_its_brdf_as_a_shader_function() {
         }
     }
 }
+
+/// `plot` in a user's project (only their own form and lobe specs, built into their own
+/// generated folder): the figures of both specs are drawn, the families whose committed files
+/// are absent are skipped with one note each (naming the file once), and the run succeeds.
+#[test]
+fn plot_draws_a_users_own_specs_from_their_generated_folder() {
+    let d = tempfile::tempdir().unwrap();
+    std::fs::create_dir(d.path().join("fits")).unwrap();
+    for s in ["studio_env_brdf", "studio_cloth"] {
+        std::fs::copy(repo().join(format!("fits/{s}.toml")), d.path().join(format!("fits/{s}.toml"))).unwrap();
+    }
+    let in_dir = |args: &[&str]| Command::new(env!("CARGO_BIN_EXE_shadefit")).current_dir(d.path()).args(args).output().unwrap();
+    let b = in_dir(&["--generated", "mine", "build"]);
+    assert!(b.status.success(), "{}", String::from_utf8_lossy(&b.stderr));
+    let p = in_dir(&["--generated", "mine", "plot", "--out", "figs"]);
+    let err = String::from_utf8_lossy(&p.stderr);
+    assert!(p.status.success(), "{err}");
+    for f in ["forms/studio_env_brdf_scale_published.png", "forms/studio_env_brdf_bias_refit.svg", "lobes/studio_cloth_albedo.png"] {
+        assert!(d.path().join("figs").join(f).is_file(), "{f} missing; stderr:\n{err}");
+    }
+    assert!(err.contains("note: gloss: figures left out from here on (mine/json/"), "{err}");
+    assert!(err.lines().all(|l| l.matches("No such file").count() <= 1), "{err}");
+}

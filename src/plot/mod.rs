@@ -13,6 +13,7 @@
 
 mod colormap;
 pub mod ticks;
+pub mod user;
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -30,13 +31,14 @@ pub enum PlotError {
     Font,
     #[error("{path}: {message}")]
     Draw { path: PathBuf, message: String },
-    #[error("{path}: {source}")]
+    /// (The source is the next link of the error chain: `{:#}` prints "path: source".)
+    #[error("{path}")]
     Io {
         path: PathBuf,
         #[source]
         source: std::io::Error,
     },
-    #[error("{path}: {source}")]
+    #[error("{path}")]
     Json {
         path: PathBuf,
         #[source]
@@ -44,6 +46,16 @@ pub enum PlotError {
     },
     #[error("{path}: invalid plot data: {message}")]
     Data { path: PathBuf, message: String },
+}
+
+impl PlotError {
+    /// The file the error is about (none for the font).
+    pub fn path(&self) -> Option<&Path> {
+        match self {
+            PlotError::Font => None,
+            PlotError::Draw { path, .. } | PlotError::Io { path, .. } | PlotError::Json { path, .. } | PlotError::Data { path, .. } => Some(path),
+        }
+    }
 }
 
 /// The house style of a chart's axes: dark axis lines, tick labels and descriptions in the
