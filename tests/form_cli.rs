@@ -97,3 +97,37 @@ fn bad_form_specs_exit_2_naming_the_place_and_write_nothing() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("not a form spec"));
 }
+
+/// Spec axes may be named by an alias of their parameter (`roughness` for α = r², as `eval`
+/// takes it): a table over roughness holds bit for bit the values of the same table over α with
+/// the perceptual mapping, and a form over roughness measures exactly what the committed form
+/// (α, mapping = "perceptual") measures. An alias's own domain bounds the axis.
+#[test]
+fn spec_axes_may_be_named_by_an_alias() {
+    let d = tempfile::tempdir().unwrap();
+    let fits = d.path().join("fits");
+    std::fs::create_dir(&fits).unwrap();
+    let table = |name: &str, axis: &str| {
+        format!(
+            "name = \"{name}\"\nkind = \"table\"\nquantity = \"ggx-albedo\"\ntolerance = 1e-8\n\n[[axis]]\n{axis}\nrange = [0.05, 1.0]\ncount = 9\nverify = 9\n\n\
+             [[axis]]\nname = \"n_dot_v\"\nrange = [0.0, 1.0]\ncount = 9\nverify = 9\n\n[emit]\nfunction = \"{name}\"\n"
+        )
+    };
+    std::fs::write(fits.join("t_alias.toml"), table("t_alias", "name = \"roughness\"")).unwrap();
+    std::fs::write(fits.join("t_mapped.toml"), table("t_mapped", "name = \"alpha\"\nmapping = \"perceptual\"")).unwrap();
+    let form = std::fs::read_to_string(repo().join("fits/studio_env_brdf.toml")).unwrap();
+    let aliased = form.replacen("name = \"alpha\"\nmapping = \"perceptual\"", "name = \"roughness\"", 1).replace("order = [\"n_dot_v\", \"alpha\"]", "order = [\"n_dot_v\", \"roughness\"]");
+    assert_ne!(aliased, form, "the committed form's axis is alpha with the perceptual mapping");
+    std::fs::write(fits.join("studio_env_brdf.toml"), &aliased).unwrap();
+    let b = run(d.path(), &["build", "--only", "t_alias,t_mapped"]);
+    assert!(b.status.success(), "{}", String::from_utf8_lossy(&b.stderr));
+    let values = |n: &str| -> Value { serde_json::from_str::<Value>(&std::fs::read_to_string(d.path().join(format!("generated/json/{n}.json"))).unwrap()).unwrap()["values"].clone() };
+    assert_eq!(values("t_alias"), values("t_mapped"));
+    let (mine, committed) = (json(&run(d.path(), &["measure", "fits/studio_env_brdf.toml", "--json"])), json(&run(&repo(), &["measure", "fits/studio_env_brdf.toml", "--json"])));
+    assert_eq!(mine["published"], committed["published"]);
+    // ggx-albedo's roughness alias starts at 1e-3 (no mirror limit there): r = 0 is refused.
+    std::fs::write(fits.join("t_alias.toml"), table("t_alias", "name = \"roughness\"").replace("range = [0.05, 1.0]", "range = [0.0, 1.0]")).unwrap();
+    let e = run(d.path(), &["build", "--only", "t_alias"]);
+    assert_eq!(e.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&e.stderr).contains("field 'range': axis 'roughness' range [0, 1] must be finite, increasing and inside [0.001, 1]"), "{}", String::from_utf8_lossy(&e.stderr));
+}

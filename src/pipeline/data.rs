@@ -160,7 +160,7 @@ fn spec_of(req: &DataFit, model: RationalModel, data: &Data) -> Result<Spec, Bui
             float32_filterable: false,
         },
     };
-    Ok(Spec { path: req.csv.to_path_buf(), text, file, quantity: &DATA, model: Some(model), channel: None, origin: Some(origin), feature: "core", merged: None, table: None })
+    Ok(Spec { path: req.csv.to_path_buf(), text, file, quantity: &DATA, model: Some(model), channel: None, convert: [None; crate::spec::MAX_ALIASED], origin: Some(origin), feature: "core", merged: None, table: None })
 }
 
 /// Fit `data` (read from `req.csv`) with `model` and render the files of a fit spec: the fit

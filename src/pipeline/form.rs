@@ -188,6 +188,8 @@ pub struct Form {
     pub objective: RefitObjective,
     pub starts: usize,
     pub function: String,
+    /// Axes named by an alias of their parameter (`roughness` for α), converted when sampled.
+    convert: spec::Conversions,
 }
 
 /// The spec-file column (1-based) of character `column` of the TOML string at `span`.
@@ -235,8 +237,13 @@ impl Form {
         let names_q: Vec<&str> = quantity.params.iter().map(|p| p.name).collect();
         let axis_names: Vec<&str> = f.axis.iter().map(|a| a.name.as_str()).collect();
         let rest_default = quantity.params.get(axis_names.len()..).is_some_and(|r| r.iter().all(|p| p.default.is_some()));
-        if axis_names.is_empty() || axis_names.len() > names_q.len() || axis_names[..] != names_q[..axis_names.len()] || !rest_default {
+        let named = axis_names.iter().enumerate().all(|(i, n)| spec::axis_param(quantity, i, n).is_some());
+        if axis_names.is_empty() || axis_names.len() > names_q.len() || !named || !rest_default {
             return Err(at("axis", format!("axes must be the quantity's parameters in order: [{}], found [{}]", names_q.join(", "), axis_names.join(", "))));
+        }
+        let mut convert: spec::Conversions = [None; spec::MAX_ALIASED];
+        for (i, n) in axis_names.iter().enumerate().take(spec::MAX_ALIASED) {
+            convert[i] = spec::axis_param(quantity, i, n).and_then(|(_, f)| f);
         }
         for a in &f.axis {
             if !(1..=100_000).contains(&a.count) {
@@ -351,6 +358,7 @@ impl Form {
             objective: f.refit.objective,
             starts: f.refit.starts,
             function: f.emit.function.clone(),
+            convert,
         };
         // The published form must be finite on its grid in f64, and as the emitted f32 code there
         // and on a dense sample of its clamp box.
@@ -444,7 +452,9 @@ pub fn spec_file(path: &Path, text: &str, catalog: &Catalog) -> Result<Option<Sp
         return Ok(None);
     }
     let (form, f) = Form::parse_file(path, text, catalog)?;
-    let axes = f.axis.iter().map(|a| serde_json::json!({"name": a.name, "range": a.range, "count": a.count})).collect();
+    // The common spec names the quantity's own parameters (an axis may be named by an alias:
+    // the form's checker converted it).
+    let axes = f.axis.iter().zip(form.quantity.params).map(|(a, p)| serde_json::json!({"name": p.name, "range": a.range, "count": a.count})).collect();
     let common = CustomSpec { kind: KIND, name: &form.name, quantity: &f.quantity, description: &f.description, tolerance: form.tolerance, axes, function: &form.function };
     common.spec_file(path, text).map(Some)
 }
@@ -481,7 +491,7 @@ pub struct Truth {
 impl Form {
     /// Integrate the quantity at every grid point (in parallel, in point order).
     pub fn truth(&self) -> Truth {
-        let sampler = spec::Sampler { quantity: self.quantity, channel: None, tolerance: self.tolerance };
+        let sampler = spec::Sampler { quantity: self.quantity, channel: None, tolerance: self.tolerance, convert: self.convert };
         let points = self.grid.points();
         let est = self.grid.sample(&sampler, &self.channels, &points);
         let max_error_estimate = est.iter().flatten().map(|e| e.error).fold(0.0, f64::max);

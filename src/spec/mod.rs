@@ -653,6 +653,8 @@ pub struct Spec {
     pub merged: Option<std::sync::Arc<Vec<u8>>>,
     /// kind = "table": its channels, placements and mappings (None for the other kinds).
     pub table: Option<TableLayout>,
+    /// Axes named by an alias of their parameter, and its conversion (see [`axis_param`]).
+    pub convert: Conversions,
 }
 
 /// How a spec evaluates its quantity at a point of its axes: the channel it takes, and the
@@ -662,9 +664,34 @@ pub struct Sampler {
     pub quantity: &'static QuantityDef,
     pub channel: Option<usize>,
     pub tolerance: f64,
+    /// The conversion of each leading axis named by an alias of its parameter (`roughness` for
+    /// α): the point's coordinate is the alias's value (see [`axis_param`]).
+    pub convert: Conversions,
+}
+
+/// The conversions of the axes named by aliases, by axis (the first [`MAX_ALIASED`] axes).
+pub type Conversions = [Option<fn(f64) -> f64>; MAX_ALIASED];
+/// How many leading axes may be named by an alias.
+pub const MAX_ALIASED: usize = 4;
+
+/// The parameter axis `i` named `name` gives: the quantity's parameter `i` itself, or one of its
+/// aliases (its domain, and the conversion to the canonical parameter); None when `name` is
+/// neither.
+pub fn axis_param(quantity: &QuantityDef, i: usize, name: &str) -> Option<(&'static crate::quantity::ParamSpec, Option<fn(f64) -> f64>)> {
+    let (params, aliases): (&'static [crate::quantity::ParamSpec], &'static [(crate::quantity::ParamSpec, usize, fn(f64) -> f64)]) = (quantity.params, quantity.aliases);
+    let p = params.get(i)?;
+    if p.name == name {
+        return Some((p, None));
+    }
+    aliases.iter().find(|(a, k, _)| *k == i && a.name == name && i < MAX_ALIASED).map(|(a, _, f)| (a, Some(*f)))
 }
 
 impl Sampler {
+    /// The sampler of `quantity` on its own parameters (no alias axes).
+    pub fn new(quantity: &'static QuantityDef, channel: Option<usize>, tolerance: f64) -> Sampler {
+        Sampler { quantity, channel, tolerance, convert: [None; MAX_ALIASED] }
+    }
+
     /// The integral at `point` (the spec's axes, in order) to the spec's tolerance.
     pub fn eval(&self, point: &[f64]) -> Estimate {
         let q = self.quantity;
@@ -691,14 +718,23 @@ impl Sampler {
     /// only left-out parameters that have a default).
     fn complete(&self, point: &[f64]) -> Vec<f64> {
         let q = self.quantity;
-        point.iter().copied().chain(q.params.get(point.len()..).unwrap_or(&[]).iter().map(|p| p.default.unwrap_or(f64::NAN))).collect()
+        let converted = point.iter().enumerate().map(|(i, &v)| match self.convert.get(i).copied().flatten() {
+            // As `QuantityDef::resolve`: the converted value clamped into the canonical domain
+            // (rounding at its ends), the parameter's limit kept.
+            Some(f) => {
+                let (c, p) = (f(v), &q.params[i]);
+                if p.limit == Some(c) { c } else { c.clamp(p.min, p.max) }
+            }
+            None => v,
+        });
+        converted.chain(q.params.get(point.len()..).unwrap_or(&[]).iter().map(|p| p.default.unwrap_or(f64::NAN))).collect()
     }
 }
 
 impl Spec {
     /// The spec's evaluator of its quantity (see [`Sampler`]).
     pub fn sampler(&self) -> Sampler {
-        Sampler { quantity: self.quantity, channel: self.channel, tolerance: self.file.tolerance }
+        Sampler { quantity: self.quantity, channel: self.channel, tolerance: self.file.tolerance, convert: self.convert }
     }
 
     /// The name of the channel the spec takes, if any.
@@ -823,7 +859,9 @@ impl Spec {
         let names: Vec<&str> = quantity.params.iter().map(|p| p.name).collect();
         let axis_names: Vec<&str> = file.axis.iter().map(|a| a.name.as_str()).collect();
         let left_out_have_defaults = quantity.params.get(axis_names.len()..).is_some_and(|rest| rest.iter().all(|p| p.default.is_some()));
-        if axis_names.len() > names.len() || axis_names[..] != names[..axis_names.len()] || !left_out_have_defaults {
+        let own_axes = matches!(file.kind, Kind::Custom(_));
+        let named = |i: usize, n: &str| if own_axes { names.get(i) == Some(&n) } else { axis_param(quantity, i, n).is_some() };
+        if axis_names.len() > names.len() || !axis_names.iter().enumerate().all(|(i, n)| named(i, n)) || !left_out_have_defaults {
             let optional: Vec<&str> = quantity.params.iter().filter(|p| p.default.is_some()).map(|p| p.name).collect();
             let note = if optional.is_empty() { String::new() } else { format!(" (trailing parameters with a default may be left out: {})", optional.join(", ")) };
             return Err(at(
@@ -833,8 +871,12 @@ impl Spec {
         }
         // A family kind spells its axes out from fields its own checker has checked (a fixed
         // parameter is an axis of one point; texel centres may lie outside `eval`'s domain).
-        let own_axes = matches!(file.kind, Kind::Custom(_));
-        for (a, p) in file.axis.iter().zip(quantity.params).filter(|_| !own_axes) {
+        let mut convert: Conversions = [None; MAX_ALIASED];
+        for (i, a) in file.axis.iter().enumerate().filter(|_| !own_axes) {
+            let (p, conv) = axis_param(quantity, i, &a.name).expect("checked above");
+            if i < MAX_ALIASED {
+                convert[i] = conv;
+            }
             let [lo, hi] = a.range;
             if a.mapping.is_some() || a.placement.is_some() {
                 if file.kind != Kind::Table {
@@ -888,7 +930,7 @@ impl Spec {
                 {
                     return Err(at("features", "a fit spec takes its features from its axes; remove 'features'".into()));
                 }
-                let sampler = Sampler { quantity, channel, tolerance: file.tolerance };
+                let sampler = Sampler { quantity, channel, tolerance: file.tolerance, convert };
                 Some(m.build(path, &text, features, &|x: &[f64]| Some(sampler.eval(x).value))?)
             }
             (Kind::Fit, None) => return Err(at("model", "kind = \"fit\" needs a [model] section".into())),
@@ -907,7 +949,7 @@ impl Spec {
             Kind::Table => Some(table_layout(path, &text, &file, quantity, catalog)?),
             _ => None,
         };
-        Ok(Spec { path: path.to_path_buf(), text, file, quantity, model, channel, origin: None, feature: catalog.feature(quantity.name), merged: None, table })
+        Ok(Spec { path: path.to_path_buf(), text, file, quantity, model, channel, origin: None, feature: catalog.feature(quantity.name), merged: None, table, convert })
     }
 }
 
@@ -933,7 +975,9 @@ pub(crate) fn table_layout(path: &Path, text: &str, file: &SpecFile, quantity: &
         }
     }
     let mut axes = Vec::new();
-    for (a, p) in file.axis.iter().zip(quantity.params) {
+    for (i, a) in file.axis.iter().enumerate() {
+        // The domain of the parameter or of the alias the axis is named by.
+        let p = axis_param(quantity, i, &a.name).map_or(&quantity.params[i], |(p, _)| p);
         let mapping = match &a.mapping {
             None => &table::LINEAR,
             Some(m) => catalog.mapping(m).ok_or_else(|| {

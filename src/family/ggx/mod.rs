@@ -67,6 +67,9 @@ const SCHEME: ParamSpec = ParamSpec {
 };
 
 const ROUGHNESS_ALIAS: (ParamSpec, usize, fn(f64) -> f64) = (ROUGHNESS, 0, crate::shading::roughness::alpha_from_roughness);
+/// [`ROUGHNESS_ALIAS`] reaching r = 0 (α = 0, the mirror limit of [`ALPHA_OR_MIRROR`]).
+const ROUGHNESS_OR_MIRROR_ALIAS: (ParamSpec, usize, fn(f64) -> f64) =
+    (ParamSpec { limit: Some(0.0), ..ROUGHNESS }, 0, crate::shading::roughness::alpha_from_roughness);
 
 /// The GGX lobe of the quantities: α = p[0], height-correlated Smith G2.
 struct HeightCorrelated;
@@ -105,7 +108,7 @@ pub static QUANTITIES: &[QuantityDef] = &[
         name: "ggx-env",
         doc: "split-sum environment BRDF [scale, bias] (F = F0·scale + bias), lights in a cone",
         params: &[ALPHA_OR_MIRROR, N_DOT_V, COS_CONE],
-        aliases: &[ROUGHNESS_ALIAS],
+        aliases: &[ROUGHNESS_OR_MIRROR_ALIAS],
         eval: &eval_split_sum_scale::<HeightCorrelated>,
         inverse: None,
         channels: &["scale", "bias"],
@@ -116,7 +119,7 @@ pub static QUANTITIES: &[QuantityDef] = &[
         name: "ggx-env-ue4",
         doc: "[scale, bias] with UE4's separable Schlick-Smith G (k = alpha/2), hemisphere",
         params: &[ALPHA_OR_MIRROR, N_DOT_V],
-        aliases: &[ROUGHNESS_ALIAS],
+        aliases: &[ROUGHNESS_OR_MIRROR_ALIAS],
         eval: &eval_split_sum_scale::<Ue4>,
         inverse: None,
         channels: &["scale", "bias"],

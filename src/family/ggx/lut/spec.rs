@@ -267,7 +267,7 @@ impl DfgLut {
     /// The quantity tabulated ([scale, bias]), integrated to `tolerance`.
     pub fn sampler(&self, tolerance: f64) -> Sampler {
         let quantity: &'static QuantityDef = crate::family::ggx::QUANTITIES.iter().find(|q| q.name == self.quantity).expect("a checked DFG quantity");
-        Sampler { quantity, channel: None, tolerance }
+        Sampler::new(quantity, None, tolerance)
     }
 
     /// The shadowing at α (UE4's separable G takes k = α/2).
