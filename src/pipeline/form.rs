@@ -119,9 +119,10 @@ impl Default for RefitSection {
     }
 }
 
+/// A `[[let]]` binding of a form or lobe spec.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
-struct LetSpec {
+pub(crate) struct LetSpec {
     name: String,
     value: Spanned<String>,
 }
@@ -200,6 +201,74 @@ pub(crate) fn string_position(text: &str, span: std::ops::Range<usize>, column: 
     (line, text[line_start..span.start].chars().count() + quote + column)
 }
 
+/// The names a spec's expressions use (arguments, constants, bindings): each a distinct
+/// identifier that neither the expression language nor the emitted module takes.
+pub(crate) struct Names<'a> {
+    path: &'a Path,
+    reserved_by_module: Vec<String>,
+    taken: Vec<(String, &'static str)>,
+}
+
+impl<'a> Names<'a> {
+    pub(crate) fn new(path: &'a Path, reserved_by_module: Vec<String>) -> Self {
+        Names { path, reserved_by_module, taken: Vec::new() }
+    }
+
+    /// Takes `name` as `is` ("a constant"…), or says why not (`what` names it in the message,
+    /// the error is at `line`, `field`); an argument is checked as an emitted argument.
+    pub(crate) fn claim(&mut self, name: &str, line: usize, field: &str, what: &str, argument: bool, is: &'static str) -> Result<(), SpecError> {
+        let err = |msg: String| SpecError::new(self.path, line, field, msg);
+        let why = if argument { names::check_argument(name) } else { names::check_identifier(name) };
+        if let Some(why) = why {
+            return Err(err(format!("{what} {why}")));
+        }
+        if parse::is_reserved(name) {
+            return Err(err(format!("{what} '{name}' is a word of the expression language (its functions and pi)")));
+        }
+        if self.reserved_by_module.iter().any(|r| r == name) {
+            return Err(err(format!("{what} '{name}' is a name the emitted module defines")));
+        }
+        if let Some((_, other)) = self.taken.iter().find(|(n, _)| n == name) {
+            return Err(err(format!("{what} '{name}' is already {other}")));
+        }
+        self.taken.push((name.to_string(), is));
+        Ok(())
+    }
+
+    /// Takes `[constants]` (each finite in f32, as the emitted code carries it): their names and
+    /// values, in name order.
+    pub(crate) fn constants(&mut self, text: &str, constants: &BTreeMap<String, f64>) -> Result<(Vec<String>, Vec<f64>), SpecError> {
+        for (name, &v) in constants {
+            self.claim(name, line_of(text, name), name, "constant", false, "a constant")?;
+            if !v.is_finite() || !(v as f32).is_finite() {
+                return Err(SpecError::new(self.path, line_of(text, name), name, format!("constant '{name}' = {v} must be finite in f32 (the emitted code carries it as f32)")));
+            }
+        }
+        Ok((constants.keys().cloned().collect(), constants.values().copied().collect()))
+    }
+
+    /// Takes and parses `[[let]]` bindings in order (each may use the earlier ones): the
+    /// bindings and their names.
+    pub(crate) fn lets(&mut self, text: &str, lets: &[LetSpec], inputs: &[String], constants: &[String]) -> Result<(Vec<(String, Expr)>, Vec<String>), SpecError> {
+        let mut out: Vec<(String, Expr)> = Vec::new();
+        let mut let_names: Vec<String> = Vec::new();
+        for l in lets {
+            let field = format!("let {}", l.name);
+            self.claim(&l.name, spec::line_of_offset(text, l.value.span().start), &field, "binding", false, "a binding")?;
+            let e = parse::parse(l.value.get_ref(), Scope { inputs, constants, lets: &let_names }).map_err(|e| expression_error(self.path, text, &field, l.value.span(), e))?;
+            let_names.push(l.name.clone());
+            out.push((l.name.clone(), e));
+        }
+        Ok((out, let_names))
+    }
+}
+
+/// A parse error of the expression at `span` as a spec error at its line and column in the file.
+pub(crate) fn expression_error(path: &Path, text: &str, field: &str, span: std::ops::Range<usize>, e: parse::ParseError) -> SpecError {
+    let (line, column) = string_position(text, span, e.column);
+    SpecError::new(path, line, field, format!("column {column}: {}", e.message))
+}
+
 impl Form {
     /// Parse and check a form spec's text.
     pub fn parse(path: &Path, text: &str, catalog: &Catalog) -> Result<Form, SpecError> {
@@ -272,56 +341,16 @@ impl Form {
         if let Some(why) = names::check_identifier(&f.emit.function) {
             return Err(at("function", format!("not a valid function name: {why}")));
         }
-        let mut taken: Vec<(String, &str)> = Vec::new();
-        let reserved_by_module = [f.emit.function.clone(), format!("{}_published", f.emit.function), format!("{}_input", f.name), "input".to_string()];
-        let claim = |name: &str, line: usize, field: &str, what: &str, argument: bool, taken: &[(String, &str)]| -> Result<(), SpecError> {
-            let err = |msg: String| SpecError::new(path, line, field, msg);
-            let why = if argument { names::check_argument(name) } else { names::check_identifier(name) };
-            if let Some(why) = why {
-                return Err(err(format!("{what} {why}")));
-            }
-            if parse::is_reserved(name) {
-                return Err(err(format!("{what} '{name}' is a word of the expression language (its functions and pi)")));
-            }
-            if reserved_by_module.iter().any(|r| r == name) {
-                return Err(err(format!("{what} '{name}' is a name the emitted module defines")));
-            }
-            if let Some((_, other)) = taken.iter().find(|(n, _)| n == name) {
-                return Err(err(format!("{what} '{name}' is already {other}")));
-            }
-            Ok(())
-        };
+        let mut names = Names::new(path, vec![f.emit.function.clone(), format!("{}_published", f.emit.function), format!("{}_input", f.name), "input".to_string()]);
         for a in &args {
-            claim(a, line_of(text, "args"), "args", "argument", true, &taken)?;
-            taken.push((a.clone(), "an argument"));
+            names.claim(a, line_of(text, "args"), "args", "argument", true, "an argument")?;
         }
         if f.constants.is_empty() || f.constants.len() > MAX_CONSTANTS {
             return Err(at("constants", format!("a form has 1 to {MAX_CONSTANTS} constants to refit, not {}", f.constants.len())));
         }
-        for (name, &v) in &f.constants {
-            claim(name, line_of(text, name), name, "constant", false, &taken)?;
-            if !v.is_finite() || !(v as f32).is_finite() {
-                return Err(at(name, format!("constant '{name}' = {v} must be finite in f32 (the emitted code carries it as f32)")));
-            }
-            taken.push((name.clone(), "a constant"));
-        }
-        let constants: Vec<String> = f.constants.keys().cloned().collect();
-        let published: Vec<f64> = f.constants.values().copied().collect();
-        let expr_err = |field: &str, span: std::ops::Range<usize>, e: parse::ParseError| {
-            let (line, column) = string_position(text, span, e.column);
-            SpecError::new(path, line, field, format!("column {column}: {}", e.message))
-        };
-        let mut lets: Vec<(String, Expr)> = Vec::new();
-        let mut let_names: Vec<String> = Vec::new();
-        for l in &f.lets {
-            let field = format!("let {}", l.name);
-            claim(&l.name, spec::line_of_offset(text, l.value.span().start), &field, "binding", false, &taken)?;
-            let e = parse::parse(l.value.get_ref(), Scope { inputs: &args, constants: &constants, lets: &let_names })
-                .map_err(|e| expr_err(&field, l.value.span(), e))?;
-            taken.push((l.name.clone(), "a binding"));
-            let_names.push(l.name.clone());
-            lets.push((l.name.clone(), e));
-        }
+        let (constants, published) = names.constants(text, &f.constants)?;
+        let expr_err = |field: &str, span: std::ops::Range<usize>, e: parse::ParseError| expression_error(path, text, field, span, e);
+        let (lets, let_names) = names.lets(text, &f.lets, &args, &constants)?;
         let mut results = Vec::new();
         for o in &outputs {
             let text_o = &f.outputs[o];

@@ -56,7 +56,7 @@
 //! is not finite on its clamp box. Numbers in the expressions are f32 literals (as the shader
 //! carries them); `pi` is π to f64 in the integrals and its f32 value in the emitted code.
 
-use super::form::string_position;
+use super::form::{LetSpec, Names, expression_error};
 use super::module::{module_built, module_json};
 use super::{BuildError, Built, Mode, input_hash, spec_rel_path};
 use crate::emit::header_lines;
@@ -95,13 +95,6 @@ struct ParamFile {
     range: [f64; 2],
     #[serde(default)]
     doc: String,
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct LetFile {
-    name: String,
-    value: Spanned<String>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -166,7 +159,7 @@ struct LobeFile {
     #[serde(default)]
     constants: BTreeMap<String, f64>,
     #[serde(default, rename = "let")]
-    lets: Vec<LetFile>,
+    lets: Vec<LetSpec>,
     brdf: BrdfFile,
     #[serde(default)]
     measure: MeasureFile,
@@ -236,65 +229,28 @@ impl LobeDef {
         }
 
         // Names: the four cosines, the parameters, constants and bindings, all distinct.
-        let mut taken: Vec<(String, &str)> = ARGS.iter().map(|a| (a.to_string(), "an argument of every lobe")).collect();
-        let reserved_by_module = [function.clone(), format!("{}_input", f.name), "input".to_string()];
-        let claim = |name: &str, line: usize, field: &str, what: &str, argument: bool, taken: &[(String, &str)]| -> Result<(), SpecError> {
-            let err = |msg: String| SpecError::new(path, line, field, msg);
-            let why = if argument { names::check_argument(name) } else { names::check_identifier(name) };
-            if let Some(why) = why {
-                return Err(err(format!("{what} {why}")));
-            }
-            if parse::is_reserved(name) {
-                return Err(err(format!("{what} '{name}' is a word of the expression language (its functions and pi)")));
-            }
-            if reserved_by_module.iter().any(|r| r == name) {
-                return Err(err(format!("{what} '{name}' is a name the emitted module defines")));
-            }
-            if let Some((_, other)) = taken.iter().find(|(n, _)| n == name) {
-                return Err(err(format!("{what} '{name}' is already {other}")));
-            }
-            Ok(())
-        };
+        let mut names = Names::new(path, vec![function.clone(), format!("{}_input", f.name), "input".to_string()]);
+        for a in ARGS {
+            names.claim(a, 1, "parameter", "argument", true, "an argument of every lobe").expect("the cosines are valid names");
+        }
         let mut params = Vec::new();
         for p in &f.parameters {
             let line = text.find(&format!("\"{}\"", p.name)).map_or_else(|| line_of(text, "parameter"), |o| spec::line_of_offset(text, o));
-            claim(&p.name, line, "parameter", "parameter", true, &taken)?;
+            names.claim(&p.name, line, "parameter", "parameter", true, "a parameter")?;
             let [lo, hi] = p.range;
             if !(lo.is_finite() && hi.is_finite() && lo < hi) || !((lo as f32).is_finite() && (hi as f32).is_finite()) {
                 return Err(SpecError::new(path, line, "range", format!("parameter '{}': range [{lo}, {hi}] must be finite (in f32 too) with lo < hi", p.name)));
             }
-            taken.push((p.name.clone(), "a parameter"));
             params.push(LobeParam { name: p.name.clone(), range: (lo, hi), doc: p.doc.clone() });
         }
-        for (name, &v) in &f.constants {
-            claim(name, line_of(text, name), name, "constant", false, &taken)?;
-            if !v.is_finite() || !(v as f32).is_finite() {
-                return Err(at(name, format!("constant '{name}' = {v} must be finite in f32 (the emitted code carries it as f32)")));
-            }
-            taken.push((name.clone(), "a constant"));
-        }
-        let mut constants: Vec<String> = f.constants.keys().cloned().collect();
-        let mut values: Vec<f64> = f.constants.values().copied().collect();
+        let (mut constants, mut values) = names.constants(text, &f.constants)?;
         constants.push("pi".into());
         values.push(std::f64::consts::PI);
 
         let inputs: Vec<String> = ARGS.iter().map(|a| a.to_string()).chain(params.iter().map(|p| p.name.clone())).collect();
         let param_names: Vec<String> = params.iter().map(|p| p.name.clone()).collect();
-        let expr_err = |field: &str, span: std::ops::Range<usize>, e: parse::ParseError| {
-            let (line, column) = string_position(text, span, e.column);
-            SpecError::new(path, line, field, format!("column {column}: {}", e.message))
-        };
-        let mut lets: Vec<(String, Expr)> = Vec::new();
-        let mut let_names: Vec<String> = Vec::new();
-        for l in &f.lets {
-            let field = format!("let {}", l.name);
-            claim(&l.name, spec::line_of_offset(text, l.value.span().start), &field, "binding", false, &taken)?;
-            let e = parse::parse(l.value.get_ref(), Scope { inputs: &inputs, constants: &constants, lets: &let_names })
-                .map_err(|e| expr_err(&field, l.value.span(), e))?;
-            taken.push((l.name.clone(), "a binding"));
-            let_names.push(l.name.clone());
-            lets.push((l.name.clone(), e));
-        }
+        let expr_err = |field: &str, span: std::ops::Range<usize>, e: parse::ParseError| expression_error(path, text, field, span, e);
+        let (lets, let_names) = names.lets(text, &f.lets, &inputs, &constants)?;
         let scope = Scope { inputs: &inputs, constants: &constants, lets: &let_names };
         let term = |field: &str, s: &Spanned<String>| parse::parse(s.get_ref(), scope).map_err(|e| expr_err(field, s.span(), e));
         let b = &f.brdf;
