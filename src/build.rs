@@ -98,6 +98,7 @@ pub fn build_spec(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildEr
 /// Every spec in `paths.fits`, checking that each name in `only` is one of them and that
 /// `[emit] targets` names targets.
 pub fn load_specs(paths: &Paths, only: &[String]) -> Result<Vec<Spec>, Error> {
+    family::register_lobes(&paths.fits)?;
     let specs = spec::load_dir(&paths.fits, family::catalog())?;
     for s in &specs {
         spec_targets(s)?;
@@ -469,6 +470,7 @@ pub enum Status {
 /// committed JSON with the spec's (no integration, fitting or rendering); `build --check`
 /// re-renders every file and compares the bytes.
 pub fn status(paths: &Paths) -> Result<Vec<(Spec, Status)>, Error> {
+    family::register_lobes(&paths.fits)?;
     let specs = spec::load_dir(&paths.fits, family::catalog())?;
     Ok(specs
         .into_iter()
@@ -670,6 +672,7 @@ mod tests {
     #[test]
     fn the_runtime_index_gates_modules_on_features_the_runtime_crate_declares() {
         let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+        family::register_lobes(&root.join("fits")).unwrap();
         let specs = spec::load_dir(&root.join("fits"), family::catalog()).unwrap();
         assert!(specs.len() > 20, "{} specs", specs.len());
         let text = String::from_utf8(pipeline::runtime_index(&specs).contents).unwrap();
@@ -680,7 +683,12 @@ mod tests {
             assert!(declared.contains_key(*f), "the index names feature '{f}', which generated/Cargo.toml does not declare");
         }
         for s in &specs {
-            let fam = s.file.quantity.split_once('-').map_or(s.file.quantity.as_str(), |(f, _)| f);
+            // A family's quantities are named FAMILY-…; a lobe spec's module is the lobes feature's.
+            let fam = if s.file.kind == spec::Kind::Custom(pipeline::lobe::KIND) {
+                "lobes"
+            } else {
+                s.file.quantity.split_once('-').map_or(s.file.quantity.as_str(), |(f, _)| f)
+            };
             let gate = format!("#[cfg(feature = \"{fam}\")]\n#[path = \"{}.rs\"]", s.file.name);
             assert!(text.contains(&gate), "{}: no '{gate}'", s.file.name);
         }

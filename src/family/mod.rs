@@ -136,20 +136,33 @@ pub fn families() -> &'static [&'static Family] {
     FAMILIES
 }
 
-/// Every quantity and family spec kind, for the spec layer.
+/// Every quantity and family spec kind, for the spec layer: the families' and those of the lobe
+/// specs registered so far ([`register_lobes`]; a registration makes the next call build the
+/// catalog again, and catalogs handed out before stay valid).
 pub fn catalog() -> &'static Catalog {
-    static CATALOG: OnceLock<Catalog> = OnceLock::new();
-    CATALOG.get_or_init(|| Catalog {
-        quantities: FAMILIES.iter().flat_map(|f| f.quantities.iter()).chain(lobe_quantities().iter().copied()).collect(),
+    if let Some(c) = *CATALOG.read().expect("the catalog lock") {
+        return c;
+    }
+    let mut slot = CATALOG.write().expect("the catalog lock");
+    if let Some(c) = *slot {
+        return c;
+    }
+    let lobes = lobe_quantities();
+    let c: &'static Catalog = Box::leak(Box::new(Catalog {
+        quantities: FAMILIES.iter().flat_map(|f| f.quantities.iter()).chain(lobes.iter().copied()).collect(),
         kinds: FAMILIES.iter().flat_map(|f| f.spec_kinds.iter().map(|k| &k.spec)).chain([&REFIT.spec, &FORM.spec, &LOBE.spec]).collect(),
         features: FAMILIES
             .iter()
             .flat_map(|f| f.quantities.iter().map(|q| (q.name, f.feature)))
-            .chain(lobe_quantities().iter().map(|q| (q.name, LOBES_FEATURE)))
+            .chain(lobes.iter().map(|q| (q.name, LOBES_FEATURE)))
             .collect(),
         mappings: FAMILIES.iter().flat_map(|f| f.axis_mappings.iter().copied()).collect(),
-    })
+    }));
+    *slot = Some(c);
+    c
 }
+
+static CATALOG: std::sync::RwLock<Option<&'static Catalog>> = std::sync::RwLock::new(None);
 
 /// The family spec kind named `name`.
 pub fn spec_kind(name: &str) -> Option<&'static SpecKind> {
@@ -202,26 +215,39 @@ pub static LOBE: SpecKind = SpecKind {
 /// The runtime crate's feature of the lobe specs' modules (and of tables of their quantities).
 pub const LOBES_FEATURE: &str = "lobes";
 
-static LOBES: OnceLock<Vec<&'static pipeline::lobe::LobeDef>> = OnceLock::new();
+/// The registered lobes, each with its quantities.
+static LOBES: std::sync::Mutex<Vec<(&'static pipeline::lobe::LobeDef, Vec<&'static QuantityDef>)>> = std::sync::Mutex::new(Vec::new());
 
 /// Registers the lobe specs (`kind = "lobe"`) directly in `dir` — the `--fits` folder — so that
-/// the catalog serves their quantities; call it before anything reads the catalog (a later
-/// call, or one after the catalog was built, changes nothing). Returns how many it registered.
+/// the catalog serves their quantities (the CLI calls it before parsing the command line, the
+/// build before loading the specs). A lobe registered before from the same file is kept; one of
+/// the same name from another file is refused. Returns how many it added.
 pub fn register_lobes(dir: &Path) -> Result<usize, crate::spec::SpecError> {
-    if LOBES.get().is_some() {
-        return Ok(0);
-    }
     let known: Vec<&str> = FAMILIES.iter().flat_map(|f| f.quantities.iter().map(|q| q.name)).collect();
     let defs = pipeline::lobe::read_dir(dir, &known)?;
-    let n = defs.len();
-    let _ = LOBES.set(defs.into_iter().map(|d| &*Box::leak(Box::new(d))).collect());
-    Ok(n)
+    let mut lobes = LOBES.lock().expect("the lobe registry lock");
+    let mut added = 0;
+    for d in defs {
+        if let Some((old, _)) = lobes.iter().find(|(l, _)| l.name == d.name) {
+            if old.path == d.path {
+                continue;
+            }
+            let text = std::fs::read_to_string(&d.path).unwrap_or_default();
+            return Err(crate::spec::SpecError::new(&d.path, crate::spec::line_of(&text, "name"), "name", format!("lobe '{}' is also {}", d.name, old.path.display())));
+        }
+        let def: &'static pipeline::lobe::LobeDef = Box::leak(Box::new(d));
+        lobes.push((def, pipeline::lobe::quantities(def)));
+        added += 1;
+    }
+    if added > 0 {
+        *CATALOG.write().expect("the catalog lock") = None;
+    }
+    Ok(added)
 }
 
-/// The registered lobes' quantities (none before [`register_lobes`]).
-fn lobe_quantities() -> &'static [&'static QuantityDef] {
-    static Q: OnceLock<Vec<&'static QuantityDef>> = OnceLock::new();
-    Q.get_or_init(|| LOBES.get_or_init(Vec::new).iter().flat_map(|d| pipeline::lobe::quantities(d)).collect())
+/// The registered lobes' quantities, in registration order.
+fn lobe_quantities() -> Vec<&'static QuantityDef> {
+    LOBES.lock().expect("the lobe registry lock").iter().flat_map(|(_, q)| q.iter().copied()).collect()
 }
 
 /// The specs whose committed outputs `spec` reads when built (a refit spec's forms' `reads`;
@@ -252,7 +278,7 @@ pub fn scene_features() -> Vec<&'static Feature> {
 /// The `eval --help` text: every quantity with its parameters and what it is.
 pub fn eval_help() -> String {
     let mut out = String::from("Quantities:\n");
-    for q in FAMILIES.iter().flat_map(|f| f.quantities.iter()).chain(lobe_quantities().iter().copied()) {
+    for q in FAMILIES.iter().flat_map(|f| f.quantities.iter()).chain(lobe_quantities()) {
         let mut params: Vec<String> = q
             .params
             .iter()

@@ -178,6 +178,8 @@ pub struct LobeParam {
 /// A lobe spec, checked.
 #[derive(Debug, Clone)]
 pub struct LobeDef {
+    /// The spec file it was read from.
+    pub path: std::path::PathBuf,
     pub name: String,
     pub description: String,
     pub source: String,
@@ -282,6 +284,7 @@ impl LobeDef {
             (MeasureKind::TrowbridgeReitz, None) => return Err(at("measure", "kind = \"trowbridge-reitz\" needs alpha = \"…\", the measure's roughness over the parameters".into())),
         };
         let def = LobeDef {
+            path: path.to_path_buf(),
             name: f.name.clone(),
             description: f.description.clone(),
             source: f.source.clone(),
