@@ -657,11 +657,7 @@ pub fn plot(paths: &Paths, out: &Path) -> Result<()> {
         match &s.file.kind {
             spec::Kind::Custom(k) if *k == crate::pipeline::form::KIND => {
                 let form = crate::pipeline::form::Form::from_spec(&s, family::catalog()).map_err(input_err)?;
-                let hash = crate::pipeline::input_hash(&s);
-                let committed = crate::pipeline::committed_json_with_hash(&paths.generated, &s, &hash)
-                    .ok()
-                    .and_then(|v| serde_json::from_value::<crate::pipeline::form::Committed>(v["form"].clone()).ok());
-                match committed {
+                match crate::pipeline::form::committed(&paths.generated, &s) {
                     Some(c) => files.extend(user::form_figures(&form, &c, out)?),
                     None => eprintln!("note: {}: no figures (its refit is not committed in {}: run `shadefit build`)", s.file.name, paths.generated.display()),
                 }

@@ -37,6 +37,14 @@ fn pick<'a>(qs: &[&'a QuantityDef], name: &str) -> &'a QuantityDef {
     qs.iter().copied().find(|q| q.name == name).unwrap_or_else(|| panic!("no quantity {name}"))
 }
 
+/// `build --only SPECS` of the lobe specs in tests/data/lobes into a fresh folder.
+fn build_lobes(specs: &str) -> tempfile::TempDir {
+    let out = tempfile::tempdir().unwrap();
+    let r = run(&["--fits", "tests/data/lobes", "--generated", out.path().to_str().unwrap(), "build", "--only", specs]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    out
+}
+
 /// A deterministic uniform sample in [0, 1) (SplitMix64).
 fn uniform(state: &mut u64) -> f64 {
     *state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
@@ -106,10 +114,7 @@ fn lambert_written_out_has_albedo_rho() {
 /// each side, and they agree to 1e-7.
 #[test]
 fn written_ggx_split_sum_table_matches_ggx_dfg_lut() {
-    let out = tempfile::tempdir().unwrap();
-    let generated = out.path().to_str().unwrap();
-    let r = run(&["--fits", "tests/data/lobes", "--generated", generated, "build", "--only", "ggx_written_dfg"]);
-    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let out = build_lobes("ggx_written_dfg");
     let mine: Value = serde_json::from_str(&std::fs::read_to_string(out.path().join("json/ggx_written_dfg.json")).unwrap()).unwrap();
     let lut: Value = serde_json::from_str(&std::fs::read_to_string(repo().join("generated/json/ggx_dfg_lut.json")).unwrap()).unwrap();
     let (a, b) = (mine["values"].as_array().unwrap(), lut["values"].as_array().unwrap());
@@ -136,10 +141,7 @@ fn the_cloth_example_is_the_charlie_neubelt_lobe() {
 /// E = ρ at every corner, to its error estimate).
 #[test]
 fn a_lobe_spec_builds_its_brdf_as_a_shader_function() {
-    let out = tempfile::tempdir().unwrap();
-    let generated = out.path().to_str().unwrap();
-    let r = run(&["--fits", "tests/data/lobes", "--generated", generated, "build", "--only", "ggx_written,lambert_written"]);
-    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let out = build_lobes("ggx_written,lambert_written");
     for (name, function) in [("ggx_written", "fn ggx_written(n_dot_v: f32, n_dot_l: f32, n_dot_h: f32, v_dot_h: f32, alpha: f32) -> f32 {"), ("lambert_written", "fn lambert_written(")] {
         let wgsl = std::fs::read_to_string(out.path().join(format!("wgsl/{name}.wgsl"))).unwrap();
         assert!(wgsl.contains(function), "{wgsl}");

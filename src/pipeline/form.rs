@@ -306,14 +306,10 @@ impl Form {
         let names_q: Vec<&str> = quantity.params.iter().map(|p| p.name).collect();
         let axis_names: Vec<&str> = f.axis.iter().map(|a| a.name.as_str()).collect();
         let rest_default = quantity.params.get(axis_names.len()..).is_some_and(|r| r.iter().all(|p| p.default.is_some()));
-        let named = axis_names.iter().enumerate().all(|(i, n)| spec::axis_param(quantity, i, n).is_some());
-        if axis_names.is_empty() || axis_names.len() > names_q.len() || !named || !rest_default {
+        let convert = spec::conversions(quantity, &axis_names);
+        let Some(convert) = convert.filter(|_| !axis_names.is_empty() && axis_names.len() <= names_q.len() && rest_default) else {
             return Err(at("axis", format!("axes must be the quantity's parameters in order: [{}], found [{}]", names_q.join(", "), axis_names.join(", "))));
-        }
-        let mut convert: spec::Conversions = [None; spec::MAX_ALIASED];
-        for (i, n) in axis_names.iter().enumerate().take(spec::MAX_ALIASED) {
-            convert[i] = spec::axis_param(quantity, i, n).and_then(|(_, f)| f);
-        }
+        };
         for a in &f.axis {
             if !(1..=100_000).contains(&a.count) {
                 return Err(at("count", format!("axis '{}' count {} must be in [1, 100000]", a.name, a.count)));
@@ -628,6 +624,13 @@ pub struct Committed {
     /// The refit's errors with its constants rounded to f32, evaluated in f64.
     pub refit_errors: Errors,
     pub max_error_estimate: f64,
+}
+
+/// The committed constants and measures of form spec `spec` in `generated` (None when absent or
+/// written for another version of the spec).
+pub fn committed(generated: &Path, spec: &Spec) -> Option<Committed> {
+    let v = committed_json_with_hash(generated, spec, &input_hash(spec)).ok()?;
+    serde_json::from_value(v["form"].clone()).ok()
 }
 
 /// A form measured and refitted (what the build commits and `measure --refit` prints).

@@ -198,15 +198,14 @@ pub struct LobeDef {
 }
 
 thread_local! {
-    /// Registers and inputs of the tapes, reused between evaluations on each thread.
-    static SCRATCH: RefCell<(Vec<f64>, Vec<f64>)> = const { RefCell::new((Vec::new(), Vec::new())) };
+    /// The tapes' registers, reused between evaluations on each thread.
+    static REGS: RefCell<Vec<f64>> = const { RefCell::new(Vec::new()) };
 }
 
 fn run(tape: &Tape, inputs: &[f64], consts: &[f64]) -> f64 {
-    SCRATCH.with(|s| {
-        let (regs, _) = &mut *s.borrow_mut();
+    REGS.with(|regs| {
         let mut out = [0.0];
-        tape.eval(inputs, consts, regs, &mut out);
+        tape.eval(inputs, consts, &mut regs.borrow_mut(), &mut out);
         out[0]
     })
 }
@@ -444,10 +443,7 @@ pub fn quantities(def: &'static LobeDef) -> Vec<&'static QuantityDef> {
         Box::leak(Box::new(QuantityDef { name: leak(name), doc: leak(doc), params, aliases: &[], eval, inverse: None, channels, eval_channels, basis: None }))
     };
     let of = if def.description.is_empty() { def.name.clone() } else { format!("{} ({})", def.name, def.description) };
-    let split = move |p: &[f64], tol: f64| {
-        let r = split_sum(&def.lobe(&p[..k]), p[k], p.get(k + 1).copied().unwrap_or(0.0), tol);
-        vec![Estimate { value: r.scale, error: r.error, evals: r.evals }, Estimate { value: r.bias, error: r.error, evals: 0 }]
-    };
+    let split = move |p: &[f64], tol: f64| split_sum(&def.lobe(&p[..k]), p[k], p.get(k + 1).copied().unwrap_or(0.0), tol).channels();
     vec![
         q(
             format!("{}-albedo", def.name),

@@ -81,6 +81,12 @@ impl SplitSum {
     pub fn albedo(&self) -> Estimate {
         Estimate { value: self.scale + self.bias, error: 2.0 * self.error, evals: self.evals }
     }
+
+    /// [scale, bias] as a vector quantity's channels: each carries the pair's error; the
+    /// evaluations are counted once, on the first.
+    pub fn channels(&self) -> Vec<Estimate> {
+        vec![Estimate { value: self.scale, error: self.error, evals: self.evals }, Estimate { value: self.bias, error: self.error, evals: 0 }]
+    }
 }
 
 /// `tol`, or [`DEFAULT_TOL`] where it is not positive (or NaN).
@@ -530,8 +536,7 @@ pub fn eval_albedo_avg<P: LobeParams>(p: &[f64], tol: f64) -> Estimate {
 /// `eval_channels`): each channel carries the pair's error; the evaluations are counted once,
 /// on the first.
 pub fn eval_split_sum<P: LobeParams>(p: &[f64], tol: f64) -> Vec<Estimate> {
-    let r = split_sum(&P::lobe(p), p[P::COUNT], p.get(P::COUNT + 1).copied().unwrap_or(0.0), tol);
-    vec![Estimate { value: r.scale, error: r.error, evals: r.evals }, Estimate { value: r.bias, error: r.error, evals: 0 }]
+    split_sum(&P::lobe(p), p[P::COUNT], p.get(P::COUNT + 1).copied().unwrap_or(0.0), tol).channels()
 }
 
 /// Channel 0 (scale) of [`eval_split_sum`] (a vector quantity's `eval`).

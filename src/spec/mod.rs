@@ -686,6 +686,19 @@ pub fn axis_param(quantity: &QuantityDef, i: usize, name: &str) -> Option<(&'sta
     aliases.iter().find(|(a, k, _)| *k == i && a.name == name && i < MAX_ALIASED).map(|(a, _, f)| (a, Some(*f)))
 }
 
+/// The conversions of axes named `axis_names` (in parameter order), or None when one of them is
+/// neither its parameter nor an alias of it.
+pub fn conversions(quantity: &QuantityDef, axis_names: &[&str]) -> Option<Conversions> {
+    let mut convert: Conversions = [None; MAX_ALIASED];
+    for (i, n) in axis_names.iter().enumerate() {
+        let (_, f) = axis_param(quantity, i, n)?;
+        if let Some(slot) = convert.get_mut(i) {
+            *slot = f;
+        }
+    }
+    Some(convert)
+}
+
 impl Sampler {
     /// The sampler of `quantity` on its own parameters (no alias axes).
     pub fn new(quantity: &'static QuantityDef, channel: Option<usize>, tolerance: f64) -> Sampler {
@@ -860,23 +873,20 @@ impl Spec {
         let axis_names: Vec<&str> = file.axis.iter().map(|a| a.name.as_str()).collect();
         let left_out_have_defaults = quantity.params.get(axis_names.len()..).is_some_and(|rest| rest.iter().all(|p| p.default.is_some()));
         let own_axes = matches!(file.kind, Kind::Custom(_));
-        let named = |i: usize, n: &str| if own_axes { names.get(i) == Some(&n) } else { axis_param(quantity, i, n).is_some() };
-        if axis_names.len() > names.len() || !axis_names.iter().enumerate().all(|(i, n)| named(i, n)) || !left_out_have_defaults {
+        // A family kind's axes are its quantity's own parameters; the generic kinds' may be aliases.
+        let convert = if own_axes { (axis_names[..] == names[..axis_names.len().min(names.len())]).then_some([None; MAX_ALIASED]) } else { conversions(quantity, &axis_names) };
+        let Some(convert) = convert.filter(|_| axis_names.len() <= names.len() && left_out_have_defaults) else {
             let optional: Vec<&str> = quantity.params.iter().filter(|p| p.default.is_some()).map(|p| p.name).collect();
             let note = if optional.is_empty() { String::new() } else { format!(" (trailing parameters with a default may be left out: {})", optional.join(", ")) };
             return Err(at(
                 "axis",
                 format!("axes must be the quantity's parameters in order: [{}], found [{}]{note}", names.join(", "), axis_names.join(", ")),
             ));
-        }
+        };
         // A family kind spells its axes out from fields its own checker has checked (a fixed
         // parameter is an axis of one point; texel centres may lie outside `eval`'s domain).
-        let mut convert: Conversions = [None; MAX_ALIASED];
         for (i, a) in file.axis.iter().enumerate().filter(|_| !own_axes) {
-            let (p, conv) = axis_param(quantity, i, &a.name).expect("checked above");
-            if i < MAX_ALIASED {
-                convert[i] = conv;
-            }
+            let (p, _) = axis_param(quantity, i, &a.name).expect("checked above");
             let [lo, hi] = a.range;
             if a.mapping.is_some() || a.placement.is_some() {
                 if file.kind != Kind::Table {

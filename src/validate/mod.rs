@@ -4,7 +4,7 @@
 //! findings: what the numbers say about the published constants (noise, typos, conventions).
 
 use crate::pipeline::committed::Refit;
-use crate::pipeline::{self, form::{Committed, Form}};
+use crate::pipeline::form::Form;
 use crate::fit::published::as_emitted;
 use crate::spec::{Spec, SpecError};
 use crate::spec::Catalog;
@@ -91,7 +91,7 @@ pub fn form_item(spec: &Spec, generated: &Path, catalog: &Catalog) -> Result<Ite
     for (o, s) in &published.outputs {
         item.extra.push((format!("{o}_max_abs_error"), s.max_abs_error));
     }
-    match pipeline::committed_json_with_hash(generated, spec, &pipeline::input_hash(spec)).ok().and_then(|v| serde_json::from_value::<Committed>(v["form"].clone()).ok()) {
+    match crate::pipeline::form::committed(generated, spec) {
         Some(k) => {
             let refit: Vec<f64> = k.constants.iter().map(|k| k.refit).collect();
             let r = form.errors(&truth, &as_emitted(&refit)).all;
