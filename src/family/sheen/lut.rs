@@ -239,8 +239,8 @@ fn sampler_item() -> Item {
              the integral weighted by an extra 2π D cos θh; and the D it weighs with takes α = r, not r². Weighting each sample by its own \
              pdf (4 V NoL VoH/NoH) gives E within {m_cons:.3e} at the same 1024 samples."
         ),
-        "The Sample Viewer's lut_charlie.png itself is not measured here (the repositories holding it exceed the fetch limit); \
-         lut_sheen_E.png has no generator in the IBL Sampler and is not measured."
+        "The glTF Sample Renderer makes its Charlie LUT at load time with its own port of this sampler (it reads no lut_charlie.png); \
+         the one sheen LUT it ships as a file, lut_sheen_E.png, is the next item."
             .into(),
     ];
     item

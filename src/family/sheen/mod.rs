@@ -16,6 +16,7 @@ pub mod plot;
 pub mod published;
 pub mod refit;
 pub mod velvet;
+pub mod viewer;
 
 use super::Family;
 use crate::integrate::Estimate;

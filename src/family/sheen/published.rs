@@ -11,7 +11,9 @@
 //!   candidate (four lobes × α = r or r²) as extras: the closest candidate says what a
 //!   fit was made for when its source does not;
 //! - Filament's DFG blue channel and the glTF IBL Sampler's Charlie LUT, regenerated with their
-//!   own estimators ([`super::lut`]), as tables.
+//!   own estimators ([`super::lut`]), as tables;
+//! - the glTF Sample Viewer's shipped `lut_sheen_E.png`, decoded and measured as a table
+//!   ([`super::viewer`]).
 
 use super::grid::{self, Convention, Target};
 use super::lambda_table;
@@ -26,6 +28,7 @@ pub fn items(generated: &Path) -> Vec<Item> {
         items.push(form_item(generated, name, form));
     }
     items.extend(super::lut::items(generated));
+    items.push(super::viewer::item());
     items
 }
 
