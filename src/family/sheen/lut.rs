@@ -228,6 +228,12 @@ fn sampler_item() -> Item {
     let (m_conv, m_cons) = (m(&converged, &truth), m(&consistent, &truth));
     item.extra.push(("max_abs_error_16384_samples".into(), m_conv));
     item.extra.push(("max_abs_error_consistent_weight".into(), m_cons));
+    // shadefit's table in the same layout and format: the integral at the same texel centres,
+    // saturated and stored RGBA8 UNORM: its error is the 1/255 steps' rounding only.
+    let ours: Vec<f64> = truth_sat.iter().map(|&e| (e.max(0.0) * 255.0).round() / 255.0).collect();
+    let (m_ours, rms_ours, _) = crate::validate::measure(&pts, &truth_sat, &ours);
+    item.extra.push(("refit_max_abs_error".into(), m_ours));
+    item.extra.push(("refit_rms_error".into(), rms_ours));
     item.findings = vec![
         format!(
             "Against min(1, E) of Charlie D × Ashikhmin V at α = r² (the lobe whose V the LUT uses, and glTF's α): max {:.3e}, rms {:.3e}. \
@@ -238,6 +244,10 @@ fn sampler_item() -> Item {
             "Why: H is drawn from D·cos θh at α = r², but each sample is weighted as a uniform one (8π V D NoL VoH), so the estimate is \
              the integral weighted by an extra 2π D cos θh; and the D it weighs with takes α = r, not r². Weighting each sample by its own \
              pdf (4 V NoL VoH/NoH) gives E within {m_cons:.3e} at the same 1024 samples."
+        ),
+        format!(
+            "shadefit's table in the same layout and format (min(1, E) at the same texel centres, RGBA8 UNORM): max {m_ours:.3e}, \
+             rms {rms_ours:.3e} — the 1/255 steps only."
         ),
         "The glTF Sample Renderer makes its Charlie LUT at load time with its own port of this sampler (it reads no lut_charlie.png); \
          the one sheen LUT it ships as a file, lut_sheen_E.png, is the next item."

@@ -217,5 +217,11 @@ fn gltf_albedo() -> Item {
          the integral over h then cancels), which no finite Λ(0) gives.",
         item.max_abs_error, item.rms_error
     ));
+    item.findings.push(
+        "No same-form refit: this row is the cost of a definition (glTF's E is by definition E under the curve), not a fitted \
+         approximation; the curve's own refit is the previous row, and E under the exact Λ is what `sheen-albedo` and \
+         fits/sheen_albedo_table.toml give."
+            .into(),
+    );
     item
 }
