@@ -123,12 +123,20 @@ pub fn spec_targets(s: &Spec) -> Result<Vec<Target>, SpecError> {
 
 /// The files of the other targets for every WGSL module among `artifacts` (`wgsl/NAME.wgsl`):
 /// those `module_targets(NAME)` names, translated in parallel and collected in module order.
+/// Every WGSL module among them is first checked by naga ([`targets::check`]), with or without
+/// other targets: a module naga rejects fails the build before anything is written.
 pub fn target_artifacts(artifacts: &[Artifact], module_targets: &(dyn Fn(&str) -> Vec<Target> + Sync)) -> Result<Vec<Artifact>, Error> {
-    let modules: Vec<(String, &Artifact, Vec<Target>)> = artifacts
+    let wgsl: Vec<(String, &Artifact)> = artifacts
         .iter()
         .filter_map(|a| {
             let rel = a.path.strip_prefix("wgsl").ok()?;
-            let name = rel.to_str()?.strip_suffix(".wgsl")?.to_string();
+            Some((rel.to_str()?.strip_suffix(".wgsl")?.to_string(), a))
+        })
+        .collect();
+    wgsl.par_iter().map(|(name, a)| targets::check(name, &String::from_utf8_lossy(&a.contents))).collect::<Result<Vec<()>, TargetError>>()?;
+    let modules: Vec<(String, &Artifact, Vec<Target>)> = wgsl
+        .into_iter()
+        .filter_map(|(name, a)| {
             let t = module_targets(&name);
             (!t.iter().all(|t| *t == Target::Wgsl)).then_some((name, a, t))
         })
@@ -415,6 +423,7 @@ pub fn run_scene(paths: &Paths, file: &Path, force: bool, extra: &[Target]) -> R
     keep_modules(paths, &scene::runtime_index(&specs, &scenes))?;
     // Every module in the `--target` targets and its spec's own, as `build` writes them.
     let translate = |module: &str, text: &str| -> Result<Vec<Artifact>, BuildError> {
+        targets::check(module, text)?;
         let mut t: Vec<Target> = extra.to_vec();
         if let Some(s) = specs.iter().find(|s| s.file.name == module) {
             t.extend(spec_targets(s)?);
@@ -663,6 +672,21 @@ pub fn merge(paths: &Paths, files: &[PathBuf], tick: &(dyn Fn(usize) + Sync)) ->
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A WGSL module naga rejects fails `target_artifacts` even when no other target is asked
+    /// for (the build's backstop before its transaction commits), and names the module; the
+    /// same module made valid passes.
+    #[test]
+    fn every_emitted_wgsl_module_is_checked_by_naga() {
+        let module = |body: &str| Artifact {
+            path: PathBuf::from("wgsl/m.wgsl"),
+            contents: format!("// header\n#define_import_path shadefit::m\n\nfn m_f(min: f32) -> f32 {{\n    return {body};\n}}\n").into_bytes(),
+        };
+        let err = target_artifacts(&[module("min(min, 1f)")], &|_| vec![Target::Wgsl]).unwrap_err();
+        let err = format!("{err}: {}", std::error::Error::source(&err).map(|e| e.to_string()).unwrap_or_default());
+        assert!(err.contains("m: naga rejects the emitted WGSL module"), "{err}");
+        assert!(target_artifacts(&[module("max(min, 1f)")], &|_| vec![Target::Wgsl]).unwrap().is_empty());
+    }
 
     /// Every module of the runtime index is gated on its family's feature (its quantity up to the
     /// first '-'), and the runtime crate's manifest declares every feature the index names: a

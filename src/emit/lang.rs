@@ -76,7 +76,7 @@ impl Lang {
 
     pub fn clamp(self, module: &str, v: &str, lo: f64, hi: f64) -> String {
         match self {
-            Lang::Wgsl => format!("{module}_input({v}, {}, {})", self.lit(lo), self.lit(hi)),
+            Lang::Wgsl => format!("{}({v}, {}, {})", crate::spec::names::input_helper(module), self.lit(lo), self.lit(hi)),
             Lang::Rust => format!("input({v}, {}, {})", self.lit(lo), self.lit(hi)),
         }
     }

@@ -118,6 +118,8 @@ pub fn parse_list<S: AsRef<str>>(names: &[S]) -> Result<Vec<Target>, String> {
 pub enum TargetError {
     #[error("{module}: {what} (targets other than wgsl need a self-contained module)")]
     Unsupported { module: String, what: String },
+    #[error("{module}: naga rejects the emitted WGSL module (nothing is written): {message}")]
+    Rejected { module: String, message: String },
     #[error("{module}: naga rejects the module with its entry point appended: {message}")]
     Invalid { module: String, message: String },
     #[error("{module}: naga's {target} backend: {message}")]
@@ -254,6 +256,18 @@ fn parse(module: &str, text: &str) -> Result<(naga::Module, naga::valid::ModuleI
         .validate(&m)
         .map_err(|e| invalid(e.emit_to_string(text)))?;
     Ok((m, info))
+}
+
+/// Checks the WGSL module `module` (the text of `wgsl/NAME.wgsl`) as naga parses and validates
+/// it, so that no build writes a module the runtime crate or an engine would refuse.
+pub fn check(module: &str, wgsl: &str) -> Result<(), TargetError> {
+    let src = split_module(module, wgsl)?;
+    let rejected = |message: String| TargetError::Rejected { module: module.to_string(), message };
+    let m = naga::front::wgsl::parse_str(src.code).map_err(|e| rejected(e.emit_to_string(src.code)))?;
+    naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::default())
+        .validate(&m)
+        .map_err(|e| rejected(e.emit_to_string(src.code)))?;
+    Ok(())
 }
 
 /// The files of `targets` for the WGSL module `module` (the text of `wgsl/NAME.wgsl`); the

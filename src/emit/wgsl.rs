@@ -149,10 +149,10 @@ fn prelude(header: &[String], f: &Function<'_>) -> String {
     s.push_str(&format!("#define_import_path shadefit::{}\n\n", f.module));
     s.push_str(&format!(
         "// Clamp an input to [lo, hi]; NaN (any exponent-all-ones pattern with a non-zero\n\
-         // mantissa) maps to lo.\nfn {m}_input(v: f32, lo: f32, hi: f32) -> f32 {{\n    \
+         // mantissa) maps to lo.\nfn {helper}(v: f32, lo: f32, hi: f32) -> f32 {{\n    \
          let nan = (bitcast<u32>(v) & 0x7fffffffu) > 0x7f800000u;\n    \
          return select(clamp(v, lo, hi), lo, nan);\n}}\n\n",
-        m = f.module
+        helper = crate::spec::names::input_helper(f.module)
     ));
     s
 }
@@ -163,7 +163,7 @@ fn input_lines(f: &Function<'_>) -> String {
         .iter()
         .zip(f.domain)
         .enumerate()
-        .map(|(i, (a, (lo, hi)))| format!("    let x{i} = {}_input({a}, {}, {});\n", f.module, lit(*lo), lit(*hi)))
+        .map(|(i, (a, (lo, hi)))| format!("    let x{i} = {}({a}, {}, {});\n", crate::spec::names::input_helper(f.module), lit(*lo), lit(*hi)))
         .chain(f.derived.iter().enumerate().map(|(k, d)| {
             format!("    let x{} = {};\n", f.args.len() + k, derived_expr(d, &lit, &|fun, v| format!("{fun}({v})")))
         }))

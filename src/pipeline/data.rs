@@ -116,6 +116,11 @@ fn spec_of(req: &DataFit, model: RationalModel, data: &Data) -> Result<Spec, Bui
             return Err(input(format!("argument '{a}' is named twice")));
         }
     }
+    let arg_names: Vec<&str> = args.iter().map(String::as_str).collect();
+    if let Some((field, why)) = names::check_emitted(req.name, req.function, &arg_names) {
+        let opt = if field == "function" { "--function" } else if req.args.is_some() { "--args" } else { "--x (the arguments' names; give --args)" };
+        return Err(input(format!("{opt}: {why}")));
+    }
     let bounds = data_box(req.x, data, req.domain).map_err(input)?;
     let mut axis = Vec::new();
     for (j, (col, &[lo, hi])) in req.x.iter().zip(&bounds).enumerate() {

@@ -337,7 +337,10 @@ impl Form {
         if let Some(why) = names::check_identifier(&f.emit.function) {
             return Err(at("function", format!("not a valid function name: {why}")));
         }
-        let mut names = Names::new(path, vec![f.emit.function.clone(), format!("{}_published", f.emit.function), format!("{}_input", f.name), "input".to_string()]);
+        if let Some((field, why)) = names::check_emitted(&f.name, &f.emit.function, &[]) {
+            return Err(at(field, why));
+        }
+        let mut names = Names::new(path, vec![f.emit.function.clone(), format!("{}_published", f.emit.function), names::input_helper(&f.name), "input".to_string()]);
         for a in &args {
             names.claim(a, line_of(text, "args"), "args", "argument", true, "an argument")?;
         }
@@ -786,7 +789,8 @@ function = "exp_quadratic"
             ("c2 = 0.5\n", "", &[":21", "column 24: unknown name 'c2'"]),
             ("c2 = 0.5", "c2 = nan", &[":15", "c2", "must be finite"]),
             ("c2 = 0.5", "c2 = 1e39", &[":15", "must be finite in f32"]),
-            ("c2 = 0.5", "min = 0.5", &["'min' is a word of the expression language"]),
+            ("c2 = 0.5", "inversesqrt = 0.5", &["'inversesqrt' is a word of the expression language"]),
+            ("c2 = 0.5", "min = 0.5", &["'min' is a WGSL built-in that emitted code calls"]),
             ("name = \"xx\"", "name = \"x\"", &["binding 'x' is already an argument"]),
             ("name = \"xx\"", "name = \"smooth\"", &["'smooth' is a WGSL keyword"]),
             ("name = \"xx\"", "name = \"exp_quadratic_input\"", &["a name the emitted module defines"]),

@@ -225,12 +225,15 @@ impl LobeDef {
         if let Some(why) = names::check_identifier(&function) {
             return Err(at("function", format!("not a valid function name: {why}")));
         }
+        if let Some((field, why)) = names::check_emitted(&f.name, &function, &[]) {
+            return Err(at(field, why));
+        }
         if !(f.emit.min_cosine >= 0.0 && f.emit.min_cosine < 1.0) {
             return Err(at("min_cosine", format!("{} must be in [0, 1)", f.emit.min_cosine)));
         }
 
         // Names: the four cosines, the parameters, constants and bindings, all distinct.
-        let mut names = Names::new(path, vec![function.clone(), format!("{}_input", f.name), "input".to_string()]);
+        let mut names = Names::new(path, vec![function.clone(), names::input_helper(&f.name), "input".to_string()]);
         for a in ARGS {
             names.claim(a, 1, "parameter", "argument", true, "an argument of every lobe").expect("the cosines are valid names");
         }

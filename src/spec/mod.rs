@@ -813,6 +813,14 @@ impl Spec {
         {
             return Err(at("args", format!("the axis '{}' would name an argument: {why}; give [emit] args", a.name)));
         }
+        let args: Vec<&str> = match &file.emit.args {
+            Some(a) => a.iter().map(String::as_str).collect(),
+            None => file.axis.iter().take(n_args).map(|a| a.name.as_str()).collect(),
+        };
+        if let Some((field, why)) = names::check_emitted(&file.name, &file.emit.function, &args) {
+            let why = if field == "args" && file.emit.args.is_none() { format!("{why}: an axis name would name it; give [emit] args") } else { why };
+            return Err(at(field, why));
+        }
         let form = file.emit.form.unwrap_or_default();
         if file.emit.form.is_some() && file.kind != Kind::Table {
             return Err(at("form", format!("applies to kind = \"table\" only, not \"{}\"", file.kind.name())));

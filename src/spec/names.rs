@@ -34,6 +34,45 @@ const WGSL: &[&str] = &[
     "volatile", "wgsl", "where", "with", "writeonly", "yield",
 ];
 
+/// WGSL built-ins (functions and predeclared types) that emitted code calls or names: a
+/// module, function, argument, constant or binding of the same name would shadow it in the
+/// bodies (`args = ["min"]`: the table body's `min(u32(t0), 254u)` then calls the argument).
+/// Names the bodies do not use (`length`, `dot`…) stay free. Kept true by the test
+/// `every_builtin_the_emitted_modules_use_is_reserved`, which reads every committed module.
+const EMITTED_BUILTINS: &[&str] = &[
+    "abs", "acos", "array", "atan2", "bitcast", "bool", "clamp", "cos", "exp", "exp2", "f16", "f32", "floor", "fma",
+    "fract", "i32", "log", "log2", "mat2x2", "mat3x3", "mat4x4", "max", "min", "mix", "pow", "round", "sampler",
+    "saturate", "select", "sign", "sin", "sqrt", "texture_2d", "texture_2d_array", "texture_3d", "trunc", "u32",
+    "vec2", "vec2f", "vec3", "vec3f", "vec4", "vec4f",
+];
+
+/// The input clamp every emitted WGSL module declares (`fn NAME_input(v, lo, hi)`; its CPU
+/// twin in Rust is `input`): each body calls it on each argument.
+pub fn input_helper(module: &str) -> String {
+    format!("{module}_input")
+}
+
+/// Why a spec's function and argument names collide with what its emitted module declares
+/// (`None`: they do not), as (field, reason): the function may not be the module's input clamp;
+/// an argument may not be the clamp (WGSL's `NAME_input`, Rust's `input`), the function, or a
+/// function derived from the function's or the module's name (`FUNCTION_load`, `NAME_uv`…),
+/// which the bodies call.
+pub fn check_emitted(module: &str, function: &str, args: &[&str]) -> Option<(&'static str, String)> {
+    let helper = input_helper(module);
+    if function == helper {
+        return Some(("function", format!("'{function}' is the input clamp the emitted module declares ({helper})")));
+    }
+    for a in args {
+        if *a == helper || *a == "input" {
+            return Some(("args", format!("'{a}' is the input clamp the emitted module declares ({helper} in WGSL, input in Rust)")));
+        }
+        if *a == function || a.starts_with(&format!("{function}_")) || *a == module || a.starts_with(&format!("{module}_")) {
+            return Some(("args", format!("'{a}' is a name the module's functions take ({function}, {function}_…, {module}_…)")));
+        }
+    }
+    None
+}
+
 /// Files of the runtime crate (`generated/src/`) that specs must not overwrite: the crate root,
 /// the emitted index and the hand-written runtime module.
 const RESERVED_MODULES: &[&str] = &["lib", "emitted", "runtime", "main"];
@@ -111,6 +150,9 @@ pub fn check_identifier(s: &str) -> Option<String> {
     if WGSL.contains(&s) {
         return Some(format!("'{s}' is a WGSL keyword or reserved word"));
     }
+    if EMITTED_BUILTINS.contains(&s) {
+        return Some(format!("'{s}' is a WGSL built-in that emitted code calls"));
+    }
     None
 }
 
@@ -153,6 +195,62 @@ pub fn check_spec_name(s: &str) -> Option<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Every lowercase name a committed module calls or names as a type (`name(` or `name<`)
+    /// that the module does not declare itself is a WGSL built-in, and must be reserved.
+    #[test]
+    fn every_builtin_the_emitted_modules_use_is_reserved() {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("generated/wgsl");
+        let mut seen = 0;
+        for entry in std::fs::read_dir(&dir).unwrap() {
+            let path = entry.unwrap().path();
+            let text = std::fs::read_to_string(&path).unwrap();
+            let code: String = text.lines().filter(|l| !l.trim_start().starts_with("//") && !l.starts_with('#')).collect::<Vec<_>>().join("\n");
+            let declared: Vec<&str> = code
+                .split(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
+                .collect::<Vec<_>>()
+                .windows(2)
+                .filter(|w| matches!(w[0], "fn" | "struct" | "alias"))
+                .map(|w| w[1])
+                .collect();
+            let bytes = code.as_bytes();
+            let mut i = 0;
+            while i < bytes.len() {
+                if bytes[i].is_ascii_alphabetic() || bytes[i] == b'_' {
+                    let start = i;
+                    while i < bytes.len() && (bytes[i].is_ascii_alphanumeric() || bytes[i] == b'_') {
+                        i += 1;
+                    }
+                    let name = &code[start..i];
+                    // A call `name (` or a type `name<` (a comparison `x < y` has spaces).
+                    let call = code[i..].trim_start().starts_with('(') || code[i..].starts_with('<');
+                    let preceded_by_digit = start > 0 && bytes[start - 1].is_ascii_digit();
+                    if call && is_identifier(name) && !declared.contains(&name) && !preceded_by_digit {
+                        assert!(
+                            EMITTED_BUILTINS.contains(&name) || WGSL.contains(&name),
+                            "{} calls or names '{name}', which EMITTED_BUILTINS does not hold",
+                            path.display()
+                        );
+                        seen += 1;
+                    }
+                } else {
+                    i += 1;
+                }
+            }
+        }
+        assert!(seen > 100, "{seen} built-in uses: the scan read too little");
+    }
+
+    #[test]
+    fn emitted_names_may_not_take_the_modules_own() {
+        assert!(check_emitted("gloss_length", "gloss_length_input", &["gloss"]).is_some_and(|e| e.0 == "function"));
+        assert!(check_emitted("gloss_length", "f", &["gloss_length_input"]).is_some_and(|e| e.0 == "args"));
+        assert!(check_emitted("m", "f", &["input"]).is_some());
+        assert!(check_emitted("m", "f", &["f_load"]).is_some());
+        assert!(check_emitted("m", "f", &["f"]).is_some());
+        assert!(check_emitted("gloss_table", "lut", &["gloss"]).is_none());
+        assert!(check_identifier("min").is_some() && check_identifier("length").is_none());
+    }
 
     #[test]
     fn rejects_keywords_reserved_names_and_collisions() {
