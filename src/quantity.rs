@@ -88,6 +88,12 @@ pub struct InnerBasis {
     pub range: (f64, f64),
 }
 
+/// A number for a message: its shortest round-trip form, in exponent form below 1e-4 and from
+/// 1e6 up (`1e-310`, not 310 decimals).
+pub fn short_number(v: f64) -> String {
+    if v != 0.0 && v.is_finite() && (v.abs() >= 1e6 || v.abs() < 1e-4) { format!("{v:e}") } else { format!("{v}") }
+}
+
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum QuantityError {
     #[error("unknown quantity '{0}' (known: {1})")]
@@ -96,9 +102,9 @@ pub enum QuantityError {
     UnknownParam { quantity: String, param: String, expected: String },
     #[error("{quantity}: missing parameter '{param}'")]
     MissingParam { quantity: String, param: String },
-    #[error("{quantity}: parameter '{param}' = {value} is outside its domain [{min}, {max}]")]
+    #[error("{quantity}: parameter '{param}' = {} is outside its domain [{}, {}]", short_number(*value), short_number(*min), short_number(*max))]
     OutOfDomain { quantity: String, param: String, value: f64, min: f64, max: f64 },
-    #[error("{quantity}: parameter '{param}' = {value} must be a whole number")]
+    #[error("{quantity}: parameter '{param}' = {} must be a whole number", short_number(*value))]
     NotInteger { quantity: String, param: String, value: f64 },
     #[error("{quantity}: parameter '{param}' is given twice (directly or through an alias)")]
     Duplicate { quantity: String, param: String },

@@ -87,7 +87,27 @@ pub fn line_of(text: &str, key: &str) -> usize {
             return i + 1;
         }
     }
+    // A key of an inline table (`derived = { beta = "…", gamma = "…" }`).
+    for (i, line) in text.lines().enumerate() {
+        let inline = [format!("{{ {last} ="), format!("{{{last} ="), format!(", {last} ="), format!(",{last} =")];
+        if inline.iter().any(|k| line.contains(k.as_str())) {
+            return i + 1;
+        }
+    }
     1
+}
+
+/// The line of the `at` of the k-th `[[model.pin]]` (its header's line when it has none).
+fn pin_line(text: &str, k: usize) -> usize {
+    let lines: Vec<&str> = text.lines().collect();
+    let Some(start) = lines.iter().enumerate().filter(|(_, l)| l.trim() == "[[model.pin]]").map(|(i, _)| i).nth(k) else {
+        return line_of(text, "pin");
+    };
+    lines[start + 1..]
+        .iter()
+        .take_while(|l| !l.trim_start().starts_with('['))
+        .position(|l| l.trim_start().starts_with("at ") || l.trim_start().starts_with("at="))
+        .map_or(start + 1, |i| start + 2 + i)
 }
 
 pub fn line_of_offset(text: &str, offset: usize) -> usize {
@@ -896,6 +916,17 @@ impl Spec {
         for (i, a) in file.axis.iter().enumerate().filter(|_| !own_axes) {
             let (p, _) = axis_param(quantity, i, &a.name).expect("checked above");
             let [lo, hi] = a.range;
+            // An axis samples (and its verification grid interpolates) between its points: a
+            // parameter of whole numbers only (an SH band, a scheme) has no values there.
+            if p.integer {
+                let line = text.lines().position(|l| l.trim_start().starts_with("name") && l.contains(&format!("\"{}\"", a.name))).map_or(1, |i| i + 1);
+                return Err(SpecError::new(
+                    path,
+                    line,
+                    "axis",
+                    format!("axis '{}': the parameter takes whole numbers only ({}), so it cannot be a sampled axis", a.name, p.doc),
+                ));
+            }
             if a.mapping.is_some() || a.placement.is_some() {
                 if file.kind != Kind::Table {
                     let field = if a.mapping.is_some() { "mapping" } else { "placement" };
@@ -947,6 +978,18 @@ impl Spec {
                     && f != &features
                 {
                     return Err(at("features", "a fit spec takes its features from its axes; remove 'features'".into()));
+                }
+                // A pin is a point of the fit's domain (its axes' box), where the quantity is
+                // integrated for its value as any sample is.
+                for (k, pin) in m.pin.iter().enumerate() {
+                    if let Some((v, a)) = pin.at.iter().zip(&file.axis).find(|(v, a)| !(**v >= a.range[0] && **v <= a.range[1])) {
+                        return Err(SpecError::new(
+                            path,
+                            pin_line(&text, k),
+                            "pin.at",
+                            format!("{} is outside axis '{}' range [{}, {}]: a pin lies in the fit's domain", crate::quantity::short_number(*v), a.name, a.range[0], a.range[1]),
+                        ));
+                    }
                 }
                 let sampler = Sampler { quantity, channel, tolerance: file.tolerance, convert };
                 Some(m.build(path, &text, features, &|x: &[f64]| Some(sampler.eval(x).value))?)
