@@ -325,6 +325,22 @@ pub fn fit_data(
     let data: Data = read_csv(data_path, x_cols, y_col).map_err(input_err)?;
     // The box is checked against the rows before the fit runs (and again where it is made).
     pipeline::data::data_box(x_cols, &data, &domain).map_err(|why| input_err(format!("{}: {why}", data_path.display())))?;
+    // Emitted code computes in f32: data it cannot represent is refused before the fit runs.
+    if emit.is_some() {
+        let columns = x_cols.iter().map(String::as_str).chain([y_col]);
+        for (i, row) in data.x.iter().zip(&data.y).enumerate() {
+            for (v, col) in row.0.iter().chain([row.1]).zip(columns.clone()) {
+                if *v != 0.0 && !(v.abs() >= f32::MIN_POSITIVE as f64 && v.abs() <= f32::MAX as f64) {
+                    return Err(input_err(format!(
+                        "{}: data row {}, column '{col}': {} is not a normal f32 number, which emitted code computes in; scale the column, or fit without --emit",
+                        data_path.display(),
+                        i + 1,
+                        crate::quantity::short_number(*v)
+                    )));
+                }
+            }
+        }
+    }
     let opts = FitOptions { objective, ..FitOptions::default() };
     let f = match fit::fit_rescaled(&model, &data, &opts, &data_path.display().to_string()) {
         // Too few rows for the model, or none: the user's input.
@@ -336,6 +352,13 @@ pub fn fit_data(
     let mut den = vec![1.0];
     den.extend((nn..model.n_full()).map(|j| c[j]));
     let r = &f.report;
+    if !(r.rss.is_finite() && r.max_abs_error.is_finite() && r.rms_error.is_finite()) {
+        return Err(input_err(format!(
+            "{}: the fit's residuals overflow (rss {:e}): the values are too large to square in f64; scale the data",
+            data_path.display(),
+            r.rss
+        )));
+    }
     if as_json {
         let out = json!({
             "model": model_arg,

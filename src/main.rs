@@ -114,7 +114,7 @@ enum Command {
         /// there.
         #[arg(long, value_name = "DIR")]
         emit: Option<PathBuf>,
-        /// With --emit: more outputs (wgsl-plain, hlsl, glsl, glsl-es, msl, spirv, c).
+        /// With --emit: more outputs, comma-separated (wgsl-plain, hlsl, glsl, glsl-es, msl, spirv, c, wesl: a WESL package of the module and its wesl.toml).
         #[arg(long, value_delimiter = ',', requires = "emit")]
         target: Vec<String>,
         /// With --emit: the module name (default: the CSV file's stem).

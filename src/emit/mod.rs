@@ -46,7 +46,7 @@ pub fn header_lines(spec_path: &str, input_hash: &str, error_line: &str) -> Vec<
 }
 
 #[derive(Debug, thiserror::Error)]
-#[error("cannot write {path}: {source}")]
+#[error("cannot write {path}")] // the cause follows in the error chain (the CLI prints it once)
 pub struct WriteError {
     pub path: String,
     #[source]
@@ -274,11 +274,21 @@ fn remove_staging(root: &Path) -> Result<(), WriteError> {
 }
 
 /// Write every artifact under `root` as one [`Transaction`]: all or nothing.
+/// A folder this call made is removed again when the write fails (a full disk, a bad path):
+/// a failed write leaves nothing behind, not even an empty folder.
 pub fn write_all(root: &Path, artifacts: &[Artifact]) -> Result<usize, WriteError> {
-    let mut tx = Transaction::begin(root)?;
-    let n = tx.write(artifacts)?;
-    tx.commit()?;
-    Ok(n)
+    let existed = root.exists();
+    let written = (|| {
+        let mut tx = Transaction::begin(root)?;
+        let n = tx.write(artifacts)?;
+        tx.commit()?;
+        Ok(n)
+    })();
+    if written.is_err() && !existed {
+        // Only an empty folder goes (remove_dir refuses one that holds anything).
+        let _ = std::fs::remove_dir(root);
+    }
+    written
 }
 
 #[cfg(test)]
@@ -302,6 +312,21 @@ mod tests {
         }
         out.sort();
         out
+    }
+
+    /// A write that fails part way (a file where a folder must go) into a folder that did not
+    /// exist leaves no folder behind; into one that did, leaves it as it was.
+    #[test]
+    fn a_failed_write_leaves_no_folder_it_made() {
+        let tmp = tempfile::tempdir().unwrap();
+        let root = tmp.path().join("out");
+        let bad = [art("a", "x"), art("a/b", "y")];
+        assert!(write_all(&root, &bad).is_err());
+        assert!(!root.exists(), "{} was left behind", root.display());
+        std::fs::create_dir(&root).unwrap();
+        std::fs::write(root.join("keep"), "k").unwrap();
+        assert!(write_all(&root, &bad).is_err());
+        assert_eq!(tree(&root), vec![("keep".to_string(), "k".to_string())]);
     }
 
     #[test]

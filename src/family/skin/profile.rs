@@ -213,6 +213,9 @@ fn load_gaussians(gs: &Spanned<Vec<GaussianEntry>>, file: &Path, text: &str) -> 
 
 /// A tabulated radial profile from CSV bytes (header `radius_mm,red,green,blue`); errors name
 /// `path`, the line and the column.
+/// The largest magnitude a profile CSV's radius or channel may take.
+pub const PROFILE_VALUE_MAX: f64 = 1e100;
+
 pub fn read_profile_csv(path: &Path, bytes: &[u8]) -> Result<Profile, SpecError> {
     let mut rdr = csv::ReaderBuilder::new().trim(csv::Trim::All).comment(Some(b'#')).from_reader(bytes);
     let headers = rdr.headers().map_err(|e| SpecError::new(path, 1, "(header)", e.to_string()))?.clone();
@@ -249,6 +252,11 @@ pub fn read_profile_csv(path: &Path, bytes: &[u8]) -> Result<Profile, SpecError>
                 .map_err(|_| SpecError::new(path, line, columns[k], format!("'{s}' is not a number")))?;
             if !v.is_finite() {
                 return Err(SpecError::new(path, line, columns[k], format!("'{s}' is not finite")));
+            }
+            // The profile is normalised by integrals of value × r (and r²): past this bound
+            // their products overflow f64 and the channel would read as zero.
+            if v.abs() > PROFILE_VALUE_MAX {
+                return Err(SpecError::new(path, line, columns[k], format!("'{s}' is beyond ±{PROFILE_VALUE_MAX:e}: the profile's integrals would overflow; scale the column")));
             }
             row[k] = v;
         }

@@ -97,9 +97,8 @@ struct SkinLutFile {
     curvature_max: f64,
     #[serde(default)]
     curvature_mapping: CurvatureMapping,
-    #[serde(default)]
-    #[allow(dead_code)] // one variant: parsing it is the check
-    n_dot_l_mapping: NDotLMapping,
+    #[allow(dead_code)] // one variant: parsing it is the check (and its presence on skin-sh)
+    n_dot_l_mapping: Option<NDotLMapping>,
     kernel: Option<KernelName>,
     texture_format: Option<TextureFormat>,
     #[serde(default)]
@@ -221,6 +220,9 @@ impl Preset for SkinLut {
                     "kernel",
                     "skin-sh integrates the radial profile over the sphere; 'kernel' applies to skin-punctual only".into(),
                 ));
+            }
+            if f.n_dot_l_mapping.is_some() {
+                return Err(at("n_dot_l_mapping", "a skin-sh LUT has no n·l axis (its rows are SH bands); 'n_dot_l_mapping' applies to skin-punctual only".into()));
             }
             SkinLutKind::Sh
         };
