@@ -230,7 +230,8 @@ pub fn eval_kc_fms(p: &[f64], tol: f64) -> Estimate {
 /// [`Scheme::ALL`]). Error: the inputs' errors times a bound on the formula's sensitivity
 /// (each scheme's albedo moves by at most a few times the change of A, B or E_avg away from
 /// E → 0; reported as 4·(error of A, B + error of E_avg)/min(E, 1 − E_avg), and 4·error/A² for
-/// bevy's 1/A).
+/// bevy's 1/A); Kulla–Conty's, whose sensitivity is bounded without that divisor, as twice its
+/// first-order propagation.
 pub fn eval_furnace(p: &[f64], tol: f64) -> Estimate {
     let (alpha, mu, f0) = (p[0], p[1], p[2]);
     let scheme = Scheme::ALL[(p[3] as usize).min(Scheme::ALL.len() - 1)];
@@ -239,6 +240,17 @@ pub fn eval_furnace(p: &[f64], tol: f64) -> Estimate {
     let r = integrals::env(alpha, mu, 0.0, Shadowing::HeightCorrelated, tol);
     let x = Inputs { a: r.scale, b: r.bias, e_avg: avg.value };
     let value = furnace(scheme, f0, &x, 1.0 - x.e_avg);
+    if scheme == Scheme::KullaConty {
+        // v = f0 A + B + F_ms (1 − A − B), F_ms = F_avg² E_avg / (1 − F_avg (1 − E_avg)): its
+        // partial derivatives are f0 − F_ms, 1 − F_ms and (1 − E) F_avg² (1 − F_avg)/(1 − F_avg
+        // (1 − E_avg))², all bounded (at F0 = 1 all vanish: v is 1 whatever the inputs), twice the
+        // first-order propagation for what the linearisation leaves out, plus the rounding.
+        let f_avg = integrals::f_avg_schlick(f0);
+        let f_ms = kc_f_ms(f_avg, x.e_avg);
+        let d_avg = (1.0 - x.e()) * f_avg * f_avg * (1.0 - f_avg) / (1.0 - f_avg * (1.0 - x.e_avg)).powi(2);
+        let first = ((f0 - f_ms).abs() + (1.0 - f_ms).abs()) * r.error + d_avg.abs() * avg.error;
+        return Estimate { value, error: 2.0 * first + 4.0 * f64::EPSILON * value.abs(), evals: r.evals + avg.evals };
+    }
     let denom = match scheme {
         Scheme::BevyOld => x.a * x.a,
         _ => x.e().min(1.0 - x.e_avg.min(1.0 - 1e-300)).max(1e-300),
@@ -520,6 +532,13 @@ mod tests {
                 let got = eval_furnace(&[alpha, mu, 0.04, k], tol);
                 let want = match s {
                     Scheme::BevyOld => 4.0 * r.error / (r.scale * r.scale),
+                    // Kulla–Conty's partial derivatives written out by hand (F0 = 0.04).
+                    Scheme::KullaConty => {
+                        let f = integrals::f_avg_schlick(0.04);
+                        let fms = f * f * avg.value / (1.0 - f * (1.0 - avg.value));
+                        let d = (1.0 - e) * f * f * (1.0 - f) / (1.0 - f + f * avg.value).powi(2);
+                        2.0 * ((0.04 - fms).abs() + (1.0 - fms).abs()) * r.error + 2.0 * d * avg.error + 4.0 * f64::EPSILON * got.value
+                    }
                     _ => 4.0 * (r.error + avg.error) / e.min(1.0 - avg.value),
                 };
                 assert!((got.error - want).abs() <= 1e-12 * want, "{s:?} α {alpha}: {:e} vs {want:e}", got.error);
