@@ -36,6 +36,14 @@ pub enum Error {
         #[source]
         source: BuildError,
     },
+    /// A merge whose shards passed every check but whose merged build failed (a forged
+    /// payload: its checksum recomputed over values the family cannot build from).
+    #[error("merging {files}")]
+    Merged {
+        files: String,
+        #[source]
+        source: Box<Error>,
+    },
     #[error("building scene {scene}")]
     Scene {
         scene: String,
@@ -73,6 +81,7 @@ impl Error {
             // A spec whose model cannot avoid a pole on its domain or whose basis is degenerate on
             // its samples (e.g. fixed denominator coefficients forcing a pole), or a scene naming a spec that fits/ lacks: the spec or
             // the manifest is what must change.
+            Error::Merged { source, .. } => source.is_input(),
             Error::Build { source, .. } | Error::Scene { source, .. } => matches!(
                 source,
                 BuildError::Fit(FitError::PoleInDomain { .. } | FitError::SingularStart { .. })
@@ -666,7 +675,8 @@ pub fn merge(paths: &Paths, files: &[PathBuf], tick: &(dyn Fn(usize) + Sync)) ->
         }
         merged.insert(name, payload);
     }
-    run_merged(paths, &names, false, true, &[], tick, merged)
+    let given = files.iter().map(|f| f.display().to_string()).collect::<Vec<_>>().join(", ");
+    run_merged(paths, &names, false, true, &[], tick, merged).map_err(|e| Error::Merged { files: given, source: Box::new(e) })
 }
 
 #[cfg(test)]

@@ -148,4 +148,20 @@ fn merge_builds_from_the_shards_cells() {
     let got = std::fs::read_to_string(many.path().join("generated/json/msd_s.json")).unwrap();
     assert_ne!(got, want, "the merged build ignored the shard's cells");
     assert!(got.contains(&format!("{changed:?}")) && !want.contains(&format!("{changed:?}")), "the changed cell {changed:?} is not in the merged JSON");
+    // A forged NaN cell (its checksum recomputed) passes the shard checks; the merged build then
+    // fails (exit 1), naming the shard files it was merging, and writes nothing new.
+    let before = files(&many.path().join("generated"));
+    let mut forged = bytes.clone();
+    forged[start..start + 8].copy_from_slice(&f64::NAN.to_le_bytes());
+    let sum: String = sha2::Sha256::digest(&forged[start..]).iter().map(|b| format!("{b:02x}")).collect();
+    header["payload_sha256"] = serde_json::json!(sum);
+    let mut rewritten = forged[..header_start].to_vec();
+    rewritten.extend(header.to_string().into_bytes());
+    rewritten.extend(&forged[header_end..]);
+    std::fs::write(&path, &rewritten).unwrap();
+    let r = run(many.path(), &["merge", path.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&r.stderr).to_string();
+    assert_eq!(r.status.code(), Some(1), "{err}");
+    assert!(err.contains(&format!("merging {}", path.display())), "{err}");
+    assert_eq!(files(&many.path().join("generated")), before, "a failed merge wrote files");
 }
