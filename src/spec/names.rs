@@ -243,12 +243,12 @@ mod tests {
 
     #[test]
     fn emitted_names_may_not_take_the_modules_own() {
-        assert!(check_emitted("gloss_length", "gloss_length_input", &["gloss"]).is_some_and(|e| e.0 == "function"));
-        assert!(check_emitted("gloss_length", "f", &["gloss_length_input"]).is_some_and(|e| e.0 == "args"));
+        assert!(check_emitted("len_fit", "len_fit_input", &["g"]).is_some_and(|e| e.0 == "function"));
+        assert!(check_emitted("len_fit", "f", &["len_fit_input"]).is_some_and(|e| e.0 == "args"));
         assert!(check_emitted("m", "f", &["input"]).is_some());
         assert!(check_emitted("m", "f", &["f_load"]).is_some());
         assert!(check_emitted("m", "f", &["f"]).is_some());
-        assert!(check_emitted("gloss_table", "lut", &["gloss"]).is_none());
+        assert!(check_emitted("len_table", "lut", &["g"]).is_none());
         assert!(check_identifier("min").is_some() && check_identifier("length").is_none());
     }
 
