@@ -136,13 +136,18 @@ fn merge_builds_from_the_shards_cells() {
     use sha2::Digest;
     let header_end = start - 1;
     let header_start = bytes.iter().position(|b| *b == b'\n').unwrap() + 1;
-    let mut header: serde_json::Value = serde_json::from_slice(&bytes[header_start..header_end]).unwrap();
-    let sum: String = sha2::Sha256::digest(&bytes[start..]).iter().map(|b| format!("{b:02x}")).collect();
-    header["payload_sha256"] = serde_json::json!(sum);
-    let mut rewritten = bytes[..header_start].to_vec();
-    rewritten.extend(header.to_string().into_bytes());
-    rewritten.extend(&bytes[header_end..]);
-    std::fs::write(&path, &rewritten).unwrap();
+    let header: serde_json::Value = serde_json::from_slice(&bytes[header_start..header_end]).unwrap();
+    // The shard file of these bytes with its header's checksum made to match their payload.
+    let rechecksummed = |b: &[u8]| -> Vec<u8> {
+        let mut h = header.clone();
+        let sum: String = sha2::Sha256::digest(&b[start..]).iter().map(|x| format!("{x:02x}")).collect();
+        h["payload_sha256"] = serde_json::json!(sum);
+        let mut out = b[..header_start].to_vec();
+        out.extend(h.to_string().into_bytes());
+        out.extend(&b[header_end..]);
+        out
+    };
+    std::fs::write(&path, rechecksummed(&bytes)).unwrap();
     let r = run(many.path(), &["merge", path.to_str().unwrap()]);
     assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
     let got = std::fs::read_to_string(many.path().join("generated/json/msd_s.json")).unwrap();
@@ -153,12 +158,7 @@ fn merge_builds_from_the_shards_cells() {
     let before = files(&many.path().join("generated"));
     let mut forged = bytes.clone();
     forged[start..start + 8].copy_from_slice(&f64::NAN.to_le_bytes());
-    let sum: String = sha2::Sha256::digest(&forged[start..]).iter().map(|b| format!("{b:02x}")).collect();
-    header["payload_sha256"] = serde_json::json!(sum);
-    let mut rewritten = forged[..header_start].to_vec();
-    rewritten.extend(header.to_string().into_bytes());
-    rewritten.extend(&forged[header_end..]);
-    std::fs::write(&path, &rewritten).unwrap();
+    std::fs::write(&path, rechecksummed(&forged)).unwrap();
     let r = run(many.path(), &["merge", path.to_str().unwrap()]);
     let err = String::from_utf8_lossy(&r.stderr).to_string();
     assert_eq!(r.status.code(), Some(1), "{err}");

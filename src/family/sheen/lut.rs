@@ -85,6 +85,22 @@ pub fn ibl_sampler_charlie(nov: f64, r: f64, n: u32, consistent: bool) -> f64 {
     c / n as f64
 }
 
+/// `v` stored as a UNORM texel of `max` + 1 levels (saturated, rounded to the nearest step).
+pub fn unorm(v: f64, max: f64) -> f64 {
+    (v.clamp(0.0, 1.0) * max).round() / max
+}
+
+/// shadefit's table in a shipped table's layout and UNORM format: `truth` (in [0, 1], the
+/// integral at the same texel centres) stored with `max` + 1 levels, whose error is the format's
+/// rounding only; recorded as the item's refit, and returned as (max, rms).
+pub fn same_layout_unorm(item: &mut Item, pts: &[Vec<f64>], truth: &[f64], max: f64) -> (f64, f64) {
+    let ours: Vec<f64> = truth.iter().map(|&e| unorm(e, max)).collect();
+    let (m, rms, _) = crate::validate::measure(pts, truth, &ours);
+    item.extra.push(("refit_max_abs_error".into(), m));
+    item.extra.push(("refit_rms_error".into(), rms));
+    (m, rms)
+}
+
 /// Filament's size (desktop 128²; 64² on mobile) and sample count.
 pub const FILAMENT_SIZE: usize = 128;
 pub const FILAMENT_SAMPLES: u32 = 4096;
@@ -206,7 +222,7 @@ fn sampler_item() -> Item {
             let (i, j) = (k % n, k / n);
             let (nov, r) = ((i as f64 + 0.5) / n as f64, (j as f64 + 0.5) / n as f64);
             let raw = ibl_sampler_charlie(nov, r, SAMPLER_SAMPLES, false);
-            let stored = (raw.clamp(0.0, 1.0) * 255.0).round() / 255.0;
+            let stored = unorm(raw, 255.0);
             let converged = ibl_sampler_charlie(nov, r, 16 * SAMPLER_SAMPLES, false);
             let consistent = ibl_sampler_charlie(nov, r, SAMPLER_SAMPLES, true);
             (vec![r, nov], [stored, converged, consistent, e_ashikhmin(nov, r * r)])
@@ -228,12 +244,8 @@ fn sampler_item() -> Item {
     let (m_conv, m_cons) = (m(&converged, &truth), m(&consistent, &truth));
     item.extra.push(("max_abs_error_16384_samples".into(), m_conv));
     item.extra.push(("max_abs_error_consistent_weight".into(), m_cons));
-    // shadefit's table in the same layout and format: the integral at the same texel centres,
-    // saturated and stored RGBA8 UNORM: its error is the 1/255 steps' rounding only.
-    let ours: Vec<f64> = truth_sat.iter().map(|&e| (e.max(0.0) * 255.0).round() / 255.0).collect();
-    let (m_ours, rms_ours, _) = crate::validate::measure(&pts, &truth_sat, &ours);
-    item.extra.push(("refit_max_abs_error".into(), m_ours));
-    item.extra.push(("refit_rms_error".into(), rms_ours));
+    // shadefit's table in the same layout and format (RGBA8 UNORM).
+    let (m_ours, rms_ours) = same_layout_unorm(&mut item, &pts, &truth_sat, 255.0);
     item.findings = vec![
         format!(
             "Against min(1, E) of Charlie D × Ashikhmin V at α = r² (the lobe whose V the LUT uses, and glTF's α): max {:.3e}, rms {:.3e}. \

@@ -117,12 +117,8 @@ pub fn item() -> Item {
     };
     let (flat_table, flat_truth) = (column_range(&decoded), column_range(&truth));
     item.extra.push(("decoded_column_range_r_lt_0.25".into(), flat_table));
-    // shadefit's equivalent: the same integral at the same texel centres in the same format
-    // (16-bit UNORM, linear): its error is the format's rounding only.
-    let ours: Vec<f64> = truth.iter().map(|&e| (e.max(0.0) * 65535.0).round() / 65535.0).collect();
-    let (m_ours, rms_ours, _) = crate::validate::measure(&pts, &truth, &ours);
-    item.extra.push(("refit_max_abs_error".into(), m_ours));
-    item.extra.push(("refit_rms_error".into(), rms_ours));
+    // shadefit's equivalent in the same layout and format (16-bit UNORM, linear).
+    let (m_ours, rms_ours) = super::lut::same_layout_unorm(&mut item, &pts, &truth, 65535.0);
     item.findings = vec![
         format!(
             "As the Sample Renderer samples it (the stored numbers as linear values) against min(1, E) (E itself reaches {e_max:.2} at the \
