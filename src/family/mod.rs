@@ -12,6 +12,7 @@ pub mod fiber;
 pub mod fuzz;
 pub mod ggx;
 pub mod gloss;
+pub mod ltc;
 pub mod msdiffuse;
 pub mod sggx;
 pub mod sheen;
@@ -130,7 +131,7 @@ pub struct Family {
 
 /// Every family, in the order `eval --help`, `validate` and `plot` list them.
 pub static FAMILIES: &[&Family] =
-    &[&gloss::FAMILY, &fuzz::FAMILY, &skin::FAMILY, &ggx::FAMILY, &fiber::FAMILY, &sggx::FAMILY, &msdiffuse::FAMILY, &sheen::FAMILY];
+    &[&gloss::FAMILY, &fuzz::FAMILY, &skin::FAMILY, &ggx::FAMILY, &fiber::FAMILY, &sggx::FAMILY, &msdiffuse::FAMILY, &sheen::FAMILY, &ltc::FAMILY];
 
 pub fn families() -> &'static [&'static Family] {
     FAMILIES
@@ -312,6 +313,7 @@ pub(crate) mod tests {
     const NO_FORMS: &[(&str, &str)] = &[
         ("sheen", "its published curves are measured by validate; their shader forms are not ranked yet"),
         ("sggx", "emits exact formulas (the course's decoder and D): no approximations to rank yet"),
+        ("ltc", "its tables are fitted by the fit module and audited by validate; no shader form is emitted yet"),
     ];
 
     /// Families whose shader forms include no table form, with the reason (each must say why).
