@@ -165,3 +165,19 @@ mod tests {
         assert!(read_dds(&LTC_1[..100]).is_err());
     }
 }
+
+#[cfg(test)]
+mod report {
+    /// `cargo test --release --lib ltc_audit_cells -- --ignored --nocapture`: every audited
+    /// cell's δ/2 (published, refit), mass below the horizon and quadrature estimate.
+    #[test]
+    #[ignore]
+    fn ltc_audit_cells() {
+        for c in super::audit(super::AUDIT_STEP) {
+            println!(
+                "i {:2} j {:2}  tv {:.4} refit {:.4}  below {:.4} refit {:.4}  est {:.1e}  E {:.4} vs {:.4}",
+                c.i, c.j, 0.5 * c.published, 0.5 * c.refit, c.published_below, c.refit_below, 0.5 * c.published_error, c.magnitude, c.published_magnitude
+            );
+        }
+    }
+}
