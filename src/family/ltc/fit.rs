@@ -355,3 +355,28 @@ mod tests {
         }
     }
 }
+/// The table fit's timing and bits, printed: `LTC_N=64 RAYON_NUM_THREADS=2 cargo test --release
+/// --lib ltc_fit_table_report -- --ignored --nocapture` (the SHA-256 of every cell's f64 bits,
+/// to compare across thread counts).
+#[cfg(test)]
+mod report {
+    use sha2::{Digest, Sha256};
+
+    #[test]
+    #[ignore]
+    fn ltc_fit_table_report() {
+        let t0 = std::time::Instant::now();
+        let n: usize = std::env::var("LTC_N").ok().and_then(|s| s.parse().ok()).unwrap_or(16);
+        let t = super::fit_table(n, crate::family::ltc::published::MIN_ALPHA, super::FIT_NODES, &crate::family::ltc::published::ggx);
+        let elapsed = t0.elapsed();
+        let mut h = Sha256::new();
+        for c in &t.cells {
+            for x in [c.ltc.a, c.ltc.b, c.ltc.c, c.ltc.d, c.magnitude, c.fresnel, c.distance] {
+                h.update(x.to_le_bytes());
+            }
+        }
+        let ds: Vec<f64> = t.cells.iter().map(|c| c.distance).collect();
+        let rms = (ds.iter().map(|d| d * d).sum::<f64>() / ds.len() as f64).sqrt();
+        eprintln!("{n}x{n} GGX LTC table: {elapsed:?}, delta max {:.4} rms {:.4}, repaired {}, sha256 {:x}", ds.iter().cloned().fold(0.0, f64::max), rms, t.repaired, h.finalize());
+    }
+}
