@@ -106,6 +106,7 @@ pub const AUDIT_STEP: usize = 4;
 /// The validate items (see the module doc).
 pub fn items(_generated: &Path) -> Vec<Item> {
     let cells = audit(AUDIT_STEP);
+    let (_, t2) = tables();
     let points: Vec<Vec<f64>> = cells.iter().map(|c| vec![c.i as f64 / (SIZE - 1) as f64, c.j as f64 / (SIZE - 1) as f64]).collect();
     let zero = vec![0.0; cells.len()];
     let source = "selfshadow/ltc_code fit/results/ltc_1.dds, ltc_2.dds (assets/published/ltc_code)";
@@ -140,7 +141,20 @@ pub fn items(_generated: &Path) -> Vec<Item> {
     let truth: Vec<f64> = cells.iter().map(|c| c.fresnel).collect();
     let got: Vec<f64> = cells.iter().map(|c| c.published_fresnel).collect();
     let fres = Item::measured("ltc_code Fresnel term (ltc_2.y) vs GGX int f cos (1 - v.h)^5", source, domain, &points, &truth, &got);
-    vec![lobe, mag, fres]
+    // ltc_2.w against the closed form of the clipped sphere form factor at every texel node.
+    let w = super::sphere::table(SIZE);
+    let points: Vec<Vec<f64>> = (0..SIZE * SIZE).map(|k| vec![(k % SIZE) as f64 / (SIZE - 1) as f64, (k / SIZE) as f64 / (SIZE - 1) as f64]).collect();
+    let got: Vec<f64> = t2.iter().map(|t| t[3]).collect();
+    let mut sphere = Item::measured(
+        "ltc_code horizon-clipped sphere form factor (ltc_2.w) vs Snyder's closed form",
+        source,
+        "x = cos(omega)/2 + 1/2 = i/63, y = sin^2(sigma) = j/63, every texel",
+        &points,
+        &w,
+        &got,
+    );
+    sphere.extra.push(("ltc_2_z_max_abs".to_string(), t2.iter().map(|t| t[2].abs()).fold(0.0, f64::max)));
+    vec![lobe, mag, fres, sphere]
 }
 
 #[cfg(test)]
