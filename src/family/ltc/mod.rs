@@ -7,6 +7,7 @@
 
 pub mod fit;
 pub mod published;
+pub mod reference;
 pub mod sphere;
 pub mod transform;
 
