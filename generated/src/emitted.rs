@@ -73,6 +73,9 @@ pub mod gloss_length;
 #[cfg(feature = "gloss")]
 #[path = "gloss_table.rs"]
 pub mod gloss_table;
+#[cfg(feature = "ltc")]
+#[path = "ltc_ggx.rs"]
+pub mod ltc_ggx;
 #[cfg(feature = "ms")]
 #[path = "ms_diffuse_rational.rs"]
 pub mod ms_diffuse_rational;
@@ -175,6 +178,8 @@ pub mod wgsl {
     pub const GLOSS_LENGTH: &str = include_str!("../wgsl/gloss_length.wgsl");
     #[cfg(feature = "gloss")]
     pub const GLOSS_TABLE: &str = include_str!("../wgsl/gloss_table.wgsl");
+    #[cfg(feature = "ltc")]
+    pub const LTC_GGX: &str = include_str!("../wgsl/ltc_ggx.wgsl");
     #[cfg(feature = "ms")]
     pub const MS_DIFFUSE_RATIONAL: &str = include_str!("../wgsl/ms_diffuse_rational.wgsl");
     #[cfg(feature = "ms")]
@@ -261,6 +266,8 @@ pub mod wgsl {
             "gloss_length" => Some(GLOSS_LENGTH),
             #[cfg(feature = "gloss")]
             "gloss_table" => Some(GLOSS_TABLE),
+            #[cfg(feature = "ltc")]
+            "ltc_ggx" => Some(LTC_GGX),
             #[cfg(feature = "ms")]
             "ms_diffuse_rational" => Some(MS_DIFFUSE_RATIONAL),
             #[cfg(feature = "ms")]
@@ -349,6 +356,8 @@ pub mod wgsl {
         "gloss_length",
         #[cfg(feature = "gloss")]
         "gloss_table",
+        #[cfg(feature = "ltc")]
+        "ltc_ggx",
         #[cfg(feature = "ms")]
         "ms_diffuse_rational",
         #[cfg(feature = "ms")]
