@@ -218,6 +218,21 @@ pub fn fit_cell<L: Lobe>(cell: &Cell<'_, L>, start: Ltc, isotropic: bool) -> (Lt
     (Ltc { a: x[0], b: x[1], c: x[2], d: x[3] }, e)
 }
 
+/// `ltc` turned about y so that the direction of its peak, M·z, points along `target` (in the
+/// xz-plane): M⁻¹·R(φ) keeps the table's form (y decoupled, middle element 1).
+pub fn aim(ltc: Ltc, target: Vec3) -> Ltc {
+    let angle = |w: Vec3| w[0].atan2(w[2]);
+    let goal = angle(target);
+    let delta = goal - angle(normalize(ltc.from_cosine([0.0, 0.0, 1.0])));
+    let turn = |phi: f64| {
+        let (s, c) = phi.sin_cos();
+        Ltc { a: ltc.a * c - ltc.b * s, b: ltc.a * s + ltc.b * c, c: ltc.c * c - ltc.d * s, d: ltc.c * s + ltc.d * c }
+    };
+    let miss = |l: &Ltc| (angle(normalize(l.from_cosine([0.0, 0.0, 1.0]))) - goal).abs();
+    let (p, m) = (turn(delta), turn(-delta));
+    if !p.is_valid() || (m.is_valid() && miss(&m) < miss(&p)) { m } else { p }
+}
+
 /// One fitted cell.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Fitted {
@@ -265,7 +280,12 @@ pub fn fit_table<L: Lobe + Send>(n: usize, min_alpha: f64, nodes: usize, lobe: &
             for j in 1..n {
                 let (_, theta) = cell_parameters(i, j, n, min_alpha);
                 let cell = Cell::new(&l, theta, nodes);
-                let (ltc, distance) = fit_cell(&cell, row[j - 1].ltc, false);
+                // The previous cell's LTC, or the same turned onto this lobe's average direction
+                // where that starts closer (a narrow lobe moves by more than its width a cell).
+                let previous = row[j - 1].ltc;
+                let turned = aim(previous, cell.average_direction());
+                let start = if cell.distance(&turned) < cell.distance(&previous) { turned } else { previous };
+                let (ltc, distance) = fit_cell(&cell, start, false);
                 row.push(Fitted { ltc, magnitude: cell.magnitude, fresnel: cell.fresnel, distance });
             }
             row
@@ -337,6 +357,19 @@ mod tests {
             assert!(cell.distance(&Ltc::IDENTITY) < 1e-12, "{}", cell.distance(&Ltc::IDENTITY));
             let (ltc, d) = fit_cell(&cell, Ltc { a: 1.3, b: 0.2, c: -0.1, d: 0.8 }, false);
             assert!(d < 1e-3, "θ {theta}: {ltc:?} at {d}");
+        }
+    }
+
+    /// Turning an LTC onto a direction moves its peak there and keeps its mass (the
+    /// determinant of M⁻¹ is unchanged by a rotation).
+    #[test]
+    fn aim_turns_the_peak_onto_the_target() {
+        let l = Ltc { a: 0.9, b: 0.05, c: 0.02, d: 0.01 };
+        for t in [0.3f64, -0.2, 1.2] {
+            let a = aim(l, [t.sin(), 0.0, t.cos()]);
+            let peak = normalize(a.from_cosine([0.0, 0.0, 1.0]));
+            assert!((peak[0].atan2(peak[2]) - t).abs() < 1e-12, "{t}: {peak:?}");
+            assert!((a.det_inv() - l.det_inv()).abs() < 1e-15);
         }
     }
 

@@ -228,8 +228,50 @@ fn end_to_end(t: &Table, x: &Texels) -> (serde_json::Value, [f64; 6]) {
         let theirs = reference::measure(&p1, &p2, t.n, &r);
         out["ltc_code"] = row(reference::summary(&theirs));
         out["ltc_code_pairs"] = json!(theirs.iter().map(|m| [m.clipped, m.sphere]).collect::<Vec<_>>());
+        out["per_cell_versus_ltc_code"] = versus_published(t, x, &p1);
     }
     (out, s)
+}
+
+/// Per cell, ltc_code's δ (at the table's nodes) and mass below the horizon beside the table's:
+/// how many cells are no worse in each.
+fn versus_published(t: &Table, x: &Texels, p1: &[[f64; 4]]) -> serde_json::Value {
+    use rayon::prelude::*;
+    let theirs: Vec<f64> = (0..t.n * t.n)
+        .into_par_iter()
+        .map(|k| {
+            let (alpha, theta) = super::fit::cell_parameters(k % t.n, k / t.n, t.n, t.min_alpha);
+            let lobe = published::ggx(alpha);
+            super::fit::Cell::new(&lobe, theta, t.nodes).distance(&super::transform::Ltc::from_texel(p1[k]))
+        })
+        .collect();
+    let below = |q: &[f64; 4]| super::transform::Ltc::from_texel(*q).mass_below_horizon();
+    let cells = (t.n * t.n) as f64;
+    let no_worse_distance = x.distance.iter().zip(&theirs).filter(|(a, b)| a <= b).count();
+    let no_worse_below = x.ltc_1.iter().zip(p1).filter(|(a, b)| below(a) <= below(b)).count();
+    // The cells that leak more than ltc_code's: by how much, and whether their δ is lower.
+    let leak: Vec<(f64, bool)> = (0..t.n * t.n)
+        .filter_map(|k| {
+            let more = below(&x.ltc_1[k]) - below(&p1[k]);
+            (more > 0.0).then_some((more, x.distance[k] <= theirs[k]))
+        })
+        .collect();
+    let within = t.n * t.n - leak.iter().filter(|(m, _)| *m > 1e-4).count();
+    let rms = |v: &[f64]| (v.iter().map(|d| d * d).sum::<f64>() / v.len() as f64).sqrt();
+    json!({
+        "cells": t.n * t.n,
+        "distance_no_worse": no_worse_distance,
+        "distance_no_worse_share": no_worse_distance as f64 / cells,
+        "mass_below_horizon_no_worse": no_worse_below,
+        "mass_below_horizon_no_worse_share": no_worse_below as f64 / cells,
+        "mass_below_horizon_no_worse_within_1e-4": within,
+        "mass_below_horizon_most_above_ltc_code": leak.iter().map(|l| l.0).fold(0.0, f64::max),
+        "cells_leaking_more_with_lower_distance": leak.iter().filter(|l| l.1).count(),
+        "ltc_code_distance_max": theirs.iter().copied().fold(0.0, f64::max),
+        "ltc_code_distance_rms": rms(&theirs),
+        "ltc_code_mass_below_horizon_max": p1.iter().map(below).fold(0.0, f64::max),
+        "ltc_code_distance": theirs,
+    })
 }
 
 fn committed(v: &serde_json::Value, t: &Table) -> Result<Texels, BuildError> {
