@@ -76,6 +76,9 @@ pub mod gloss_table;
 #[cfg(feature = "ltc")]
 #[path = "ltc_ggx.rs"]
 pub mod ltc_ggx;
+#[cfg(feature = "ltc")]
+#[path = "ltc_sheen.rs"]
+pub mod ltc_sheen;
 #[cfg(feature = "ms")]
 #[path = "ms_diffuse_rational.rs"]
 pub mod ms_diffuse_rational;
@@ -180,6 +183,8 @@ pub mod wgsl {
     pub const GLOSS_TABLE: &str = include_str!("../wgsl/gloss_table.wgsl");
     #[cfg(feature = "ltc")]
     pub const LTC_GGX: &str = include_str!("../wgsl/ltc_ggx.wgsl");
+    #[cfg(feature = "ltc")]
+    pub const LTC_SHEEN: &str = include_str!("../wgsl/ltc_sheen.wgsl");
     #[cfg(feature = "ms")]
     pub const MS_DIFFUSE_RATIONAL: &str = include_str!("../wgsl/ms_diffuse_rational.wgsl");
     #[cfg(feature = "ms")]
@@ -268,6 +273,8 @@ pub mod wgsl {
             "gloss_table" => Some(GLOSS_TABLE),
             #[cfg(feature = "ltc")]
             "ltc_ggx" => Some(LTC_GGX),
+            #[cfg(feature = "ltc")]
+            "ltc_sheen" => Some(LTC_SHEEN),
             #[cfg(feature = "ms")]
             "ms_diffuse_rational" => Some(MS_DIFFUSE_RATIONAL),
             #[cfg(feature = "ms")]
@@ -358,6 +365,8 @@ pub mod wgsl {
         "gloss_table",
         #[cfg(feature = "ltc")]
         "ltc_ggx",
+        #[cfg(feature = "ltc")]
+        "ltc_sheen",
         #[cfg(feature = "ms")]
         "ms_diffuse_rational",
         #[cfg(feature = "ms")]

@@ -172,6 +172,8 @@ pub struct Texels {
     pub ltc_1: Vec<[f64; 4]>,
     pub ltc_2: Vec<[f64; 4]>,
     pub distance: Vec<f64>,
+    /// |δ(n) − δ(2n)| per cell: the estimate of the error of `distance`.
+    pub distance_error: Vec<f64>,
     /// Cells the repair pass refitted (0 when read back).
     pub repaired: usize,
 }
@@ -186,11 +188,34 @@ pub fn fit(t: &Table) -> Texels {
 
 fn texels(t: &Table, f: Fitted) -> Texels {
     let w = sphere::table(t.n);
+    let ltc_1: Vec<[f64; 4]> = f.cells.iter().map(|c| c.ltc.texel()).collect();
+    let (distance, distance_error) = distances(t, &ltc_1);
     Texels {
-        ltc_1: f.cells.iter().map(|c| c.ltc.texel()).collect(),
         ltc_2: f.cells.iter().zip(&w).map(|(c, &w)| [c.magnitude, c.fresnel, 0.0, w]).collect(),
-        distance: f.cells.iter().map(|c| c.distance).collect(),
+        ltc_1,
+        distance,
+        distance_error,
         repaired: f.repaired,
+    }
+}
+
+/// δ of each cell's LTC (texels of ltc_1) at twice the fit's nodes, and |δ(n) − δ(2n)| (the fit
+/// minimised δ(n), whose kinks converge as n⁻²: the reported δ is the finer rule's).
+pub fn distances(t: &Table, ltc_1: &[[f64; 4]]) -> (Vec<f64>, Vec<f64>) {
+    use rayon::prelude::*;
+    fn of<L: Lobe>(t: &Table, ltc_1: &[[f64; 4]], lobe: &(dyn Fn(f64) -> L + Sync)) -> (Vec<f64>, Vec<f64>) {
+        (0..t.n * t.n)
+            .into_par_iter()
+            .map(|k| {
+                let (alpha, theta) = super::fit::cell_parameters(k % t.n, k / t.n, t.n, t.min_alpha);
+                let ltc = super::transform::Ltc::from_texel(ltc_1[k]);
+                super::fit::distance_with_error(&lobe(alpha), theta, &ltc, t.nodes)
+            })
+            .unzip()
+    }
+    match t.lobe {
+        LobeName::Ggx => of(t, ltc_1, &published::ggx),
+        LobeName::Charlie => of(t, ltc_1, &crate::shading::charlie::Charlie::new),
     }
 }
 
@@ -236,15 +261,7 @@ fn end_to_end(t: &Table, x: &Texels) -> (serde_json::Value, [f64; 6]) {
 /// Per cell, ltc_code's δ (at the table's nodes) and mass below the horizon beside the table's:
 /// how many cells are no worse in each.
 fn versus_published(t: &Table, x: &Texels, p1: &[[f64; 4]]) -> serde_json::Value {
-    use rayon::prelude::*;
-    let theirs: Vec<f64> = (0..t.n * t.n)
-        .into_par_iter()
-        .map(|k| {
-            let (alpha, theta) = super::fit::cell_parameters(k % t.n, k / t.n, t.n, t.min_alpha);
-            let lobe = published::ggx(alpha);
-            super::fit::Cell::new(&lobe, theta, t.nodes).distance(&super::transform::Ltc::from_texel(p1[k]))
-        })
-        .collect();
+    let (theirs, _) = distances(t, p1);
     let below = |q: &[f64; 4]| super::transform::Ltc::from_texel(*q).mass_below_horizon();
     let cells = (t.n * t.n) as f64;
     let no_worse_distance = x.distance.iter().zip(&theirs).filter(|(a, b)| a <= b).count();
@@ -288,12 +305,16 @@ fn committed(v: &serde_json::Value, t: &Table) -> Result<Texels, BuildError> {
             })
             .collect()
     };
-    let distance: Vec<f64> = v["distance"].as_array().map(|a| a.iter().filter_map(|x| x.as_f64()).collect()).unwrap_or_default();
-    if distance.len() != t.n * t.n {
-        return Err(bad("'distance' does not hold one number per cell".into()));
-    }
+    let numbers = |key: &str| -> Result<Vec<f64>, BuildError> {
+        let v: Vec<f64> = v[key].as_array().map(|a| a.iter().filter_map(|x| x.as_f64()).collect()).unwrap_or_default();
+        if v.len() != t.n * t.n {
+            return Err(bad(format!("'{key}' does not hold one number per cell")));
+        }
+        Ok(v)
+    };
+    let (distance, distance_error) = (numbers("distance")?, numbers("distance_error")?);
     let repaired = v["statistics"]["repaired_cells"].as_u64().unwrap_or(0) as usize;
-    Ok(Texels { ltc_1: quad("ltc_1")?, ltc_2: quad("ltc_2")?, distance, repaired })
+    Ok(Texels { ltc_1: quad("ltc_1")?, ltc_2: quad("ltc_2")?, distance, distance_error, repaired })
 }
 
 /// The artifacts of a table from its texels.
@@ -340,7 +361,7 @@ pub fn render(spec: &Spec, t: &Table, x: &Texels) -> Result<Built, BuildError> {
         "resolution": n,
         "min_alpha": t.min_alpha,
         "nodes": t.nodes,
-        "metric": "per cell: delta = int |p - D| over the sphere (p = f cos / E, D the LTC), by Gauss-Legendre on two maps (src/family/ltc/fit.rs); delta/2 bounds the relative error of any light at the cell",
+        "metric": "per cell: delta = int |p - D| over the sphere (p = f cos / E, D the LTC), by Gauss-Legendre on two maps (src/family/ltc/fit.rs) at twice the fit's nodes per axis, distance_error = its change from the fit's nodes; delta/2 bounds the relative error of any light at the cell",
         "axes": [
             {"name": "roughness", "texture_axis": "x", "nodes": "i/(n - 1); alpha = max(roughness^2, min_alpha)"},
             {"name": "sqrt(1 - cos theta)", "texture_axis": "y", "nodes": "j/(n - 1); theta at most 1.57"},
@@ -356,6 +377,7 @@ pub fn render(spec: &Spec, t: &Table, x: &Texels) -> Result<Built, BuildError> {
         "statistics": {
             "distance_max": dmax,
             "distance_rms": rms(&x.distance),
+            "distance_error_max": x.distance_error.iter().copied().fold(0.0, f64::max),
             "distance_worst_cell": cell_point(worst),
             "mass_below_horizon_max": max_at(&below).0,
             "mass_below_horizon_rms": rms(&below),
@@ -363,6 +385,7 @@ pub fn render(spec: &Spec, t: &Table, x: &Texels) -> Result<Built, BuildError> {
         },
         "end_to_end": e2e,
         "distance": x.distance,
+        "distance_error": x.distance_error,
         "mass_below_horizon": below,
         "ltc_1": x.ltc_1,
         "ltc_2": x.ltc_2,
