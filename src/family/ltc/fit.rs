@@ -373,15 +373,16 @@ mod tests {
         }
     }
 
-    /// δ's quadrature converges: the 24- and 48-node rules agree to 2e-3 for a GGX cell at a
-    /// grazing view and a rough and a glossy α against a fitted LTC (kinks: O(n⁻²) error),
-    /// and δ lies in [0, 2].
+    /// δ's quadrature converges: the n- and 2n-node rules agree within 2 % of δ (1e-3 where
+    /// δ < 0.05) for a GGX cell at a grazing view and a rough and a glossy α against a fitted
+    /// LTC (kinks: O(n⁻²) error), and δ lies in [0, 2]. (tests/python/test_ltc.py checks the
+    /// reported δ against an independent rule aligned with the kinks.)
     #[test]
     fn the_distance_converges_with_the_nodes() {
         for (alpha, theta) in [(0.5, 1.2), (0.05, 0.8), (0.01, 0.3)] {
             let g = Ggx::new(alpha, Shadowing::HeightCorrelated);
             let cell = Cell::new(&g, theta, FIT_NODES);
-            let start = if theta == 0.0 { Ltc { a: 1.0, b: 0.0, c: 0.0, d: alpha } } else { Ltc { a: 1.0, b: 0.0, c: 0.0, d: alpha } };
+            let start = Ltc { a: 1.0, b: 0.0, c: 0.0, d: alpha };
             let (ltc, d) = fit_cell(&cell, start, false);
             let (fine, err) = distance_with_error(&g, theta, &ltc, FIT_NODES);
             assert!((0.0..=2.0).contains(&fine) && err < 2e-2 * fine.max(0.05), "α {alpha} θ {theta}: {d} vs {fine} ± {err}");
