@@ -5,10 +5,12 @@
 //! of the L1 distance between the normalised lobes; [`sphere`] is ltc_2's clipped sphere form
 //! factor in closed form; [`reference`] integrates the true lobe over polygon lights, the
 //! end-to-end check; [`table`] is the spec kind (`ltc-table`) and [`emit`] its light functions;
-//! [`published`] measures ltc_code's shipped GGX tables the same way.
+//! [`published`] measures ltc_code's shipped GGX tables the same way; [`plot`] draws the
+//! committed tables' per-cell maps and lobe slices.
 
 pub mod emit;
 pub mod fit;
+pub mod plot;
 pub mod published;
 pub mod reference;
 pub mod sphere;
@@ -91,7 +93,7 @@ pub static FAMILY: Family = Family {
     spec_kinds: &[table::TABLE],
     eval_options: None,
     validate: published::items,
-    figures: |_, _| Ok(vec![]),
+    figures: plot::figures,
     bench: FamilyBench::NONE,
     scene_features: &[],
     commands: &[],
