@@ -711,7 +711,7 @@ pub struct BenchArgs {
 
 pub fn bench(paths: &Paths, a: &BenchArgs) -> Result<()> {
     use crate::bench::{self, Mode, Sections, tables};
-    const KNOWN: [&str; 4] = ["integrators", "fits", "tables", "forms"];
+    const KNOWN: [&str; 5] = ["integrators", "fits", "tables", "builds", "forms"];
     if let Some(bad) = a.only.iter().find(|s| !KNOWN.contains(&s.as_str())) {
         return Err(input_err(format!(
             "--only: unknown section '{bad}' (known: {})",
@@ -723,6 +723,7 @@ pub fn bench(paths: &Paths, a: &BenchArgs) -> Result<()> {
         integrators: on("integrators"),
         fits: on("fits"),
         tables: on("tables"),
+        builds: on("builds"),
         forms: on("forms"),
     };
     let specs = load_specs(paths, &[])?;

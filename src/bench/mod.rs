@@ -7,6 +7,8 @@
 //! - [`fits`]: every fit solver × objective → time, iterations, max and rms error.
 //! - [`tables`]: each default table, shadefit against `benches/numpy_tables.py` at equal max
 //!   error, with the speed ratio.
+//! - [`builds`]: whole spec builds from scratch, on the pool and on one thread (byte-identical
+//!   or not), with the op counts of named emitted functions.
 //! - [`forms`]: shader cost (op counts from naga's IR, [`ops`]) against max error, several
 //!   approximation forms per quantity.
 //!
@@ -17,6 +19,7 @@
 //! Quick mode (`--quick`, what the test command runs) uses fewer points and settings; both
 //! modes print one table per section, or one JSON document with `--json`.
 
+pub mod builds;
 pub mod fits;
 pub mod forms;
 pub mod integrals;
@@ -180,6 +183,7 @@ pub struct Sections {
     pub integrators: bool,
     pub fits: bool,
     pub tables: bool,
+    pub builds: bool,
     pub forms: bool,
 }
 
@@ -192,6 +196,7 @@ pub struct Report {
     pub integrators: Vec<integrals::IntegratorRow>,
     pub fits: Vec<fits::FitRow>,
     pub tables: Vec<tables::TableRow>,
+    pub builds: Vec<builds::BuildRow>,
     pub forms: Vec<forms::FormRow>,
 }
 
@@ -226,6 +231,11 @@ pub fn run(mode: Mode, sections: Sections, inputs: &Inputs, families: &[&FamilyB
     } else {
         Vec::new()
     };
+    let builds = if sections.builds {
+        builds::all(&mode, inputs.specs, inputs.generated, families)?
+    } else {
+        Vec::new()
+    };
     let forms = if sections.forms {
         let ctx = forms::Ctx { fits: inputs.fits, generated: inputs.generated, quick: mode.quick, catalog: inputs.catalog };
         forms::all(&ctx, families)?
@@ -239,6 +249,7 @@ pub fn run(mode: Mode, sections: Sections, inputs: &Inputs, families: &[&FamilyB
         integrators,
         fits,
         tables,
+        builds,
         forms,
     })
 }
@@ -388,6 +399,10 @@ pub fn render(r: &Report) -> String {
             }
         }
     }
+    if !r.builds.is_empty() {
+        let _ = writeln!(s, "\n## Builds (from scratch, nothing written: the pool, then one thread)\n");
+        s.push_str(&builds::render(&r.builds));
+    }
     if !r.forms.is_empty() {
         let _ = writeln!(
             s,
@@ -428,13 +443,15 @@ pub struct FamilyBench {
     pub fits: &'static [fits::FitBench],
     /// Default tables compared with numpy/scipy (the tables section).
     pub tables: &'static [tables::TableBench],
+    /// Specs built whole, timed on the pool and on one thread (the builds section).
+    pub builds: &'static [builds::BuildBench],
     /// Shader forms, one set per quantity (the forms section).
     pub forms: &'static [forms::FormSet],
 }
 
 impl FamilyBench {
     /// No rows.
-    pub const NONE: FamilyBench = FamilyBench { integrators: &[], fits: &[], tables: &[], forms: &[] };
+    pub const NONE: FamilyBench = FamilyBench { integrators: &[], fits: &[], tables: &[], builds: &[], forms: &[] };
 }
 
 /// The items `field` picks from every family, by `order` (stable: ties keep the families' order).

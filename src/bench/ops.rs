@@ -15,7 +15,9 @@
 //! - `other`: comparisons, select, clamp/min/max/abs, integer and bit operations, float ↔ int
 //!   conversions (a bitcast is free and not counted).
 //!
-//! Both sides of a branch are counted. Counts are of the WGSL as written, with no
+//! Both sides of a branch are counted. A loop's body and continuing block count once, the cost
+//! of one iteration (trip counts are data; `loops` says how many loops the counts hold); stores
+//! to locals are free (register writes). Counts are of the WGSL as written, with no
 //! common-subexpression elimination and no fusing of `a*b + c`: they rank forms rather than
 //! predict cycles. [`OpCounts::weighted`] folds them into one number for that ranking.
 
@@ -41,6 +43,8 @@ pub struct OpCounts {
     pub tex: usize,
     pub const_loads: usize,
     pub other: usize,
+    /// Loops in the function and its callees, each counted for one iteration.
+    pub loops: usize,
     /// The transcendental functions called (sin, cos, sqrt, ...).
     pub transc_fns: BTreeSet<&'static str>,
 }
@@ -55,6 +59,7 @@ impl OpCounts {
         self.tex += o.tex;
         self.const_loads += o.const_loads;
         self.other += o.other;
+        self.loops += o.loops;
         self.transc_fns.extend(o.transc_fns.iter().copied());
     }
 
@@ -172,7 +177,12 @@ impl Source {
                     let callee = self.counts(*function, memo)?;
                     c.plus(&callee);
                 }
-                Statement::Return { .. } => {}
+                Statement::Loop { body, continuing, .. } => {
+                    c.loops += 1;
+                    self.block(f, body, c, memo)?;
+                    self.block(f, continuing, c, memo)?;
+                }
+                Statement::Return { .. } | Statement::Store { .. } | Statement::Break | Statement::Continue => {}
                 other => return Err(self.unsupported(f, format!("statement {other:?}"))),
             }
         }
@@ -312,5 +322,19 @@ mod tests {
         assert_eq!(c.weighted(), 9 + 9 + 3 + 4 * 2 + 4 * 2);
         assert!(matches!(count(src, "h"), Err(OpsError::NoFunction(_))));
         assert!(matches!(count("fn f( {", "f"), Err(OpsError::Parse(_))));
+    }
+
+    /// A loop counts one iteration: its body (the add, the mul and the store to a local, which
+    /// is free) and its continuing block (i++: 1 other), and the loop guard (i < n: 1 other).
+    #[test]
+    fn a_loop_counts_one_iteration() {
+        let src = "fn f(n: u32, x: f32) -> f32 {\n\
+                var s = 0f;\n\
+                for (var i = 0u; i < n; i++) { s += x * x; }\n\
+                return s;\n\
+            }\n";
+        let c = count(src, "f").unwrap();
+        assert_eq!((c.add, c.mul, c.loops), (1, 1, 1), "{c:?}");
+        assert_eq!(c.other, 2, "{c:?}");
     }
 }

@@ -18,6 +18,7 @@ pub const BENCH: FamilyBench = FamilyBench {
     integrators: &[IntegratorBench { order: 10, run: norm_integrators }],
     fits: &[FitBench { spec: "fiber_phase_scale", order: 10, quick: true }],
     tables: &[],
+    builds: &[],
     forms: &[FormSet { quantity: "fiber-phase-scale", order: 10, forms: fiber_phase_scale }],
 };
 

@@ -73,6 +73,7 @@ pub const BENCH: FamilyBench = FamilyBench {
             shape: Shape::SCALAR,
         },
     ],
+    builds: &[],
     forms: &[
         FormSet { quantity: "fuzz-q", order: 2, forms: fuzz_q },
         FormSet { quantity: "fuzz-g", order: 3, forms: fuzz_g },

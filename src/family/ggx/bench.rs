@@ -21,7 +21,7 @@ pub static INTEGRATORS: &[IntegratorBench] =
 const GGX_WRITTEN: &str = include_str!("../../../tests/data/lobes/ggx_written.toml");
 
 pub static BENCH: FamilyBench =
-    FamilyBench { integrators: INTEGRATORS, fits: published::FITS, tables: lut::TABLES, forms: published::FORMS };
+    FamilyBench { integrators: INTEGRATORS, fits: published::FITS, tables: lut::TABLES, builds: &[], forms: published::FORMS };
 
 /// (α, n·v, cos_cone) of the study.
 fn points(mode: &Mode) -> Vec<[f64; 3]> {

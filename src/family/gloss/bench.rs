@@ -52,6 +52,7 @@ pub const BENCH: FamilyBench = FamilyBench {
             shape: Shape::SCALAR,
         },
     ],
+    builds: &[],
     forms: &[
         FormSet { quantity: "gloss-length", order: 0, forms: gloss_length },
         FormSet { quantity: "gloss-combine", order: 1, forms: gloss_combine },

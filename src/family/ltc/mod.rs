@@ -19,6 +19,7 @@ pub mod transform;
 
 use super::Family;
 use crate::bench::FamilyBench;
+use crate::bench::builds::BuildBench;
 use crate::integrate::Estimate;
 use crate::quantity::{ParamSpec, QuantityDef};
 use crate::shading::Lobe;
@@ -94,7 +95,13 @@ pub static FAMILY: Family = Family {
     eval_options: None,
     validate: published::items,
     figures: plot::figures,
-    bench: FamilyBench::NONE,
+    bench: FamilyBench {
+        builds: &[
+            BuildBench { spec: "ltc_ggx", order: 0, quick: false, functions: &["ltc_ggx_rect", "ltc_ggx_rect_sphere", "ltc_ggx_polygon"] },
+            BuildBench { spec: "ltc_sheen", order: 1, quick: false, functions: &[] },
+        ],
+        ..FamilyBench::NONE
+    },
     scene_features: &[],
     commands: &[],
     axis_mappings: &[],

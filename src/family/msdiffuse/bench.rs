@@ -24,6 +24,7 @@ pub const BENCH: FamilyBench = FamilyBench {
     integrators: &[IntegratorBench { order: 12, run: walk_rows }],
     fits: &[],
     tables: &[],
+    builds: &[],
     forms: &[FormSet { quantity: "ms-diffuse-cosines", order: 12, forms: rational_forms }],
 };
 

@@ -18,6 +18,7 @@ pub const BENCH: FamilyBench = FamilyBench {
     integrators: &[IntegratorBench { order: 7, run: projected_area_integrators }],
     fits: &[],
     tables: &[],
+    builds: &[],
     forms: &[],
 };
 

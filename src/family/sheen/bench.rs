@@ -12,7 +12,7 @@ use crate::integrate::Estimate;
 use crate::shading::charlie::lambda_exact;
 use crate::shading::hemisphere::{LobeParams, albedo};
 
-pub static BENCH: FamilyBench = FamilyBench { integrators: &[IntegratorBench { order: 14, run: albedo_integrators }], fits: &[], tables: &[], forms: &[] };
+pub static BENCH: FamilyBench = FamilyBench { integrators: &[IntegratorBench { order: 14, run: albedo_integrators }], fits: &[], tables: &[], builds: &[], forms: &[] };
 
 /// (α, n·v) of the study.
 fn points(mode: &Mode) -> Vec<[f64; 2]> {

@@ -43,6 +43,7 @@ pub const BENCH: FamilyBench = FamilyBench {
             shape: Shape { params: Params::Pick(&[(0, "kappa")]), channels: 6, fold_last_axis: true },
         },
     ],
+    builds: &[],
     forms: &[FormSet { quantity: "skin-punctual", order: 6, forms: skin_punctual }],
 };
 
