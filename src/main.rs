@@ -176,7 +176,7 @@ enum Command {
         quick: bool,
         #[arg(long)]
         json: bool,
-        /// Sections to run, comma-separated: integrators, fits, tables, forms (default: all).
+        /// Sections to run, comma-separated: integrators, fits, tables, builds, forms (default: all).
         #[arg(long, value_delimiter = ',')]
         only: Vec<String>,
         /// Families whose rows to run, comma-separated (default: all; see `shadefit families`).

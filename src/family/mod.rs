@@ -313,7 +313,7 @@ pub(crate) mod tests {
     const NO_FORMS: &[(&str, &str)] = &[
         ("sheen", "its published curves are measured by validate; their shader forms are not ranked yet"),
         ("sggx", "emits exact formulas (the course's decoder and D): no approximations to rank yet"),
-        ("ltc", "its tables are fitted by the fit module and audited by validate; no shader form is emitted yet"),
+        ("ltc", "its light functions integrate a polygon light, not one quantity on a grid: their op counts and the tables' fit times are in the builds section, their end-to-end error in the tables' JSON"),
     ];
 
     /// Families whose shader forms include no table form, with the reason (each must say why).

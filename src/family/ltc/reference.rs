@@ -37,8 +37,9 @@ pub struct Light {
     pub vertices: Vec<Vec3>,
 }
 
-/// A rectangle of `width` × `height` centred at `centre`, facing the origin (counter-clockwise
-/// seen from it), its width along the horizontal tangent of the direction to it.
+/// A rectangle of `width` × `height` centred at `centre`, facing the origin (its vertices wound
+/// counter-clockwise about the direction from the origin to it, as a one-sided light that
+/// shines on the origin), its width along the horizontal tangent of the direction to it.
 pub fn facing_rectangle(centre: Vec3, width: f64, height: f64) -> Vec<Vec3> {
     let t = normalize(centre);
     let side = if t[2].abs() > 0.999 { [0.0, 1.0, 0.0] } else { normalize(cross([0.0, 0.0, 1.0], t)) };

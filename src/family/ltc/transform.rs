@@ -109,8 +109,9 @@ impl Ltc {
         (w, self.eval(w))
     }
 
-    /// ∫_P D over the polygon with vertices `p` (directions from the shaded point, any length,
-    /// counter-clockwise seen from the point for a positive result), clipped in the cosine
+    /// ∫_P D over the polygon with vertices `p` (directions from the shaded point, any length;
+    /// positive when they wind counter-clockwise about the direction from the point to the
+    /// polygon by the right-hand rule, i.e. clockwise as seen from the point), clipped in the cosine
     /// space; [`polygon_cosine`] of M⁻¹P.
     pub fn polygon(&self, p: &[Vec3]) -> f64 {
         let q: Vec<Vec3> = p.iter().map(|&v| self.to_cosine(v)).collect();
@@ -133,7 +134,8 @@ impl Ltc {
 
 /// (1/2π) Σ acos(p_i·p_j) n̂_ij·z over the edges of the polygon `q` (vertices in order, any
 /// length) clipped to z ≥ 0: the clamped cosine's integral over it, positive for a polygon
-/// counter-clockwise seen from the origin (a one-sided light takes max(0, ·), a two-sided |·|,
+/// wound counter-clockwise about the direction from the origin to it (right-hand rule; seen
+/// from the origin, clockwise) (a one-sided light takes max(0, ·), a two-sided |·|,
 /// as ltc_code's shaders do).
 pub fn polygon_cosine(q: &[Vec3]) -> f64 {
     let clipped = clip_to_horizon(q);
@@ -178,7 +180,9 @@ pub fn clip_to_horizon(q: &[Vec3]) -> Vec<Vec3> {
 }
 
 /// The corners of a rectangle centred at `centre` with half-edge vectors `ex`, `ey`, in the
-/// order that makes its side facing the origin counter-clockwise when ex × ey points away.
+/// order (−−, +−, ++, −+): when ex × ey points away from the origin they wind counter-clockwise
+/// about the direction from the origin to the rectangle (right-hand rule), the orientation in
+/// which a one-sided light shines on the origin.
 pub fn rectangle(centre: Vec3, ex: Vec3, ey: Vec3) -> [Vec3; 4] {
     let at = |sx: f64, sy: f64| [centre[0] + sx * ex[0] + sy * ey[0], centre[1] + sx * ex[1] + sy * ey[1], centre[2] + sx * ex[2] + sy * ey[2]];
     [at(-1.0, -1.0), at(1.0, -1.0), at(1.0, 1.0), at(-1.0, 1.0)]
