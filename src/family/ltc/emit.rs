@@ -47,13 +47,14 @@ fn {p}_finite(x: f32) -> f32 {{
     return select(x, 0f, bad);
 }}
 
-fn {p}_finite3(x: vec3<f32>) -> vec3<f32> {{
+// The same per component (no emitted name ends in a digit: naga's other backends would rename it).
+fn {p}_finite_vec(x: vec3<f32>) -> vec3<f32> {{
     return vec3<f32>({p}_finite(x.x), {p}_finite(x.y), {p}_finite(x.z));
 }}
 
 // The unit vector along x, scaled by its largest component first; 0 for a zero or non-finite x.
 fn {p}_direction(x: vec3<f32>) -> vec3<f32> {{
-    let y = {p}_finite3(x);
+    let y = {p}_finite_vec(x);
     let m = max(max(abs(y.x), abs(y.y)), abs(y.z));
     if !(m > 0f) {{
         return vec3<f32>(0f);
@@ -99,11 +100,11 @@ fn {p}_edge(a: vec3<f32>, b: vec3<f32>) -> vec3<f32> {{
 // clipped to the horizon in the cosine space.
 fn {p}_polygon(ltc_1: vec4<f32>, n: vec3<f32>, v: vec3<f32>, p: vec3<f32>, vertices: array<vec3<f32>, 8>, count: u32, two_sided: bool) -> f32 {{
     let k = min(count, 8u);
-    let origin = {p}_finite3(p);
+    let origin = {p}_finite_vec(p);
     var corners = vertices;
     var q: array<vec3<f32>, 8>;
     for (var i = 0u; i < k; i++) {{
-        q[i] = {p}_direction({p}_to_cosine(ltc_1, n, v, {p}_direction({p}_finite3(corners[i]) - origin)));
+        q[i] = {p}_direction({p}_to_cosine(ltc_1, n, v, {p}_direction({p}_finite_vec(corners[i]) - origin)));
     }}
     var c: array<vec3<f32>, 9>;
     var m = 0u;
@@ -161,10 +162,10 @@ fn {p}_sphere_clip(z: f32, s: f32) -> f32 {{
 // The rectangle by the sphere path: the unclipped vector form factor F in the cosine space,
 // then |F| w(F_z/|F|, |F|).
 fn {p}_rect_sphere(ltc_1: vec4<f32>, n: vec3<f32>, v: vec3<f32>, p: vec3<f32>, centre: vec3<f32>, half_x: vec3<f32>, half_y: vec3<f32>, two_sided: bool) -> f32 {{
-    let origin = {p}_finite3(p);
-    let cc = {p}_finite3(centre);
-    let hx = {p}_finite3(half_x);
-    let hy = {p}_finite3(half_y);
+    let origin = {p}_finite_vec(p);
+    let cc = {p}_finite_vec(centre);
+    let hx = {p}_finite_vec(half_x);
+    let hy = {p}_finite_vec(half_y);
     var q: array<vec3<f32>, 4>;
     q[0] = {p}_direction({p}_to_cosine(ltc_1, n, v, {p}_direction(cc - hx - hy - origin)));
     q[1] = {p}_direction({p}_to_cosine(ltc_1, n, v, {p}_direction(cc + hx - hy - origin)));
@@ -174,7 +175,7 @@ fn {p}_rect_sphere(ltc_1: vec4<f32>, n: vec3<f32>, v: vec3<f32>, p: vec3<f32>, c
     for (var i = 0u; i < 4u; i++) {{
         f += {p}_edge(q[i], q[(i + 1u) % 4u]);
     }}
-    f = {p}_finite3(f * {inv_2pi});
+    f = {p}_finite_vec(f * {inv_2pi});
     let len = length(f);
     let front = dot({p}_direction(cc - origin), {p}_direction(cross({p}_direction(hx), {p}_direction(hy)))) > 0f;
     if !(len > 0f) || (!front && !two_sided) {{
@@ -187,7 +188,7 @@ fn {p}_rect_sphere(ltc_1: vec4<f32>, n: vec3<f32>, v: vec3<f32>, p: vec3<f32>, c
 
 // The specular colour that multiplies a light's integral: F0 E + (1 - F0) times the Fresnel term.
 fn {p}_scale(ltc_2: vec4<f32>, f0: vec3<f32>) -> vec3<f32> {{
-    let f = clamp({p}_finite3(f0), vec3<f32>(0f), vec3<f32>(1f));
+    let f = clamp({p}_finite_vec(f0), vec3<f32>(0f), vec3<f32>(1f));
     return f * max({p}_finite(ltc_2.x), 0f) + (vec3<f32>(1f) - f) * max({p}_finite(ltc_2.y), 0f);
 }}
 "#

@@ -107,3 +107,27 @@ pub static FAMILY: Family = Family {
     axis_mappings: &[],
     forms: &[],
 };
+
+#[cfg(test)]
+mod tests {
+    use crate::spec::Spec;
+
+    /// The builds bench row of a small table (8², 12 nodes): the one-thread build gives the
+    /// pool's bytes, the row counts its files and the rect light's ops (its polygon's three
+    /// loops counted once each); a function the module lacks is an error naming it.
+    #[test]
+    fn a_build_row_times_both_pools_and_counts_the_light_s_ops() {
+        let tmp = tempfile::tempdir().unwrap();
+        let path = tmp.path().join("ltc_t.toml");
+        let text = "name = \"ltc_t\"\nkind = \"ltc-table\"\nquantity = \"ltc-ggx-distance\"\ndescription = \"t\"\nresolution = 8\nnodes = 12\n[emit]\nfunction = \"ltc_t\"\n";
+        std::fs::write(&path, text).unwrap();
+        let spec = Spec::load(&path, crate::family::catalog()).unwrap();
+        let custom = |k: &str| crate::family::spec_kind(k).map(|s| s.build);
+        let r = crate::bench::builds::row(&spec, &["ltc_t_rect"], tmp.path(), &custom).unwrap();
+        assert!(r.identical && r.files == 9 && r.seconds > 0.0 && r.seconds_one_thread > 0.0, "{r:?}");
+        assert_eq!(r.ops.len(), 1);
+        assert!(r.ops[0].1.weighted() > 0 && r.ops[0].1.loops == 3, "{r:?}");
+        let e = crate::bench::builds::row(&spec, &["no_such_function"], tmp.path(), &custom).unwrap_err();
+        assert!(format!("{e:?}").contains("no_such_function"), "{e:?}");
+    }
+}
