@@ -323,3 +323,61 @@ mod report {
         }
     }
 }
+
+/// `cargo test --release --lib ltc_per_cell_end_to_end_report -- --ignored --nocapture`: per
+/// cell at the nodes (every 4th cell and the last, roughness ≥ 0.25 where the reference's
+/// quadrature resolves the peak within its panel budget), the largest |LTC − I|/E over the
+/// committed lights through the cell's own texels (no interpolation), for the committed 64²
+/// GGX table (binary16, as its texture holds it) and ltc_code's; how many cells are no worse.
+#[cfg(test)]
+mod per_cell_report {
+    use super::*;
+    use crate::family::ltc::{fit, published};
+    use rayon::prelude::*;
+
+    #[test]
+    #[ignore]
+    fn ltc_per_cell_end_to_end_report() {
+        let t0 = std::time::Instant::now();
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("generated/json/ltc_ggx.json");
+        let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+        let h = |x: f64| half::f16::from_f64(x).to_f64();
+        let quad = |key: &str| -> Vec<[f64; 4]> { v[key].as_array().unwrap().iter().map(|t| serde_json::from_value::<[f64; 4]>(t.clone()).unwrap().map(h)).collect() };
+        let (s1, s2) = (quad("ltc_1"), quad("ltc_2"));
+        let (p1, p2) = published::tables();
+        let n = published::SIZE;
+        let steps: Vec<usize> = (0..n).step_by(published::AUDIT_STEP).chain([n - 1]).collect();
+        let cells: Vec<(usize, usize)> = steps.iter().flat_map(|&j| steps.iter().filter(|&&i| i * 4 >= n - 1).map(move |&i| (i, j))).collect();
+        let ls = lights();
+        let rows: Vec<(f64, f64, f64)> = cells
+            .par_iter()
+            .map(|&(i, j)| {
+                let (alpha, theta) = fit::cell_parameters(i, j, n, published::MIN_ALPHA);
+                let g = published::ggx(alpha);
+                let energy = crate::shading::hemisphere::albedo(&g, theta.cos(), 1e-10).value;
+                let k = i + n * j;
+                let (mut ours, mut theirs, mut est) = (0.0f64, 0.0f64, 0.0f64);
+                for light in &ls {
+                    let (r, e) = reference(&g, theta, &light.vertices);
+                    ours = ours.max((shaded(s1[k], s2[k], &light.vertices).0 - r).abs() / energy);
+                    theirs = theirs.max((shaded(p1[k], p2[k], &light.vertices).0 - r).abs() / energy);
+                    est = est.max(e / energy);
+                }
+                (ours, theirs, est)
+            })
+            .collect();
+        let stats = |f: &dyn Fn(&(f64, f64, f64)) -> f64| {
+            let x: Vec<f64> = rows.iter().map(f).collect();
+            (x.iter().copied().fold(0.0, f64::max), (x.iter().map(|a| a * a).sum::<f64>() / x.len() as f64).sqrt())
+        };
+        let no_worse = rows.iter().filter(|r| r.0 <= r.1).count();
+        let within = rows.iter().filter(|r| r.0 <= r.1 + r.2 + 1e-4).count();
+        eprintln!("{} cells x {} lights in {:.1?}", rows.len(), ls.len(), t0.elapsed());
+        eprintln!("shadefit: per-cell max |LTC - I|/E: max {:.4} rms {:.4}", stats(&|r| r.0).0, stats(&|r| r.0).1);
+        eprintln!("ltc_code: per-cell max |LTC - I|/E: max {:.4} rms {:.4}", stats(&|r| r.1).0, stats(&|r| r.1).1);
+        eprintln!("no worse: {no_worse} of {} ({:.1} %); within 1e-4 + the reference's estimate: {within}; reference estimate max {:.1e}", rows.len(), 100.0 * no_worse as f64 / rows.len() as f64, stats(&|r| r.2).0);
+        for (c, r) in cells.iter().zip(&rows).filter(|(_, r)| r.0 > r.1) {
+            eprintln!("  worse at cell {:?}: {:.4} vs {:.4}", c, r.0, r.1);
+        }
+    }
+}
