@@ -238,6 +238,42 @@ pub fn summary(m: &[Measured]) -> [f64; 6] {
     [cm, cr, sm, sr, rel, est]
 }
 
+/// Least roughness of [`per_cell`]: below it the lobe's peak is narrower than the reference's
+/// panel budget resolves over a whole light.
+pub const PER_CELL_MIN_ROUGHNESS: f64 = 0.25;
+
+/// Per cell of an `n` × `n` table at its nodes, roughness ≥ [`PER_CELL_MIN_ROUGHNESS`] (`None`
+/// below): for each of `tables` (ltc_1, ltc_2 texels) the largest |LTC − I|/E over the committed
+/// lights through the cell's own texels (clipped path, no interpolation), and the largest
+/// reference error estimate over E. Cells in parallel, in order.
+#[allow(clippy::type_complexity)]
+pub fn per_cell<L: Lobe>(lobe: &(dyn Fn(f64) -> L + Sync), n: usize, min_alpha: f64, tables: &[(&[[f64; 4]], &[[f64; 4]])]) -> Vec<Option<(Vec<f64>, f64)>> {
+    use rayon::prelude::*;
+    let ls = lights();
+    (0..n * n)
+        .into_par_iter()
+        .map(|k| {
+            let (i, j) = (k % n, k / n);
+            if (i as f64) < PER_CELL_MIN_ROUGHNESS * (n - 1) as f64 {
+                return None;
+            }
+            let (alpha, theta) = super::fit::cell_parameters(i, j, n, min_alpha);
+            let l = lobe(alpha);
+            let energy = crate::shading::hemisphere::albedo(&l, theta.cos(), 1e-10).value;
+            let mut worst = vec![0.0f64; tables.len()];
+            let mut estimate = 0.0f64;
+            for light in &ls {
+                let (r, e) = reference(&l, theta, &light.vertices);
+                for (w, (t1, t2)) in worst.iter_mut().zip(tables) {
+                    *w = w.max((shaded(t1[k], t2[k], &light.vertices).0 - r).abs() / energy);
+                }
+                estimate = estimate.max(e / energy);
+            }
+            Some((worst, estimate))
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -320,64 +356,6 @@ mod report {
             for r in &m {
                 eprintln!("  light {} view {:2}: ref {:.5} E {:.4} clipped {:.5} sphere {:.5}", r.light, r.view, r.reference, r.energy, r.clipped, r.sphere);
             }
-        }
-    }
-}
-
-/// `cargo test --release --lib ltc_per_cell_end_to_end_report -- --ignored --nocapture`: per
-/// cell at the nodes (every 4th cell and the last, roughness ≥ 0.25 where the reference's
-/// quadrature resolves the peak within its panel budget), the largest |LTC − I|/E over the
-/// committed lights through the cell's own texels (no interpolation), for the committed 64²
-/// GGX table (binary16, as its texture holds it) and ltc_code's; how many cells are no worse.
-#[cfg(test)]
-mod per_cell_report {
-    use super::*;
-    use crate::family::ltc::{fit, published};
-    use rayon::prelude::*;
-
-    #[test]
-    #[ignore]
-    fn ltc_per_cell_end_to_end_report() {
-        let t0 = std::time::Instant::now();
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("generated/json/ltc_ggx.json");
-        let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
-        let h = |x: f64| half::f16::from_f64(x).to_f64();
-        let quad = |key: &str| -> Vec<[f64; 4]> { v[key].as_array().unwrap().iter().map(|t| serde_json::from_value::<[f64; 4]>(t.clone()).unwrap().map(h)).collect() };
-        let (s1, s2) = (quad("ltc_1"), quad("ltc_2"));
-        let (p1, p2) = published::tables();
-        let n = published::SIZE;
-        let steps: Vec<usize> = (0..n).step_by(published::AUDIT_STEP).chain([n - 1]).collect();
-        let cells: Vec<(usize, usize)> = steps.iter().flat_map(|&j| steps.iter().filter(|&&i| i * 4 >= n - 1).map(move |&i| (i, j))).collect();
-        let ls = lights();
-        let rows: Vec<(f64, f64, f64)> = cells
-            .par_iter()
-            .map(|&(i, j)| {
-                let (alpha, theta) = fit::cell_parameters(i, j, n, published::MIN_ALPHA);
-                let g = published::ggx(alpha);
-                let energy = crate::shading::hemisphere::albedo(&g, theta.cos(), 1e-10).value;
-                let k = i + n * j;
-                let (mut ours, mut theirs, mut est) = (0.0f64, 0.0f64, 0.0f64);
-                for light in &ls {
-                    let (r, e) = reference(&g, theta, &light.vertices);
-                    ours = ours.max((shaded(s1[k], s2[k], &light.vertices).0 - r).abs() / energy);
-                    theirs = theirs.max((shaded(p1[k], p2[k], &light.vertices).0 - r).abs() / energy);
-                    est = est.max(e / energy);
-                }
-                (ours, theirs, est)
-            })
-            .collect();
-        let stats = |f: &dyn Fn(&(f64, f64, f64)) -> f64| {
-            let x: Vec<f64> = rows.iter().map(f).collect();
-            (x.iter().copied().fold(0.0, f64::max), (x.iter().map(|a| a * a).sum::<f64>() / x.len() as f64).sqrt())
-        };
-        let no_worse = rows.iter().filter(|r| r.0 <= r.1).count();
-        let within = rows.iter().filter(|r| r.0 <= r.1 + r.2 + 1e-4).count();
-        eprintln!("{} cells x {} lights in {:.1?}", rows.len(), ls.len(), t0.elapsed());
-        eprintln!("shadefit: per-cell max |LTC - I|/E: max {:.4} rms {:.4}", stats(&|r| r.0).0, stats(&|r| r.0).1);
-        eprintln!("ltc_code: per-cell max |LTC - I|/E: max {:.4} rms {:.4}", stats(&|r| r.1).0, stats(&|r| r.1).1);
-        eprintln!("no worse: {no_worse} of {} ({:.1} %); within 1e-4 + the reference's estimate: {within}; reference estimate max {:.1e}", rows.len(), 100.0 * no_worse as f64 / rows.len() as f64, stats(&|r| r.2).0);
-        for (c, r) in cells.iter().zip(&rows).filter(|(_, r)| r.0 > r.1) {
-            eprintln!("  worse at cell {:?}: {:.4} vs {:.4}", c, r.0, r.1);
         }
     }
 }

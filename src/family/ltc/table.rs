@@ -234,7 +234,8 @@ fn end_to_end(t: &Table, x: &Texels) -> (serde_json::Value, [f64; 6]) {
         LobeName::Ggx => refs(&published::ggx),
         LobeName::Charlie => refs(&|a: f64| crate::shading::charlie::Charlie::new(a.max(LobeName::Charlie.floor()))),
     };
-    let ours = reference::measure(&half(&x.ltc_1), &half(&x.ltc_2), t.n, &r);
+    let (h1, h2) = (half(&x.ltc_1), half(&x.ltc_2));
+    let ours = reference::measure(&h1, &h2, t.n, &r);
     let s = reference::summary(&ours);
     let row = |s: [f64; 6]| {
         json!({"clipped_max": s[0], "clipped_rms": s[1], "sphere_max": s[2], "sphere_rms": s[3], "relative_max_where_reference_at_least_e_over_20": s[4]})
@@ -248,14 +249,55 @@ fn end_to_end(t: &Table, x: &Texels) -> (serde_json::Value, [f64; 6]) {
         "pairs_layout": "pairs[view * lights + light] = [reference, clipped, sphere, E]",
         "pairs": ours.iter().map(|m| [m.reference, m.clipped, m.sphere, m.energy]).collect::<Vec<_>>(),
     });
-    if t.lobe == LobeName::Ggx && t.n == published::SIZE {
-        let (p1, p2) = published::tables();
+    let published_tables = (t.lobe == LobeName::Ggx && t.n == published::SIZE).then(published::tables);
+    let mut tables: Vec<(&[[f64; 4]], &[[f64; 4]])> = vec![(&h1, &h2)];
+    if let Some((p1, p2)) = &published_tables {
+        tables.push((p1, p2));
+    }
+    let cells = match t.lobe {
+        LobeName::Ggx => reference::per_cell(&published::ggx, t.n, t.min_alpha, &tables),
+        LobeName::Charlie => reference::per_cell(&|a: f64| crate::shading::charlie::Charlie::new(a.max(LobeName::Charlie.floor())), t.n, t.min_alpha, &tables),
+    };
+    out["per_cell"] = per_cell_json(&cells, published_tables.is_some());
+    if let Some((p1, p2)) = published_tables {
         let theirs = reference::measure(&p1, &p2, t.n, &r);
         out["ltc_code"] = row(reference::summary(&theirs));
         out["ltc_code_pairs"] = json!(theirs.iter().map(|m| [m.clipped, m.sphere]).collect::<Vec<_>>());
         out["per_cell_versus_ltc_code"] = versus_published(t, x, &p1);
     }
     (out, s)
+}
+
+/// The per-cell end-to-end errors ([`reference::per_cell`]: shadefit's, and ltc_code's when
+/// `published`) with their max, rms and how many cells are no worse.
+fn per_cell_json(cells: &[Option<(Vec<f64>, f64)>], published: bool) -> serde_json::Value {
+    let column = |c: usize| -> Vec<Option<f64>> { cells.iter().map(|x| x.as_ref().map(|(w, _)| w[c])).collect() };
+    let stats = |v: &[Option<f64>]| {
+        let x: Vec<f64> = v.iter().flatten().copied().collect();
+        (x.iter().copied().fold(0.0, f64::max), (x.iter().map(|a| a * a).sum::<f64>() / x.len().max(1) as f64).sqrt())
+    };
+    let ours = column(0);
+    let (max, rms) = stats(&ours);
+    let measured = ours.iter().flatten().count();
+    let mut out = json!({
+        "metric": format!("per cell at its node, roughness >= {}: max over the committed lights of |LTC result - reference| / E through the cell's own binary16 texels (clipped path); null below that roughness", reference::PER_CELL_MIN_ROUGHNESS),
+        "cells": measured,
+        "reference_error_max": cells.iter().flatten().map(|(_, e)| *e).fold(0.0, f64::max),
+        "shadefit_max": max,
+        "shadefit_rms": rms,
+        "shadefit": ours,
+    });
+    if published {
+        let theirs = column(1);
+        let (tmax, trms) = stats(&theirs);
+        let no_worse = ours.iter().zip(&theirs).filter(|(a, b)| matches!((a, b), (Some(a), Some(b)) if a <= b)).count();
+        out["ltc_code_max"] = json!(tmax);
+        out["ltc_code_rms"] = json!(trms);
+        out["no_worse_than_ltc_code"] = json!(no_worse);
+        out["no_worse_than_ltc_code_share"] = json!(no_worse as f64 / measured.max(1) as f64);
+        out["ltc_code"] = json!(theirs);
+    }
+    out
 }
 
 /// Per cell, ltc_code's δ (at the table's nodes) and mass below the horizon beside the table's:
