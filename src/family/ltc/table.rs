@@ -374,7 +374,7 @@ pub fn render(spec: &Spec, t: &Table, x: &Texels) -> Result<Built, BuildError> {
     let cell_point = |k: usize| vec![(k % n) as f64 / (n - 1) as f64, (k / n) as f64 / (n - 1) as f64];
     let (e2e, s) = end_to_end(t, x);
     let err_line = format!(
-        "end to end over {} lights x {} views, |LTC - reference|/E: clipped max {} rms {}, sphere path max {} rms {}; per cell L1 distance to the lobe max {} rms {}",
+        "end to end over {} lights x {} views, |LTC - reference|/E of the clipped path: max abs {}, rms {}; sphere path max {} rms {}; per cell L1 distance to the lobe max {} rms {}",
         reference::lights().len(),
         reference::views().len(),
         fmt_err(s[0]),
