@@ -63,17 +63,13 @@ pub fn row(spec: &Spec, functions: &[&str], generated: &Path, custom: &(dyn Fn(&
     let start = Instant::now();
     let again = one.install(build)?;
     let seconds_one_thread = start.elapsed().as_secs_f64();
-    let bytes = |b: &crate::pipeline::Built| b.artifacts.iter().map(|a| (a.path.clone(), a.contents.clone())).collect::<Vec<_>>();
-    let identical = bytes(&built) == bytes(&again);
-    let wgsl = built
-        .artifacts
-        .iter()
-        .find(|a| a.path.extension().is_some_and(|x| x == "wgsl"))
-        .ok_or_else(|| BenchError::NoWgsl { spec: name.clone() });
+    let identical = built.artifacts.len() == again.artifacts.len()
+        && built.artifacts.iter().zip(&again.artifacts).all(|(a, b)| a.path == b.path && a.contents == b.contents);
     let ops = if functions.is_empty() {
         Vec::new()
     } else {
-        let text = std::str::from_utf8(&wgsl?.contents).map_err(|source| BenchError::WgslUtf8 { spec: name.clone(), source })?;
+        let wgsl = built.artifacts.iter().find(|a| a.path.extension().is_some_and(|x| x == "wgsl")).ok_or_else(|| BenchError::NoWgsl { spec: name.clone() })?;
+        let text = std::str::from_utf8(&wgsl.contents).map_err(|source| BenchError::WgslUtf8 { spec: name.clone(), source })?;
         let source = super::forms::parse(name, text)?;
         functions.iter().map(|f| Ok((f.to_string(), super::forms::count_in(name, &source, f)?))).collect::<Result<_, BenchError>>()?
     };

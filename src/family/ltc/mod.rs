@@ -119,8 +119,7 @@ mod tests {
     fn a_build_row_times_both_pools_and_counts_the_light_s_ops() {
         let tmp = tempfile::tempdir().unwrap();
         let path = tmp.path().join("ltc_t.toml");
-        let text = "name = \"ltc_t\"\nkind = \"ltc-table\"\nquantity = \"ltc-ggx-distance\"\ndescription = \"t\"\nresolution = 8\nnodes = 12\n[emit]\nfunction = \"ltc_t\"\n";
-        std::fs::write(&path, text).unwrap();
+        std::fs::write(&path, super::table::tests::SPEC).unwrap();
         let spec = Spec::load(&path, crate::family::catalog()).unwrap();
         let custom = |k: &str| crate::family::spec_kind(k).map(|s| s.build);
         let r = crate::bench::builds::row(&spec, &["ltc_t_rect"], tmp.path(), &custom).unwrap();

@@ -4,7 +4,7 @@
 //! incidence: the normalised lobe p = f cos θl / E against the table's LTC (and ltc_code's).
 
 use super::fit::{Cell, cell_parameters};
-use super::table::{LobeName, Table, distances};
+use super::table::{self, LobeName, Table};
 use super::transform::Ltc;
 use super::{fit, published};
 use crate::plot::{Panel, PlotError, Series, SeriesStyle, data_err, grid_of_heatmaps, heatmap, line_plot};
@@ -16,12 +16,14 @@ const SLICE_CELLS: [(usize, usize); 3] = [(16, 24), (32, 40), (56, 58)];
 /// Polar angles of a slice, −90°…90° (the view at +θv).
 const SLICE_POINTS: usize = 181;
 
-/// A committed ltc-table: its table parameters and the per-cell arrays the figures show.
+/// A committed ltc-table: its table parameters and the per-cell arrays the figures show (the
+/// texels and δ through the build's own reader, [`table::committed`]; ltc_code's δ as the build
+/// measured it, when the table is beside it).
 struct Committed {
     table: Table,
     ltc_1: Vec<[f64; 4]>,
     distance: Vec<f64>,
-    below: Vec<f64>,
+    ltc_code_distance: Option<Vec<f64>>,
 }
 
 fn load(path: &Path) -> Result<Option<Committed>, PlotError> {
@@ -37,19 +39,8 @@ fn load(path: &Path) -> Result<Option<Committed>, PlotError> {
     };
     let number = |k: &str| v[k].as_f64().ok_or_else(|| data_err(path, format!("no number '{k}'")));
     let n = number("resolution")? as usize;
-    let numbers = |k: &str| -> Result<Vec<f64>, PlotError> {
-        let a: Vec<f64> = v[k].as_array().map(|a| a.iter().filter_map(|x| x.as_f64()).collect()).unwrap_or_default();
-        if a.len() != n * n {
-            return Err(data_err(path, format!("'{k}' does not hold one number per cell")));
-        }
-        Ok(a)
-    };
-    let ltc_1: Vec<[f64; 4]> = v["ltc_1"]
-        .as_array()
-        .map(|a| a.iter().filter_map(|t| serde_json::from_value::<[f64; 4]>(t.clone()).ok()).collect())
-        .unwrap_or_default();
-    if ltc_1.len() != n * n || n < 2 {
-        return Err(data_err(path, "'ltc_1' does not hold one texel per cell"));
+    if n < 2 {
+        return Err(data_err(path, "'resolution' is below 2"));
     }
     let table = Table {
         name: v["name"].as_str().unwrap_or_default().to_string(),
@@ -60,7 +51,12 @@ fn load(path: &Path) -> Result<Option<Committed>, PlotError> {
         nodes: number("nodes")? as usize,
         min_alpha: number("min_alpha")?,
     };
-    Ok(Some(Committed { table, ltc_1, distance: numbers("distance")?, below: numbers("mass_below_horizon")? }))
+    let texels = table::committed(&v, &table).map_err(|e| data_err(path, e.to_string()))?;
+    let ltc_code_distance = v["end_to_end"]["per_cell_versus_ltc_code"]["ltc_code_distance"]
+        .as_array()
+        .map(|a| a.iter().filter_map(|x| x.as_f64()).collect::<Vec<f64>>())
+        .filter(|d| d.len() == n * n);
+    Ok(Some(Committed { table, ltc_1: texels.ltc_1, distance: texels.distance, ltc_code_distance }))
 }
 
 pub fn figures(out: &Path, generated: &Path) -> Result<Vec<PathBuf>, PlotError> {
@@ -83,26 +79,27 @@ fn table_figures(out: &Path, c: &Committed) -> Result<Vec<PathBuf>, PlotError> {
     let axis: Vec<f64> = (0..t.n).map(|i| i as f64 / (t.n - 1) as f64).collect();
     let (xl, yl) = ("roughness", "sqrt(1 − cos θv)");
     let name = &t.name;
-    // ltc_code's tables are GGX at 64²: beside a table of that lobe and size only.
-    let theirs = (t.lobe == LobeName::Ggx && t.n == published::SIZE).then(|| {
+    let mass_below = |texels: &[[f64; 4]]| -> Vec<f64> { texels.iter().map(|q| Ltc::from_texel(*q).mass_below_horizon()).collect() };
+    let below = mass_below(&c.ltc_1);
+    // ltc_code's tables are GGX at 64²: beside a table the build measured against them only.
+    let theirs = c.ltc_code_distance.clone().map(|d| {
         let (p1, _) = published::tables();
-        let (d, _) = distances(t, &p1);
-        let below: Vec<f64> = p1.iter().map(|q| Ltc::from_texel(*q).mass_below_horizon()).collect();
+        let below = mass_below(&p1);
         (p1, d, below)
     });
     let mut files = Vec::new();
     match &theirs {
-        Some((_, d, below)) => {
+        Some((_, d, theirs_below)) => {
             let panels = [Panel { title: "shadefit", values: &c.distance }, Panel { title: "ltc_code", values: d }];
             files.extend(grid_of_heatmaps(&out.join(format!("{name}_distance")), &format!("{name}: δ = ∫|p − D| per cell"), xl, yl, &axis, &axis, &panels, 2, "δ", false, None)?);
             let diff: Vec<f64> = c.distance.iter().zip(d).map(|(a, b)| a - b).collect();
             files.extend(heatmap(&out.join(format!("{name}_distance_versus_ltc_code")), &format!("{name}: δ(shadefit) − δ(ltc_code); negative: shadefit closer"), xl, yl, &axis, &axis, &diff, "Δδ", true)?);
-            let panels = [Panel { title: "shadefit", values: &c.below }, Panel { title: "ltc_code", values: below }];
+            let panels = [Panel { title: "shadefit", values: &below }, Panel { title: "ltc_code", values: theirs_below }];
             files.extend(grid_of_heatmaps(&out.join(format!("{name}_horizon")), &format!("{name}: LTC mass below the horizon per cell"), xl, yl, &axis, &axis, &panels, 2, "mass", false, None)?);
         }
         None => {
             files.extend(heatmap(&out.join(format!("{name}_distance")), &format!("{name}: δ = ∫|p − D| per cell"), xl, yl, &axis, &axis, &c.distance, "δ", false)?);
-            files.extend(heatmap(&out.join(format!("{name}_horizon")), &format!("{name}: LTC mass below the horizon per cell"), xl, yl, &axis, &axis, &c.below, "mass", false)?);
+            files.extend(heatmap(&out.join(format!("{name}_horizon")), &format!("{name}: LTC mass below the horizon per cell"), xl, yl, &axis, &axis, &below, "mass", false)?);
         }
     }
     for (i, j) in SLICE_CELLS.map(|(i, j)| (i * (t.n - 1) / 63, j * (t.n - 1) / 63)) {

@@ -219,6 +219,11 @@ pub fn distances(t: &Table, ltc_1: &[[f64; 4]]) -> (Vec<f64>, Vec<f64>) {
     }
 }
 
+/// Root mean square of `v`.
+fn rms(v: &[f64]) -> f64 {
+    (v.iter().map(|d| d * d).sum::<f64>() / v.len() as f64).sqrt()
+}
+
 /// The texels rounded to binary16 (what an RGBA16F texture holds).
 pub fn half(texels: &[[f64; 4]]) -> Vec<[f64; 4]> {
     texels.iter().map(|t| t.map(|x| half::f16::from_f64(x).to_f64())).collect()
@@ -227,14 +232,21 @@ pub fn half(texels: &[[f64; 4]]) -> Vec<[f64; 4]> {
 /// The end-to-end measurement of the RGBA16F texels of `x` (and of ltc_code's for GGX):
 /// [`reference::summary`]s and the per-pair shares.
 fn end_to_end(t: &Table, x: &Texels) -> (serde_json::Value, [f64; 6]) {
-    fn refs<L: Lobe>(lobe: &(dyn Fn(f64) -> L + Sync)) -> Vec<(f64, f64, f64)> {
-        reference::references(lobe)
+    /// The committed (light, view) references and the per-cell errors of `tables`, for one lobe.
+    #[allow(clippy::type_complexity)]
+    fn integrals<L: Lobe>(lobe: &(dyn Fn(f64) -> L + Sync), t: &Table, tables: &[(&[[f64; 4]], &[[f64; 4]])]) -> (Vec<(f64, f64, f64)>, Vec<Option<(Vec<f64>, f64)>>) {
+        (reference::references(lobe), reference::per_cell(lobe, t.n, t.min_alpha, tables))
     }
-    let r = match t.lobe {
-        LobeName::Ggx => refs(&published::ggx),
-        LobeName::Charlie => refs(&|a: f64| crate::shading::charlie::Charlie::new(a.max(LobeName::Charlie.floor()))),
-    };
     let (h1, h2) = (half(&x.ltc_1), half(&x.ltc_2));
+    let published_tables = (t.lobe == LobeName::Ggx && t.n == published::SIZE).then(published::tables);
+    let mut tables: Vec<(&[[f64; 4]], &[[f64; 4]])> = vec![(&h1, &h2)];
+    if let Some((p1, p2)) = &published_tables {
+        tables.push((p1, p2));
+    }
+    let (r, cells) = match t.lobe {
+        LobeName::Ggx => integrals(&published::ggx, t, &tables),
+        LobeName::Charlie => integrals(&|a: f64| crate::shading::charlie::Charlie::new(a.max(LobeName::Charlie.floor())), t, &tables),
+    };
     let ours = reference::measure(&h1, &h2, t.n, &r);
     let s = reference::summary(&ours);
     let row = |s: [f64; 6]| {
@@ -249,15 +261,6 @@ fn end_to_end(t: &Table, x: &Texels) -> (serde_json::Value, [f64; 6]) {
         "pairs_layout": "pairs[view * lights + light] = [reference, clipped, sphere, E]",
         "pairs": ours.iter().map(|m| [m.reference, m.clipped, m.sphere, m.energy]).collect::<Vec<_>>(),
     });
-    let published_tables = (t.lobe == LobeName::Ggx && t.n == published::SIZE).then(published::tables);
-    let mut tables: Vec<(&[[f64; 4]], &[[f64; 4]])> = vec![(&h1, &h2)];
-    if let Some((p1, p2)) = &published_tables {
-        tables.push((p1, p2));
-    }
-    let cells = match t.lobe {
-        LobeName::Ggx => reference::per_cell(&published::ggx, t.n, t.min_alpha, &tables),
-        LobeName::Charlie => reference::per_cell(&|a: f64| crate::shading::charlie::Charlie::new(a.max(LobeName::Charlie.floor())), t.n, t.min_alpha, &tables),
-    };
     out["per_cell"] = per_cell_json(&cells, published_tables.is_some());
     if let Some((p1, p2)) = published_tables {
         let theirs = reference::measure(&p1, &p2, t.n, &r);
@@ -274,7 +277,7 @@ fn per_cell_json(cells: &[Option<(Vec<f64>, f64)>], published: bool) -> serde_js
     let column = |c: usize| -> Vec<Option<f64>> { cells.iter().map(|x| x.as_ref().map(|(w, _)| w[c])).collect() };
     let stats = |v: &[Option<f64>]| {
         let x: Vec<f64> = v.iter().flatten().copied().collect();
-        (x.iter().copied().fold(0.0, f64::max), (x.iter().map(|a| a * a).sum::<f64>() / x.len().max(1) as f64).sqrt())
+        (x.iter().copied().fold(0.0, f64::max), rms(&x))
     };
     let ours = column(0);
     let (max, rms) = stats(&ours);
@@ -316,7 +319,6 @@ fn versus_published(t: &Table, x: &Texels, p1: &[[f64; 4]]) -> serde_json::Value
         })
         .collect();
     let within = t.n * t.n - leak.iter().filter(|(m, _)| *m > 1e-4).count();
-    let rms = |v: &[f64]| (v.iter().map(|d| d * d).sum::<f64>() / v.len() as f64).sqrt();
     json!({
         "cells": t.n * t.n,
         "distance_no_worse": no_worse_distance,
@@ -333,7 +335,7 @@ fn versus_published(t: &Table, x: &Texels, p1: &[[f64; 4]]) -> serde_json::Value
     })
 }
 
-fn committed(v: &serde_json::Value, t: &Table) -> Result<Texels, BuildError> {
+pub(super) fn committed(v: &serde_json::Value, t: &Table) -> Result<Texels, BuildError> {
     let bad = |why: String| BuildError::NoCommitted { spec: t.name.clone(), why };
     let quad = |key: &str| -> Result<Vec<[f64; 4]>, BuildError> {
         let a = v[key].as_array().ok_or_else(|| bad(format!("no '{key}' array")))?;
@@ -369,7 +371,6 @@ pub fn render(spec: &Spec, t: &Table, x: &Texels) -> Result<Built, BuildError> {
     }
     let below: Vec<f64> = x.ltc_1.iter().map(|q| super::transform::Ltc::from_texel(*q).mass_below_horizon()).collect();
     let max_at = |v: &[f64]| v.iter().enumerate().fold((0.0f64, 0usize), |m, (k, &d)| if d > m.0 { (d, k) } else { m });
-    let rms = |v: &[f64]| (v.iter().map(|d| d * d).sum::<f64>() / v.len() as f64).sqrt();
     let (dmax, worst) = max_at(&x.distance);
     let cell_point = |k: usize| vec![(k % n) as f64 / (n - 1) as f64, (k / n) as f64 / (n - 1) as f64];
     let (e2e, s) = end_to_end(t, x);
@@ -506,7 +507,7 @@ pub fn build(spec: &Spec, mode: Mode, root: &Path) -> Result<Built, BuildError> 
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
 
     pub const SPEC: &str = "name = \"ltc_t\"\nkind = \"ltc-table\"\nquantity = \"ltc-ggx-distance\"\n\
