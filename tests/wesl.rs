@@ -1,4 +1,5 @@
-//! The WESL package (`build --target wesl`, src/emit/targets.rs): every committed module of
+//! The WESL package (`build --target wesl`, src/emit/targets.rs), linked with bevy's wesl version
+//! (0.4.2): every committed module of
 //! generated/wgsl as `wesl/NAME.wesl` plus `wesl/wesl.toml`, written to a folder and resolved
 //! by wesl-rs (the WESL reference compiler in Rust) as the external package `shadefit`: a root
 //! shader imports every module (`import shadefit::NAME;`) and calls every function of each as
