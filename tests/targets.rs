@@ -20,7 +20,7 @@
 mod common;
 
 use common::{committed_modules as modules, copy_dir, root, scratch, shadefit, snapshot, stderr};
-use shadefit::emit::targets::{named_constants, translate, Flat, Target};
+use shadefit::emit::targets::{check_source, glsl_version, keep_entry_point_name, named_constants, translate, Flat, Target};
 use shadefit::emit::Artifact;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -356,8 +356,9 @@ fn glslang_compiles_every_glsl_file() {
     let mut n = 0;
     for m in translated() {
         for t in [Target::Glsl, Target::GlslEs] {
+            // The include form with its harness on, a #version first and a main last.
             let p = d.path().join(format!("{}.{}.frag", m.name, t.name()));
-            std::fs::write(&p, &m.files[&t]).unwrap();
+            std::fs::write(&p, check_source(&m.name, t, text(m, t))).unwrap();
             run_ok(Command::new(&glslang).arg(&p), &format!("glslangValidator {}", p.display()));
             n += 1;
         }
@@ -366,11 +367,10 @@ fn glslang_compiles_every_glsl_file() {
     assert_eq!(n, 2 * translated().len());
 }
 
-#[test]
-fn slang_compiles_every_hlsl_file() {
-    // The Slang compiler parses each HLSL file as HLSL, type-checks it and generates SPIR-V from
-    // its entry point (scripts/slang-hlsl-check); there is no DXC or FXC on Linux here.
-    let Some(python) = tool("python3") else { return };
+/// python3 and Slang's libraries (target/shader-tools/slang) for scripts/slang-hlsl-check, or
+/// `None` (with a note) where they are missing outside CI.
+fn slang() -> Option<(PathBuf, PathBuf)> {
+    let python = tool("python3")?;
     let libs = root().join("target/shader-tools/slang");
     let have = std::fs::read_dir(&libs)
         .map(|d| d.flatten().any(|e| e.file_name().to_string_lossy().starts_with("libslang-compiler.so")))
@@ -379,13 +379,87 @@ fn slang_compiles_every_hlsl_file() {
         let hint = "bash scripts/setup-shader-tools unpacks Slang into target/shader-tools/slang";
         assert!(!std::env::var("CI").is_ok_and(|v| v == "true"), "Slang is not installed, and CI runs every validator ({hint})");
         eprintln!("note: Slang is not installed; skipping the HLSL check ({hint})");
-        return;
+        return None;
     }
+    Some((python, libs))
+}
+
+/// Every module's file of target `t` written to `dir` as `NAME.EXT`, and a shader `shadefit_all`
+/// that `#include`s each twice (the include guards), with the harnesses on, and calls every
+/// module's harness from `shadefit_all_keep_all`.
+fn all_in_one(dir: &Path, t: Target, ext: &str) -> String {
+    let mut includes = String::new();
+    let mut calls = String::new();
+    for m in translated() {
+        std::fs::write(dir.join(format!("{}.{ext}", m.name)), &m.files[&t]).unwrap();
+        if glsl_version(t).is_some() {
+            // glslangValidator processes #include only when it targets Vulkan (-V), which the
+            // harness's unbound samplers do not fit: the text goes in as the preprocessor would
+            // put it.
+            includes.push_str(text(m, t));
+        } else {
+            includes.push_str(&format!("#include \"{}.{ext}\"\n", m.name));
+        }
+        calls.push_str(&format!("    {}();\n", keep_entry_point_name(&m.name)));
+    }
+    let twice = format!("{includes}{includes}");
+    match glsl_version(t) {
+        Some(v) => format!("{v}\n#define SHADEFIT_KEEP_ALL\n{twice}\nvoid main() {{\n{calls}}}\n"),
+        None => format!("#define SHADEFIT_KEEP_ALL\n{twice}\nvoid shadefit_all_keep_all() {{\n{calls}}}\n"),
+    }
+}
+
+#[test]
+fn every_module_includes_beside_every_other_in_one_shader() {
+    // An engine includes several modules in one shader: the HLSL files all in one Slang
+    // compilation, the GLSL 450 and GLSL ES 300 files all in one glslangValidator run (each
+    // file included twice, so the include guards are exercised too).
+    let d = tempfile::tempdir().unwrap();
+    if let Some((python, libs)) = slang() {
+        let p = d.path().join("shadefit_all.hlsl");
+        std::fs::write(&p, all_in_one(d.path(), Target::Hlsl, "hlsl")).unwrap();
+        run_ok(Command::new(&python).arg(root().join("scripts/slang-hlsl-check")).arg(&libs).arg(&p), "Slang, every HLSL module in one shader");
+    }
+    if let Some(glslang) = tool("glslangValidator") {
+        for t in [Target::Glsl, Target::GlslEs] {
+            let sub = d.path().join(t.name());
+            std::fs::create_dir(&sub).unwrap();
+            let p = sub.join("shadefit_all.frag");
+            std::fs::write(&p, all_in_one(&sub, t, "glsl")).unwrap();
+            run_ok(Command::new(&glslang).arg(&p), &format!("glslangValidator, every {} module in one shader", t.name()));
+        }
+    }
+    // MSL (no Metal compiler here): across all files together, no name is declared twice at
+    // the top level. A top-level declaration starts in column 0 with a type and names itself
+    // before `(`, ` =`, ` {` or `;`.
+    let mut seen: BTreeMap<String, String> = BTreeMap::new();
+    for m in translated() {
+        let src = text(m, Target::Msl);
+        let mut depth = 0i32;
+        for line in src.lines() {
+            if depth == 0 && !line.is_empty() && !line.starts_with([' ', '#', '/', '}', ')', ',']) && !line.starts_with("using ") {
+                let end = line.find(['(', '=', '{', ';', '[']).unwrap_or(line.len());
+                let name = line[..end].trim_end().rsplit([' ', '*', '&']).next().unwrap().to_string();
+                if let Some(other) = seen.insert(name.clone(), m.name.clone()) {
+                    panic!("MSL: {name} is declared by both {other} and {}", m.name);
+                }
+            }
+            depth += line.matches('{').count() as i32 - line.matches('}').count() as i32;
+        }
+    }
+    assert!(seen.len() > 200, "{} top-level MSL names", seen.len());
+}
+
+#[test]
+fn slang_compiles_every_hlsl_file() {
+    // The Slang compiler parses each HLSL file as HLSL, type-checks it and generates SPIR-V from
+    // its entry point (scripts/slang-hlsl-check); there is no DXC or FXC on Linux here.
+    let Some((python, libs)) = slang() else { return };
     let d = tempfile::tempdir().unwrap();
     let mut files = Vec::new();
     for m in translated() {
         let p = d.path().join(format!("{}.hlsl", m.name));
-        std::fs::write(&p, &m.files[&Target::Hlsl]).unwrap();
+        std::fs::write(&p, check_source(&m.name, Target::Hlsl, text(m, Target::Hlsl))).unwrap();
         files.push(p);
     }
     run_ok(
@@ -553,7 +627,7 @@ fn validate_written(d: &Path, files: &[PathBuf]) {
         match (target, &glslang, &val) {
             (Target::Glsl | Target::GlslEs, Some(g), _) => {
                 let p = scratch.path().join(format!("{module}.{}.frag", target.name()));
-                std::fs::write(&p, &bytes).unwrap();
+                std::fs::write(&p, check_source(module, target, std::str::from_utf8(&bytes).unwrap())).unwrap();
                 run_ok(Command::new(g).arg(&p), &format!("glslangValidator {}", f.display()));
             }
             (Target::Spirv, _, Some(v)) => {

@@ -19,7 +19,8 @@
 //! Translation is a pure function of the WGSL text, so outputs are byte-identical whatever the
 //! thread count.
 
-use super::{f32_literal, Artifact};
+use super::{f32_literal, include, Artifact};
+use std::collections::BTreeSet;
 use naga::{ArraySize, ImageClass, ImageDimension, Literal, Scalar, ScalarKind, TypeInner};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -291,13 +292,34 @@ pub fn translate(module: &str, wgsl: &str, targets: &[Target]) -> Result<Vec<Art
         let module = module.to_string();
         move |e: &dyn std::fmt::Display| TargetError::Backend { module, target: target.name(), message: e.to_string() }
     };
-    let note = |t: Target| {
-        format!(
-            "{} translated from {from} by {TRANSLATOR}; the entry point {}{} calls every function once so that none is dropped",
+    let note = |t: Target| match t {
+        Target::Hlsl | Target::Glsl | Target::GlslEs | Target::Msl => format!(
+            "{} translated from {from} by {TRANSLATOR}; include form{}: the module's functions and constants, naga's helpers named {module}_*; the harness {} (define {}) calls every function once",
             t.name(),
+            match t {
+                Target::Glsl => " (include after #version 450 core)",
+                Target::GlslEs => " (include after #version 300 es)",
+                _ => "",
+            },
             keep_entry_point_name(module),
-            if matches!(t, Target::Glsl | Target::GlslEs) { " (main)" } else { "" }
-        )
+            include::KEEP_ALL_MACRO
+        ),
+        _ => format!(
+            "{} translated from {from} by {TRANSLATOR}; the entry point {} calls every function once so that none is dropped",
+            t.name(),
+            keep_entry_point_name(module)
+        ),
+    };
+    let owned: BTreeSet<String> = plain_ir
+        .functions
+        .iter()
+        .filter_map(|(_, f)| f.name.clone())
+        .chain(plain_ir.constants.iter().filter_map(|(_, c)| c.name.clone()))
+        .chain(plain_ir.types.iter().filter_map(|(_, t)| t.name.clone()))
+        .collect();
+    let included = |t: Target, lang: include::Lang, code: &str, entry: &str| -> Result<String, TargetError> {
+        let inc = include::split(module, lang, code, &owned, entry).map_err(|message| backend(t)(&message))?;
+        Ok(format!("{}{}", comment_header(&src.header, &note(t)), include::file_text(module, t.extension(), &inc)))
     };
     let mut out = Vec::new();
     for t in targets {
@@ -312,7 +334,7 @@ pub fn translate(module: &str, wgsl: &str, targets: &[Target]) -> Result<Vec<Art
                     .write(&ir, &info, None)
                     .map_err(|e| backend(t)(&e))?;
                 let code = hlsl_sampler_registers(&hlsl_brace_initializers(&code));
-                format!("{}{code}", comment_header(&src.header, &note(t))).into_bytes()
+                included(t, include::Lang::Hlsl, &code, &keep_entry_point_name(module))?.into_bytes()
             }
             Target::Glsl | Target::GlslEs => {
                 let version = match t {
@@ -333,15 +355,14 @@ pub fn translate(module: &str, wgsl: &str, targets: &[Target]) -> Result<Vec<Art
                 naga::back::glsl::Writer::new(&mut code, &ir, &info, &options, &pipeline, Default::default())
                     .and_then(|mut w| w.write().map(|_| ()))
                     .map_err(|e| backend(t)(&e))?;
-                // `#version` comes first (GLSL ES allows nothing before it, not even comments).
-                let (version, rest) = code.split_once('\n').unwrap_or((&code, ""));
-                format!("{version}\n{}{rest}", comment_header(&src.header, &note(t))).into_bytes()
+                // The include form has no `#version` line: the including shader's comes first.
+                included(t, include::Lang::Glsl, &code, "main")?.into_bytes()
             }
             Target::Msl => {
                 let options = naga::back::msl::Options::default();
                 let pipeline = naga::back::msl::PipelineOptions::default();
                 let (code, _) = naga::back::msl::write_string(&ir, &info, &options, &pipeline).map_err(|e| backend(t)(&e))?;
-                format!("{}{code}", comment_header(&src.header, &note(t))).into_bytes()
+                included(t, include::Lang::Msl, &code, &keep_entry_point_name(module))?.into_bytes()
             }
             Target::Spirv => {
                 use naga::back::spv;
@@ -421,6 +442,27 @@ fn hlsl_brace_initializers(code: &str) -> String {
         }
     }
     out
+}
+
+/// The `#version` line a GLSL target's include form is written for.
+pub fn glsl_version(t: Target) -> Option<&'static str> {
+    match t {
+        Target::Glsl => Some("#version 450 core"),
+        Target::GlslEs => Some("#version 300 es"),
+        _ => None,
+    }
+}
+
+/// A standalone shader of one include-form file `text` of module `module` with its harness on,
+/// as the compiler checks build it: HLSL and MSL define [`include::KEEP_ALL_MACRO`] first (the
+/// entry point is `NAME_keep_all`); GLSL also puts its `#version` first and a `main` calling
+/// `NAME_keep_all` last.
+pub fn check_source(module: &str, t: Target, text: &str) -> String {
+    let define = format!("#define {}\n", include::KEEP_ALL_MACRO);
+    match glsl_version(t) {
+        Some(v) => format!("{v}\n{define}{text}\nvoid main() {{\n    {}();\n}}\n", keep_entry_point_name(module)),
+        None => format!("{define}{text}"),
+    }
 }
 
 /// The files a set of targets needs once, beside the modules' files: for [`Target::Wesl`], the
