@@ -680,8 +680,11 @@ mod tests {
         let src = "// h\n#define_import_path shadefit::m\nfn emitted_f(x: f32) -> f32 { return x * 2.0; }\n";
         let out = translate("m", src, &[Target::Glsl, Target::GlslEs, Target::Spirv]).unwrap();
         let texts: Vec<String> = out.iter().map(|a| String::from_utf8_lossy(&a.contents).into_owned()).collect();
-        assert!(texts.iter().any(|t| t.contains("#version 450 core")), "{texts:?}");
-        assert!(texts.iter().any(|t| t.contains("#version 300 es")), "{texts:?}");
+        // The include forms name their version; the standalone check puts it first.
+        assert!(texts[0].contains("include after #version 450 core") && texts[1].contains("include after #version 300 es"), "{texts:?}");
+        assert!(check_source("m", Target::Glsl, &texts[0]).starts_with("#version 450 core\n#define SHADEFIT_KEEP_ALL\n// h\n"));
+        assert!(check_source("m", Target::GlslEs, &texts[1]).ends_with("void main() {\n    m_keep_all();\n}\n"));
+        assert!(check_source("m", Target::Hlsl, "x").starts_with("#define SHADEFIT_KEEP_ALL\nx"));
         let spv = out.iter().find(|a| a.contents.starts_with(&0x0723_0203u32.to_le_bytes())).expect("a SPIR-V module");
         let word = |k: usize| u32::from_le_bytes(spv.contents[4 * k..4 * k + 4].try_into().unwrap());
         assert_eq!(word(1), 0x0001_0000, "SPIR-V version 1.0");
@@ -972,8 +975,8 @@ mod tests {
     }
 
     /// Every text target begins with the module's header lines, then one line of its own
-    /// naming the target and the file it came from; GLSL's come right after `#version`, which
-    /// must be first. The WGSL without its directive keeps the module's code as it was.
+    /// naming the target and the file it came from. The WGSL without its directive keeps the
+    /// module's code as it was.
     #[test]
     fn every_text_target_carries_the_header_and_its_provenance() {
         let code = "fn emitted_f(x: f32) -> f32 { return x * 2.0; }\n";
@@ -984,14 +987,16 @@ mod tests {
         for (t, a) in targets.iter().zip(&out) {
             assert_eq!(a.path, t.path("m"));
             let text = String::from_utf8(a.contents.clone()).unwrap();
-            let body = if matches!(t, Target::Glsl | Target::GlslEs) {
-                let (version, rest) = text.split_once('\n').unwrap();
-                assert!(version.starts_with("#version "), "{t:?}: {version}");
-                rest
-            } else {
-                &text
-            };
-            let mut lines = body.lines();
+            // The include form has no #version (the including shader's comes first); a
+            // guard around its items and the harness behind the macro.
+            assert!(!text.lines().any(|l| l.starts_with("#version")), "{t:?}");
+            if matches!(t, Target::Hlsl | Target::Glsl | Target::GlslEs | Target::Msl) {
+                let g = include::guard("m", t.extension());
+                assert!(text.contains(&format!("#ifndef {g}\n#define {g}\n")) && text.trim_end().ends_with(&format!("#endif // {g}")), "{t:?}:\n{text}");
+                let on = text.find("#ifdef SHADEFIT_KEEP_ALL").unwrap();
+                assert!(text[on..].contains("m_keep_all(") && !text[..on].contains("m_keep_all("), "{t:?}:\n{text}");
+            }
+            let mut lines = text.lines();
             assert_eq!((lines.next(), lines.next()), (Some("// first line"), Some("// second line")), "{t:?}:\n{text}");
             let own = lines.next().unwrap();
             assert!(own.starts_with("// ") && own.contains("wgsl/m.wgsl"), "{t:?}: {own}");
