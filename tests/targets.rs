@@ -451,6 +451,44 @@ fn every_module_includes_beside_every_other_in_one_shader() {
 }
 
 #[test]
+fn the_kulla_conty_recipes_compile_against_the_include_forms() {
+    // docs/recipes: a shader of the user's own that includes three emitted modules (E, E_avg,
+    // F_avg) by their paths under generated/ and uses them, compiled as an engine would: Slang
+    // resolves the HLSL includes from its search path (entry kulla_conty_ps), glslangValidator
+    // the GLSL 450 ones for Vulkan (-V, its mode that processes #include).
+    let d = tempfile::tempdir().unwrap();
+    for m in translated() {
+        for t in [Target::Hlsl, Target::Glsl] {
+            let p = d.path().join(t.path(&m.name));
+            std::fs::create_dir_all(p.parent().unwrap()).unwrap();
+            std::fs::write(p, &m.files[&t]).unwrap();
+        }
+    }
+    let recipes = root().join("docs/recipes");
+    if let Some((python, libs)) = slang() {
+        run_ok(
+            Command::new(&python)
+                .arg(root().join("scripts/slang-hlsl-check"))
+                .arg("--entry=kulla_conty_ps")
+                .arg(&libs)
+                .arg(recipes.join("kulla_conty.hlsl"))
+                .env("SLANG_INCLUDE", d.path()),
+            "Slang, docs/recipes/kulla_conty.hlsl",
+        );
+    }
+    if let Some(glslang) = tool("glslangValidator") {
+        let spv = d.path().join("kulla_conty.spv");
+        run_ok(
+            Command::new(&glslang).arg("-V").arg(format!("-I{}", d.path().display())).arg("-o").arg(&spv).arg(recipes.join("kulla_conty.frag")),
+            "glslangValidator -V docs/recipes/kulla_conty.frag",
+        );
+        if let Some(val) = tool("spirv-val") {
+            run_ok(Command::new(&val).arg(&spv), "spirv-val of the Kulla–Conty recipe");
+        }
+    }
+}
+
+#[test]
 fn slang_compiles_every_hlsl_file() {
     // The Slang compiler parses each HLSL file as HLSL, type-checks it and generates SPIR-V from
     // its entry point (scripts/slang-hlsl-check); there is no DXC or FXC on Linux here.
