@@ -384,20 +384,20 @@ fn slang() -> Option<(PathBuf, PathBuf)> {
     Some((python, libs))
 }
 
-/// Every module's file of target `t` written to `dir` as `NAME.EXT`, and a shader `shadefit_all`
-/// that `#include`s each twice (the include guards), with the harnesses on, and calls every
+/// A shader `shadefit_all` of every module's file of target `t` (HLSL: written to `dir` as
+/// `NAME.EXT` and `#include`d; GLSL: inlined), each twice (the include guards), with the harnesses on, and calls every
 /// module's harness from `shadefit_all_keep_all`.
 fn all_in_one(dir: &Path, t: Target, ext: &str) -> String {
     let mut includes = String::new();
     let mut calls = String::new();
     for m in translated() {
-        std::fs::write(dir.join(format!("{}.{ext}", m.name)), &m.files[&t]).unwrap();
         if glsl_version(t).is_some() {
             // glslangValidator processes #include only when it targets Vulkan (-V), which the
             // harness's unbound samplers do not fit: the text goes in as the preprocessor would
             // put it.
             includes.push_str(text(m, t));
         } else {
+            std::fs::write(dir.join(format!("{}.{ext}", m.name)), &m.files[&t]).unwrap();
             includes.push_str(&format!("#include \"{}.{ext}\"\n", m.name));
         }
         calls.push_str(&format!("    {}();\n", keep_entry_point_name(&m.name)));

@@ -133,38 +133,10 @@ fn items(code: &str) -> Vec<String> {
     out
 }
 
-/// Every identifier of `text` in `map` replaced by its value.
-fn rename(text: &str, map: &BTreeMap<String, String>) -> String {
-    let mut out = String::with_capacity(text.len());
-    let mut word = String::new();
-    let flush = |word: &mut String, out: &mut String| {
-        if !word.is_empty() {
-            out.push_str(map.get(word.as_str()).map_or(word.as_str(), |s| s.as_str()));
-            word.clear();
-        }
-    };
-    // Within a number (a token starting with a digit: `10.3e-5`, `2u`) nothing is renamed.
-    let mut number = false;
-    for c in text.chars() {
-        if number && (is_ident(c) || c == '.') {
-            out.push(c);
-        } else if is_ident(c) && (!word.is_empty() || !c.is_ascii_digit()) {
-            word.push(c);
-        } else {
-            flush(&mut word, &mut out);
-            out.push(c);
-            number = c.is_ascii_digit();
-            continue;
-        }
-        number = number && (is_ident(c) || c == '.');
-    }
-    flush(&mut word, &mut out);
-    out
-}
-
-/// The identifiers of `text`.
-fn idents(text: &str) -> BTreeSet<&str> {
-    let mut out = BTreeSet::new();
+/// The byte ranges of the identifiers of `text`: a letter or `_`, then letters, digits or `_`;
+/// nothing inside a number (a token starting with a digit: `10.3e-5`, `2u`) counts.
+fn ident_spans(text: &str) -> Vec<(usize, usize)> {
+    let mut out = Vec::new();
     let mut start: Option<usize> = None;
     let mut number = false;
     for (i, c) in text.char_indices().chain(std::iter::once((text.len(), ' '))) {
@@ -176,12 +148,30 @@ fn idents(text: &str) -> BTreeSet<&str> {
             number = false;
         } else {
             if let Some(s) = start.take() {
-                out.insert(&text[s..i]);
+                out.push((s, i));
             }
             number = c.is_ascii_digit();
         }
     }
     out
+}
+
+/// Every identifier of `text` in `map` replaced by its value.
+fn rename(text: &str, map: &BTreeMap<String, String>) -> String {
+    let mut out = String::with_capacity(text.len());
+    let mut at = 0;
+    for (s, e) in ident_spans(text) {
+        out.push_str(&text[at..s]);
+        out.push_str(map.get(&text[s..e]).map_or(&text[s..e], |r| r.as_str()));
+        at = e;
+    }
+    out.push_str(&text[at..]);
+    out
+}
+
+/// The identifiers of `text`.
+fn idents(text: &str) -> BTreeSet<&str> {
+    ident_spans(text).into_iter().map(|(s, e)| &text[s..e]).collect()
 }
 
 /// A name for helper `name` of `module`: the module's prefix, without a doubled underscore
@@ -225,15 +215,15 @@ pub fn split(module: &str, lang: Lang, code: &str, owned: &BTreeSet<String>, ent
     if !list.iter().any(|i| i.name == entry) {
         return Err(format!("{module}: naga's output has no entry point {entry}"));
     }
-    // Drop helpers nothing else reads, until none is left.
+    // Drop helpers nothing else reads, until none is left (each item's identifiers read once).
+    let mut reads: Vec<BTreeSet<String>> = list.iter().map(|i| idents(&i.text).into_iter().map(str::to_string).collect()).collect();
     loop {
-        let unused = (0..list.len()).find(|&k| {
-            list[k].kind == Kind::Helper
-                && !list.iter().enumerate().any(|(j, other)| j != k && idents(&other.text).contains(list[k].name.as_str()))
-        });
+        let unused = (0..list.len())
+            .find(|&k| list[k].kind == Kind::Helper && !reads.iter().enumerate().any(|(j, r)| j != k && r.contains(&list[k].name)));
         match unused {
             Some(k) => {
                 list.remove(k);
+                reads.remove(k);
             }
             None => break,
         }
@@ -258,17 +248,16 @@ pub fn split(module: &str, lang: Lang, code: &str, owned: &BTreeSet<String>, ent
             return Err(format!("{module}: two items of naga's output declare {n}"));
         }
     }
+    // Items one blank line apart; consecutive preamble lines together.
     let join = |pick: &dyn Fn(Kind) -> bool| -> String {
-        let parts: Vec<String> = list.iter().filter(|i| pick(i.kind)).map(|i| rename(&i.text, &map)).collect();
         let mut s = String::new();
-        let mut prev_preamble = false;
-        for (k, p) in parts.iter().enumerate() {
-            let preamble = is_preamble(p.trim_start());
-            if k > 0 && !(preamble && prev_preamble) {
+        let mut prev: Option<Kind> = None;
+        for i in list.iter().filter(|i| pick(i.kind)) {
+            if prev.is_some() && !(i.kind == Kind::Preamble && prev == Some(Kind::Preamble)) {
                 s.push('\n');
             }
-            s.push_str(p);
-            prev_preamble = preamble;
+            s.push_str(&rename(&i.text, &map));
+            prev = Some(i.kind);
         }
         s
     };

@@ -296,11 +296,7 @@ pub fn translate(module: &str, wgsl: &str, targets: &[Target]) -> Result<Vec<Art
         Target::Hlsl | Target::Glsl | Target::GlslEs | Target::Msl => format!(
             "{} translated from {from} by {TRANSLATOR}; include form{}: the module's functions and constants, naga's helpers named {module}_*; the harness {} (define {}) calls every function once",
             t.name(),
-            match t {
-                Target::Glsl => " (include after #version 450 core)",
-                Target::GlslEs => " (include after #version 300 es)",
-                _ => "",
-            },
+            glsl_version(t).map(|v| format!(" (include after {v})")).unwrap_or_default(),
             keep_entry_point_name(module),
             include::KEEP_ALL_MACRO
         ),
