@@ -61,7 +61,7 @@ fn check(path: &str) -> Result<String, String> {
             return Err(format!("libktx error {rc} (GetImageOffset, level {level})"));
         }
         // GetImageSize is one image: a depth slice of a 3-D texture, one face, one layer. The
-        // level holds them all, consecutively (KTX 2.0 §4.1).
+        // level holds them all, consecutively (KTX 2.0 mip level layout).
         let image = unsafe { (vtbl.GetImageSize.unwrap())(t.base(), level) };
         let slices = if h.numDimensions == 3 { (h.baseDepth >> level).max(1) } else { 1 };
         let size = image * (slices * h.numLayers * h.numFaces) as usize;
