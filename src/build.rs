@@ -111,6 +111,7 @@ pub fn load_specs(paths: &Paths, only: &[String]) -> Result<Vec<Spec>, Error> {
     let specs = spec::load_dir(&paths.fits, family::catalog())?;
     for s in &specs {
         spec_targets(s)?;
+        spec_formats(s)?;
     }
     for name in only {
         if !specs.iter().any(|s| &s.file.name == name) {
@@ -128,6 +129,24 @@ pub fn load_specs(paths: &Paths, only: &[String]) -> Result<Vec<Spec>, Error> {
 pub fn spec_targets(s: &Spec) -> Result<Vec<Target>, SpecError> {
     targets::parse_list(s.file.emit.targets.as_deref().unwrap_or_default())
         .map_err(|why| SpecError::new(&s.path, spec::line_of(&s.text, "targets"), "targets", why))
+}
+
+/// `[emit] formats` checked before anything is built: known names, one KTX2 form, and a spec
+/// that writes a texture (a fit, a two-stage fit or a `form = "const"` table writes none; a
+/// family kind without textures refuses the key when it parses).
+pub fn spec_formats(s: &Spec) -> Result<(), SpecError> {
+    let Some(list) = &s.file.emit.formats else { return Ok(()) };
+    let bad = |why: String| SpecError::new(&s.path, spec::line_of(&s.text, "formats"), "formats", why);
+    emit::formats::parse_list(list).map_err(bad)?;
+    let texture = match s.file.kind {
+        spec::Kind::Fit | spec::Kind::Fields => false,
+        spec::Kind::Table => s.file.emit.form.unwrap_or_default().has_texture(),
+        spec::Kind::Custom(_) => true,
+    };
+    if !texture {
+        return Err(bad("this spec writes no texture (data/NAME.ktx2) to write in other formats".into()));
+    }
+    Ok(())
 }
 
 /// The files of the other targets for every WGSL module among `artifacts` (`wgsl/NAME.wgsl`):

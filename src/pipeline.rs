@@ -162,7 +162,8 @@ pub type CustomBuild = fn(&Spec, Mode, &Path) -> Result<Built, BuildError>;
 /// Build one spec in the given mode; `root` is the generated/ folder; `custom` finds the builder
 /// of a family spec kind by name.
 pub fn build_spec(spec: &Spec, mode: Mode, root: &Path, custom: &dyn Fn(&str) -> Option<CustomBuild>) -> Result<Built, BuildError> {
-    let b = build_any(spec, mode, root, custom)?;
+    let mut b = build_any(spec, mode, root, custom)?;
+    b.artifacts = texture_files(spec, std::mem::take(&mut b.artifacts))?;
     // A spec's `max_error` bounds the measured error of its emitted f32 code (NaN fails too).
     let measured = b.verification.max_abs_error_f32;
     if let Some(bound) = spec.file.max_error
@@ -171,6 +172,32 @@ pub fn build_spec(spec: &Spec, mode: Mode, root: &Path, custom: &dyn Fn(&str) ->
         return Err(BuildError::ErrorBound { spec: spec.file.name.clone(), measured, bound });
     }
     Ok(b)
+}
+
+/// Every texture a spec writes (`data/NAME.ktx2`) in the formats of its `[emit] formats`
+/// ([`emit::formats`]; by default KTX2, DDS and, for float texels, EXR), in place of the KTX2.
+fn texture_files(spec: &Spec, artifacts: Vec<Artifact>) -> Result<Vec<Artifact>, BuildError> {
+    let bad = |why: String| spec::SpecError::new(&spec.path, spec::line_of(&spec.text, "formats"), "formats", why);
+    let listed = spec.file.emit.formats.as_deref().map(emit::formats::parse_list).transpose().map_err(bad)?;
+    let mut out = Vec::with_capacity(artifacts.len());
+    let mut textures = 0;
+    for a in artifacts {
+        if !(a.path.starts_with("data") && a.path.extension().is_some_and(|e| e == "ktx2")) {
+            out.push(a);
+            continue;
+        }
+        textures += 1;
+        let formats = match &listed {
+            Some(l) => l.clone(),
+            None => emit::formats::default_formats(&emit::formats::Texture::parse(&a.contents).map_err(|e| bad(format!("{}: {e}", a.path.display())))?),
+        };
+        let files = emit::formats::files(&a.path, &a.contents, &formats).map_err(bad)?;
+        out.extend(files.into_iter().map(|(path, contents)| Artifact { path, contents }));
+    }
+    if listed.is_some() && textures == 0 {
+        return Err(bad("this spec writes no texture (data/NAME.ktx2) to write in other formats".into()).into());
+    }
+    Ok(out)
 }
 
 fn build_any(spec: &Spec, mode: Mode, root: &Path, custom: &dyn Fn(&str) -> Option<CustomBuild>) -> Result<Built, BuildError> {

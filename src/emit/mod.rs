@@ -6,6 +6,7 @@
 /// The expression tree of a fitted model (it lives with the model; emit renders it).
 pub use crate::fit::expr;
 pub mod fields;
+pub mod formats;
 pub mod include;
 pub mod lang;
 #[cfg(test)]

@@ -21,6 +21,7 @@
 //! `kind = "table"` specs) one, and both start at a multiple of lcm(texel size, 4). Texel values are written as given:
 //! no tonemapping, no gamma (the DFD says so with `KHR_DF_TRANSFER_LINEAR`).
 
+use super::formats::Texture;
 use serde::{Deserialize, Serialize};
 
 /// Texel format of a KTX2 texture (WebGPU names).
@@ -77,32 +78,20 @@ impl TextureFormat {
     }
 }
 
-const KTX2_IDENTIFIER: [u8; 12] = [0xAB, 0x4B, 0x54, 0x58, 0x20, 0x32, 0x30, 0xBB, 0x0D, 0x0A, 0x1A, 0x0A];
-/// Header (48) + index (32) + one level-index entry (24).
-const LEVEL_INDEX_END: usize = 104;
+pub(crate) const KTX2_IDENTIFIER: [u8; 12] = [0xAB, 0x4B, 0x54, 0x58, 0x20, 0x32, 0x30, 0xBB, 0x0D, 0x0A, 0x1A, 0x0A];
 
 fn put_u32(out: &mut Vec<u8>, v: u32) {
     out.extend_from_slice(&v.to_le_bytes());
 }
 
-fn put_u64(out: &mut Vec<u8>, v: u64) {
-    out.extend_from_slice(&v.to_le_bytes());
-}
-
 /// The alignment of every level's data: lcm(texel block size, 4) (KTX 2.0 §3.9.7, the
 /// level index, without supercompression).
-fn level_alignment(texel_size: usize) -> usize {
+pub(crate) fn level_alignment(texel_size: usize) -> usize {
     let (mut a, mut b) = (texel_size, 4);
     while b != 0 {
         (a, b) = (b, a % b);
     }
     texel_size / a * 4
-}
-
-fn pad_to(out: &mut Vec<u8>, align: usize) {
-    while !out.len().is_multiple_of(align) {
-        out.push(0);
-    }
 }
 
 /// Channel ids of an R (1), RG (2) or RGBA (4) texel: R = 0, G = 1, B = 2, A = 15.
@@ -162,21 +151,16 @@ fn data_format_descriptor(format: TextureFormat, channels: usize) -> Vec<u8> {
     })
 }
 
-/// Key/value data: entries sorted by key, each `length, key NUL value, padding to 4`.
-fn key_value_data(entries: &[(&str, &str)]) -> Vec<u8> {
-    let mut sorted: Vec<&(&str, &str)> = entries.iter().collect();
-    sorted.sort_by(|a, b| a.0.as_bytes().cmp(b.0.as_bytes()));
-    let mut out = Vec::new();
-    for (k, v) in sorted {
-        let len = k.len() + 1 + v.len() + 1;
-        put_u32(&mut out, len as u32);
-        out.extend_from_slice(k.as_bytes());
-        out.push(0);
-        out.extend_from_slice(v.as_bytes());
-        out.push(0);
-        pad_to(&mut out, 4);
-    }
-    out
+/// Key/value entries sorted by key (each value with its NUL): `KTXorientation`, `KTXwriter` =
+/// the generator, then `metadata`.
+fn key_values(orientation: &str, metadata: &[(&str, &str)]) -> Vec<(String, Vec<u8>)> {
+    let mut kv: Vec<(String, Vec<u8>)> = [("KTXorientation", orientation), ("KTXwriter", super::GENERATOR)]
+        .iter()
+        .chain(metadata)
+        .map(|(k, v)| (k.to_string(), format!("{v}\0").into_bytes()))
+        .collect();
+    kv.sort_by(|a, b| a.0.as_bytes().cmp(b.0.as_bytes()));
+    kv
 }
 
 /// A KTX2 file holding one `width`×`height` RGBA image, texels row by row from the top
@@ -223,42 +207,22 @@ pub fn ktx2_volume(
     metadata: &[(&str, &str)],
 ) -> Vec<u8> {
     assert_eq!(values.len(), (width * height * depth.max(1)) as usize * channels, "value count differs from width × height × depth × channels");
-    let dfd = data_format_descriptor(format, channels);
     let orientation = if depth == 0 { "rd" } else { "rdi" };
-    let mut kv = vec![("KTXorientation", orientation), ("KTXwriter", super::GENERATOR)];
-    kv.extend_from_slice(metadata);
-    let kvd = key_value_data(&kv);
-    let dfd_offset = LEVEL_INDEX_END;
-    let kvd_offset = dfd_offset + dfd.len();
-    let texel_size = channels * format.type_size() as usize;
     let mut level = Vec::with_capacity(values.len() * format.type_size() as usize);
     for &c in values {
         format.push(&mut level, c);
     }
-    let align = level_alignment(texel_size);
-    let level_offset = (kvd_offset + kvd.len()).next_multiple_of(align);
-
-    let mut out = Vec::with_capacity(level_offset + level.len());
-    out.extend_from_slice(&KTX2_IDENTIFIER);
-    for v in [vk_format(format, channels), format.type_size(), width, height, depth, 0, 1, 1, 0] {
-        put_u32(&mut out, v);
+    Texture {
+        vk_format: vk_format(format, channels),
+        type_size: format.type_size(),
+        width,
+        height,
+        depth,
+        dfd: data_format_descriptor(format, channels),
+        kv: key_values(orientation, metadata),
+        levels: vec![level],
     }
-    put_u32(&mut out, dfd_offset as u32);
-    put_u32(&mut out, dfd.len() as u32);
-    put_u32(&mut out, kvd_offset as u32);
-    put_u32(&mut out, kvd.len() as u32);
-    put_u64(&mut out, 0); // sgdByteOffset
-    put_u64(&mut out, 0); // sgdByteLength
-    put_u64(&mut out, level_offset as u64);
-    put_u64(&mut out, level.len() as u64);
-    put_u64(&mut out, level.len() as u64);
-    debug_assert_eq!(out.len(), LEVEL_INDEX_END);
-    out.extend_from_slice(&dfd);
-    out.extend_from_slice(&kvd);
-    pad_to(&mut out, align);
-    debug_assert_eq!(out.len(), level_offset);
-    out.extend_from_slice(&level);
-    out
+    .ktx2(None)
 }
 
 /// `VkFormat` of a UNORM texture of `channels` (2: RG, 4: RGBA) and `bits` (8, 16) per channel:
@@ -306,46 +270,17 @@ pub fn ktx2_unorm_mips(levels: &[UnormLevel], channels: usize, bits: u32, metada
             out
         })
         .collect();
-    let dfd = data_format_descriptor_unorm(channels, bits);
-    let mut kv = vec![("KTXorientation", "rd"), ("KTXwriter", super::GENERATOR)];
-    kv.extend_from_slice(metadata);
-    let kvd = key_value_data(&kv);
-    let index_end = 80 + 24 * levels.len();
-    let dfd_offset = index_end;
-    let kvd_offset = dfd_offset + dfd.len();
-    let align = level_alignment(channels * type_size as usize);
-    // Offsets: smallest level first in the file.
-    let mut offsets = vec![0usize; levels.len()];
-    let mut at = kvd_offset + kvd.len();
-    for i in (0..levels.len()).rev() {
-        at = at.next_multiple_of(align);
-        offsets[i] = at;
-        at += data[i].len();
+    Texture {
+        vk_format: vk_format_unorm(channels, bits),
+        type_size,
+        width: levels[0].width,
+        height: levels[0].height,
+        depth: 0,
+        dfd: data_format_descriptor_unorm(channels, bits),
+        kv: key_values("rd", metadata),
+        levels: data,
     }
-    let mut out = Vec::with_capacity(at);
-    out.extend_from_slice(&KTX2_IDENTIFIER);
-    for v in [vk_format_unorm(channels, bits), type_size, levels[0].width, levels[0].height, 0, 0, 1, levels.len() as u32, 0] {
-        put_u32(&mut out, v);
-    }
-    put_u32(&mut out, dfd_offset as u32);
-    put_u32(&mut out, dfd.len() as u32);
-    put_u32(&mut out, kvd_offset as u32);
-    put_u32(&mut out, kvd.len() as u32);
-    put_u64(&mut out, 0);
-    put_u64(&mut out, 0);
-    for (o, d) in offsets.iter().zip(&data) {
-        put_u64(&mut out, *o as u64);
-        put_u64(&mut out, d.len() as u64);
-        put_u64(&mut out, d.len() as u64);
-    }
-    out.extend_from_slice(&dfd);
-    out.extend_from_slice(&kvd);
-    for i in (0..levels.len()).rev() {
-        pad_to(&mut out, align);
-        debug_assert_eq!(out.len(), offsets[i]);
-        out.extend_from_slice(&data[i]);
-    }
-    out
+    .ktx2(None)
 }
 
 /// The sRGB transfer function (IEC 61966-2-1) of a linear value clamped to [0, 1], as 8 bits.

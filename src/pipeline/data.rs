@@ -160,6 +160,7 @@ fn spec_of(req: &DataFit, model: RationalModel, data: &Data) -> Result<Spec, Bui
             args: req.args.map(<[String]>::to_vec),
             evaluator: None,
             targets: None,
+            formats: None,
             form: None,
             texture_format: None,
             float32_filterable: false,

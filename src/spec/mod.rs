@@ -34,6 +34,8 @@
 //! function = "my_function"
 //! args = ["x"]                     # optional: argument names (default: the axis names)
 //! targets = ["hlsl", "spirv"]      # optional: more outputs than the WGSL module (emit::targets)
+//! formats = ["ktx2", "dds"]        # specs with a texture: its files (emit::formats; default
+//!                                  # ktx2, dds and exr for float texels)
 //! ```
 
 pub mod data;
@@ -403,13 +405,16 @@ pub struct CustomSpec<'a> {
 }
 
 impl CustomSpec<'_> {
-    /// The common spec; an error names the file and the `kind` line. `[emit] targets` is taken
-    /// from the text as it is for every spec (the family's checker accepts the key and leaves it
-    /// to the common one; `build` checks the names).
+    /// The common spec; an error names the file and the `kind` line. `[emit] targets` and
+    /// `formats` are taken from the text as they are for every spec (the family's checker
+    /// accepts the keys and leaves them to the common one; `build` checks the names).
     pub fn spec_file(self, path: &Path, text: &str) -> Result<SpecFile, SpecError> {
-        let targets = toml::from_str::<toml::Value>(text).ok().and_then(|v| {
-            v.get("emit")?.get("targets")?.as_array()?.iter().map(|t| t.as_str().map(String::from)).collect::<Option<Vec<String>>>()
-        });
+        let list = |key: &str| {
+            toml::from_str::<toml::Value>(text).ok().and_then(|v| {
+                v.get("emit")?.get(key)?.as_array()?.iter().map(|t| t.as_str().map(String::from)).collect::<Option<Vec<String>>>()
+            })
+        };
+        let (targets, formats) = (list("targets"), list("formats"));
         let v = serde_json::json!({
             "name": self.name,
             "kind": "table",
@@ -417,7 +422,7 @@ impl CustomSpec<'_> {
             "description": self.description,
             "tolerance": self.tolerance,
             "axis": self.axes,
-            "emit": {"function": self.function, "targets": targets},
+            "emit": {"function": self.function, "targets": targets, "formats": formats},
         });
         let mut file: SpecFile =
             serde_json::from_value(v).map_err(|e| SpecError::new(path, line_of(text, "kind"), "kind", e.to_string()))?;
@@ -587,6 +592,9 @@ pub struct EmitSection {
     /// Outputs besides the WGSL module (`emit::targets::Target` names: "wgsl-plain", "hlsl",
     /// "glsl", "glsl-es", "msl", "spirv", "c", "wesl"; `build` checks them); `build --target` adds to them.
     pub targets: Option<Vec<String>>,
+    /// Specs that write a texture (`data/NAME.ktx2`): its file formats (`emit::formats`
+    /// names: "ktx2", "ktx2-zstd", "dds", "exr"; default KTX2, DDS and, for float texels, EXR).
+    pub formats: Option<Vec<String>>,
     /// kind = "table": the WGSL forms of the table (default `const`).
     pub form: Option<TableForm>,
     /// kind = "table" with a texture form: the texel format of `data/NAME.ktx2` (default

@@ -99,6 +99,9 @@ struct TableEmit {
     function: String,
     #[allow(dead_code)] // read from the text by the common spec
     targets: Option<Vec<String>>,
+    /// The texture's file formats, as for every spec (`[emit] formats`, read the same way).
+    #[allow(dead_code)]
+    formats: Option<Vec<String>>,
 }
 
 #[derive(Debug, Clone, Deserialize)]

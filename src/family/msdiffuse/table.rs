@@ -113,6 +113,9 @@ struct TableEmit {
     /// reads them from the text: `spec::CustomSpec::spec_file`).
     #[allow(dead_code)]
     targets: Option<Vec<String>>,
+    /// The texture's file formats, as for every spec (`[emit] formats`, read the same way).
+    #[allow(dead_code)]
+    formats: Option<Vec<String>>,
 }
 
 #[derive(Debug, Clone, Deserialize)]
