@@ -41,6 +41,9 @@ pub mod ggx_cone_scale_rational;
 #[path = "ggx_dfg_lut.rs"]
 pub mod ggx_dfg_lut;
 #[cfg(feature = "ggx")]
+#[path = "ggx_dfg_lut_bevy.rs"]
+pub mod ggx_dfg_lut_bevy;
+#[cfg(feature = "ggx")]
 #[path = "ggx_dfg_lut_filament.rs"]
 pub mod ggx_dfg_lut_filament;
 #[cfg(feature = "ggx")]
@@ -160,6 +163,8 @@ pub mod wgsl {
     #[cfg(feature = "ggx")]
     pub const GGX_DFG_LUT: &str = include_str!("../wgsl/ggx_dfg_lut.wgsl");
     #[cfg(feature = "ggx")]
+    pub const GGX_DFG_LUT_BEVY: &str = include_str!("../wgsl/ggx_dfg_lut_bevy.wgsl");
+    #[cfg(feature = "ggx")]
     pub const GGX_DFG_LUT_FILAMENT: &str = include_str!("../wgsl/ggx_dfg_lut_filament.wgsl");
     #[cfg(feature = "ggx")]
     pub const GGX_ENV_BIAS_RATIONAL: &str = include_str!("../wgsl/ggx_env_bias_rational.wgsl");
@@ -249,6 +254,8 @@ pub mod wgsl {
             "ggx_cone_scale_rational" => Some(GGX_CONE_SCALE_RATIONAL),
             #[cfg(feature = "ggx")]
             "ggx_dfg_lut" => Some(GGX_DFG_LUT),
+            #[cfg(feature = "ggx")]
+            "ggx_dfg_lut_bevy" => Some(GGX_DFG_LUT_BEVY),
             #[cfg(feature = "ggx")]
             "ggx_dfg_lut_filament" => Some(GGX_DFG_LUT_FILAMENT),
             #[cfg(feature = "ggx")]
@@ -341,6 +348,8 @@ pub mod wgsl {
         "ggx_cone_scale_rational",
         #[cfg(feature = "ggx")]
         "ggx_dfg_lut",
+        #[cfg(feature = "ggx")]
+        "ggx_dfg_lut_bevy",
         #[cfg(feature = "ggx")]
         "ggx_dfg_lut_filament",
         #[cfg(feature = "ggx")]

@@ -63,3 +63,23 @@ fn the_runtime_composer_resolves_the_same_shader() {
         }
     }
 }
+
+#[test]
+fn the_bevy_energy_recipe_composes() {
+    // docs/recipes/bevy_energy.wgsl (README "Engine recipes": bevy): a user's shader importing four
+    // emitted modules by naga_oil path and calling them prefixed, as a bevy material would.
+    let mut composer = Composer::default();
+    for (name, src) in libraries() {
+        let path = format!("wgsl/{name}.wgsl");
+        composer.add_composable_module(ComposableModuleDescriptor { source: src, file_path: &path, ..Default::default() }).unwrap();
+    }
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/recipes/bevy_energy.wgsl");
+    let shader = std::fs::read_to_string(path).unwrap();
+    let module = composer
+        .make_naga_module(NagaModuleDescriptor { source: &shader, file_path: "bevy_energy.wgsl", ..Default::default() })
+        .unwrap_or_else(|e| panic!("{}", e.emit_to_string(&composer)));
+    naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::default())
+        .validate(&module)
+        .unwrap_or_else(|e| panic!("{e:?}"));
+    assert_eq!(module.entry_points.iter().map(|e| e.name.as_str()).collect::<Vec<_>>(), ["energy_fs"]);
+}

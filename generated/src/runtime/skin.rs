@@ -148,14 +148,15 @@ impl LutFormat {
 
 /// The one level of a KTX2 file: size, format and the texels (little-endian, row 0 of slice 0
 /// first).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Ktx2Image<'a> {
     pub width: u32,
     pub height: u32,
     /// The file's `pixelDepth`: 0 for a 2-D image, the slice count of a 3-D one (the cone LUT).
     pub depth: u32,
     pub format: LutFormat,
-    pub data: &'a [u8],
+    /// Borrowed from the file, or inflated from a Zstandard-supercompressed one.
+    pub data: std::borrow::Cow<'a, [u8]>,
 }
 
 impl<'a> Ktx2Image<'a> {
@@ -180,19 +181,31 @@ impl<'a> Ktx2Image<'a> {
         };
         let (width, height, depth, layers, faces, levels, scheme) =
             (u32_at(20), u32_at(24), u32_at(28), u32_at(32), u32_at(36), u32_at(40), u32_at(44));
-        if scheme != 0 {
-            return Err(Ktx2Error::Unsupported("supercompression"));
+        // Supercompression scheme 0 (none) or 2 (Zstandard, as bevy's dfg.ktx2 and the
+        // `ktx2-zstd` table format store it).
+        if scheme != 0 && scheme != 2 {
+            return Err(Ktx2Error::Unsupported("supercompression other than Zstandard"));
         }
         if layers > 1 || faces != 1 || levels > 1 || height == 0 || width == 0 {
             return Err(Ktx2Error::Unsupported("not a single-level 2-D or 3-D image"));
         }
-        let (offset, length) = (u64_at(80) as usize, u64_at(88) as usize);
+        let (offset, length, full) = (u64_at(80) as usize, u64_at(88) as usize, u64_at(96) as usize);
         let texel = format.channels() * format.channel_size();
         let expected = (width as usize).checked_mul(height as usize).and_then(|n| n.checked_mul(depth.max(1) as usize)).and_then(|n| n.checked_mul(texel));
-        if Some(length) != expected {
+        if Some(full) != expected || (scheme == 0 && length != full) {
             return Err(Ktx2Error::Malformed("level length differs from width × height × depth × texel size"));
         }
-        let data = offset.checked_add(length).and_then(|end| bytes.get(offset..end)).ok_or(Ktx2Error::Malformed("level data beyond the end"))?;
+        let stored = offset.checked_add(length).and_then(|end| bytes.get(offset..end)).ok_or(Ktx2Error::Malformed("level data beyond the end"))?;
+        let data = if scheme == 0 {
+            std::borrow::Cow::Borrowed(stored)
+        } else {
+            let mut out = Vec::with_capacity(full);
+            ruzstd::decoding::FrameDecoder::new().decode_all_to_vec(stored, &mut out).map_err(|_| Ktx2Error::Malformed("the Zstandard level data does not decode"))?;
+            if out.len() != full {
+                return Err(Ktx2Error::Malformed("the Zstandard level data inflate to another length than uncompressedByteLength"));
+            }
+            std::borrow::Cow::Owned(out)
+        };
         Ok(Ktx2Image { width, height, depth, format, data })
     }
 
@@ -279,7 +292,7 @@ mod gpu {
                 view_formats: &[],
             },
             wgpu::util::TextureDataOrder::LayerMajor,
-            img.data,
+            &img.data,
         ))
     }
 
