@@ -489,6 +489,32 @@ fn the_kulla_conty_recipes_compile_against_the_include_forms() {
 }
 
 #[test]
+fn the_godot_recipe_compiles_as_a_compute_shader() {
+    // docs/recipes/godot_energy.glsl: a Godot RenderingDevice compute shader including two GLSL
+    // 450 modules. Godot takes its `#[compute]` line before handing the rest to glslang, so the
+    // check drops that line and compiles the rest for Vulkan as a compute stage.
+    let Some(glslang) = tool("glslangValidator") else { return };
+    let d = tempfile::tempdir().unwrap();
+    for m in translated() {
+        let p = d.path().join(Target::Glsl.path(&m.name));
+        std::fs::create_dir_all(p.parent().unwrap()).unwrap();
+        std::fs::write(p, &m.files[&Target::Glsl]).unwrap();
+    }
+    let text = std::fs::read_to_string(root().join("docs/recipes/godot_energy.glsl")).unwrap();
+    let body = text.strip_prefix("#[compute]\n").expect("the recipe starts with Godot's section line");
+    let src = d.path().join("godot_energy.comp");
+    std::fs::write(&src, body).unwrap();
+    let spv = d.path().join("godot_energy.spv");
+    run_ok(
+        Command::new(&glslang).arg("-V").arg("-S").arg("comp").arg(format!("-I{}", d.path().display())).arg("-o").arg(&spv).arg(&src),
+        "glslangValidator -V -S comp docs/recipes/godot_energy.glsl",
+    );
+    if let Some(val) = tool("spirv-val") {
+        run_ok(Command::new(&val).arg(&spv), "spirv-val of the Godot recipe");
+    }
+}
+
+#[test]
 fn slang_compiles_every_hlsl_file() {
     // The Slang compiler parses each HLSL file as HLSL, type-checks it and generates SPIR-V from
     // its entry point (scripts/slang-hlsl-check); there is no DXC or FXC on Linux here.
