@@ -209,3 +209,64 @@ fn a_formats_list_picks_the_files_and_bad_lists_are_bad_input() {
         assert_nothing_written(d.path());
     }
 }
+
+/// node on PATH; missing, a note (a failure under CI=true, where the test command installs it).
+fn node() -> Option<std::path::PathBuf> {
+    let found = std::env::var_os("PATH").and_then(|p| std::env::split_paths(&p).map(|d| d.join("node")).find(|p| p.is_file()));
+    if found.is_none() {
+        assert!(!std::env::var("CI").is_ok_and(|v| v == "true"), "node is not installed (bash scripts/setup-ktx-loaders installs it)");
+        eprintln!("note: node is not installed; skipping the JavaScript form's check");
+    }
+    found
+}
+
+/// Level 0's bytes as lowercase hex.
+fn hex(bytes: &[u8]) -> String {
+    bytes.iter().map(|b| format!("{b:02x}")).collect()
+}
+
+#[test]
+fn the_c_and_js_forms_hold_the_ktx2_texels() {
+    // A 32F (gloss_table, R32F) and a 16F table (gloss_combine_lut, R16F) in the C and
+    // JavaScript forms, read as a C compiler and node read them: the array's bytes (x86 and
+    // node's typed arrays are little-endian, as KTX2 is) are the KTX2 level's bytes.
+    let d = scratch();
+    for spec in ["gloss_table", "gloss_combine_lut"] {
+        set_formats(d.path(), spec, "formats = [\"ktx2\", \"c\", \"js\"]");
+    }
+    let o = shadefit(&["build", "--only", "gloss_table,gloss_combine_lut"], Some(d.path()));
+    assert!(o.status.success(), "{}", stderr(&o));
+    let data = d.path().join("generated/data");
+    let node = node();
+    for name in ["gloss_table", "gloss_combine_lut"] {
+        let k = read_ktx2(&std::fs::read(data.join(format!("{name}.ktx2"))).unwrap());
+        assert!(!data.join(format!("{name}.dds")).exists(), "{name}: dds was not asked for");
+        let up = name.to_uppercase();
+        let (w, h) = (k.header.pixel_width, k.header.pixel_height);
+        let c = d.path().join(format!("{name}_dump.c"));
+        std::fs::write(
+            &c,
+            format!(
+                "#include <stdio.h>\n#include \"{name}.h\"\nint main(void) {{\n    const unsigned char *p = (const unsigned char *){up}_DATA;\n    \
+                 for (unsigned long i = 0; i < sizeof {up}_DATA; i++) printf(\"%02x\", p[i]);\n    \
+                 printf(\" %d %d %d %d\\n\", {up}_WIDTH, {up}_HEIGHT, {up}_DEPTH, {up}_CHANNELS);\n    return 0;\n}}\n"
+            ),
+        )
+        .unwrap();
+        let exe = d.path().join(format!("{name}_dump"));
+        let cc = std::process::Command::new("cc").args(["-std=c99", "-Wall", "-Werror", "-I"]).arg(&data).arg("-o").arg(&exe).arg(&c).output().unwrap();
+        assert!(cc.status.success(), "{name}.h: {}", String::from_utf8_lossy(&cc.stderr));
+        let out = String::from_utf8(std::process::Command::new(&exe).output().unwrap().stdout).unwrap();
+        assert_eq!(out.trim_end(), format!("{} {w} {h} 0 1", hex(&k.levels[0])), "{name}.h");
+        if let Some(node) = &node {
+            let js = data.join(format!("{name}.js"));
+            let script = format!(
+                "import {{ {up} as t }} from {:?}; process.stdout.write(Buffer.from(t.data.buffer).toString('hex') + ` ${{t.width}} ${{t.height}} ${{t.depth}} ${{t.channels}}`);",
+                format!("file://{}", js.display())
+            );
+            let o = std::process::Command::new(node).args(["--input-type=module", "-e", &script]).output().unwrap();
+            assert!(o.status.success(), "{name}.js: {}", String::from_utf8_lossy(&o.stderr));
+            assert_eq!(String::from_utf8(o.stdout).unwrap(), format!("{} {w} {h} 0 1", hex(&k.levels[0])), "{name}.js");
+        }
+    }
+}

@@ -7,6 +7,8 @@
 //! | `ktx2-zstd` | `NAME.ktx2`     | bevy (its `dfg.ktx2` is stored so), three.js | the same with every level Zstandard-compressed (scheme 2, level [`ZSTD_LEVEL`]) |
 //! | `dds`       | `NAME.dds`      | Unity, Godot, Direct3D, DirectXTex | `DDS ` + DDS_HEADER + DDS_HEADER_DXT10, levels largest first |
 //! | `exr`       | `NAME.exr`      | Unreal, Unity, Nuke | one scanline part, channels R (G, B, A) as half or float, uncompressed |
+//! | `c`         | `NAME.h`        | C/C++ engines, tools | `NAME_DATA`: level 0's texels as `uint16_t` (16F bit patterns, UNORM16), `uint8_t` or round-trip `float` literals |
+//! | `js`        | `NAME.js`       | three.js `DataTexture` | `export const NAME` with `data` a `Uint16Array` (16F bits: `HalfFloatType`), `Float32Array` or `Uint8Array` |
 //!
 //! Every format keeps the KTX2 texel bits (16F as 16F, 32F as 32F; no conversion), rows from
 //! the top (KTX2 `KTXorientation` `rd`, DDS rows, EXR increasing y, all row 0 first). A 3-D
@@ -34,10 +36,12 @@ pub enum TableFormat {
     Ktx2Zstd,
     Dds,
     Exr,
+    C,
+    Js,
 }
 
 impl TableFormat {
-    pub const ALL: [TableFormat; 4] = [TableFormat::Ktx2, TableFormat::Ktx2Zstd, TableFormat::Dds, TableFormat::Exr];
+    pub const ALL: [TableFormat; 6] = [TableFormat::Ktx2, TableFormat::Ktx2Zstd, TableFormat::Dds, TableFormat::Exr, TableFormat::C, TableFormat::Js];
 
     pub fn name(self) -> &'static str {
         match self {
@@ -45,6 +49,8 @@ impl TableFormat {
             TableFormat::Ktx2Zstd => "ktx2-zstd",
             TableFormat::Dds => "dds",
             TableFormat::Exr => "exr",
+            TableFormat::C => "c",
+            TableFormat::Js => "js",
         }
     }
 
@@ -53,6 +59,8 @@ impl TableFormat {
             TableFormat::Ktx2 | TableFormat::Ktx2Zstd => "ktx2",
             TableFormat::Dds => "dds",
             TableFormat::Exr => "exr",
+            TableFormat::C => "h",
+            TableFormat::Js => "js",
         }
     }
 }
@@ -71,7 +79,7 @@ pub fn parse_list(names: &[String]) -> Result<Vec<TableFormat>, String> {
         let f = TableFormat::ALL
             .into_iter()
             .find(|f| f.name() == n)
-            .ok_or_else(|| format!("unknown table format '{n}' (known: ktx2, ktx2-zstd, dds, exr)"))?;
+            .ok_or_else(|| format!("unknown table format '{n}' (known: ktx2, ktx2-zstd, dds, exr, c, js)"))?;
         if out.contains(&f) {
             return Err(format!("'{n}' is listed twice"));
         }
@@ -139,6 +147,78 @@ pub struct Texture {
     /// Key/value entries in file order (sorted by key), values with their NUL.
     pub kv: Vec<(String, Vec<u8>)>,
     pub levels: Vec<Vec<u8>>,
+}
+
+/// Level 0's texels as array literals: the element type of C and of JavaScript, and the values
+/// (16F as their binary16 bit patterns, 32F as round-trip decimal literals, UNORM as codes).
+fn array_elements(t: &Texture) -> (&'static str, &'static str, Vec<String>) {
+    let texel = t.texel();
+    let data = &t.levels[0];
+    match (texel.float, texel.bits) {
+        (true, 32) => ("float", "Float32Array", data.chunks_exact(4).map(|b| super::f32_literal(f32::from_le_bytes(b.try_into().unwrap()))).collect()),
+        (_, 16) => ("uint16_t", "Uint16Array", data.chunks_exact(2).map(|b| format!("0x{:04x}", u16::from_le_bytes([b[0], b[1]]))).collect()),
+        _ => ("uint8_t", "Uint8Array", data.iter().map(|b| b.to_string()).collect()),
+    }
+}
+
+/// The values 8 a line, each followed by `suffix` (C's `f` on float literals).
+fn rows(values: &[String], suffix: &str) -> String {
+    values.chunks(8).map(|c| format!("    {},\n", c.iter().map(|v| format!("{v}{suffix}")).collect::<Vec<_>>().join(", "))).collect()
+}
+
+impl Texture {
+    /// What the array files say of the texture: size, channels, format.
+    fn array_comment(&self, name: &str) -> String {
+        let t = self.texel();
+        let kind = if t.float { format!("{}-bit float", t.bits) } else { format!("{}-bit UNORM", t.bits) };
+        let size = if self.depth > 0 { format!("{}x{}x{}", self.width, self.height, self.depth) } else { format!("{}x{}", self.width, self.height) };
+        let channels = if t.channels == 1 { "1 channel".to_string() } else { format!("{} channels", t.channels) };
+        format!("{name}: {size} texels, {channels}, {kind} (VkFormat {}); row 0 first, slice after slice, the channels of a texel together", self.vk_format)
+    }
+
+    fn header_comment(&self) -> String {
+        self.value("shadefit").map(|h| String::from_utf8_lossy(h).lines().map(|l| format!("// {l}\n")).collect()).unwrap_or_default()
+    }
+
+    /// The C header: `NAME_WIDTH`, `_HEIGHT`, `_DEPTH`, `_CHANNELS` and `NAME_DATA`, level 0.
+    /// `None` for a mip chain.
+    pub fn c_header(&self, name: &str) -> Option<String> {
+        if self.levels.len() != 1 {
+            return None;
+        }
+        let up = name.to_uppercase();
+        let (ty, _, values) = array_elements(self);
+        let mut s = self.header_comment();
+        s.push_str(&format!("// {}\n", self.array_comment(name)));
+        s.push_str(&format!("#ifndef {up}_H\n#define {up}_H\n\n#include <stdint.h>\n\n"));
+        for (k, v) in [("WIDTH", self.width), ("HEIGHT", self.height), ("DEPTH", self.depth), ("CHANNELS", self.texel().channels as u32)] {
+            s.push_str(&format!("#define {up}_{k} {v}\n"));
+        }
+        s.push_str(&format!("\nstatic const {ty} {up}_DATA[{}] = {{\n{}}};\n\n#endif\n", values.len(), rows(&values, if ty == "float" { "f" } else { "" })));
+        Some(s)
+    }
+
+    /// The JavaScript module: `export const NAME = { width, height, depth, channels, vkFormat,
+    /// data }`, level 0. `None` for a mip chain.
+    pub fn js_module(&self, name: &str) -> Option<String> {
+        if self.levels.len() != 1 {
+            return None;
+        }
+        let up = name.to_uppercase();
+        let (_, array, values) = array_elements(self);
+        let mut s = self.header_comment();
+        s.push_str(&format!("// {}\n", self.array_comment(name)));
+        s.push_str(&format!(
+            "export const {up} = {{\n  width: {}, height: {}, depth: {}, channels: {}, vkFormat: {},\n  data: new {array}([\n{}  ]),\n}};\n",
+            self.width,
+            self.height,
+            self.depth,
+            self.texel().channels,
+            self.vk_format,
+            rows(&values, "")
+        ));
+        Some(s)
+    }
 }
 
 fn u32_at(b: &[u8], at: usize) -> Result<u32, String> {
@@ -338,6 +418,11 @@ pub fn files(path: &std::path::Path, ktx2: &[u8], formats: &[TableFormat]) -> Re
             TableFormat::Exr => t.exr().ok_or_else(|| {
                 format!("{}: OpenEXR holds float texels of one level; this texture is {}-bit {} with {} level(s)", path.display(), t.texel().bits, if t.texel().float { "float" } else { "UNORM" }, t.levels.len())
             })?,
+            TableFormat::C | TableFormat::Js => {
+                let name = path.file_stem().and_then(|s| s.to_str()).unwrap_or("table");
+                let text = if f == TableFormat::C { t.c_header(name) } else { t.js_module(name) };
+                text.ok_or_else(|| format!("{}: the {f} form holds one level; this texture has {}", path.display(), t.levels.len()))?.into_bytes()
+            }
         };
         out.push((path.with_extension(f.extension()), bytes));
     }
