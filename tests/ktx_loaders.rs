@@ -114,9 +114,9 @@ fn check_loader(what: &str, mut cmd: Command) {
 
 #[test]
 fn libktx_reads_every_committed_ktx2_file() {
-    let bin = root().join("target/loaders/release/libktx-check");
+    let bin = root().join("target/loaders/debug/libktx-check");
     if !bin.is_file() {
-        return skip("libktx (target/loaders/release/libktx-check)");
+        return skip("libktx (target/loaders/debug/libktx-check)");
     }
     check_loader("libktx", Command::new(bin));
 }
