@@ -26,8 +26,8 @@ fn function_names() -> Vec<String> {
         .collect()
 }
 
-#[test]
-fn naga_oil_composes_every_module_in_the_prefixed_style() {
+/// A naga_oil composer holding every emitted module under its `#define_import_path`.
+fn composer() -> Composer {
     let mut composer = Composer::default();
     for (name, src) in libraries() {
         let path = format!("wgsl/{name}.wgsl");
@@ -37,6 +37,12 @@ fn naga_oil_composes_every_module_in_the_prefixed_style() {
             panic!("{path}: {}", e.emit_to_string(&composer));
         }
     }
+    composer
+}
+
+#[test]
+fn naga_oil_composes_every_module_in_the_prefixed_style() {
+    let mut composer = composer();
     let shader = every_function(&libraries(), Style::Prefixed);
     let module = composer
         .make_naga_module(NagaModuleDescriptor { source: &shader, file_path: "every_function.wgsl", ..Default::default() })
@@ -68,11 +74,7 @@ fn the_runtime_composer_resolves_the_same_shader() {
 fn the_bevy_energy_recipe_composes() {
     // docs/recipes/bevy_energy.wgsl (README "Engine recipes": bevy): a user's shader importing four
     // emitted modules by naga_oil path and calling them prefixed, as a bevy material would.
-    let mut composer = Composer::default();
-    for (name, src) in libraries() {
-        let path = format!("wgsl/{name}.wgsl");
-        composer.add_composable_module(ComposableModuleDescriptor { source: src, file_path: &path, ..Default::default() }).unwrap();
-    }
+    let mut composer = composer();
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/recipes/bevy_energy.wgsl");
     let shader = std::fs::read_to_string(path).unwrap();
     let module = composer

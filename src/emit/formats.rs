@@ -176,20 +176,21 @@ impl Texture {
         format!("{name}: {size} texels, {channels}, {kind} (VkFormat {}); row 0 first, slice after slice, the channels of a texel together", self.vk_format)
     }
 
-    fn header_comment(&self) -> String {
-        self.value("shadefit").map(|h| String::from_utf8_lossy(h).lines().map(|l| format!("// {l}\n")).collect()).unwrap_or_default()
+    /// What the array forms share, for a one-level texture: the name in capitals, the elements
+    /// ([`array_elements`]) and the comment lines (the generated-file header, the layout).
+    fn array_parts(&self, name: &str) -> Option<(String, (&'static str, &'static str, Vec<String>), String)> {
+        if self.levels.len() != 1 {
+            return None;
+        }
+        let mut preamble: String = self.value("shadefit").map(|h| String::from_utf8_lossy(h).lines().map(|l| format!("// {l}\n")).collect()).unwrap_or_default();
+        preamble.push_str(&format!("// {}\n", self.array_comment(name)));
+        Some((name.to_uppercase(), array_elements(self), preamble))
     }
 
     /// The C header: `NAME_WIDTH`, `_HEIGHT`, `_DEPTH`, `_CHANNELS` and `NAME_DATA`, level 0.
     /// `None` for a mip chain.
     pub fn c_header(&self, name: &str) -> Option<String> {
-        if self.levels.len() != 1 {
-            return None;
-        }
-        let up = name.to_uppercase();
-        let (ty, _, values) = array_elements(self);
-        let mut s = self.header_comment();
-        s.push_str(&format!("// {}\n", self.array_comment(name)));
+        let (up, (ty, _, values), mut s) = self.array_parts(name)?;
         s.push_str(&format!("#ifndef {up}_H\n#define {up}_H\n\n#include <stdint.h>\n\n"));
         for (k, v) in [("WIDTH", self.width), ("HEIGHT", self.height), ("DEPTH", self.depth), ("CHANNELS", self.texel().channels as u32)] {
             s.push_str(&format!("#define {up}_{k} {v}\n"));
@@ -201,13 +202,7 @@ impl Texture {
     /// The JavaScript module: `export const NAME = { width, height, depth, channels, vkFormat,
     /// data }`, level 0. `None` for a mip chain.
     pub fn js_module(&self, name: &str) -> Option<String> {
-        if self.levels.len() != 1 {
-            return None;
-        }
-        let up = name.to_uppercase();
-        let (_, array, values) = array_elements(self);
-        let mut s = self.header_comment();
-        s.push_str(&format!("// {}\n", self.array_comment(name)));
+        let (up, (_, array, values), mut s) = self.array_parts(name)?;
         s.push_str(&format!(
             "export const {up} = {{\n  width: {}, height: {}, depth: {}, channels: {}, vkFormat: {},\n  data: new {array}([\n{}  ]),\n}};\n",
             self.width,
