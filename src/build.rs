@@ -131,7 +131,7 @@ pub fn spec_targets(s: &Spec) -> Result<Vec<Target>, SpecError> {
         .map_err(|why| SpecError::new(&s.path, spec::line_of(&s.text, "targets"), "targets", why))
 }
 
-/// `[emit] formats` checked before anything is built: known names, one KTX2 form, and a spec
+/// `[emit] formats` checked before anything is built: known names, each once, and a spec
 /// that writes a texture (a fit, a two-stage fit or a `form = "const"` table writes none; a
 /// family kind without textures refuses the key when it parses).
 pub fn spec_formats(s: &Spec) -> Result<(), SpecError> {

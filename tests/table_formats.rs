@@ -1,14 +1,14 @@
 //! The table textures in every format their specs ask for (`[emit] formats`, `emit::formats`):
 //! - every committed `generated/data/NAME.ktx2` has exactly the DDS and EXR siblings its spec
-//!   names (by default both, EXR only for float texels of one level), and a `ktx2-zstd` spec's
-//!   KTX2 is Zstandard-supercompressed;
+//!   names (by default both, EXR only for float texels of one level), is itself uncompressed,
+//!   and a `ktx2-zstd` spec's `NAME.zstd.ktx2` is the same texture Zstandard-supercompressed;
 //! - each DDS file, read by the `ddsfile` crate, has the KTX2's size, depth, level count, the
 //!   `DXGI_FORMAT` of its `VkFormat` (the table below, from the Vulkan and DXGI enumerations) and,
 //!   level after level, the same texel bytes as the KTX2 read by the `ktx2` crate (inflated by
 //!   `ruzstd` where supercompressed). No tolerance: the bytes are the texels, which each family's
 //!   tests compare with its JSON values. (The EXR files are read by OpenEXR's own library in
 //!   tests/python/test_table_formats.py.)
-//! - the bevy-layout spec's file has the header fields and DFD of bevy's `dfg.ktx2`
+//! - the bevy-layout spec's zstd file has the header fields and DFD of bevy's `dfg.ktx2`
 //!   (tests/data/bevy) and texels close to bevy's;
 //! - a bad `formats` list is a spec error naming the file, line and field, with nothing written.
 
@@ -93,7 +93,7 @@ fn every_texture_has_the_files_its_spec_names_and_the_dds_holds_the_ktx2_texels(
     for e in std::fs::read_dir(&data).unwrap() {
         names.insert(e.unwrap().file_name().to_string_lossy().into_owned());
     }
-    for file in names.iter().filter(|n| n.ends_with(".ktx2")) {
+    for file in names.iter().filter(|n| n.ends_with(".ktx2") && !n.ends_with(".zstd.ktx2")) {
         let stem = file.strip_suffix(".ktx2").unwrap();
         let k = read_ktx2(&std::fs::read(data.join(file)).unwrap());
         let (spec, listed) = spec_formats(stem);
@@ -104,8 +104,14 @@ fn every_texture_has_the_files_its_spec_names_and_the_dds_holds_the_ktx2_texels(
             }
             f
         });
-        let zstd = formats.iter().any(|f| f == "ktx2-zstd");
-        assert_eq!(k.header.supercompression_scheme.is_some(), zstd, "{file} ({spec}): supercompression");
+        assert!(k.header.supercompression_scheme.is_none(), "{file} ({spec}): the KTX2 the runtime reads is uncompressed");
+        if formats.iter().any(|f| f == "ktx2-zstd") {
+            let z = read_ktx2(&std::fs::read(data.join(format!("{stem}.zstd.ktx2"))).expect("the zstd KTX2 asked for"));
+            assert_eq!(z.header.supercompression_scheme, Some(ktx2::SupercompressionScheme::Zstandard), "{stem}.zstd.ktx2");
+            assert!(z.levels == k.levels, "{stem}.zstd.ktx2 inflates to other texels than {file}");
+        } else {
+            assert!(!names.contains(&format!("{stem}.zstd.ktx2")), "{stem}.zstd.ktx2 not asked for");
+        }
         for (ext, want) in [("dds", formats.iter().any(|f| f == "dds")), ("exr", formats.iter().any(|f| f == "exr"))] {
             assert_eq!(names.contains(&format!("{stem}.{ext}")), want, "{file} ({spec}): {stem}.{ext} {}", if want { "missing" } else { "not asked for" });
         }
@@ -124,9 +130,9 @@ fn every_texture_has_the_files_its_spec_names_and_the_dds_holds_the_ktx2_texels(
         textures += 1;
     }
     assert!(textures >= 20, "the committed tables: {textures} KTX2 files");
-    // No DDS or EXR without its KTX2.
-    for n in names.iter().filter(|n| n.ends_with(".dds") || n.ends_with(".exr")) {
-        let stem = n.rsplit_once('.').unwrap().0;
+    // No DDS, EXR or zstd KTX2 without its KTX2.
+    for n in names.iter().filter(|n| n.ends_with(".dds") || n.ends_with(".exr") || n.ends_with(".zstd.ktx2")) {
+        let stem = n.strip_suffix(".zstd.ktx2").unwrap_or_else(|| n.rsplit_once('.').unwrap().0);
         assert!(names.contains(&format!("{stem}.ktx2")), "{n} has no KTX2 beside it");
     }
 }
@@ -141,7 +147,7 @@ fn dfd(bytes: &[u8]) -> &[u8] {
 
 #[test]
 fn the_bevy_layout_lut_has_bevys_header_and_close_texels() {
-    let ours_bytes = std::fs::read(root().join("generated/data/ggx_dfg_lut_bevy.ktx2")).unwrap();
+    let ours_bytes = std::fs::read(root().join("generated/data/ggx_dfg_lut_bevy.zstd.ktx2")).unwrap();
     let bevy_bytes = std::fs::read(root().join("tests/data/bevy/dfg.ktx2")).unwrap();
     let (ours, bevy) = (read_ktx2(&ours_bytes), read_ktx2(&bevy_bytes));
     let fields = |h: &ktx2::Header| {
@@ -181,9 +187,9 @@ fn set_formats(d: &Path, spec: &str, line: &str) -> String {
 
 #[test]
 fn a_formats_list_picks_the_files_and_bad_lists_are_bad_input() {
-    // `gloss_table` (a one-channel R32F table): only the KTX2 and the EXR.
+    // `gloss_table` (a one-channel R32F table): the KTX2 (always) and the EXR.
     let d = scratch();
-    set_formats(d.path(), "gloss_table", "formats = [\"exr\", \"ktx2\"]");
+    set_formats(d.path(), "gloss_table", "formats = [\"exr\"]");
     let o = shadefit(&["build", "--only", "gloss_table"], Some(d.path()));
     assert!(o.status.success(), "{}", stderr(&o));
     let g = d.path().join("generated/data");
@@ -193,9 +199,8 @@ fn a_formats_list_picks_the_files_and_bad_lists_are_bad_input() {
     assert!(o.status.success(), "{}", stderr(&o));
 
     for (spec, line, why) in [
-        ("gloss_table", "formats = [\"dds\"]", "no KTX2 form"),
         ("gloss_table", "formats = [\"ktx2\", \"png\"]", "unknown table format 'png'"),
-        ("gloss_table", "formats = [\"ktx2\", \"ktx2-zstd\"]", "same file"),
+        ("gloss_table", "formats = [\"dds\", \"exr\", \"dds\"]", "listed twice"),
         // A fit writes no texture.
         ("gloss_length", "formats = [\"ktx2\"]", "writes no texture"),
     ] {

@@ -8,7 +8,7 @@
 //! bound somewhere, on every axis. Inputs cover the domain and 10 % beyond each end (the clamps)
 //! and NaN. With no adapter the test is skipped, unless `CI` is set.
 
-use shadefit_runtime::{compose, ggx_cone_lut as cone, ggx_dfg_lut as sb, ggx_dfg_lut_filament as fil, gpu, skin};
+use shadefit_runtime::{compose, ggx_cone_lut as cone, ggx_dfg_lut as sb, ggx_dfg_lut_bevy as bevy, ggx_dfg_lut_filament as fil, gpu, skin};
 use wgpu::util::DeviceExt;
 
 #[path = "support/harness.rs"]
@@ -57,6 +57,16 @@ fn luts() -> Vec<Lut> {
             cpu_sample: |p| fil::ggx_dfg_filament(p[0], p[1]),
             cpu_specular: |p| fil::ggx_dfg_filament_specular(F0, p[0], p[1]),
             difference: true,
+        },
+        Lut {
+            module: "ggx_dfg_lut_bevy",
+            function: "ggx_dfg_bevy",
+            uv: "ggx_dfg_bevy_uv",
+            ktx2: bevy::GGX_DFG_LUT_BEVY_KTX2,
+            cpu_uv: |p| bevy::ggx_dfg_bevy_uv(p[0], p[1]).to_vec(),
+            cpu_sample: |p| bevy::ggx_dfg_bevy(p[0], p[1]),
+            cpu_specular: |p| bevy::ggx_dfg_bevy_specular(F0, p[0], p[1]),
+            difference: false,
         },
         Lut {
             module: "ggx_cone_lut",

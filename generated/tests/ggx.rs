@@ -1,11 +1,15 @@
 //! The DFG LUT modules: the CPU lookups read the KTX2 texels they ship (f16, exact) and hit them
 //! at the texel centres, clamp beyond the outer centres, and decode both layouts to (scale, bias).
 
-use shadefit_runtime::{ggx_dfg_lut as sb, ggx_dfg_lut_filament as fil, skin};
+use shadefit_runtime::{ggx_dfg_lut as sb, ggx_dfg_lut_bevy as bevy, ggx_dfg_lut_filament as fil, skin};
 
 #[test]
 fn ktx2_headers_name_rg16f_and_the_size() {
-    for (bytes, size) in [(sb::GGX_DFG_LUT_KTX2, sb::GGX_DFG_LUT_SIZE), (fil::GGX_DFG_LUT_FILAMENT_KTX2, fil::GGX_DFG_LUT_FILAMENT_SIZE)] {
+    for (bytes, size) in [
+        (sb::GGX_DFG_LUT_KTX2, sb::GGX_DFG_LUT_SIZE),
+        (fil::GGX_DFG_LUT_FILAMENT_KTX2, fil::GGX_DFG_LUT_FILAMENT_SIZE),
+        (bevy::GGX_DFG_LUT_BEVY_KTX2, bevy::GGX_DFG_LUT_BEVY_SIZE),
+    ] {
         let u32_at = |k: usize| u32::from_le_bytes(bytes[k..k + 4].try_into().unwrap());
         assert_eq!(&bytes[1..4], b"KTX");
         assert_eq!(u32_at(12), 83, "VK_FORMAT_R16G16_SFLOAT");
@@ -20,6 +24,7 @@ fn the_runtime_ktx2_reader_gives_the_emitted_texels() {
     for (bytes, [w, h], texel) in [
         (sb::GGX_DFG_LUT_KTX2, sb::GGX_DFG_LUT_SIZE, sb::ggx_dfg_texel as fn(u32, u32) -> [f32; 2]),
         (fil::GGX_DFG_LUT_FILAMENT_KTX2, fil::GGX_DFG_LUT_FILAMENT_SIZE, fil::ggx_dfg_filament_texel),
+        (bevy::GGX_DFG_LUT_BEVY_KTX2, bevy::GGX_DFG_LUT_BEVY_SIZE, bevy::ggx_dfg_bevy_texel),
     ] {
         let img = skin::Ktx2Image::parse(bytes).expect("an RG16F KTX2");
         assert_eq!((img.width, img.height, img.depth, img.format), (w, h, 0, skin::LutFormat::Rg16Float));
@@ -57,8 +62,10 @@ fn both_layouts_decode_to_the_same_scale_and_bias() {
     for &(u, r) in &[(0.3f32, 0.4f32), (0.7, 0.2), (0.95, 0.9), (0.5, 0.6)] {
         let a = sb::ggx_dfg_scale_bias(u, r);
         let b = fil::ggx_dfg_filament_scale_bias(u, r);
-        for c in 0..2 {
-            assert!((a[c] - b[c]).abs() < 3e-3, "({u}, {r}): {a:?} vs {b:?}");
+        // bevy's layout is the 64² table in the scale-bias layout: the same bound.
+        let c = bevy::ggx_dfg_bevy_scale_bias(u, r);
+        for k in 0..2 {
+            assert!((a[k] - b[k]).abs() < 3e-3 && (a[k] - c[k]).abs() < 3e-3, "({u}, {r}): {a:?} vs {b:?}, {c:?}");
         }
     }
 }

@@ -3,8 +3,8 @@
 //!
 //! | format      | file            | for | layout |
 //! |-------------|-----------------|-----|--------|
-//! | `ktx2`      | `NAME.ktx2`     | wgpu, bevy, three.js (KTX2Loader), Vulkan | as written, no supercompression |
-//! | `ktx2-zstd` | `NAME.ktx2`     | bevy (its `dfg.ktx2` is stored so), three.js | the same with every level Zstandard-compressed (scheme 2, level [`ZSTD_LEVEL`]) |
+//! | `ktx2`      | `NAME.ktx2`     | wgpu, bevy, three.js (KTX2Loader), Vulkan | as written, no supercompression; always written |
+//! | `ktx2-zstd` | `NAME.zstd.ktx2` | bevy (its `dfg.ktx2` is stored so), three.js | the same with every level Zstandard-compressed (scheme 2, level [`ZSTD_LEVEL`]) |
 //! | `dds`       | `NAME.dds`      | Unity, Godot, Direct3D, DirectXTex | `DDS ` + DDS_HEADER + DDS_HEADER_DXT10, levels largest first |
 //! | `exr`       | `NAME.exr`      | Unreal, Unity, Nuke | one scanline part, channels R (G, B, A) as half or float, uncompressed |
 //! | `c`         | `NAME.h`        | C/C++ engines, tools | `NAME_DATA`: level 0's texels as `uint16_t` (16F bit patterns, UNORM16), `uint8_t` or round-trip `float` literals |
@@ -56,7 +56,8 @@ impl TableFormat {
 
     pub fn extension(self) -> &'static str {
         match self {
-            TableFormat::Ktx2 | TableFormat::Ktx2Zstd => "ktx2",
+            TableFormat::Ktx2 => "ktx2",
+            TableFormat::Ktx2Zstd => "zstd.ktx2",
             TableFormat::Dds => "dds",
             TableFormat::Exr => "exr",
             TableFormat::C => "h",
@@ -71,28 +72,27 @@ impl fmt::Display for TableFormat {
     }
 }
 
-/// `[emit] formats` parsed: each name once, exactly one KTX2 form (the runtime crate and the
-/// WGSL accessors read `NAME.ktx2`, so it is always written).
+/// `[emit] formats` parsed: each name once, in file order, `ktx2` first whether listed or not
+/// (the WGSL accessors, the Rust modules and the runtime crate read the uncompressed
+/// `NAME.ktx2`, so it is always written).
 pub fn parse_list(names: &[String]) -> Result<Vec<TableFormat>, String> {
-    let mut out = Vec::new();
+    let mut out = vec![TableFormat::Ktx2];
+    let mut seen = Vec::new();
     for n in names {
         let f = TableFormat::ALL
             .into_iter()
             .find(|f| f.name() == n)
             .ok_or_else(|| format!("unknown table format '{n}' (known: ktx2, ktx2-zstd, dds, exr, c, js)"))?;
-        if out.contains(&f) {
+        if seen.contains(&f) {
             return Err(format!("'{n}' is listed twice"));
         }
-        out.push(f);
-    }
-    match out.iter().filter(|f| f.extension() == "ktx2").count() {
-        0 => Err("lists no KTX2 form: the WGSL accessors and the runtime crate read NAME.ktx2, so add \"ktx2\" or \"ktx2-zstd\"".into()),
-        1 => {
-            out.sort();
-            Ok(out)
+        seen.push(f);
+        if f != TableFormat::Ktx2 {
+            out.push(f);
         }
-        _ => Err("lists both \"ktx2\" and \"ktx2-zstd\", which are the same file NAME.ktx2".into()),
     }
+    out.sort();
+    Ok(out)
 }
 
 /// The formats of a texture when its spec names none: KTX2, DDS, and EXR when the texels are
@@ -400,8 +400,8 @@ impl Texture {
     }
 }
 
-/// The files of one KTX2 texture `path` (`data/NAME.ktx2`) in `formats` (the KTX2 form
-/// replaces the file in place); `Err` names a format the texture cannot take.
+/// The files of one KTX2 texture `path` (`data/NAME.ktx2`) in `formats` (`ktx2`: the file as
+/// given); `Err` names a format the texture cannot take.
 pub fn files(path: &std::path::Path, ktx2: &[u8], formats: &[TableFormat]) -> Result<Vec<(std::path::PathBuf, Vec<u8>)>, String> {
     let t = Texture::parse(ktx2).map_err(|e| format!("{}: {e}", path.display()))?;
     let mut out = Vec::new();
@@ -465,8 +465,8 @@ mod tests {
     fn format_lists_need_one_ktx2_form_and_known_names() {
         let p = |v: &[&str]| parse_list(&v.iter().map(|s| s.to_string()).collect::<Vec<_>>());
         assert_eq!(p(&["exr", "ktx2"]).unwrap(), [TableFormat::Ktx2, TableFormat::Exr]);
-        assert!(p(&["dds"]).unwrap_err().contains("no KTX2 form"));
-        assert!(p(&["ktx2", "ktx2-zstd"]).unwrap_err().contains("same file"));
+        // The uncompressed KTX2 is written whether listed or not.
+        assert_eq!(p(&["ktx2-zstd", "dds"]).unwrap(), [TableFormat::Ktx2, TableFormat::Ktx2Zstd, TableFormat::Dds]);
         assert!(p(&["ktx2", "png"]).unwrap_err().contains("unknown table format 'png'"));
         assert!(p(&["ktx2", "ktx2"]).unwrap_err().contains("twice"));
     }

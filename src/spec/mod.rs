@@ -34,8 +34,8 @@
 //! function = "my_function"
 //! args = ["x"]                     # optional: argument names (default: the axis names)
 //! targets = ["hlsl", "spirv"]      # optional: more outputs than the WGSL module (emit::targets)
-//! formats = ["ktx2", "dds"]        # specs with a texture: its files (emit::formats; default
-//!                                  # ktx2, dds and exr for float texels)
+//! formats = ["dds", "exr"]         # specs with a texture: its files besides NAME.ktx2
+//!                                  # (emit::formats; default dds, and exr for float texels)
 //! ```
 
 pub mod data;
@@ -593,7 +593,8 @@ pub struct EmitSection {
     /// "glsl", "glsl-es", "msl", "spirv", "c", "wesl"; `build` checks them); `build --target` adds to them.
     pub targets: Option<Vec<String>>,
     /// Specs that write a texture (`data/NAME.ktx2`): its file formats (`emit::formats`
-    /// names: "ktx2", "ktx2-zstd", "dds", "exr"; default KTX2, DDS and, for float texels, EXR).
+    /// names: "ktx2", "ktx2-zstd", "dds", "exr", "c", "js"; NAME.ktx2 always; default DDS and,
+    /// for float texels, EXR besides).
     pub formats: Option<Vec<String>>,
     /// kind = "table": the WGSL forms of the table (default `const`).
     pub form: Option<TableForm>,

@@ -78,8 +78,9 @@ def test_bevy_dfg_lut_texels():
     from test_ggx import ROUNDING, reference_env
 
     g = json.loads((DATA.parent / "json" / "ggx_dfg_lut_bevy.json").read_text())
-    vk, w, h, d, data = ktx2_level0(DATA / "ggx_dfg_lut_bevy.ktx2")
+    vk, w, h, d, data = ktx2_level0(DATA / "ggx_dfg_lut_bevy.zstd.ktx2")
     assert (vk, w, h, d) == (83, 64, 64, 0)
+    assert ktx2_level0(DATA / "ggx_dfg_lut_bevy.ktx2")[4] == data, "the uncompressed KTX2 holds the same texels"
     values = np.array(g["values"], dtype=np.float64)
     texels = np.frombuffer(data, dtype="<f2").reshape(h * w, 2)
     assert np.array_equal(texels.view(np.uint16), values.astype(np.float32).astype(np.float16).view(np.uint16))
