@@ -72,7 +72,7 @@ impl fmt::Display for TableFormat {
     }
 }
 
-/// `[emit] formats` parsed: each name once, in file order, `ktx2` first whether listed or not
+/// `[emit] formats` parsed: each name once, in [`TableFormat`] order, `ktx2` whether listed or not
 /// (the WGSL accessors, the Rust modules and the runtime crate read the uncompressed
 /// `NAME.ktx2`, so it is always written).
 pub fn parse_list(names: &[String]) -> Result<Vec<TableFormat>, String> {
@@ -96,10 +96,10 @@ pub fn parse_list(names: &[String]) -> Result<Vec<TableFormat>, String> {
 }
 
 /// The formats of a texture when its spec names none: KTX2, DDS, and EXR when the texels are
-/// floats.
+/// floats of one level.
 pub fn default_formats(texture: &Texture) -> Vec<TableFormat> {
     let mut f = vec![TableFormat::Ktx2, TableFormat::Dds];
-    if texture.texel().float {
+    if texture.texel().float && texture.levels.len() == 1 {
         f.push(TableFormat::Exr);
     }
     f
