@@ -144,7 +144,7 @@ pub fn spec_formats(s: &Spec) -> Result<(), SpecError> {
         spec::Kind::Custom(_) => true,
     };
     if !texture {
-        return Err(bad("this spec writes no texture (data/NAME.ktx2) to write in other formats".into()));
+        return Err(bad(emit::formats::NO_TEXTURE.into()));
     }
     Ok(())
 }

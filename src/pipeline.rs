@@ -175,7 +175,7 @@ pub fn build_spec(spec: &Spec, mode: Mode, root: &Path, custom: &dyn Fn(&str) ->
 }
 
 /// Every texture a spec writes (`data/NAME.ktx2`) in the formats of its `[emit] formats`
-/// ([`emit::formats`]; by default KTX2, DDS and, for float texels, EXR), in place of the KTX2.
+/// ([`emit::formats`]; by default the KTX2, DDS and, for float texels, EXR).
 fn texture_files(spec: &Spec, artifacts: Vec<Artifact>) -> Result<Vec<Artifact>, BuildError> {
     let bad = |why: String| spec::SpecError::new(&spec.path, spec::line_of(&spec.text, "formats"), "formats", why);
     let listed = spec.file.emit.formats.as_deref().map(emit::formats::parse_list).transpose().map_err(bad)?;
@@ -187,15 +187,11 @@ fn texture_files(spec: &Spec, artifacts: Vec<Artifact>) -> Result<Vec<Artifact>,
             continue;
         }
         textures += 1;
-        let formats = match &listed {
-            Some(l) => l.clone(),
-            None => emit::formats::default_formats(&emit::formats::Texture::parse(&a.contents).map_err(|e| bad(format!("{}: {e}", a.path.display())))?),
-        };
-        let files = emit::formats::files(&a.path, &a.contents, &formats).map_err(bad)?;
+        let files = emit::formats::files(&a.path, &a.contents, listed.as_deref()).map_err(bad)?;
         out.extend(files.into_iter().map(|(path, contents)| Artifact { path, contents }));
     }
     if listed.is_some() && textures == 0 {
-        return Err(bad("this spec writes no texture (data/NAME.ktx2) to write in other formats".into()).into());
+        return Err(bad(emit::formats::NO_TEXTURE.into()).into());
     }
     Ok(out)
 }

@@ -47,19 +47,7 @@ struct Ktx2 {
 fn read_ktx2(bytes: &[u8]) -> Ktx2 {
     let r = ktx2::Reader::new(bytes).expect("a valid KTX2 file");
     let header = r.header();
-    let levels = r
-        .levels()
-        .map(|l| match header.supercompression_scheme {
-            None => l.data.to_vec(),
-            Some(ktx2::SupercompressionScheme::Zstandard) => {
-                let mut out = Vec::with_capacity(l.uncompressed_byte_length as usize);
-                ruzstd::decoding::FrameDecoder::new().decode_all_to_vec(l.data, &mut out).expect("the level inflates");
-                assert_eq!(out.len() as u64, l.uncompressed_byte_length);
-                out
-            }
-            Some(s) => panic!("supercompression {s:?}"),
-        })
-        .collect();
+    let levels = r.levels().map(|l| common::ktx2_level_bytes("KTX2", header.supercompression_scheme, &l)).collect();
     // KHR_DF_SAMPLE_DATATYPE_FLOAT (0x80) in the first sample's channel byte.
     let float = r.basic_dfd().expect("a basic DFD").sample_information[0].channel_type_qualifiers.contains(ktx2::dfd::ChannelTypeQualifiers::FLOAT);
     Ktx2 { header, float, levels }

@@ -40,16 +40,22 @@ fn composer() -> Composer {
     composer
 }
 
-#[test]
-fn naga_oil_composes_every_module_in_the_prefixed_style() {
+/// `shader` composed against every emitted module by naga_oil, then validated by naga.
+fn compose_and_validate(shader: &str, file_path: &str) -> naga::Module {
     let mut composer = composer();
-    let shader = every_function(&libraries(), Style::Prefixed);
     let module = composer
-        .make_naga_module(NagaModuleDescriptor { source: &shader, file_path: "every_function.wgsl", ..Default::default() })
+        .make_naga_module(NagaModuleDescriptor { source: shader, file_path, ..Default::default() })
         .unwrap_or_else(|e| panic!("{}\n{shader}", e.emit_to_string(&composer)));
     naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::default())
         .validate(&module)
         .unwrap_or_else(|e| panic!("{e:?}"));
+    module
+}
+
+#[test]
+fn naga_oil_composes_every_module_in_the_prefixed_style() {
+    let shader = every_function(&libraries(), Style::Prefixed);
+    let module = compose_and_validate(&shader, "every_function.wgsl");
     // naga_oil keeps what the entry point uses (and renames it): every function is there.
     assert_eq!(module.entry_points.len(), 1);
     // naga_oil names an imported item NAME followed by its module's encoded path.
@@ -74,14 +80,7 @@ fn the_runtime_composer_resolves_the_same_shader() {
 fn the_bevy_energy_recipe_composes() {
     // docs/recipes/bevy_energy.wgsl (README "Engine recipes": bevy): a user's shader importing four
     // emitted modules by naga_oil path and calling them prefixed, as a bevy material would.
-    let mut composer = composer();
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/recipes/bevy_energy.wgsl");
-    let shader = std::fs::read_to_string(path).unwrap();
-    let module = composer
-        .make_naga_module(NagaModuleDescriptor { source: &shader, file_path: "bevy_energy.wgsl", ..Default::default() })
-        .unwrap_or_else(|e| panic!("{}", e.emit_to_string(&composer)));
-    naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::default())
-        .validate(&module)
-        .unwrap_or_else(|e| panic!("{e:?}"));
+    let module = compose_and_validate(&std::fs::read_to_string(path).unwrap(), "bevy_energy.wgsl");
     assert_eq!(module.entry_points.iter().map(|e| e.name.as_str()).collect::<Vec<_>>(), ["energy_fs"]);
 }

@@ -400,10 +400,22 @@ impl Texture {
     }
 }
 
-/// The files of one KTX2 texture `path` (`data/NAME.ktx2`) in `formats` (`ktx2`: the file as
-/// given); `Err` names a format the texture cannot take.
-pub fn files(path: &std::path::Path, ktx2: &[u8], formats: &[TableFormat]) -> Result<Vec<(std::path::PathBuf, Vec<u8>)>, String> {
+/// Why a `formats` list is refused on a spec that writes no texture.
+pub const NO_TEXTURE: &str = "this spec writes no texture (data/NAME.ktx2) to write in other formats";
+
+/// The files of one KTX2 texture `path` (`data/NAME.ktx2`) in `formats`, or in its
+/// [`default_formats`] for `None` (`ktx2`: the file as given); `Err` names a format the texture
+/// cannot take.
+pub fn files(path: &std::path::Path, ktx2: &[u8], formats: Option<&[TableFormat]>) -> Result<Vec<(std::path::PathBuf, Vec<u8>)>, String> {
     let t = Texture::parse(ktx2).map_err(|e| format!("{}: {e}", path.display()))?;
+    let defaults;
+    let formats = match formats {
+        Some(f) => f,
+        None => {
+            defaults = default_formats(&t);
+            &defaults
+        }
+    };
     let mut out = Vec::new();
     for &f in formats {
         let bytes = match f {
@@ -474,7 +486,7 @@ mod tests {
     #[test]
     fn unorm_mips_have_no_exr_and_a_volume_is_a_dx10_texture3d() {
         let mips = ktx2_unorm_mips(&[UnormLevel { width: 1, height: 1, values: vec![0.0; 2] }], 2, 8, &[]);
-        assert!(files("data/x.ktx2".as_ref(), &mips, &[TableFormat::Ktx2, TableFormat::Exr]).unwrap_err().contains("UNORM"));
+        assert!(files("data/x.ktx2".as_ref(), &mips, Some(&[TableFormat::Ktx2, TableFormat::Exr])).unwrap_err().contains("UNORM"));
         let vol = ktx2_volume(2, 2, 3, 1, &[0.5; 12], TextureFormat::Rgba32float, &[]);
         let dds = Texture::parse(&vol).unwrap().dds();
         // DDS_HEADER_DXT10 starts at 4 + 124: resource dimension 4 (TEXTURE3D); dwDepth at 4 + 20.

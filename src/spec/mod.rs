@@ -409,10 +409,9 @@ impl CustomSpec<'_> {
     /// `formats` are taken from the text as they are for every spec (the family's checker
     /// accepts the keys and leaves them to the common one; `build` checks the names).
     pub fn spec_file(self, path: &Path, text: &str) -> Result<SpecFile, SpecError> {
+        let toml = toml::from_str::<toml::Value>(text).ok();
         let list = |key: &str| {
-            toml::from_str::<toml::Value>(text).ok().and_then(|v| {
-                v.get("emit")?.get(key)?.as_array()?.iter().map(|t| t.as_str().map(String::from)).collect::<Option<Vec<String>>>()
-            })
+            toml.as_ref()?.get("emit")?.get(key)?.as_array()?.iter().map(|t| t.as_str().map(String::from)).collect::<Option<Vec<String>>>()
         };
         let (targets, formats) = (list("targets"), list("formats"));
         let v = serde_json::json!({

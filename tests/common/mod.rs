@@ -117,3 +117,24 @@ pub fn committed_modules() -> Vec<(String, String)> {
     assert!(out.len() >= 20, "the committed modules ({})", out.len());
     out
 }
+
+/// A KTX2 level's texel bytes as the `ktx2` crate gives them, Zstandard levels inflated by
+/// `ruzstd` (frames back to back: a level may hold more than one); the level index's
+/// uncompressedByteLength checked for either scheme.
+pub fn ktx2_level_bytes(name: &str, scheme: Option<ktx2::SupercompressionScheme>, level: &ktx2::Level) -> Vec<u8> {
+    use std::io::Read;
+    let data = match scheme {
+        None => level.data.to_vec(),
+        Some(ktx2::SupercompressionScheme::Zstandard) => {
+            let (mut src, mut out) = (level.data, Vec::new());
+            while !src.is_empty() {
+                let mut frame = ruzstd::decoding::StreamingDecoder::new(&mut src).expect("a zstd frame header");
+                frame.read_to_end(&mut out).expect("a whole zstd frame");
+            }
+            out
+        }
+        Some(s) => panic!("{name}: supercompression {s:?} is neither none nor zstd"),
+    };
+    assert_eq!(data.len() as u64, level.uncompressed_byte_length, "{name}: uncompressedByteLength");
+    data
+}
