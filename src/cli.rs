@@ -553,8 +553,26 @@ fn selected_families(names: &[String]) -> Result<Vec<&'static family::Family>> {
 /// `shadefit validate [--family A,B] [--only SPEC,…] [--json]`: the families' published
 /// constants and the form specs of `fits/` measured. With neither option, every family and
 /// every form spec; with either, only what they name.
-pub fn validate(paths: &Paths, families: &[String], only: &[String], as_json: bool) -> Result<()> {
+pub fn validate(paths: &Paths, families: &[String], only: &[String], as_json: bool, no_cache: bool) -> Result<()> {
+    use crate::validate::cache;
     let everything = families.is_empty() && only.is_empty();
+    // Each section (a family's items, a form spec's item) is read from the cache when the
+    // executable and the inputs are those it was computed from (`validate::cache`).
+    let cached = cache::dir().and_then(|d| Some((cache::base(&paths.fits, &paths.generated)?, d)));
+    let (mut hits, mut sections) = (0usize, 0usize);
+    let mut section = |name: String, compute: &mut dyn FnMut() -> Result<Vec<crate::validate::Item>>| -> Result<Vec<crate::validate::Item>> {
+        sections += 1;
+        if let Some((base, dir)) = &cached {
+            if !no_cache && let Some(items) = cache::read(dir, base, &name) {
+                hits += 1;
+                return Ok(items);
+            }
+            let items = compute()?;
+            cache::write(dir, base, &name, &items);
+            return Ok(items);
+        }
+        compute()
+    };
     let selected = if everything || !families.is_empty() { selected_families(families)? } else { vec![] };
     // One step per family and per form spec, drawn on a terminal only (indicatif hides itself
     // on a pipe, so `--json` and CI output stay clean).
@@ -562,7 +580,7 @@ pub fn validate(paths: &Paths, families: &[String], only: &[String], as_json: bo
     let mut items = Vec::new();
     for f in &selected {
         pb.set_message(format!("validate {}", f.name));
-        items.extend(crate::validate::all(&paths.generated, &[f.validate]));
+        items.extend(section(format!("family:{}", f.name), &mut || Ok(crate::validate::all(&paths.generated, &[f.validate])))?);
         pb.inc(1);
     }
     let forms: Vec<Spec> = if everything && !paths.fits.is_dir() {
@@ -581,10 +599,13 @@ pub fn validate(paths: &Paths, families: &[String], only: &[String], as_json: bo
     pb.set_length((selected.len() + forms.len()) as u64);
     for s in &forms {
         pb.set_message(format!("validate {}", s.file.name));
-        items.push(crate::validate::form_item(s, &paths.generated, family::catalog()).map_err(input_err)?);
+        items.extend(section(format!("form:{}", s.file.name), &mut || Ok(vec![crate::validate::form_item(s, &paths.generated, family::catalog()).map_err(input_err)?]))?);
         pb.inc(1);
     }
     pb.finish_and_clear();
+    if hits > 0 {
+        eprintln!("validate: {hits} of {sections} section(s) from the cache (same executable and inputs; --no-cache recomputes)");
+    }
     if as_json {
         println!("{}", serde_json::to_string_pretty(&json!({ "items": items }))?);
         return Ok(());

@@ -157,6 +157,11 @@ enum Command {
         /// --only and no --family, no family is measured).
         #[arg(long, value_delimiter = ',')]
         only: Vec<String>,
+        /// Recompute every section instead of reading the cache of earlier runs with the same
+        /// executable and inputs ($SHADEFIT_CACHE, else $XDG_CACHE_HOME/shadefit, else
+        /// ~/.cache/shadefit); the cache is rewritten.
+        #[arg(long)]
+        no_cache: bool,
     },
     /// Measure a form spec (kind = "form": your own formula) against its integral on its grid,
     /// writing nothing; --refit also refits its constants.
@@ -248,7 +253,7 @@ fn main() -> ExitCode {
         }
         Command::Samples { name, json } => cli::samples(&paths, &name, json),
         Command::Plot { out } => cli::plot(&paths, &out),
-        Command::Validate { json, family, only } => cli::validate(&paths, &family, &only, json),
+        Command::Validate { json, family, only, no_cache } => cli::validate(&paths, &family, &only, json, no_cache),
         Command::Measure { file, refit, json } => cli::measure(&file, refit, json),
         Command::Bench { quick, json, only, family, python, no_python } => {
             cli::bench(&paths, &cli::BenchArgs { quick, json, only, family, python, no_python })

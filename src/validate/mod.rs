@@ -8,10 +8,12 @@ use crate::pipeline::form::Form;
 use crate::fit::published::as_emitted;
 use crate::spec::{Spec, SpecError};
 use crate::spec::Catalog;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::path::Path;
 
-#[derive(Debug, Clone, Serialize)]
+pub mod cache;
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Item {
     pub name: String,
     pub source: String,

@@ -6,7 +6,8 @@ use std::process::{Command, Output};
 
 pub fn shadefit(args: &[&str], dir: Option<&Path>) -> Output {
     let mut c = Command::new(env!("CARGO_BIN_EXE_shadefit"));
-    c.args(args);
+    // `validate`'s cache in the build's scratch folder, not the user's.
+    c.args(args).env("SHADEFIT_CACHE", Path::new(env!("CARGO_TARGET_TMPDIR")).join("shadefit-cache"));
     if let Some(d) = dir {
         c.current_dir(d);
     }
