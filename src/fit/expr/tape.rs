@@ -2,9 +2,9 @@
 //! loops of refits (one objective evaluation visits every point of a grid). The operations are
 //! those of [`super::eval_as`] on one lane in the same order (f64's `min`/`max`, clamp as
 //! `max(lo).min(hi)`, literals as their f32 values), so a tape's results are bit for bit the
-//! program's `eval_f64`; it skips the tree walk and the four lanes a program value carries, and
-//! computes a repeated sub-expression once (the same operation of the same registers is one
-//! register: pure operations give the same bits).
+//! program's `eval_f64`; it skips the tree walk and the lanes of a scalar (a vector's lanes are
+//! registers of their own), and computes a repeated sub-expression once (the same operation of
+//! the same registers is one register: pure operations give the same bits).
 
 use super::Expr;
 use super::program::Program;
@@ -38,57 +38,82 @@ pub struct Tape {
     results: Vec<usize>,
 }
 
-fn emit(e: &Expr, ops: &mut Vec<Op>, lets: &[usize]) -> Option<usize> {
-    let two = |a: &Expr, b: &Expr, ops: &mut Vec<Op>, f: fn(usize, usize) -> Op| -> Option<Op> {
+/// A register holding `op`: the one already on the tape for the same operation of the same
+/// registers (the shading terms repeat their arguments, bindings repeat sub-expressions, and
+/// the lanes of a scalar are one register), else a new one.
+fn intern(op: Op, ops: &mut Vec<Op>) -> usize {
+    if let Some(i) = ops.iter().position(|o| *o == op) {
+        return i;
+    }
+    ops.push(op);
+    ops.len() - 1
+}
+
+/// The registers of a node's four lanes, as [`super::program::Lanes`] holds them: a scalar in
+/// every lane, lane-wise operations on all four (lanes past a vector's length included, as
+/// `Lanes` computes them), zeros where a vector or a swizzle leaves a lane empty.
+fn emit(e: &Expr, ops: &mut Vec<Op>, lets: &[[usize; 4]]) -> Option<[usize; 4]> {
+    let scalar = |op: Op, ops: &mut Vec<Op>| [intern(op, ops); 4];
+    let one = |a: &Expr, ops: &mut Vec<Op>, f: &dyn Fn(usize) -> Op| -> Option<[usize; 4]> {
         let a = emit(a, ops, lets)?;
-        let b = emit(b, ops, lets)?;
-        Some(f(a, b))
+        Some(std::array::from_fn(|k| intern(f(a[k]), ops)))
     };
-    let op = match e {
-        Expr::Lit(v) => Op::Lit(*v as f64),
-        Expr::Var(i) => Op::Var(*i),
-        Expr::Coef(0, j) => Op::Coef(*j),
-        Expr::Let(k) => return lets.get(*k).copied(),
+    let two = |a: &Expr, b: &Expr, ops: &mut Vec<Op>, f: fn(usize, usize) -> Op| -> Option<[usize; 4]> {
+        let (a, b) = (emit(a, ops, lets)?, emit(b, ops, lets)?);
+        Some(std::array::from_fn(|k| intern(f(a[k], b[k]), ops)))
+    };
+    Some(match e {
+        Expr::Lit(v) => scalar(Op::Lit(*v as f64), ops),
+        Expr::Var(i) => scalar(Op::Var(*i), ops),
+        Expr::Coef(0, j) => scalar(Op::Coef(*j), ops),
+        Expr::Let(k) => *lets.get(*k)?,
         Expr::Add(a, b) => two(a, b, ops, Op::Add)?,
         Expr::Sub(a, b) => two(a, b, ops, Op::Sub)?,
         Expr::Mul(a, b) => two(a, b, ops, Op::Mul)?,
         Expr::Div(a, b) => two(a, b, ops, Op::Div)?,
         Expr::Min(a, b) => two(a, b, ops, Op::Min)?,
         Expr::Max(a, b) => two(a, b, ops, Op::Max)?,
-        Expr::Neg(a) => Op::Neg(emit(a, ops, lets)?),
-        Expr::Sqrt(a) => Op::Sqrt(emit(a, ops, lets)?),
-        Expr::Exp2(a) => Op::Exp2(emit(a, ops, lets)?),
-        Expr::Log2(a) => Op::Log2(emit(a, ops, lets)?),
-        Expr::Abs(a) => Op::Abs(emit(a, ops, lets)?),
-        Expr::Pow(a, p) => Op::Pow(emit(a, ops, lets)?, *p as f64),
+        Expr::Neg(a) => one(a, ops, &Op::Neg)?,
+        Expr::Sqrt(a) => one(a, ops, &Op::Sqrt)?,
+        Expr::Exp2(a) => one(a, ops, &Op::Exp2)?,
+        Expr::Log2(a) => one(a, ops, &Op::Log2)?,
+        Expr::Abs(a) => one(a, ops, &Op::Abs)?,
+        Expr::Pow(a, p) => one(a, ops, &|r| Op::Pow(r, *p as f64))?,
         Expr::Clamp(x, lo, hi) => {
             let (x, lo, hi) = (emit(x, ops, lets)?, emit(lo, ops, lets)?, emit(hi, ops, lets)?);
-            Op::Clamp(x, lo, hi)
+            std::array::from_fn(|k| intern(Op::Clamp(x[k], lo[k], hi[k]), ops))
         }
         Expr::Select(c, a, b) => {
             let (c, a, b) = (emit(c, ops, lets)?, emit(a, ops, lets)?, emit(b, ops, lets)?);
-            Op::Positive(c, a, b)
+            std::array::from_fn(|k| intern(Op::Positive(c[k], a[k], b[k]), ops))
         }
         Expr::Less(x, y, a, b) => {
             let (x, y, a, b) = (emit(x, ops, lets)?, emit(y, ops, lets)?, emit(a, ops, lets)?, emit(b, ops, lets)?);
-            Op::Less(x, y, a, b)
+            std::array::from_fn(|k| intern(Op::Less(x[k], y[k], a[k], b[k]), ops))
         }
-        // Vectors (other than a result of scalar lanes) and denominator coefficients are not
-        // compiled.
-        Expr::Coef(..) | Expr::Vector(_) | Expr::Splat(..) | Expr::Swizzle(..) => return None,
-    };
-    // An operation already on the tape (the same operation of the same registers) is that
-    // register: the shading terms repeat their arguments, bindings repeat sub-expressions.
-    if let Some(i) = ops.iter().position(|o| *o == op) {
-        return Some(i);
-    }
-    ops.push(op);
-    Some(ops.len() - 1)
+        Expr::Vector(items) => {
+            let lanes = items.iter().map(|i| emit(i, ops, lets).map(|l| l[0])).collect::<Option<Vec<usize>>>()?;
+            let zero = intern(Op::Lit(0.0), ops);
+            std::array::from_fn(|k| lanes.get(k).copied().unwrap_or(zero))
+        }
+        Expr::Splat(_, x) => [emit(x, ops, lets)?[0]; 4],
+        Expr::Swizzle(x, lanes) => {
+            let x = emit(x, ops, lets)?;
+            if let [k] = lanes.as_slice() {
+                [x[*k as usize]; 4]
+            } else {
+                let zero = intern(Op::Lit(0.0), ops);
+                std::array::from_fn(|k| lanes.get(k).map_or(zero, |&i| x[i as usize]))
+            }
+        }
+        // Denominator coefficients are not compiled.
+        Expr::Coef(..) => return None,
+    })
 }
 
 impl Tape {
-    /// The tape of a program whose bindings are scalars and whose result is a scalar or a
-    /// vector of scalar lanes; `None` for any other program.
+    /// The tape of a program (scalar or vector bindings and result); `None` for a program
+    /// with denominator coefficients.
     pub fn compile(p: &Program) -> Option<Tape> {
         let mut ops = Vec::new();
         let mut lets = Vec::new();
@@ -96,10 +121,8 @@ impl Tape {
             let r = emit(e, &mut ops, &lets)?;
             lets.push(r);
         }
-        let results = match &p.result {
-            Expr::Vector(items) => items.iter().map(|e| emit(e, &mut ops, &lets)).collect::<Option<Vec<_>>>()?,
-            e => vec![emit(e, &mut ops, &lets)?],
-        };
+        let lanes = emit(&p.result, &mut ops, &lets)?;
+        let results = lanes[..p.width().min(4)].to_vec();
         Some(Tape { ops, results })
     }
 
@@ -175,7 +198,38 @@ mod tests {
                 }
             }
         }
-        let vector = Program { lets: vec![], result: Expr::Splat(2, Box::new(Expr::Var(0))) };
-        assert!(Tape::compile(&vector).is_none());
+        let denominator = Program { lets: vec![], result: Expr::Coef(1, 0) };
+        assert!(Tape::compile(&denominator).is_none());
+    }
+
+    /// A vector program (vector bindings, splats, swizzles of one and of several lanes, a
+    /// vector result) compiles to the program's own lanes bit for bit: the published Karis,
+    /// Lazarov and MaterialX forms on a grid through their ends, and an edge of every
+    /// vector node.
+    #[test]
+    fn a_vector_program_compiles_to_its_lanes_bit_for_bit() {
+        use crate::family::ggx::published::forms::{KARIS, KARIS_FORM, LAZAROV, LAZAROV_FORM, MATERIALX, MATERIALX_FORM};
+        let v = |e: Expr| Box::new(e);
+        let edge = Program {
+            lets: vec![("a".into(), Expr::Vector(vec![Expr::Var(0), Expr::Lit(0.5), Expr::Mul(v(Expr::Var(1)), v(Expr::Coef(0, 0)))]))],
+            result: Expr::Add(
+                v(Expr::Swizzle(v(Expr::Let(0)), vec![2, 0])),
+                v(Expr::Mul(v(Expr::Splat(2, v(Expr::Swizzle(v(Expr::Let(0)), vec![1])))), v(Expr::Swizzle(v(Expr::Let(0)), vec![3, 1])))),
+            ),
+        };
+        let cases: [(&Program, Vec<f64>); 4] =
+            [(&KARIS_FORM, KARIS.params()), (&LAZAROV_FORM, LAZAROV.params()), (&MATERIALX_FORM, MATERIALX.params()), (&edge, vec![-1.5])];
+        for (program, consts) in cases {
+            let tape = Tape::compile(program).expect("a vector program compiles");
+            assert_eq!(tape.width(), program.width());
+            let (mut regs, mut out) = (Vec::new(), vec![0.0; tape.width()]);
+            for x in [0.0, 1.0 / 3.0, 0.5, 1.0, -0.25, f64::NAN] {
+                for y in [0.0, 0.01, 0.7, 1.0] {
+                    tape.eval(&[x, y], &consts, &mut regs, &mut out);
+                    let want = program.eval_f64(&[x, y], &consts);
+                    assert_eq!(out.iter().map(|o| o.to_bits()).collect::<Vec<_>>(), want.iter().map(|w| w.to_bits()).collect::<Vec<_>>(), "at ({x}, {y})");
+                }
+            }
+        }
     }
 }

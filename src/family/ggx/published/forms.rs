@@ -8,14 +8,37 @@
 //! (`super::emit`) and the bench's shader forms all derive from it.
 
 use crate::fit::expr::program::{Program, build::*};
+use crate::fit::expr::tape::Tape;
 use std::array::from_fn;
 use std::sync::LazyLock;
 
-/// [A, B] of a pair form at `inputs`.
-fn pair(p: &Program, inputs: [f64; 2], consts: &[f64]) -> [f64; 2] {
-    let v = p.eval(&inputs, consts);
-    [v.v[0], v.v[1]]
+/// A pair form's program compiled once (bit for bit its `eval_f64`: the refits' objectives
+/// evaluate it at every grid point of every step).
+pub struct Compiled(LazyLock<Tape>);
+
+impl Compiled {
+    const fn of(program: fn() -> Tape) -> Compiled {
+        Compiled(LazyLock::new(program))
+    }
+
+    /// [A, B] at `inputs` with the form's constants `consts` (its `params()` order).
+    pub fn pair(&self, inputs: [f64; 2], consts: &[f64]) -> [f64; 2] {
+        thread_local! {
+            static REGS: std::cell::RefCell<Vec<f64>> = const { std::cell::RefCell::new(Vec::new()) };
+        }
+        let mut out = [0.0; 2];
+        REGS.with(|r| self.0.eval(&inputs, consts, &mut r.borrow_mut(), &mut out));
+        out
+    }
 }
+
+fn compile(p: &Program) -> Tape {
+    Tape::compile(p).expect("a published pair form compiles")
+}
+
+pub static KARIS_TAPE: Compiled = Compiled::of(|| compile(&KARIS_FORM));
+pub static LAZAROV_TAPE: Compiled = Compiled::of(|| compile(&LAZAROV_FORM));
+pub static MATERIALX_TAPE: Compiled = Compiled::of(|| compile(&MATERIALX_FORM));
 
 /// Karis 2014, "Physically Based Shading on Mobile" (Unreal Engine blog), `EnvBRDFApprox`
 /// (as in UE's `BRDF.ush`; bevy's `F_AB` up to v0.18.1 is the same text):
@@ -55,7 +78,7 @@ pub static KARIS_FORM: LazyLock<Program> = LazyLock::new(|| {
 impl Karis {
     /// [A, B] at perceptual roughness `r` and n·v.
     pub fn eval(&self, r: f64, n_dot_v: f64) -> [f64; 2] {
-        pair(&KARIS_FORM, [r, n_dot_v], &self.params())
+        KARIS_TAPE.pair([r, n_dot_v], &self.params())
     }
 
     pub fn params(&self) -> Vec<f64> {
@@ -112,7 +135,7 @@ pub static LAZAROV_FORM: LazyLock<Program> = LazyLock::new(|| {
 impl Lazarov {
     /// [A, B] at gloss g and n·v.
     pub fn eval(&self, g: f64, n_dot_v: f64) -> [f64; 2] {
-        pair(&LAZAROV_FORM, [g, n_dot_v], &self.params())
+        LAZAROV_TAPE.pair([g, n_dot_v], &self.params())
     }
 
     pub fn params(&self) -> Vec<f64> {
@@ -192,7 +215,7 @@ pub static MATERIALX_FORM: LazyLock<Program> = LazyLock::new(|| {
 impl MaterialX {
     /// [A, B] at n·v and α.
     pub fn eval(&self, n_dot_v: f64, alpha: f64) -> [f64; 2] {
-        pair(&MATERIALX_FORM, [n_dot_v, alpha], &self.params())
+        MATERIALX_TAPE.pair([n_dot_v, alpha], &self.params())
     }
 
     /// The rows of R, one after another.

@@ -15,7 +15,7 @@
 //! refits when built and commits the constants in generated/json/ggx_published_refits.json;
 //! validate, figures and benchmarks read them from there ([`Refits::committed`]).
 
-use super::forms::{KARIS, KARIS_FORM, KULLA_CONTY, KULLA_CONTY_FORM, Karis, KullaConty, LAZAROV, LAZAROV_FORM, Lazarov, MATERIALX, MATERIALX_FORM, MaterialX};
+use super::forms::{KARIS, KARIS_FORM, KARIS_TAPE, LAZAROV_TAPE, KULLA_CONTY, KULLA_CONTY_FORM, Karis, KullaConty, LAZAROV, LAZAROV_FORM, Lazarov, MATERIALX, MATERIALX_FORM, MaterialX};
 use crate::fit::published::{Errors, FormError, PublishedForm, as_emitted};
 use crate::pipeline::BuildError;
 use std::path::Path;
@@ -29,14 +29,15 @@ use nalgebra::DVector;
 /// Karis's form refitted to the grid of `target` (perceptual roughness on its second axis).
 pub fn karis(target: Target, start: &Karis) -> Karis {
     let g = grid::standard(target);
-    let (p, _) = nelder_mead(|p| g.max_error(|m, r| Karis::from_params(p).eval(r, m)), &start.params());
+    // `p` is the form's constants in `params()` order.
+    let (p, _) = nelder_mead(|p| g.max_error(|m, r| KARIS_TAPE.pair([r, m], p)), &start.params());
     Karis::from_params(&p)
 }
 
 /// Lazarov's form refitted to the gloss grid.
 pub fn lazarov(start: &Lazarov) -> Lazarov {
     let g = grid::standard(Target::Gloss);
-    let (p, _) = nelder_mead(|p| g.max_error(|m, gl| Lazarov::from_params(p).eval(gl, m)), &start.params());
+    let (p, _) = nelder_mead(|p| g.max_error(|m, gl| LAZAROV_TAPE.pair([gl, m], p)), &start.params());
     Lazarov::from_params(&p)
 }
 
