@@ -10,6 +10,7 @@
 use super::forms::*;
 use super::grid::{self, Convention, Target, Visibility};
 use crate::fit::expr::program::Program;
+use crate::fit::expr::tape::Tape;
 use crate::fit::published::{Errors, FormError, PublishedForm};
 use crate::fit::model::{ModelParts, Term};
 use crate::fit::positivity::{Positivity, prove_denominator_positive};
@@ -80,12 +81,29 @@ fn saturated(t: Target) -> Vec<f64> {
 impl Form {
     /// The measured value of the form with constants `c` at every grid point.
     pub fn values(&self, c: &[f64]) -> Vec<f64> {
-        grid::points().iter().map(|p| (self.measured)(self.program.eval_f64(&(self.inputs)(p[0], p[1]), c)[0])).collect()
+        self.values_with(&self.tape(), c)
     }
 
-    fn max_error(&self, c: &[f64], truth: &[f64]) -> f64 {
-        grid::points().iter().zip(truth).fold(0.0f64, |m, (p, t)| {
-            let e = ((self.measured)(self.program.eval_f64(&(self.inputs)(p[0], p[1]), c)[0]) - t).abs();
+    /// The program compiled (bit for bit its `eval_f64`; the refit's objective evaluates it at
+    /// every grid point of every step).
+    fn tape(&self) -> Tape {
+        Tape::compile(self.program).expect("a published sheen form compiles")
+    }
+
+    fn values_with(&self, tape: &Tape, c: &[f64]) -> Vec<f64> {
+        let (mut regs, mut out) = (Vec::new(), [0.0]);
+        grid::points()
+            .iter()
+            .map(|p| {
+                tape.eval(&(self.inputs)(p[0], p[1]), c, &mut regs, &mut out);
+                (self.measured)(out[0])
+            })
+            .collect()
+    }
+
+    fn max_error(&self, tape: &Tape, c: &[f64], truth: &[f64]) -> f64 {
+        self.values_with(tape, c).iter().zip(truth).fold(0.0f64, |m, (v, t)| {
+            let e = (v - t).abs();
             if e.is_nan() { f64::INFINITY } else { m.max(e) }
         })
     }
@@ -94,7 +112,10 @@ impl Form {
     pub fn refit(&self) -> Vec<f64> {
         let truth = (self.truth)();
         match self.solver {
-            Solver::NelderMead => nelder_mead(|c| self.max_error(c, &truth), self.published).0,
+            Solver::NelderMead => {
+                let tape = self.tape();
+                nelder_mead(|c| self.max_error(&tape, c, &truth), self.published).0
+            }
             Solver::Rational => materialx_rational(&truth).unwrap_or_else(|| self.published.to_vec()),
         }
     }
