@@ -106,7 +106,7 @@ pub fn lagarde(n_dot_v: f64, v: f64, alpha: f64) -> f64 {
 /// Lagarde's shape with constants (a, b): saturate((n·v + V)^(2^(a α + b)) − 1 + V), the
 /// form's program ([`refit::LAGARDE_FORM`]) in f64.
 pub fn lagarde_with(c: [f64; 2], n_dot_v: f64, v: f64, alpha: f64) -> f64 {
-    refit::LAGARDE_FORM.eval_f64(&[n_dot_v, v, alpha], &c)[0]
+    refit::LAGARDE_TAPE.eval::<1>(&[n_dot_v, v, alpha], &c)[0]
 }
 
 /// Jimenez et al. 2016: the visibility cone (axis n) ∩ the specular cone about the mirror
@@ -160,7 +160,7 @@ pub const JIMENEZ_MULTIBOUNCE: [f64; 6] = [2.0404, -0.3324, -4.7951, 0.6417, 2.7
 
 /// max(V, ((aV + b)V + c)V) with a, b, c linear in ρ (`p` as [`JIMENEZ_MULTIBOUNCE`]).
 pub fn jimenez_multibounce(p: &[f64], v: f64, albedo: f64) -> f64 {
-    refit::MULTIBOUNCE_FORM.eval_f64(&[v, albedo], p)[0]
+    refit::MULTIBOUNCE_TAPE.eval::<1>(&[v, albedo], p)[0]
 }
 
 #[cfg(test)]

@@ -165,6 +165,32 @@ impl Tape {
     }
 }
 
+/// A program compiled on first use, for the f64 evaluation of a registered form in inner loops
+/// (bit for bit the program's `eval_f64`; the scratch registers are per thread).
+pub struct Compiled(std::sync::LazyLock<Tape>);
+
+impl Compiled {
+    /// The tape `compile` returns, built once.
+    pub const fn of(compile: fn() -> Tape) -> Compiled {
+        Compiled(std::sync::LazyLock::new(compile))
+    }
+
+    /// The first `N` results at `inputs` with constants `consts`.
+    pub fn eval<const N: usize>(&self, inputs: &[f64], consts: &[f64]) -> [f64; N] {
+        thread_local! {
+            static REGS: std::cell::RefCell<Vec<f64>> = const { std::cell::RefCell::new(Vec::new()) };
+        }
+        let mut out = [0.0; N];
+        REGS.with(|r| self.0.eval(inputs, consts, &mut r.borrow_mut(), &mut out));
+        out
+    }
+
+    /// [A, B] of a pair form.
+    pub fn pair(&self, inputs: [f64; 2], consts: &[f64]) -> [f64; 2] {
+        self.eval(&inputs, consts)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -15,6 +15,7 @@ use super::validation::{multibounce_errors, so_errors};
 use super::{JIMENEZ, JIMENEZ_MULTIBOUNCE, LAGARDE, jimenez_with, lagarde_with};
 use crate::fit::expr::Expr;
 use crate::fit::expr::program::{Program, build::*};
+use crate::fit::expr::tape::{Compiled, Tape};
 use crate::fit::published::{FormError, PublishedForm};
 use crate::pipeline::BuildError;
 use std::path::Path;
@@ -55,6 +56,11 @@ pub fn repository() -> Refits {
 /// undefined in WGSL). The floor never shows: n·v + V < 1e-30 means V < 1e-30, and then the
 /// power (≤ 1 for a base ≤ 1) minus 1 plus V is at most ~1e-30, which the saturate takes to 0
 /// or leaves below 1e-30, as the exact 0^e − 1 + V would give.
+/// [`LAGARDE_FORM`] and [`MULTIBOUNCE_FORM`] compiled (the refits' objectives evaluate them at
+/// every point of every step).
+pub static LAGARDE_TAPE: Compiled = Compiled::of(|| Tape::compile(&LAGARDE_FORM).expect("Lagarde's form compiles"));
+pub static MULTIBOUNCE_TAPE: Compiled = Compiled::of(|| Tape::compile(&MULTIBOUNCE_FORM).expect("the multi-bounce form compiles"));
+
 pub static LAGARDE_FORM: LazyLock<Program> = LazyLock::new(|| {
     let base = max(var(0) + var(1), lit(1e-30));
     let power = exp2(exp2(k(0) * var(2) + k(1)) * Expr::Log2(Box::new(base)));

@@ -8,29 +8,9 @@
 //! (`super::emit`) and the bench's shader forms all derive from it.
 
 use crate::fit::expr::program::{Program, build::*};
-use crate::fit::expr::tape::Tape;
+use crate::fit::expr::tape::{Compiled, Tape};
 use std::array::from_fn;
 use std::sync::LazyLock;
-
-/// A pair form's program compiled once (bit for bit its `eval_f64`: the refits' objectives
-/// evaluate it at every grid point of every step).
-pub struct Compiled(LazyLock<Tape>);
-
-impl Compiled {
-    const fn of(program: fn() -> Tape) -> Compiled {
-        Compiled(LazyLock::new(program))
-    }
-
-    /// [A, B] at `inputs` with the form's constants `consts` (its `params()` order).
-    pub fn pair(&self, inputs: [f64; 2], consts: &[f64]) -> [f64; 2] {
-        thread_local! {
-            static REGS: std::cell::RefCell<Vec<f64>> = const { std::cell::RefCell::new(Vec::new()) };
-        }
-        let mut out = [0.0; 2];
-        REGS.with(|r| self.0.eval(&inputs, consts, &mut r.borrow_mut(), &mut out));
-        out
-    }
-}
 
 fn compile(p: &Program) -> Tape {
     Tape::compile(p).expect("a published pair form compiles")
