@@ -252,3 +252,17 @@ impl KullaConty {
         KullaConty { above: [p[0], p[1]], below: [p[2], p[3], p[4], p[5]] }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The compiled pair forms are their programs bit for bit (what the refits' objectives and
+    /// `validate` evaluate is the form as written).
+    #[test]
+    fn the_compiled_pair_forms_are_their_programs() {
+        assert_eq!(crate::fit::expr::tape::same_bits(&KARIS_FORM, &KARIS.params()), 2);
+        assert_eq!(crate::fit::expr::tape::same_bits(&LAZAROV_FORM, &LAZAROV.params()), 2);
+        assert_eq!(crate::fit::expr::tape::same_bits(&MATERIALX_FORM, &MATERIALX.params()), 2);
+    }
+}
