@@ -550,7 +550,7 @@ fn selected_families(names: &[String]) -> Result<Vec<&'static family::Family>> {
     Ok(all.iter().filter(|f| names.is_empty() || names.iter().any(|n| n == f.name)).copied().collect())
 }
 
-/// `shadefit validate [--family A,B] [--only SPEC,…] [--json]`: the families' published
+/// `shadefit validate [--family A,B] [--only SPEC,…] [--json] [--no-cache]`: the families' published
 /// constants and the form specs of `fits/` measured. With neither option, every family and
 /// every form spec; with either, only what they name.
 pub fn validate(paths: &Paths, families: &[String], only: &[String], as_json: bool, no_cache: bool) -> Result<()> {
