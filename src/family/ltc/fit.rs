@@ -98,10 +98,19 @@ impl<'a, L: Lobe> Cell<'a, L> {
 
     /// p(ω) = f max(0, ω_z)/E.
     pub fn normalised(&self, l: Vec3) -> f64 {
+        self.normalised_at(l, self.half(l))
+    }
+
+    /// h = (v + l)/|v + l|.
+    fn half(&self, l: Vec3) -> Vec3 {
+        normalize([self.v[0] + l[0], self.v[1] + l[1], self.v[2] + l[2]])
+    }
+
+    /// [`Cell::normalised`] at l with its half vector h.
+    fn normalised_at(&self, l: Vec3, h: Vec3) -> f64 {
         if l[2] <= 0.0 || self.magnitude <= 0.0 {
             return 0.0;
         }
-        let h = normalize([self.v[0] + l[0], self.v[1] + l[1], self.v[2] + l[2]]);
         let vh = dot(self.v, h);
         if vh <= 0.0 {
             return 0.0;
@@ -111,32 +120,17 @@ impl<'a, L: Lobe> Cell<'a, L> {
 
     /// The lobe map's density at l: p_h(h)/(4|v·h|), h = ±(v + l)/|v + l| in the upper half.
     fn lobe_density(&self, l: Vec3) -> f64 {
-        self.density_of(normalize([self.v[0] + l[0], self.v[1] + l[1], self.v[2] + l[2]]))
+        self.density_at(self.half(l))
     }
 
-    /// [`Cell::lobe_density`] from h = (v + l)/|v + l|.
-    fn density_of(&self, h: Vec3) -> f64 {
+    /// [`Cell::lobe_density`] with l's half vector h.
+    fn density_at(&self, h: Vec3) -> f64 {
         let h = if h[2] < 0.0 { [-h[0], -h[1], -h[2]] } else { h };
         let vh = dot(self.v, h).abs();
         if !(vh > 0.0) {
             return f64::INFINITY;
         }
         self.lobe.pdf(h[2]) / (4.0 * vh)
-    }
-
-    /// ([`Cell::normalised`], [`Cell::lobe_density`]) at l, the half vector computed once (the
-    /// same operations as each: the same bits).
-    fn normalised_and_density(&self, l: Vec3) -> (f64, f64) {
-        let h = normalize([self.v[0] + l[0], self.v[1] + l[1], self.v[2] + l[2]]);
-        let q = self.density_of(h);
-        if l[2] <= 0.0 || self.magnitude <= 0.0 {
-            return (0.0, q);
-        }
-        let vh = dot(self.v, h);
-        if vh <= 0.0 {
-            return (0.0, q);
-        }
-        (self.lobe.eval(&self.view, vh, h[2], l[2]) * l[2] / self.magnitude, q)
     }
 
     /// δ = ∫ |p − D| (see the module doc).
@@ -155,8 +149,9 @@ impl<'a, L: Lobe> Cell<'a, L> {
             if !(d > 0.0) {
                 continue;
             }
-            let (p, q) = self.normalised_and_density(l);
-            sum += w * (p - d).abs() / (q + d);
+            // p and q of one half vector (the cosine map's hot loop).
+            let h = self.half(l);
+            sum += w * (self.normalised_at(l, h) - d).abs() / (self.density_at(h) + d);
         }
         if sum.is_finite() { sum } else { f64::INFINITY }
     }

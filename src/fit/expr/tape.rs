@@ -165,14 +165,16 @@ impl Tape {
     }
 }
 
-/// A program compiled on first use, for the f64 evaluation of a registered form in inner loops
+/// A registered form's program compiled on first use, for its f64 evaluation in inner loops
 /// (bit for bit the program's `eval_f64`; the scratch registers are per thread).
-pub struct Compiled(std::sync::LazyLock<Tape>);
+pub struct Compiled {
+    program: &'static std::sync::LazyLock<Program>,
+    tape: std::sync::OnceLock<Tape>,
+}
 
 impl Compiled {
-    /// The tape `compile` returns, built once.
-    pub const fn of(compile: fn() -> Tape) -> Compiled {
-        Compiled(std::sync::LazyLock::new(compile))
+    pub const fn of(program: &'static std::sync::LazyLock<Program>) -> Compiled {
+        Compiled { program, tape: std::sync::OnceLock::new() }
     }
 
     /// The first `N` results at `inputs` with constants `consts`.
@@ -181,7 +183,8 @@ impl Compiled {
             static REGS: std::cell::RefCell<Vec<f64>> = const { std::cell::RefCell::new(Vec::new()) };
         }
         let mut out = [0.0; N];
-        REGS.with(|r| self.0.eval(inputs, consts, &mut r.borrow_mut(), &mut out));
+        let tape = self.tape.get_or_init(|| Tape::compile(self.program).expect("a registered form compiles"));
+        REGS.with(|r| tape.eval(inputs, consts, &mut r.borrow_mut(), &mut out));
         out
     }
 

@@ -15,7 +15,7 @@ use super::validation::{multibounce_errors, so_errors};
 use super::{JIMENEZ, JIMENEZ_MULTIBOUNCE, LAGARDE, jimenez_with, lagarde_with};
 use crate::fit::expr::Expr;
 use crate::fit::expr::program::{Program, build::*};
-use crate::fit::expr::tape::{Compiled, Tape};
+use crate::fit::expr::tape::Compiled;
 use crate::fit::published::{FormError, PublishedForm};
 use crate::pipeline::BuildError;
 use std::path::Path;
@@ -51,16 +51,16 @@ pub fn repository() -> Refits {
     Refits::committed(&Path::new(env!("CARGO_MANIFEST_DIR")).join("generated")).expect("the occlusion refits are committed")
 }
 
+/// [`LAGARDE_FORM`] and [`MULTIBOUNCE_FORM`] compiled (the refits' objectives evaluate them at
+/// every point of every step).
+pub static LAGARDE_TAPE: Compiled = Compiled::of(&LAGARDE_FORM);
+pub static MULTIBOUNCE_TAPE: Compiled = Compiled::of(&MULTIBOUNCE_FORM);
+
 /// Lagarde's form over (n·v, V, α): saturate(exp2(2^(a α + b) · log2(max(n·v + V, 1e-30))) − 1 + V),
 /// the power written as exp2 · log2 as a shader's pow is, its base kept off 0 (where log2 is
 /// undefined in WGSL). The floor never shows: n·v + V < 1e-30 means V < 1e-30, and then the
 /// power (≤ 1 for a base ≤ 1) minus 1 plus V is at most ~1e-30, which the saturate takes to 0
 /// or leaves below 1e-30, as the exact 0^e − 1 + V would give.
-/// [`LAGARDE_FORM`] and [`MULTIBOUNCE_FORM`] compiled (the refits' objectives evaluate them at
-/// every point of every step).
-pub static LAGARDE_TAPE: Compiled = Compiled::of(|| Tape::compile(&LAGARDE_FORM).expect("Lagarde's form compiles"));
-pub static MULTIBOUNCE_TAPE: Compiled = Compiled::of(|| Tape::compile(&MULTIBOUNCE_FORM).expect("the multi-bounce form compiles"));
-
 pub static LAGARDE_FORM: LazyLock<Program> = LazyLock::new(|| {
     let base = max(var(0) + var(1), lit(1e-30));
     let power = exp2(exp2(k(0) * var(2) + k(1)) * Expr::Log2(Box::new(base)));
